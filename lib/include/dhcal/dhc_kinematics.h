@@ -1,0 +1,76 @@
+/* dhc_kinematics.h - the arm model and its forward kinematics (paper eq. 1-2).
+ *
+ * Joint i (1-based in documents, 0-based here) contributes
+ *     A_i = Rz(q_i + theta_offset_i) Tz(d_i) Tx(a_i) Rx(alpha_i) Ry(beta_i)
+ * Standard DH has beta_i = 0. Where axes i and i+1 are nominally parallel (alpha_i = 0 or
+ * 180 deg, i not the last joint) standard DH cannot represent a small tilt between them and
+ * its d_i is not identifiable; such joints use Hayati's convention: d_i is held at its
+ * nominal value and beta_i is a parameter instead (DESIGN.md section 3).
+ *
+ * The tool point in the world (measurement) frame is
+ *     p = base * A_1 ... A_N * tool_mm
+ * Units: lengths in mm, angles in radians. No heap, no I/O; all functions O(N).
+ */
+#ifndef DHC_KINEMATICS_H
+#define DHC_KINEMATICS_H
+
+#include <stddef.h>
+
+#include "dhc_config.h"
+#include "dhc_linalg.h"
+#include "dhc_status.h"
+
+typedef enum {
+    DHC_CONV_DH = 0,    /* parameters theta, d, a, alpha */
+    DHC_CONV_HAYATI = 1 /* parameters theta, a, alpha, beta; d fixed */
+} dhc_convention;
+
+typedef struct {
+    double theta_offset_rad;
+    double d_mm;
+    double a_mm;
+    double alpha_rad;
+    double beta_rad;
+    double min_rad; /* joint range, used to plan poses and to flag samples */
+    double max_rad;
+    dhc_convention convention;
+} dhc_joint;
+
+typedef struct {
+    size_t n_joints;
+    dhc_joint joint[DHC_MAX_JOINTS];
+    dhc_frame base; /* robot base frame in the world */
+    double tool_mm[3]; /* tool point in the last link frame */
+} dhc_arm;
+
+/* An arm with n_joints joints, all parameters 0, ranges +-pi, base identity, tool 0.
+ * DHC_ERR_CAPACITY when n_joints is 0 or above DHC_MAX_JOINTS. */
+dhc_status dhc_arm_init(dhc_arm *arm, size_t n_joints);
+
+/* Chooses each joint's convention from its nominal twist: Hayati where |sin(alpha_i)| is
+ * below parallel_tol (about 1e-3 rad suits drawings) and joint i is not the last, DH
+ * otherwise. Call once on the nominal model, before fitting. */
+void dhc_arm_choose_conventions(dhc_arm *arm, double parallel_tol);
+
+/* A_i for joint index i at joint angle q_rad. DHC_ERR_ARGUMENT when i >= n_joints. */
+dhc_status dhc_joint_transform(const dhc_arm *arm, size_t i, double q_rad, dhc_frame *out);
+
+/* Frames of the chain in the world: frames[0] = base (frame 0), frames[k] = base A_1..A_k,
+ * k = 1..N. frames must hold n_joints + 1 entries (frames_len). Also returns the tool point
+ * in the world when tool_world_mm is not NULL.
+ * DHC_ERR_DIMENSION when q_len < n_joints or frames_len < n_joints + 1;
+ * DHC_ERR_NONFINITE when a joint angle is not finite. */
+dhc_status dhc_forward_frames(const dhc_arm *arm, const double *q_rad, size_t q_len,
+                              dhc_frame *frames, size_t frames_len, double tool_world_mm[3]);
+
+/* Tool pose in the world: position of the tool point and orientation of the last link.
+ * Same errors as dhc_forward_frames. */
+dhc_status dhc_forward(const dhc_arm *arm, const double *q_rad, size_t q_len, dhc_frame *tool);
+
+/* Re-expresses an arm in pure standard DH (every beta = 0, Paul's convention) with the same
+ * joint axes and the same tool pose for every q: the convention of the paper's Table 1.
+ * Axes that are exactly parallel have no unique common normal: DHC_ERR_SINGULAR then. The
+ * base frame is kept; a change of frame 0 about/along axis 1 is folded into joint 1. */
+dhc_status dhc_arm_to_standard_dh(const dhc_arm *arm, dhc_arm *out);
+
+#endif /* DHC_KINEMATICS_H */

@@ -1,0 +1,559 @@
+/* dhc_calib.c - Levenberg-Marquardt calibration over streamed samples, with rank analysis,
+ * a structural-identifiability check and outlier rejection. */
+#include "dhcal/dhc_calib.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "dhcal/dhc_jacobian.h"
+
+/* Medians of chi-square with 3 and 6 degrees of freedom: they turn the median squared
+ * sample error into a noise variance estimate that a few outliers cannot inflate. */
+#define CHI2_MEDIAN_3DOF 2.365973884375338
+#define CHI2_MEDIAN_6DOF 5.348120627447122
+#define LAMBDA_START 1e-3
+#define LAMBDA_MAX 1e12
+#define MEDIAN_BISECTIONS 64U
+#define STRUCTURAL_EXTRA_POSES 8U
+
+void dhc_calib_default_options(dhc_calib_options *opt)
+{
+    DHC_ASSERT(opt != NULL);
+    opt->max_iterations = 100U;
+    opt->rank_rel_tol = 1e-10;
+    opt->ssr_rel_tol = 1e-14;
+    opt->step_rel_tol = 1e-12;
+    opt->orientation_weight_mm_per_rad = 1000.0;
+    opt->outlier_threshold = 6.0;
+    opt->outlier_floor_mm = 1e-6;
+    opt->joint_margin_rad = 0.1;
+    opt->max_outlier_rounds = 3U;
+    opt->structural_seed = 12345U;
+}
+
+static size_t sample_rows(const dhc_sample *s)
+{
+    return s->kind == (uint8_t)DHC_MEAS_POSE ? 6U : 3U;
+}
+
+static dhc_status check_sample(const dhc_sample *s, size_t n_joints)
+{
+    if (s->kind != (uint8_t)DHC_MEAS_POSITION && s->kind != (uint8_t)DHC_MEAS_POSE) {
+        return DHC_ERR_ARGUMENT;
+    }
+    for (size_t i = 0U; i < n_joints; ++i) {
+        if (!dhc_is_finite(s->q_rad[i])) {
+            return DHC_ERR_NONFINITE;
+        }
+    }
+    for (size_t r = 0U; r < 3U; ++r) {
+        if (!dhc_is_finite(s->p_mm[r])) {
+            return DHC_ERR_NONFINITE;
+        }
+        if (s->kind == (uint8_t)DHC_MEAS_POSE) {
+            for (size_t c = 0U; c < 3U; ++c) {
+                if (!dhc_is_finite(s->rot.m[r][c])) {
+                    return DHC_ERR_NONFINITE;
+                }
+            }
+        }
+    }
+    return DHC_OK;
+}
+
+/* Residual from an already computed model pose. */
+static void residual_from_pose(const dhc_sample *s, const double p[3], const dhc_mat3 *rot,
+                               double w_mm_per_rad, double r[DHC_MAX_ROWS_PER_SAMPLE])
+{
+    dhc_vec3_sub(s->p_mm, p, r);
+    if (s->kind == (uint8_t)DHC_MEAS_POSE) {
+        dhc_mat3 err;
+        double w[3];
+        /* R_meas = exp([w]) R_model  =>  w = log(R_meas R_model^T) */
+        dhc_rot_mul_t(&s->rot, rot, &err);
+        dhc_rot_log(&err, w);
+        for (size_t k = 0U; k < 3U; ++k) {
+            r[3U + k] = w_mm_per_rad * w[k];
+        }
+    }
+}
+
+dhc_status dhc_calib_residual(const dhc_arm *arm, const dhc_sample *s, double weight_mm_per_rad,
+                              double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows)
+{
+    if (arm == NULL || s == NULL || r == NULL || rows == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    dhc_status st = check_sample(s, arm->n_joints);
+    if (st != DHC_OK) {
+        return st;
+    }
+    dhc_frame tool;
+    st = dhc_forward(arm, s->q_rad, DHC_MAX_JOINTS, &tool);
+    if (st != DHC_OK) {
+        return st;
+    }
+    residual_from_pose(s, tool.pos, &tool.rot, weight_mm_per_rad, r);
+    *rows = sample_rows(s);
+    return DHC_OK;
+}
+
+/* Everything one pass over the samples needs; kept together to keep signatures short. */
+typedef struct {
+    const dhc_param_set *set;
+    dhc_sample_reader read;
+    void *ctx;
+    size_t n;
+    uint8_t *flags;
+    const dhc_calib_options *opt;
+    dhc_calib_workspace *ws;
+} fit_context;
+
+typedef struct {
+    double ssr;
+    double pos_ss;     /* sum of squared position errors, mm^2 */
+    double rot_ss;     /* sum of squared orientation errors, rad^2 */
+    double max_pos;
+    size_t samples;
+    size_t pose_samples;
+    size_t rows;
+} pass_totals;
+
+static double sq(double x)
+{
+    return x * x;
+}
+
+/* One pass: SSR and error totals of `arm`; with accumulate, also the normal equations. */
+static dhc_status data_pass(const fit_context *fc, const dhc_arm *arm, int accumulate,
+                            pass_totals *tot)
+{
+    dhc_calib_workspace *const ws = fc->ws;
+    const size_t p = fc->set->count;
+    const double w = fc->opt->orientation_weight_mm_per_rad;
+    *tot = (pass_totals){0};
+    if (accumulate) {
+        const dhc_status st = dhc_normal_eq_init(&ws->ne, p);
+        if (st != DHC_OK) {
+            return st;
+        }
+    }
+    for (size_t i = 0U; i < fc->n; ++i) {
+        if (fc->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
+            continue;
+        }
+        dhc_status st = fc->read(fc->ctx, i, &ws->sample);
+        if (st != DHC_OK) {
+            return st;
+        }
+        const dhc_sample *const s = &ws->sample;
+        st = check_sample(s, arm->n_joints);
+        if (st != DHC_OK) {
+            return st;
+        }
+        const size_t rows = sample_rows(s);
+        double r[DHC_MAX_ROWS_PER_SAMPLE];
+        double pos[3];
+        dhc_mat3 rot;
+        dhc_mat jac;
+        if (accumulate) {
+            st = dhc_mat_init(&jac, rows, p, ws->jac_buf, DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS);
+            if (st == DHC_OK) {
+                st = dhc_identification_jacobian(arm, fc->set, s->q_rad, DHC_MAX_JOINTS,
+                                                  rows == 6U, &jac, pos, &rot);
+            }
+        } else {
+            dhc_frame tool;
+            st = dhc_forward(arm, s->q_rad, DHC_MAX_JOINTS, &tool);
+            dhc_vec3_copy(tool.pos, pos);
+            rot = tool.rot;
+        }
+        if (st != DHC_OK) {
+            return st;
+        }
+        residual_from_pose(s, pos, &rot, w, r);
+        if (accumulate) {
+            if (rows == 6U) {
+                /* Orientation rows in mm-equivalent units, like their residuals. */
+                for (size_t k = 3U; k < 6U; ++k) {
+                    for (size_t c = 0U; c < p; ++c) {
+                        DHC_MAT_AT(&jac, k, c) *= w;
+                    }
+                }
+            }
+            st = dhc_normal_eq_add(&ws->ne, &jac, r, NULL, rows);
+            if (st != DHC_OK) {
+                return st;
+            }
+        }
+        const double e2 = sq(r[0]) + sq(r[1]) + sq(r[2]);
+        tot->pos_ss += e2;
+        tot->max_pos = fmax(tot->max_pos, sqrt(e2));
+        tot->ssr += e2;
+        if (rows == 6U) {
+            const double o2 = sq(r[3]) + sq(r[4]) + sq(r[5]);
+            tot->ssr += o2;
+            tot->rot_ss += o2 / (w * w);
+            tot->pose_samples++;
+        }
+        tot->samples++;
+        tot->rows += rows;
+    }
+    if (!dhc_is_finite(tot->ssr)) {
+        return DHC_ERR_NONFINITE;
+    }
+    return DHC_OK;
+}
+
+/* Deterministic pseudo-random numbers in [0, 1) for the structural poses (xorshift32). */
+static double next_uniform(uint32_t *state)
+{
+    uint32_t x = *state;
+    x ^= x << 13;
+    x ^= x >> 17;
+    x ^= x << 5;
+    *state = x;
+    return (double)(x >> 8) / 16777216.0;
+}
+
+/* Rank the model itself allows: the same parameters at random poses spread over the joint
+ * ranges. A data rank below it means the data, not the model, are short. */
+static dhc_status structural_rank(const fit_context *fc, const dhc_arm *arm, int pose_rows,
+                                  dhc_calib_report *rep)
+{
+    dhc_calib_workspace *const ws = fc->ws;
+    const size_t p = fc->set->count;
+    const size_t rows = pose_rows ? 6U : 3U;
+    const size_t poses = (p + rows - 1U) / rows + STRUCTURAL_EXTRA_POSES;
+    const double w = fc->opt->orientation_weight_mm_per_rad;
+    uint32_t state = fc->opt->structural_seed != 0U ? fc->opt->structural_seed : 1U;
+    dhc_status st = dhc_normal_eq_init(&ws->ne, p);
+    if (st != DHC_OK) {
+        return st;
+    }
+    for (size_t k = 0U; k < poses; ++k) {
+        double q[DHC_MAX_JOINTS] = {0.0};
+        for (size_t i = 0U; i < arm->n_joints; ++i) {
+            const dhc_joint *const j = &arm->joint[i];
+            q[i] = j->min_rad + (j->max_rad - j->min_rad) * next_uniform(&state);
+        }
+        dhc_mat jac;
+        st = dhc_mat_init(&jac, rows, p, ws->jac_buf, DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS);
+        if (st == DHC_OK) {
+            st = dhc_identification_jacobian(arm, fc->set, q, DHC_MAX_JOINTS, pose_rows, &jac,
+                                              NULL, NULL);
+        }
+        if (st != DHC_OK) {
+            return st;
+        }
+        for (size_t r = 3U; r < rows; ++r) {
+            for (size_t c = 0U; c < p; ++c) {
+                DHC_MAT_AT(&jac, r, c) *= w;
+            }
+        }
+        const double zero_r[DHC_MAX_ROWS_PER_SAMPLE] = {0.0};
+        st = dhc_normal_eq_add(&ws->ne, &jac, zero_r, NULL, rows);
+        if (st != DHC_OK) {
+            return st;
+        }
+    }
+    st = dhc_lsq_analyse(&ws->ne, fc->opt->rank_rel_tol, &ws->fac);
+    if (st != DHC_OK) {
+        return st;
+    }
+    rep->structural_rank = ws->fac.rank;
+    for (size_t k = 0U; k < p; ++k) {
+        rep->structurally_identifiable[k] = ws->fac.identifiable[k];
+    }
+    return DHC_OK;
+}
+
+/* Sample position error (all rows, mm-equivalent) squared; used for outlier screening. */
+static dhc_status sample_error2(const fit_context *fc, const dhc_arm *arm, size_t i,
+                                double *e2, size_t *rows)
+{
+    dhc_status st = fc->read(fc->ctx, i, &fc->ws->sample);
+    if (st != DHC_OK) {
+        return st;
+    }
+    double r[DHC_MAX_ROWS_PER_SAMPLE];
+    st = dhc_calib_residual(arm, &fc->ws->sample, fc->opt->orientation_weight_mm_per_rad, r, rows);
+    if (st != DHC_OK) {
+        return st;
+    }
+    double s = 0.0;
+    for (size_t k = 0U; k < *rows; ++k) {
+        s += sq(r[k]);
+    }
+    *e2 = s;
+    return DHC_OK;
+}
+
+/* Median of the squared sample errors by bisection on the value (each step one pass over
+ * the data): the library keeps no per-sample storage, so no sort. */
+static dhc_status median_error2(const fit_context *fc, const dhc_arm *arm, size_t used,
+                                double max_e2, double *median)
+{
+    double lo = 0.0;
+    double hi = max_e2;
+    const size_t half = (used + 1U) / 2U;
+    for (size_t it = 0U; it < MEDIAN_BISECTIONS && hi > lo; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        size_t below = 0U;
+        for (size_t i = 0U; i < fc->n; ++i) {
+            if (fc->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
+                continue;
+            }
+            double e2;
+            size_t rows;
+            const dhc_status st = sample_error2(fc, arm, i, &e2, &rows);
+            if (st != DHC_OK) {
+                return st;
+            }
+            below += e2 <= mid ? 1U : 0U;
+        }
+        if (below >= half) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    *median = hi;
+    return DHC_OK;
+}
+
+/* Flags samples whose error is many robust sigmas; returns how many were newly flagged. */
+static dhc_status flag_outliers(const fit_context *fc, const dhc_arm *arm, size_t *flagged)
+{
+    *flagged = 0U;
+    if (fc->opt->outlier_threshold <= 0.0) {
+        return DHC_OK;
+    }
+    size_t used = 0U;
+    size_t pose = 0U;
+    double max_e2 = 0.0;
+    for (size_t i = 0U; i < fc->n; ++i) {
+        if (fc->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
+            continue;
+        }
+        double e2;
+        size_t rows;
+        const dhc_status st = sample_error2(fc, arm, i, &e2, &rows);
+        if (st != DHC_OK) {
+            return st;
+        }
+        max_e2 = fmax(max_e2, e2);
+        used++;
+        pose += rows == 6U ? 1U : 0U;
+    }
+    if (used < 3U) {
+        return DHC_OK;
+    }
+    double median;
+    const dhc_status st = median_error2(fc, arm, used, max_e2, &median);
+    if (st != DHC_OK) {
+        return st;
+    }
+    const double chi2_median = 2U * pose > used ? CHI2_MEDIAN_6DOF : CHI2_MEDIAN_3DOF;
+    const double sigma = fmax(sqrt(median / chi2_median), fc->opt->outlier_floor_mm);
+    const double limit2 = sq(fc->opt->outlier_threshold * sigma);
+    for (size_t i = 0U; i < fc->n; ++i) {
+        if (fc->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
+            continue;
+        }
+        double e2;
+        size_t rows;
+        const dhc_status st2 = sample_error2(fc, arm, i, &e2, &rows);
+        if (st2 != DHC_OK) {
+            return st2;
+        }
+        if (e2 > limit2) {
+            fc->flags[i] = (uint8_t)DHC_SAMPLE_OUTLIER;
+            (*flagged)++;
+        }
+    }
+    return DHC_OK;
+}
+
+/* Samples whose joint angles lie far outside the model's ranges are not this arm's poses. */
+static dhc_status flag_out_of_range(const fit_context *fc, const dhc_arm *arm)
+{
+    for (size_t i = 0U; i < fc->n; ++i) {
+        if (fc->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
+            continue;
+        }
+        const dhc_status st = fc->read(fc->ctx, i, &fc->ws->sample);
+        if (st != DHC_OK) {
+            return st;
+        }
+        for (size_t j = 0U; j < arm->n_joints; ++j) {
+            const double q = fc->ws->sample.q_rad[j];
+            const double m = fc->opt->joint_margin_rad;
+            if (q < arm->joint[j].min_rad - m || q > arm->joint[j].max_rad + m) {
+                fc->flags[i] = (uint8_t)DHC_SAMPLE_OUTLIER;
+                break;
+            }
+        }
+    }
+    return DHC_OK;
+}
+
+static double scaled_step_norm(const dhc_lsq_factor *fac, const double *delta, size_t p)
+{
+    double s = 0.0;
+    for (size_t k = 0U; k < p; ++k) {
+        s += sq(delta[k] / fac->scale[k]);
+    }
+    return sqrt(s);
+}
+
+/* Levenberg-Marquardt from ws->current until the SSR stops falling. */
+static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *rep,
+                                      pass_totals *tot, int *converged)
+{
+    dhc_calib_workspace *const ws = fc->ws;
+    const size_t p = fc->set->count;
+    double lambda = LAMBDA_START;
+    *converged = 0;
+    dhc_status st = data_pass(fc, &ws->current, 1, tot);
+    if (st == DHC_OK) {
+        st = dhc_lsq_analyse(&ws->ne, fc->opt->rank_rel_tol, &ws->fac);
+    }
+    for (size_t it = 0U; st == DHC_OK && it < fc->opt->max_iterations; ++it) {
+        rep->iterations++;
+        /* A perfect fit leaves nothing to improve; relative tests would divide by ~0. */
+        if (tot->ssr <= 1e-30 * (double)tot->rows) {
+            *converged = 1;
+            break;
+        }
+        st = dhc_lsq_step(&ws->ne, &ws->fac, lambda, ws->delta, p);
+        if (st != DHC_OK) {
+            break;
+        }
+        ws->trial = ws->current;
+        st = dhc_params_apply(fc->set, &ws->trial, ws->delta, p);
+        pass_totals trial_tot;
+        if (st == DHC_OK) {
+            st = data_pass(fc, &ws->trial, 0, &trial_tot);
+        }
+        if (st != DHC_OK) {
+            break;
+        }
+        if (trial_tot.ssr < tot->ssr) {
+            const double gain = tot->ssr - trial_tot.ssr;
+            const double step = scaled_step_norm(&ws->fac, ws->delta, p);
+            ws->current = ws->trial;
+            lambda = fmax(lambda / 10.0, 1e-12);
+            st = data_pass(fc, &ws->current, 1, tot);
+            if (st == DHC_OK) {
+                st = dhc_lsq_analyse(&ws->ne, fc->opt->rank_rel_tol, &ws->fac);
+            }
+            if (gain <= fc->opt->ssr_rel_tol * tot->ssr || step <= fc->opt->step_rel_tol) {
+                *converged = 1;
+                break;
+            }
+        } else {
+            lambda *= 10.0;
+            if (lambda > LAMBDA_MAX) {
+                /* No step in any direction lowers the SSR: we are at its minimum to
+                 * working precision. */
+                *converged = 1;
+                break;
+            }
+        }
+    }
+    return st;
+}
+
+static void fill_report(const fit_context *fc, const pass_totals *tot, dhc_calib_report *rep)
+{
+    const dhc_calib_workspace *const ws = fc->ws;
+    const size_t p = fc->set->count;
+    rep->samples_used = tot->samples;
+    rep->rows = tot->rows;
+    rep->rank = ws->fac.rank;
+    rep->condition = ws->fac.condition;
+    rep->rms_mm = tot->samples > 0U ? sqrt(tot->pos_ss / (double)tot->samples) : 0.0;
+    rep->max_mm = tot->max_pos;
+    rep->rms_rad = tot->pose_samples > 0U ? sqrt(tot->rot_ss / (double)tot->pose_samples) : 0.0;
+    const double dof = (double)tot->rows - (double)ws->fac.rank;
+    rep->sigma = dof > 0.0 ? sqrt(tot->ssr / dof) : 0.0;
+    (void)dhc_lsq_std_errors(&ws->fac, rep->sigma * rep->sigma, rep->std_err, p);
+    for (size_t k = 0U; k < p; ++k) {
+        rep->identifiable[k] = ws->fac.identifiable[k];
+        rep->value[k] = dhc_params_value(fc->set, &ws->current, k);
+        for (size_t m = 0U; m < p; ++m) {
+            rep->confounded[k][m] = 0U;
+        }
+        if (!ws->fac.identifiable[k]) {
+            size_t count;
+            (void)dhc_lsq_confounded(&ws->ne, &ws->fac, k, rep->confounded[k], p, &count);
+        }
+    }
+    rep->outliers = 0U;
+    for (size_t i = 0U; i < fc->n; ++i) {
+        rep->outliers += fc->flags[i] == (uint8_t)DHC_SAMPLE_OUTLIER ? 1U : 0U;
+    }
+}
+
+dhc_status dhc_calib_fit(dhc_arm *arm, const dhc_param_set *set, dhc_sample_reader read,
+                         void *ctx, size_t n, uint8_t *flags, const dhc_calib_options *opt,
+                         dhc_calib_workspace *ws, dhc_calib_report *rep)
+{
+    if (arm == NULL || set == NULL || read == NULL || flags == NULL || opt == NULL ||
+        ws == NULL || rep == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    if (set->count == 0U || set->count > DHC_MAX_PARAMS || arm->n_joints == 0U ||
+        arm->n_joints > DHC_MAX_JOINTS) {
+        return DHC_ERR_CAPACITY;
+    }
+    /* memset, not a compound literal: the report is ~5 KiB and M4 stacks are small. */
+    memset(rep, 0, sizeof *rep);
+    rep->n_params = set->count;
+    const fit_context fc = {set, read, ctx, n, flags, opt, ws};
+    ws->current = *arm;
+
+    dhc_status st = flag_out_of_range(&fc, arm);
+    if (st != DHC_OK) {
+        return st;
+    }
+    pass_totals tot;
+    st = data_pass(&fc, arm, 0, &tot);
+    if (st != DHC_OK) {
+        return st;
+    }
+    if (tot.samples == 0U) {
+        return DHC_ERR_NO_DATA;
+    }
+    st = structural_rank(&fc, arm, 2U * tot.pose_samples > tot.samples, rep);
+    if (st != DHC_OK) {
+        return st;
+    }
+
+    int converged = 0;
+    for (size_t round = 0U; round <= opt->max_outlier_rounds; ++round) {
+        st = levenberg_marquardt(&fc, rep, &tot, &converged);
+        if (st != DHC_OK) {
+            return st;
+        }
+        if (ws->fac.rank < rep->structural_rank || tot.rows < rep->structural_rank) {
+            fill_report(&fc, &tot, rep);
+            return DHC_ERR_UNDERDETERMINED;
+        }
+        size_t flagged = 0U;
+        if (round < opt->max_outlier_rounds) {
+            st = flag_outliers(&fc, &ws->current, &flagged);
+            if (st != DHC_OK) {
+                return st;
+            }
+        }
+        if (flagged == 0U) {
+            break;
+        }
+    }
+    fill_report(&fc, &tot, rep);
+    rep->converged = converged;
+    *arm = ws->current;
+    return converged ? DHC_OK : DHC_ERR_NOT_CONVERGED;
+}

@@ -1,0 +1,225 @@
+/* dhc_kinematics.c - DH / Hayati link transforms, forward kinematics, conversion to DH. */
+#include "dhcal/dhc_kinematics.h"
+
+#include <math.h>
+
+#define DHC_PI 3.14159265358979323846
+
+dhc_status dhc_arm_init(dhc_arm *arm, size_t n_joints)
+{
+    if (arm == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    if (n_joints == 0U || n_joints > DHC_MAX_JOINTS) {
+        return DHC_ERR_CAPACITY;
+    }
+    arm->n_joints = n_joints;
+    for (size_t i = 0U; i < DHC_MAX_JOINTS; ++i) {
+        dhc_joint *const j = &arm->joint[i];
+        j->theta_offset_rad = 0.0;
+        j->d_mm = 0.0;
+        j->a_mm = 0.0;
+        j->alpha_rad = 0.0;
+        j->beta_rad = 0.0;
+        j->min_rad = -DHC_PI;
+        j->max_rad = DHC_PI;
+        j->convention = DHC_CONV_DH;
+    }
+    dhc_frame_identity(&arm->base);
+    dhc_vec3_set(arm->tool_mm, 0.0, 0.0, 0.0);
+    return DHC_OK;
+}
+
+void dhc_arm_choose_conventions(dhc_arm *arm, double parallel_tol)
+{
+    DHC_ASSERT(arm != NULL);
+    for (size_t i = 0U; i < arm->n_joints; ++i) {
+        /* The last joint has no following axis: its alpha only turns the tool frame. */
+        const int parallel = fabs(sin(arm->joint[i].alpha_rad)) < parallel_tol;
+        arm->joint[i].convention =
+            (parallel && i + 1U < arm->n_joints) ? DHC_CONV_HAYATI : DHC_CONV_DH;
+    }
+}
+
+static void joint_transform(const dhc_joint *j, double q_rad, dhc_frame *out)
+{
+    const double phi = q_rad + j->theta_offset_rad;
+    dhc_mat3 rz;
+    dhc_mat3 rx;
+    dhc_mat3 ry;
+    dhc_mat3 rzx;
+    dhc_rot_z(phi, &rz);
+    dhc_rot_x(j->alpha_rad, &rx);
+    dhc_rot_y(j->beta_rad, &ry);
+    dhc_rot_mul(&rz, &rx, &rzx);
+    dhc_rot_mul(&rzx, &ry, &out->rot);
+    out->pos[0] = j->a_mm * cos(phi);
+    out->pos[1] = j->a_mm * sin(phi);
+    out->pos[2] = j->d_mm;
+}
+
+dhc_status dhc_joint_transform(const dhc_arm *arm, size_t i, double q_rad, dhc_frame *out)
+{
+    if (arm == NULL || out == NULL || i >= arm->n_joints) {
+        return DHC_ERR_ARGUMENT;
+    }
+    if (!dhc_is_finite(q_rad)) {
+        return DHC_ERR_NONFINITE;
+    }
+    joint_transform(&arm->joint[i], q_rad, out);
+    return DHC_OK;
+}
+
+dhc_status dhc_forward_frames(const dhc_arm *arm, const double *q_rad, size_t q_len,
+                              dhc_frame *frames, size_t frames_len, double tool_world_mm[3])
+{
+    if (arm == NULL || q_rad == NULL || frames == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    const size_t n = arm->n_joints;
+    if (n == 0U || n > DHC_MAX_JOINTS) {
+        return DHC_ERR_CAPACITY;
+    }
+    if (q_len < n || frames_len < n + 1U) {
+        return DHC_ERR_DIMENSION;
+    }
+    for (size_t i = 0U; i < n; ++i) {
+        if (!dhc_is_finite(q_rad[i])) {
+            return DHC_ERR_NONFINITE;
+        }
+    }
+    frames[0] = arm->base;
+    for (size_t i = 0U; i < n; ++i) {
+        dhc_frame a;
+        joint_transform(&arm->joint[i], q_rad[i], &a);
+        dhc_frame_mul(&frames[i], &a, &frames[i + 1U]);
+    }
+    if (tool_world_mm != NULL) {
+        dhc_frame_apply(&frames[n], arm->tool_mm, tool_world_mm);
+    }
+    return DHC_OK;
+}
+
+dhc_status dhc_forward(const dhc_arm *arm, const double *q_rad, size_t q_len, dhc_frame *tool)
+{
+    if (tool == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    dhc_frame frames[DHC_MAX_JOINTS + 1U];
+    double p[3];
+    const dhc_status st = dhc_forward_frames(arm, q_rad, q_len, frames, DHC_MAX_JOINTS + 1U, p);
+    if (st != DHC_OK) {
+        return st;
+    }
+    tool->rot = frames[arm->n_joints].rot;
+    dhc_vec3_copy(p, tool->pos);
+    return DHC_OK;
+}
+
+static void frame_axis(const dhc_frame *f, size_t col, double out[3])
+{
+    dhc_rot_column(&f->rot, col, out);
+}
+
+static void frame_from_xz(const double x[3], const double z[3], const double origin[3],
+                          dhc_frame *f)
+{
+    double y[3];
+    dhc_vec3_cross(z, x, y);
+    for (size_t r = 0U; r < 3U; ++r) {
+        f->rot.m[r][0] = x[r];
+        f->rot.m[r][1] = y[r];
+        f->rot.m[r][2] = z[r];
+    }
+    dhc_vec3_copy(origin, f->pos);
+}
+
+/* Angle from u to v about the unit axis k (u, v perpendicular to k). */
+static double angle_about(const double u[3], const double v[3], const double k[3])
+{
+    double c[3];
+    dhc_vec3_cross(u, v, c);
+    return atan2(dhc_vec3_dot(c, k), dhc_vec3_dot(u, v));
+}
+
+dhc_status dhc_arm_to_standard_dh(const dhc_arm *arm, dhc_arm *out)
+{
+    if (arm == NULL || out == NULL || arm == out) {
+        return DHC_ERR_ARGUMENT;
+    }
+    const size_t n = arm->n_joints;
+    if (n == 0U || n > DHC_MAX_JOINTS) {
+        return DHC_ERR_CAPACITY;
+    }
+    /* The axes are read off the chain at q = 0, so the DH offsets come out directly. */
+    const double q0[DHC_MAX_JOINTS] = {0.0};
+    dhc_frame f[DHC_MAX_JOINTS + 1U];
+    const dhc_status st = dhc_forward_frames(arm, q0, DHC_MAX_JOINTS, f, DHC_MAX_JOINTS + 1U, NULL);
+    if (st != DHC_OK) {
+        return st;
+    }
+    *out = *arm;
+    dhc_frame prev = f[0];
+    for (size_t i = 1U; i <= n; ++i) {
+        double z_prev[3];
+        double x_prev[3];
+        double z[3];
+        double x_orig[3];
+        frame_axis(&prev, 2U, z_prev);
+        frame_axis(&prev, 0U, x_prev);
+        frame_axis(&f[i], 2U, z);
+        frame_axis(&f[i], 0U, x_orig);
+
+        double foot_prev[3]; /* foot of the common normal on the previous axis */
+        double x_new[3];
+        double o_new[3];
+        if (i < n) {
+            double normal[3];
+            dhc_vec3_cross(z_prev, z, normal);
+            const double s = dhc_vec3_norm(normal);
+            if (s < 1e-12) {
+                return DHC_ERR_SINGULAR; /* parallel axes: the common normal is not unique */
+            }
+            double w0[3];
+            dhc_vec3_sub(prev.pos, f[i].pos, w0);
+            const double b = dhc_vec3_dot(z_prev, z);
+            const double d1 = dhc_vec3_dot(z_prev, w0);
+            const double e = dhc_vec3_dot(z, w0);
+            const double t1 = (b * e - d1) / (s * s);
+            const double t2 = (e - b * d1) / (s * s);
+            dhc_vec3_axpy(prev.pos, t1, z_prev, foot_prev);
+            dhc_vec3_axpy(f[i].pos, t2, z, o_new);
+            /* Of the two normal directions keep the one nearer the model's own x axis, so
+             * signs of a and alpha stay those of the drawing. */
+            const double sign = dhc_vec3_dot(normal, x_orig) < 0.0 ? -1.0 : 1.0;
+            dhc_vec3_scale(normal, sign / s, x_new);
+        } else {
+            /* The last frame carries the tool: keep it, it must already be DH-placed. */
+            dhc_vec3_copy(x_orig, x_new);
+            dhc_vec3_copy(f[i].pos, o_new);
+            double rel[3];
+            dhc_vec3_sub(o_new, prev.pos, rel);
+            dhc_vec3_axpy(prev.pos, dhc_vec3_dot(rel, z_prev), z_prev, foot_prev);
+            double off[3];
+            dhc_vec3_sub(o_new, foot_prev, off);
+            double along_x[3];
+            dhc_vec3_cross(off, x_new, along_x);
+            const double scale = 1.0 + dhc_vec3_norm(off);
+            if (fabs(dhc_vec3_dot(x_new, z_prev)) > 1e-9 || dhc_vec3_norm(along_x) > 1e-9 * scale) {
+                return DHC_ERR_ARGUMENT; /* a last-joint beta: not expressible in DH */
+            }
+        }
+        dhc_joint *const j = &out->joint[i - 1U];
+        double rel[3];
+        dhc_vec3_sub(foot_prev, prev.pos, rel);
+        j->d_mm = dhc_vec3_dot(rel, z_prev);
+        j->theta_offset_rad = angle_about(x_prev, x_new, z_prev);
+        dhc_vec3_sub(o_new, foot_prev, rel);
+        j->a_mm = dhc_vec3_dot(rel, x_new);
+        j->alpha_rad = angle_about(z_prev, z, x_new);
+        j->beta_rad = 0.0;
+        j->convention = DHC_CONV_DH;
+        frame_from_xz(x_new, z, o_new, &prev);
+    }
+    return DHC_OK;
+}

@@ -1,0 +1,334 @@
+/* dhc_lsq.c - streaming normal equations, column scaling, rank analysis and the LM step. */
+#include "dhcal/dhc_lsq.h"
+
+#include <float.h>
+#include <math.h>
+
+/* A coefficient of the null-space combination above this (scaled units, v_j = 1) makes that
+ * parameter a partner of j; below it the coupling is rounding noise. */
+#define CONFOUND_COEF_MIN 1e-4
+
+static int finite_all(const double *x, size_t n)
+{
+    for (size_t i = 0U; i < n; ++i) {
+        if (!dhc_is_finite(x[i])) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+static int ne_valid(const dhc_normal_eq *ne)
+{
+    return ne != NULL && ne->n >= 1U && ne->n <= DHC_MAX_PARAMS;
+}
+
+static int fac_valid(const dhc_lsq_factor *fac)
+{
+    return fac != NULL && fac->n >= 1U && fac->n <= DHC_MAX_PARAMS && fac->rank <= fac->n;
+}
+
+/* A lower-triangular T of order k over borrowed storage: T(i, m) = off[i * rs + m * cs] for
+ * m < i and T(i, i) = diag[i * ds]. The analysed factor and the damped factor (kept transposed
+ * in the factor's free upper triangle) are both read through this. */
+typedef struct {
+    const double *off;
+    size_t rs;
+    size_t cs;
+    const double *diag;
+    size_t ds;
+} tri_view;
+
+static double tri_at(const tri_view *t, size_t i, size_t m)
+{
+    return t->off[i * t->rs + m * t->cs];
+}
+
+/* T x = b in place. */
+static void tri_forward(const tri_view *t, size_t k, double *x)
+{
+    for (size_t i = 0U; i < k; ++i) {
+        double s = x[i];
+        for (size_t m = 0U; m < i; ++m) {
+            s -= tri_at(t, i, m) * x[m];
+        }
+        x[i] = s / t->diag[i * t->ds];
+    }
+}
+
+/* T^T x = b in place. */
+static void tri_backward(const tri_view *t, size_t k, double *x)
+{
+    for (size_t i = k; i-- > 0U;) {
+        double s = x[i];
+        for (size_t m = i + 1U; m < k; ++m) {
+            s -= tri_at(t, m, i) * x[m];
+        }
+        x[i] = s / t->diag[i * t->ds];
+    }
+}
+
+static tri_view analysed_factor(const dhc_lsq_factor *fac)
+{
+    const tri_view t = {fac->factor, fac->n, 1U, fac->factor, fac->n + 1U};
+    return t;
+}
+
+dhc_status dhc_normal_eq_init(dhc_normal_eq *ne, size_t n)
+{
+    if (ne == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    if (n == 0U || n > DHC_MAX_PARAMS) {
+        return DHC_ERR_CAPACITY;
+    }
+    ne->n = n;
+    ne->rows = 0U;
+    ne->ssr = 0.0;
+    for (size_t i = 0U; i < n * n; ++i) {
+        ne->jtj[i] = 0.0;
+    }
+    for (size_t i = 0U; i < n; ++i) {
+        ne->jtr[i] = 0.0;
+    }
+    return DHC_OK;
+}
+
+dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double *r,
+                             const double *w, size_t k)
+{
+    if (!ne_valid(ne) || jac == NULL || jac->data == NULL || r == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    const size_t n = ne->n;
+    if (jac->rows != k || jac->cols != n) {
+        return DHC_ERR_DIMENSION;
+    }
+    if (!finite_all(jac->data, k * n) || !finite_all(r, k)) {
+        return DHC_ERR_NONFINITE;
+    }
+    if (w != NULL) {
+        for (size_t e = 0U; e < k; ++e) {
+            if (!(w[e] > 0.0) || !dhc_is_finite(w[e])) {
+                return DHC_ERR_ARGUMENT;
+            }
+        }
+    }
+    for (size_t e = 0U; e < k; ++e) {
+        const double we = w != NULL ? w[e] : 1.0;
+        const double *const row = &DHC_MAT_AT(jac, e, 0U);
+        for (size_t i = 0U; i < n; ++i) {
+            const double wji = we * row[i];
+            if (!(fabs(wji) > 0.0)) {
+                continue; /* identification Jacobians are sparse; skipping is exact */
+            }
+            for (size_t j = 0U; j <= i; ++j) {
+                ne->jtj[i * n + j] += wji * row[j];
+            }
+            ne->jtr[i] += wji * r[e];
+        }
+        ne->ssr += we * r[e] * r[e];
+    }
+    /* Accumulate one triangle, keep the stored matrix full and exactly symmetric. */
+    for (size_t i = 0U; i < n; ++i) {
+        for (size_t j = 0U; j < i; ++j) {
+            ne->jtj[j * n + i] = ne->jtj[i * n + j];
+        }
+    }
+    ne->rows += k;
+    return DHC_OK;
+}
+
+dhc_status dhc_lsq_analyse(const dhc_normal_eq *ne, double rel_tol, dhc_lsq_factor *fac)
+{
+    if (!ne_valid(ne) || fac == NULL || !(rel_tol > 0.0 && rel_tol < 1.0)) {
+        return DHC_ERR_ARGUMENT;
+    }
+    const size_t n = ne->n;
+    if (ne->rows == 0U) {
+        return DHC_ERR_NO_DATA;
+    }
+    if (!finite_all(ne->jtj, n * n) || !finite_all(ne->jtr, n) || !dhc_is_finite(ne->ssr)) {
+        return DHC_ERR_NONFINITE;
+    }
+    for (size_t i = 0U; i < n; ++i) {
+        const double d = ne->jtj[i * n + i];
+        /* Column scaling makes the rank test unit-free, so "zero" here must be absolute: a
+         * diagonal is a sum of squares, and below DBL_MIN its square root is not reliable. */
+        fac->scale[i] = d > DBL_MIN ? 1.0 / sqrt(d) : 1.0;
+    }
+    for (size_t i = 0U; i < n; ++i) {
+        for (size_t j = 0U; j < n; ++j) {
+            fac->factor[i * n + j] =
+                j <= i ? ne->jtj[i * n + j] * fac->scale[i] * fac->scale[j] : 0.0;
+        }
+    }
+    dhc_mat m;
+    dhc_status st = dhc_mat_init(&m, n, n, fac->factor, DHC_MAX_PARAMS * DHC_MAX_PARAMS);
+    size_t rank = 0U;
+    if (st == DHC_OK) {
+        st = dhc_chol_pivoted(&m, fac->perm, DHC_MAX_PARAMS, rel_tol, &rank);
+    }
+    if (st != DHC_OK) {
+        /* Only a hand-edited, indefinite accumulator gets here; leave nothing usable. */
+        fac->n = 0U;
+        fac->rank = 0U;
+        return st;
+    }
+    for (size_t i = 0U; i < n; ++i) {
+        fac->identifiable[i] = 0U;
+    }
+    for (size_t i = 0U; i < rank; ++i) {
+        fac->identifiable[fac->perm[i]] = 1U;
+    }
+    fac->n = n;
+    fac->rank = rank;
+    fac->condition = dhc_chol_condition_estimate(&m, rank);
+    return DHC_OK;
+}
+
+dhc_status dhc_lsq_step(const dhc_normal_eq *ne, dhc_lsq_factor *fac, double lambda,
+                        double *delta, size_t len)
+{
+    if (!ne_valid(ne) || !fac_valid(fac) || delta == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    const size_t n = ne->n;
+    if (fac->n != n || len < n) {
+        return DHC_ERR_DIMENSION;
+    }
+    if (!dhc_is_finite(lambda)) {
+        return DHC_ERR_NONFINITE;
+    }
+    if (!(lambda >= 0.0)) {
+        return DHC_ERR_ARGUMENT;
+    }
+    const size_t r = fac->rank;
+    const size_t *const p = fac->perm;
+    const double *const s = fac->scale;
+    /* The damped factor D (D D^T = S N11 S + lambda I, pivoted order) lives transposed in the
+     * factor's strict upper triangle, which the analysed L never uses: D(i, m) at
+     * factor[m * n + i]. Its diagonal goes into delta, free until the step is written. */
+    double *const up = fac->factor;
+    double *const dd = delta;
+    double dmax = 0.0;
+    for (size_t i = 0U; i < r; ++i) {
+        dmax = fmax(dmax, ne->jtj[p[i] * n + p[i]] * s[p[i]] * s[p[i]] + lambda);
+    }
+    const double piv_min = DBL_EPSILON * dmax;
+    for (size_t i = 0U; i < r; ++i) {
+        for (size_t m = 0U; m <= i; ++m) {
+            double sum = ne->jtj[p[i] * n + p[m]] * s[p[i]] * s[p[m]];
+            for (size_t t = 0U; t < m; ++t) {
+                sum -= up[t * n + i] * up[t * n + m];
+            }
+            if (m < i) {
+                up[m * n + i] = sum / dd[m];
+                continue;
+            }
+            sum += lambda;
+            if (!(sum > piv_min)) {
+                for (size_t k = 0U; k < n; ++k) {
+                    delta[k] = 0.0;
+                }
+                return DHC_ERR_NOT_SPD;
+            }
+            dd[i] = sqrt(sum);
+        }
+    }
+    double y[DHC_MAX_PARAMS]; /* pivoted, scaled step: the one n-sized local of this module */
+    for (size_t i = 0U; i < r; ++i) {
+        y[i] = ne->jtr[p[i]] * s[p[i]];
+    }
+    const tri_view damped = {up, 1U, n, dd, 1U};
+    tri_forward(&damped, r, y);
+    tri_backward(&damped, r, y);
+    for (size_t k = 0U; k < n; ++k) {
+        delta[k] = 0.0;
+    }
+    for (size_t i = 0U; i < r; ++i) {
+        delta[p[i]] = y[i] * s[p[i]];
+    }
+    if (!finite_all(delta, n)) {
+        for (size_t k = 0U; k < n; ++k) {
+            delta[k] = 0.0;
+        }
+        return DHC_ERR_NONFINITE;
+    }
+    return DHC_OK;
+}
+
+dhc_status dhc_lsq_std_errors(const dhc_lsq_factor *fac, double sigma2, double *std, size_t len)
+{
+    if (!fac_valid(fac) || std == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    const size_t n = fac->n;
+    if (len < n) {
+        return DHC_ERR_DIMENSION;
+    }
+    if (!dhc_is_finite(sigma2)) {
+        return DHC_ERR_NONFINITE;
+    }
+    if (!(sigma2 >= 0.0)) {
+        return DHC_ERR_ARGUMENT;
+    }
+    const size_t r = fac->rank;
+    const tri_view l = analysed_factor(fac);
+    for (size_t k = 0U; k < n; ++k) {
+        std[k] = 0.0;
+    }
+    /* diag((L L^T)^-1)_i = |L^-1 e_i|^2; the column L^-1 e_i is zero above row i. */
+    double x[DHC_MAX_PARAMS];
+    for (size_t i = 0U; i < r; ++i) {
+        double sum = 0.0;
+        for (size_t m = i; m < r; ++m) {
+            double v = m == i ? 1.0 : 0.0;
+            for (size_t t = i; t < m; ++t) {
+                v -= tri_at(&l, m, t) * x[t];
+            }
+            x[m] = v / l.diag[m * l.ds];
+            sum += x[m] * x[m];
+        }
+        const size_t k = fac->perm[i];
+        std[k] = fac->scale[k] * sqrt(sigma2 * sum);
+    }
+    return DHC_OK;
+}
+
+dhc_status dhc_lsq_confounded(const dhc_normal_eq *ne, const dhc_lsq_factor *fac, size_t j,
+                              uint8_t *partner, size_t len, size_t *count)
+{
+    if (!ne_valid(ne) || !fac_valid(fac) || partner == NULL || count == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    const size_t n = ne->n;
+    if (fac->n != n || len < n) {
+        return DHC_ERR_DIMENSION;
+    }
+    if (j >= n || fac->identifiable[j] != 0U) {
+        return DHC_ERR_ARGUMENT;
+    }
+    const size_t r = fac->rank;
+    const size_t *const p = fac->perm;
+    /* v_id = -(S N11 S)^-1 (S N1j s_j) in pivoted order. */
+    double v[DHC_MAX_PARAMS];
+    for (size_t i = 0U; i < r; ++i) {
+        v[i] = -ne->jtj[p[i] * n + j] * fac->scale[p[i]] * fac->scale[j];
+    }
+    const tri_view l = analysed_factor(fac);
+    tri_forward(&l, r, v);
+    tri_backward(&l, r, v);
+    for (size_t k = 0U; k < n; ++k) {
+        partner[k] = 0U;
+    }
+    size_t c = 0U;
+    for (size_t i = 0U; i < r; ++i) {
+        if (fabs(v[i]) > CONFOUND_COEF_MIN) {
+            partner[p[i]] = 1U;
+            ++c;
+        }
+    }
+    *count = c;
+    return DHC_OK;
+}

@@ -1,0 +1,137 @@
+/* test_paper_6dof.c - the paper's section 3 simulation of the 6-DOF arm, reproduced:
+ * actual = Table 1 with every joint offset 2 deg, nominal = Table 2, full pose measured,
+ * noise-free, calibrated from 10 and from 2 random poses. */
+#include <math.h>
+
+#include "dhc_test_arms.h"
+#include "dhc_test_samples.h"
+#include "dhcal/dhc_calib.h"
+#include "unity.h"
+
+void setUp(void) {}
+void tearDown(void) {}
+
+static test_dataset data;
+static dhc_calib_workspace ws;
+static dhc_calib_report rep;
+static dhc_param_set set;
+
+static void paper_arms(dhc_arm *truth, dhc_arm *nominal)
+{
+    test_arm_from_table(truth, TEST_TABLE1, 6U, TEST_PAPER_OFFSET_DEG);
+    test_arm_from_table(nominal, TEST_TABLE2, 6U, 0.0);
+    dhc_arm_choose_conventions(nominal, 1e-3);
+}
+
+static dhc_status calibrate(dhc_arm *arm, size_t poses, uint64_t seed)
+{
+    dhc_arm truth;
+    dhc_arm nominal;
+    paper_arms(&truth, &nominal);
+    test_rng rng = {seed};
+    test_measure(&data, &truth, poses, DHC_MEAS_POSE, &rng);
+    *arm = nominal;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, arm));
+    dhc_calib_options opt;
+    dhc_calib_default_options(&opt);
+    return dhc_calib_fit(arm, &set, test_read_sample, &data, data.n, data.flags, &opt, &ws, &rep);
+}
+
+static void test_ten_poses_reproduce_the_true_arm_everywhere(void)
+{
+    dhc_arm cal;
+    TEST_ASSERT_EQUAL(DHC_OK, calibrate(&cal, 10U, 0xC0FFEEULL));
+    TEST_ASSERT_TRUE(rep.converged);
+    TEST_ASSERT_EQUAL(24U, rep.n_params);
+    TEST_ASSERT_EQUAL(24U, rep.structural_rank);
+    TEST_ASSERT_EQUAL(24U, rep.rank);
+    TEST_ASSERT_EQUAL(0U, rep.outliers);
+    dhc_arm truth;
+    dhc_arm nominal;
+    paper_arms(&truth, &nominal);
+    test_rng fresh = {0xF00DULL};
+    double max_mm;
+    double max_rad;
+    test_compare_arms(&cal, &truth, 100U, &fresh, &max_mm, &max_rad);
+    TEST_ASSERT_TRUE(max_mm < 1e-6);
+    TEST_ASSERT_TRUE(max_rad < 1e-8);
+    /* Before calibration the same poses were millimetres off. */
+    test_compare_arms(&nominal, &truth, 100U, &fresh, &max_mm, &max_rad);
+    TEST_ASSERT_TRUE(max_mm > 5.0);
+}
+
+static void test_calibrated_parameters_in_table1_convention_match_table1(void)
+{
+    dhc_arm cal;
+    TEST_ASSERT_EQUAL(DHC_OK, calibrate(&cal, 10U, 0xBEEFULL));
+    dhc_arm dh;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_arm_to_standard_dh(&cal, &dh));
+    for (size_t i = 0U; i < 6U; ++i) {
+        TEST_ASSERT_DOUBLE_WITHIN(1e-6, TEST_PAPER_OFFSET_DEG, dh.joint[i].theta_offset_rad / TEST_DEG);
+        TEST_ASSERT_DOUBLE_WITHIN(1e-6, TEST_TABLE1[i].alpha_deg, dh.joint[i].alpha_rad / TEST_DEG);
+        TEST_ASSERT_DOUBLE_WITHIN(1e-6, TEST_TABLE1[i].a_mm, dh.joint[i].a_mm);
+        TEST_ASSERT_DOUBLE_WITHIN(1e-6, TEST_TABLE1[i].d_mm, dh.joint[i].d_mm);
+    }
+}
+
+static void test_parallel_axes_use_hayati_beta_and_the_others_plain_dh(void)
+{
+    dhc_arm cal;
+    TEST_ASSERT_EQUAL(DHC_OK, calibrate(&cal, 10U, 0xC0FFEEULL));
+    /* Joints 2, 3, 5 of Table 2 have alpha = 0: beta replaces d there, d stays nominal. */
+    const size_t hayati[3] = {1U, 2U, 4U};
+    for (size_t h = 0U; h < 3U; ++h) {
+        const size_t j = hayati[h];
+        TEST_ASSERT_EQUAL(DHC_CONV_HAYATI, cal.joint[j].convention);
+        TEST_ASSERT_TRUE(test_param_index(&set, DHC_P_BETA, j) < set.count);
+        TEST_ASSERT_EQUAL(set.count, test_param_index(&set, DHC_P_D, j));
+        TEST_ASSERT_EQUAL_DOUBLE(TEST_TABLE2[j].d_mm, cal.joint[j].d_mm);
+    }
+    TEST_ASSERT_EQUAL(DHC_CONV_DH, cal.joint[5].convention);
+    /* The tilt between axes 2 and 3 (alpha 1 deg, d 2 mm in Table 1) shows up as a beta
+     * of physical size, not as an absurd d. */
+    TEST_ASSERT_TRUE(fabs(cal.joint[1].beta_rad) < 5.0 * TEST_DEG);
+}
+
+static void test_two_poses_under_determine_the_model(void)
+{
+    dhc_arm cal;
+    dhc_arm truth;
+    dhc_arm nominal;
+    paper_arms(&truth, &nominal);
+    TEST_ASSERT_EQUAL(DHC_ERR_UNDERDETERMINED, calibrate(&cal, 2U, 0xC0FFEEULL));
+    TEST_ASSERT_EQUAL(12U, rep.rows);
+    TEST_ASSERT_EQUAL(24U, rep.structural_rank);
+    TEST_ASSERT_TRUE(rep.rank <= 12U);
+    /* Nothing half-fitted leaks out: the arm is still the nominal one. */
+    for (size_t i = 0U; i < 6U; ++i) {
+        TEST_ASSERT_EQUAL_DOUBLE(nominal.joint[i].theta_offset_rad, cal.joint[i].theta_offset_rad);
+        TEST_ASSERT_EQUAL_DOUBLE(nominal.joint[i].a_mm, cal.joint[i].a_mm);
+        TEST_ASSERT_EQUAL_DOUBLE(nominal.joint[i].alpha_rad, cal.joint[i].alpha_rad);
+        TEST_ASSERT_EQUAL_DOUBLE(nominal.joint[i].beta_rad, cal.joint[i].beta_rad);
+    }
+}
+
+static void test_result_does_not_depend_on_the_pose_draw(void)
+{
+    dhc_arm a;
+    dhc_arm b;
+    TEST_ASSERT_EQUAL(DHC_OK, calibrate(&a, 10U, 1ULL));
+    TEST_ASSERT_EQUAL(DHC_OK, calibrate(&b, 12U, 777ULL));
+    test_rng fresh = {42ULL};
+    double max_mm;
+    double max_rad;
+    test_compare_arms(&a, &b, 50U, &fresh, &max_mm, &max_rad);
+    TEST_ASSERT_TRUE(max_mm < 1e-6);
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_ten_poses_reproduce_the_true_arm_everywhere);
+    RUN_TEST(test_calibrated_parameters_in_table1_convention_match_table1);
+    RUN_TEST(test_parallel_axes_use_hayati_beta_and_the_others_plain_dh);
+    RUN_TEST(test_two_poses_under_determine_the_model);
+    RUN_TEST(test_result_does_not_depend_on_the_pose_draw);
+    return UNITY_END();
+}

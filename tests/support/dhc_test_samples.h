@@ -1,0 +1,85 @@
+/* dhc_test_samples.h - simulated measurements of a "true" arm for calibration tests. */
+#ifndef DHC_TEST_SAMPLES_H
+#define DHC_TEST_SAMPLES_H
+
+#include <math.h>
+
+#include "dhc_test_arms.h"
+#include "dhcal/dhc_calib.h"
+#include "unity.h"
+
+#define TEST_MAX_SAMPLES 200U
+
+typedef struct {
+    size_t n;
+    dhc_sample s[TEST_MAX_SAMPLES];
+    uint8_t flags[TEST_MAX_SAMPLES];
+} test_dataset;
+
+static inline dhc_status test_read_sample(void *ctx, size_t index, dhc_sample *out)
+{
+    const test_dataset *d = (const test_dataset *)ctx;
+    if (index >= d->n) {
+        return DHC_ERR_ARGUMENT;
+    }
+    *out = d->s[index];
+    return DHC_OK;
+}
+
+/* n noise-free measurements of the true arm at random poses (position or full pose). */
+static inline void test_measure(test_dataset *d, const dhc_arm *truth, size_t n, dhc_meas_kind kind,
+                         test_rng *rng)
+{
+    TEST_ASSERT_TRUE(n <= TEST_MAX_SAMPLES);
+    d->n = n;
+    for (size_t k = 0U; k < n; ++k) {
+        dhc_sample *s = &d->s[k];
+        for (size_t i = 0U; i < DHC_MAX_JOINTS; ++i) {
+            s->q_rad[i] = 0.0;
+        }
+        test_random_q(rng, truth, s->q_rad);
+        dhc_frame pose;
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_forward(truth, s->q_rad, DHC_MAX_JOINTS, &pose));
+        dhc_vec3_copy(pose.pos, s->p_mm);
+        s->rot = pose.rot;
+        s->kind = (uint8_t)kind;
+        d->flags[k] = (uint8_t)DHC_SAMPLE_USED;
+    }
+}
+
+/* Largest position (mm) and orientation (rad) difference of two arms over fresh poses. */
+static inline void test_compare_arms(const dhc_arm *a, const dhc_arm *b, size_t poses, test_rng *rng,
+                              double *max_mm, double *max_rad)
+{
+    *max_mm = 0.0;
+    *max_rad = 0.0;
+    for (size_t k = 0U; k < poses; ++k) {
+        double q[DHC_MAX_JOINTS] = {0.0};
+        test_random_q(rng, a, q);
+        dhc_frame pa;
+        dhc_frame pb;
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_forward(a, q, DHC_MAX_JOINTS, &pa));
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_forward(b, q, DHC_MAX_JOINTS, &pb));
+        double d[3];
+        dhc_vec3_sub(pa.pos, pb.pos, d);
+        *max_mm = fmax(*max_mm, dhc_vec3_norm(d));
+        dhc_mat3 rel;
+        dhc_rot_tmul(&pb.rot, &pa.rot, &rel);
+        double w[3];
+        dhc_rot_log(&rel, w);
+        *max_rad = fmax(*max_rad, dhc_vec3_norm(w));
+    }
+}
+
+/* Index of the parameter (kind, joint) in the set, or set->count when absent. */
+static inline size_t test_param_index(const dhc_param_set *set, dhc_param_kind kind, size_t joint)
+{
+    for (size_t k = 0U; k < set->count; ++k) {
+        if (set->id[k].kind == (uint8_t)kind && set->id[k].joint == (uint8_t)joint) {
+            return k;
+        }
+    }
+    return set->count;
+}
+
+#endif /* DHC_TEST_SAMPLES_H */

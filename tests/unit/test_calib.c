@@ -1,0 +1,323 @@
+/* test_calib.c - the calibration driver on noisy data: noise estimate, standard errors
+ * against a Monte Carlo spread, outlier rejection, Hayati's beta for tilted parallel axes,
+ * and every failure path. */
+#include <math.h>
+
+#include "dhc_test_arms.h"
+#include "dhc_test_samples.h"
+#include "dhcal/dhc_calib.h"
+#include "unity.h"
+
+void setUp(void) {}
+void tearDown(void) {}
+
+static test_dataset data;
+static dhc_calib_workspace ws;
+static dhc_calib_report rep;
+static dhc_param_set set;
+
+/* Standard normal deviate (Box-Muller), independent of the library. */
+static double test_gauss(test_rng *r)
+{
+    const double u1 = fmax(test_uniform(r), 1e-300);
+    const double u2 = test_uniform(r);
+    return sqrt(-2.0 * log(u1)) * cos(2.0 * TEST_PI * u2);
+}
+
+static void add_noise(test_dataset *d, double sigma_mm, test_rng *r)
+{
+    for (size_t k = 0U; k < d->n; ++k) {
+        for (size_t c = 0U; c < 3U; ++c) {
+            d->s[k].p_mm[c] += sigma_mm * test_gauss(r);
+        }
+    }
+}
+
+/* The paper's built arm (Table 3) with machining errors of realistic size. */
+static void table3_arms(dhc_arm *truth, dhc_arm *nominal)
+{
+    test_arm_from_table(nominal, TEST_TABLE3, 3U, 0.0);
+    dhc_arm_choose_conventions(nominal, 1e-3);
+    for (size_t i = 0U; i < 3U; ++i) {
+        nominal->joint[i].min_rad = -150.0 * TEST_DEG;
+        nominal->joint[i].max_rad = 150.0 * TEST_DEG;
+    }
+    *truth = *nominal;
+    truth->joint[0].theta_offset_rad = 0.3 * TEST_DEG;
+    truth->joint[0].d_mm = 434.2;
+    truth->joint[0].a_mm = 0.8;
+    truth->joint[0].alpha_rad = 89.7 * TEST_DEG;
+    truth->joint[1].theta_offset_rad = -0.4 * TEST_DEG;
+    truth->joint[1].a_mm = 399.1;
+    truth->joint[1].alpha_rad = 0.2 * TEST_DEG;
+    truth->joint[1].beta_rad = 0.05 * TEST_DEG;
+    truth->joint[2].theta_offset_rad = 0.25 * TEST_DEG;
+    truth->joint[2].a_mm = 345.9;
+    truth->joint[2].d_mm = 0.7;
+}
+
+static dhc_status fit(dhc_arm *arm, const dhc_calib_options *opt)
+{
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, arm));
+    return dhc_calib_fit(arm, &set, test_read_sample, &data, data.n, data.flags, opt, &ws, &rep);
+}
+
+static void test_noise_estimate_and_residual_match_the_noise_level(void)
+{
+    dhc_arm truth;
+    dhc_arm arm;
+    table3_arms(&truth, &arm);
+    test_rng rng = {11ULL};
+    test_measure(&data, &truth, 150U, DHC_MEAS_POSITION, &rng);
+    add_noise(&data, 0.05, &rng);
+    dhc_calib_options opt;
+    dhc_calib_default_options(&opt);
+    TEST_ASSERT_EQUAL(DHC_OK, fit(&arm, &opt));
+    TEST_ASSERT_EQUAL(0U, rep.outliers);
+    /* sigma per coordinate; RMS of the 3-D error ~ sqrt(3) sigma less the fitted share. */
+    TEST_ASSERT_DOUBLE_WITHIN(0.006, 0.05, rep.sigma);
+    TEST_ASSERT_DOUBLE_WITHIN(0.012, sqrt(3.0) * 0.05, rep.rms_mm);
+    /* The fit removed the millimetres of geometric error: fresh poses agree with the truth
+     * to far better than the noise of a single measurement. */
+    test_rng fresh = {12ULL};
+    double max_mm;
+    double max_rad;
+    test_compare_arms(&arm, &truth, 100U, &fresh, &max_mm, &max_rad);
+    TEST_ASSERT_TRUE(max_mm < 0.05);
+}
+
+static void test_standard_errors_match_the_spread_of_repeated_fits(void)
+{
+    dhc_arm truth;
+    dhc_arm nominal;
+    table3_arms(&truth, &nominal);
+    enum { DRAWS = 60 };
+    static double est[DRAWS][12];
+    double reported[12] = {0.0};
+    test_rng poses = {21ULL};
+    test_measure(&data, &truth, 30U, DHC_MEAS_POSITION, &poses);
+    static test_dataset clean;
+    clean = data;
+    dhc_calib_options opt;
+    dhc_calib_default_options(&opt);
+    opt.outlier_threshold = 0.0; /* all draws use the same rows */
+    test_rng noise = {22ULL};
+    for (size_t d = 0U; d < DRAWS; ++d) {
+        data = clean;
+        add_noise(&data, 0.05, &noise);
+        dhc_arm arm = nominal;
+        TEST_ASSERT_EQUAL(DHC_OK, fit(&arm, &opt));
+        for (size_t k = 0U; k < set.count; ++k) {
+            est[d][k] = rep.value[k];
+            reported[k] += rep.std_err[k] / DRAWS;
+        }
+    }
+    size_t checked = 0U;
+    for (size_t k = 0U; k < set.count; ++k) {
+        if (!rep.identifiable[k]) {
+            continue;
+        }
+        double mean = 0.0;
+        for (size_t d = 0U; d < DRAWS; ++d) {
+            mean += est[d][k] / DRAWS;
+        }
+        double var = 0.0;
+        for (size_t d = 0U; d < DRAWS; ++d) {
+            var += (est[d][k] - mean) * (est[d][k] - mean) / (DRAWS - 1);
+        }
+        /* With 60 draws the sample spread is within ~+-30 % of the truth at 99 %. */
+        const double ratio = sqrt(var) / reported[k];
+        TEST_ASSERT_TRUE(ratio > 0.7 && ratio < 1.3);
+        checked++;
+    }
+    TEST_ASSERT_EQUAL(11U, checked);
+}
+
+static void test_gross_errors_are_flagged_left_out_and_the_fit_repeated(void)
+{
+    dhc_arm truth;
+    dhc_arm arm;
+    table3_arms(&truth, &arm);
+    test_rng rng = {31ULL};
+    test_measure(&data, &truth, 60U, DHC_MEAS_POSITION, &rng);
+    add_noise(&data, 0.05, &rng);
+    data.s[7].p_mm[2] += 5.0;  /* a wire that slipped */
+    data.s[41].p_mm[0] -= 3.0; /* a mistyped coordinate */
+    dhc_calib_options opt;
+    dhc_calib_default_options(&opt);
+    TEST_ASSERT_EQUAL(DHC_OK, fit(&arm, &opt));
+    TEST_ASSERT_EQUAL(2U, rep.outliers);
+    TEST_ASSERT_EQUAL(DHC_SAMPLE_OUTLIER, data.flags[7]);
+    TEST_ASSERT_EQUAL(DHC_SAMPLE_OUTLIER, data.flags[41]);
+    TEST_ASSERT_EQUAL(58U, rep.samples_used);
+    TEST_ASSERT_TRUE(rep.rms_mm < 0.12);
+    test_rng fresh = {32ULL};
+    double max_mm;
+    double max_rad;
+    test_compare_arms(&arm, &truth, 50U, &fresh, &max_mm, &max_rad);
+    TEST_ASSERT_TRUE(max_mm < 0.1);
+}
+
+static void test_poses_outside_the_joint_ranges_are_outliers(void)
+{
+    dhc_arm truth;
+    dhc_arm arm;
+    table3_arms(&truth, &arm);
+    test_rng rng = {41ULL};
+    test_measure(&data, &truth, 40U, DHC_MEAS_POSITION, &rng);
+    data.s[3].q_rad[1] = 200.0 * TEST_DEG; /* range is +-150 deg */
+    dhc_calib_options opt;
+    dhc_calib_default_options(&opt);
+    TEST_ASSERT_EQUAL(DHC_OK, fit(&arm, &opt));
+    TEST_ASSERT_EQUAL(DHC_SAMPLE_OUTLIER, data.flags[3]);
+    TEST_ASSERT_EQUAL(1U, rep.outliers);
+}
+
+/* A tilt between the nominally parallel axes 2 and 3: with Hayati's beta the base model
+ * reaches the noise floor with physical parameter values; forced into plain DH the same
+ * data either leave a residual or drive d to an absurd size. */
+static void test_tilted_parallel_axes_fit_to_the_noise_floor_with_beta(void)
+{
+    dhc_arm truth;
+    dhc_arm nominal;
+    table3_arms(&truth, &nominal);
+    truth.joint[1].beta_rad = 0.1 * TEST_DEG;
+    test_rng rng = {51ULL};
+    test_measure(&data, &truth, 80U, DHC_MEAS_POSITION, &rng);
+    add_noise(&data, 0.01, &rng);
+    dhc_calib_options opt;
+    dhc_calib_default_options(&opt);
+    dhc_arm hayati = nominal;
+    TEST_ASSERT_EQUAL(DHC_OK, fit(&hayati, &opt));
+    TEST_ASSERT_DOUBLE_WITHIN(0.003, sqrt(3.0) * 0.01, rep.rms_mm);
+    TEST_ASSERT_DOUBLE_WITHIN(0.01 * TEST_DEG, 0.1 * TEST_DEG, hayati.joint[1].beta_rad);
+
+    dhc_arm dh = nominal;
+    dh.joint[1].convention = DHC_CONV_DH;
+    const dhc_status st = fit(&dh, &opt);
+    const int absurd_d = fabs(dh.joint[1].d_mm) > 100.0 || fabs(dh.joint[2].d_mm) > 100.0;
+    const int residual_left = rep.rms_mm > 3.0 * sqrt(3.0) * 0.01;
+    TEST_ASSERT_TRUE(st != DHC_OK || absurd_d || residual_left);
+}
+
+static void test_iteration_limit_reports_not_converged_with_the_best_iterate(void)
+{
+    dhc_arm truth;
+    dhc_arm arm;
+    table3_arms(&truth, &arm);
+    test_rng rng = {61ULL};
+    test_measure(&data, &truth, 30U, DHC_MEAS_POSITION, &rng);
+    dhc_calib_options opt;
+    dhc_calib_default_options(&opt);
+    opt.max_iterations = 1U;
+    const dhc_arm before = arm;
+    TEST_ASSERT_EQUAL(DHC_ERR_NOT_CONVERGED, fit(&arm, &opt));
+    TEST_ASSERT_EQUAL(0, rep.converged);
+    /* One LM step already moved the arm toward the truth. */
+    test_rng fresh = {62ULL};
+    double err_after;
+    double err_before;
+    double unused;
+    test_compare_arms(&arm, &truth, 30U, &fresh, &err_after, &unused);
+    fresh.s = 62ULL;
+    test_compare_arms(&before, &truth, 30U, &fresh, &err_before, &unused);
+    TEST_ASSERT_TRUE(err_after < err_before);
+}
+
+static dhc_status failing_reader(void *ctx, size_t index, dhc_sample *out)
+{
+    (void)ctx;
+    (void)out;
+    return index == 5U ? DHC_ERR_INCONSISTENT : test_read_sample(&data, index, out);
+}
+
+static void test_failures_leave_the_arm_unchanged(void)
+{
+    dhc_arm truth;
+    dhc_arm nominal;
+    table3_arms(&truth, &nominal);
+    test_rng rng = {71ULL};
+    test_measure(&data, &truth, 20U, DHC_MEAS_POSITION, &rng);
+    dhc_calib_options opt;
+    dhc_calib_default_options(&opt);
+    dhc_arm arm = nominal;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &arm));
+
+    TEST_ASSERT_EQUAL(DHC_ERR_INCONSISTENT, dhc_calib_fit(&arm, &set, failing_reader, NULL, data.n,
+                                                         data.flags, &opt, &ws, &rep));
+    TEST_ASSERT_EQUAL_MEMORY(&nominal, &arm, sizeof arm);
+
+    data.s[9].p_mm[1] = NAN;
+    TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, fit(&arm, &opt));
+    TEST_ASSERT_EQUAL_MEMORY(&nominal, &arm, sizeof arm);
+
+    for (size_t k = 0U; k < data.n; ++k) {
+        data.flags[k] = (uint8_t)DHC_SAMPLE_EXCLUDED;
+    }
+    TEST_ASSERT_EQUAL(DHC_ERR_NO_DATA, fit(&arm, &opt));
+    TEST_ASSERT_EQUAL_MEMORY(&nominal, &arm, sizeof arm);
+
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_calib_fit(&arm, &set, NULL, &data, data.n, data.flags,
+                                                     &opt, &ws, &rep));
+    dhc_param_set empty;
+    dhc_params_clear(&empty);
+    TEST_ASSERT_EQUAL(DHC_ERR_CAPACITY, dhc_calib_fit(&arm, &empty, test_read_sample, &data,
+                                                     data.n, data.flags, &opt, &ws, &rep));
+}
+
+static void test_caller_exclusions_are_respected(void)
+{
+    dhc_arm truth;
+    dhc_arm arm;
+    table3_arms(&truth, &arm);
+    test_rng rng = {81ULL};
+    test_measure(&data, &truth, 40U, DHC_MEAS_POSITION, &rng);
+    data.s[2].p_mm[0] += 1000.0; /* garbage the caller already knows about */
+    data.flags[2] = (uint8_t)DHC_SAMPLE_EXCLUDED;
+    dhc_calib_options opt;
+    dhc_calib_default_options(&opt);
+    TEST_ASSERT_EQUAL(DHC_OK, fit(&arm, &opt));
+    TEST_ASSERT_EQUAL(39U, rep.samples_used);
+    TEST_ASSERT_EQUAL(0U, rep.outliers);
+    TEST_ASSERT_EQUAL(DHC_SAMPLE_EXCLUDED, data.flags[2]);
+    TEST_ASSERT_TRUE(rep.rms_mm < 1e-6);
+}
+
+static void test_residual_of_a_pose_sample_has_weighted_rotation_rows(void)
+{
+    dhc_arm arm;
+    test_arm_from_table(&arm, TEST_TABLE2, 6U, 0.0);
+    dhc_sample s = {{0.1, 0.2, 0.3, 0.4, 0.5, 0.6}, {0.0, 0.0, 0.0}, {{{0}}}, DHC_MEAS_POSE};
+    dhc_frame pose;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_forward(&arm, s.q_rad, DHC_MAX_JOINTS, &pose));
+    /* Measured = model turned by 1 mrad about world z and moved 2 mm along x. */
+    const double w[3] = {0.0, 0.0, 1e-3};
+    dhc_mat3 turn;
+    dhc_rot_exp(w, &turn);
+    dhc_rot_mul(&turn, &pose.rot, &s.rot);
+    dhc_vec3_copy(pose.pos, s.p_mm);
+    s.p_mm[0] += 2.0;
+    double r[DHC_MAX_ROWS_PER_SAMPLE];
+    size_t rows;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_calib_residual(&arm, &s, 1000.0, r, &rows));
+    TEST_ASSERT_EQUAL(6U, rows);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 2.0, r[0]);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 0.0, r[3]);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 0.0, r[4]);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 1.0, r[5]); /* 1 mrad x 1000 mm/rad */
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_noise_estimate_and_residual_match_the_noise_level);
+    RUN_TEST(test_standard_errors_match_the_spread_of_repeated_fits);
+    RUN_TEST(test_gross_errors_are_flagged_left_out_and_the_fit_repeated);
+    RUN_TEST(test_poses_outside_the_joint_ranges_are_outliers);
+    RUN_TEST(test_tilted_parallel_axes_fit_to_the_noise_floor_with_beta);
+    RUN_TEST(test_iteration_limit_reports_not_converged_with_the_best_iterate);
+    RUN_TEST(test_failures_leave_the_arm_unchanged);
+    RUN_TEST(test_caller_exclusions_are_respected);
+    RUN_TEST(test_residual_of_a_pose_sample_has_weighted_rotation_rows);
+    return UNITY_END();
+}
