@@ -174,8 +174,7 @@ static void test_poses_outside_the_joint_ranges_are_outliers(void)
 }
 
 /* A tilt between the nominally parallel axes 2 and 3: with Hayati's beta the base model
- * reaches the noise floor with physical parameter values; forced into plain DH the same
- * data either leave a residual or drive d to an absurd size. */
+ * reaches the noise floor with physical parameter values; plain DH cannot. */
 static void test_tilted_parallel_axes_fit_to_the_noise_floor_with_beta(void)
 {
     dhc_arm truth;
@@ -192,12 +191,13 @@ static void test_tilted_parallel_axes_fit_to_the_noise_floor_with_beta(void)
     TEST_ASSERT_DOUBLE_WITHIN(0.003, sqrt(3.0) * 0.01, rep.rms_mm);
     TEST_ASSERT_DOUBLE_WITHIN(0.01 * TEST_DEG, 0.1 * TEST_DEG, hayati.joint[1].beta_rad);
 
+    /* Plain DH at nominally parallel axes: d2 and d3 both slide along the same axis, one
+     * of them drops out, and nothing left can tilt axis 3: the residual stays far above
+     * the noise (0.42 mm here against a floor of 0.017 mm). */
     dhc_arm dh = nominal;
     dh.joint[1].convention = DHC_CONV_DH;
-    const dhc_status st = fit(&dh, &opt);
-    const int absurd_d = fabs(dh.joint[1].d_mm) > 100.0 || fabs(dh.joint[2].d_mm) > 100.0;
-    const int residual_left = rep.rms_mm > 3.0 * sqrt(3.0) * 0.01;
-    TEST_ASSERT_TRUE(st != DHC_OK || absurd_d || residual_left);
+    TEST_ASSERT_EQUAL(DHC_OK, fit(&dh, &opt));
+    TEST_ASSERT_TRUE(rep.rms_mm > 10.0 * sqrt(3.0) * 0.01);
 }
 
 static void test_iteration_limit_reports_not_converged_with_the_best_iterate(void)
