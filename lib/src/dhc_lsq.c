@@ -164,7 +164,7 @@ dhc_status dhc_lsq_analyse(const dhc_normal_eq *ne, double rel_tol, dhc_lsq_fact
         }
     }
     dhc_mat m;
-    dhc_status st = dhc_mat_init(&m, n, n, fac->factor, DHC_MAX_PARAMS * DHC_MAX_PARAMS);
+    dhc_status st = dhc_mat_init(&m, n, n, fac->factor, sizeof fac->factor / sizeof fac->factor[0]);
     size_t rank = 0U;
     if (st == DHC_OK) {
         st = dhc_chol_pivoted(&m, fac->perm, DHC_MAX_PARAMS, rel_tol, &rank);
