@@ -57,6 +57,7 @@ static int calibrate(size_t poses, dhc_arm *out)
     uint32_t state = 2024U;
     for (size_t k = 0U; k < poses; ++k) {
         dhc_sample *s = &samples[k];
+        s->temp_c = 20.0;
         for (size_t i = 0U; i < DHC_MAX_JOINTS; ++i) {
             s->q_rad[i] = i < 6U ? next_angle(&state) : 0.0;
         }
@@ -66,15 +67,18 @@ static int calibrate(size_t poses, dhc_arm *out)
         s->rot = pose.rot;
         s->kind = (uint8_t)DHC_MEAS_POSE;
     }
-    arm_from_table(out, table2, 0.0);
-    dhc_arm_choose_conventions(out, 1e-3);
+    dhc_model model;
+    (void)dhc_model_init(&model, 6U);
+    arm_from_table(&model.arm, table2, 0.0);
+    dhc_arm_choose_conventions(&model.arm, 1e-3);
     dhc_param_set set;
-    (void)dhc_params_base_model(&set, out);
+    (void)dhc_params_base_model(&set, &model);
     dhc_calib_options opt;
     dhc_calib_default_options(&opt);
     uint8_t flags[MAX_POSES] = {0};
     const dhc_status st =
-        dhc_calib_fit(out, &set, read_sample, NULL, poses, flags, &opt, &ws, &rep);
+        dhc_calib_fit(&model, &set, read_sample, NULL, poses, flags, &opt, &ws, &rep);
+    *out = model.arm;
     if (st == DHC_ERR_UNDERDETERMINED) {
         printf("%zu poses: the data under-determine the model: %zu equations, %zu "
                "parameters identifiable by the model (data rank %zu). No parameters shown.\n",

@@ -31,73 +31,6 @@ void dhc_calib_default_options(dhc_calib_options *opt)
     opt->structural_seed = 12345U;
 }
 
-static size_t sample_rows(const dhc_sample *s)
-{
-    return s->kind == (uint8_t)DHC_MEAS_POSE ? 6U : 3U;
-}
-
-static dhc_status check_sample(const dhc_sample *s, size_t n_joints)
-{
-    if (s->kind != (uint8_t)DHC_MEAS_POSITION && s->kind != (uint8_t)DHC_MEAS_POSE) {
-        return DHC_ERR_ARGUMENT;
-    }
-    for (size_t i = 0U; i < n_joints; ++i) {
-        if (!dhc_is_finite(s->q_rad[i])) {
-            return DHC_ERR_NONFINITE;
-        }
-    }
-    for (size_t r = 0U; r < 3U; ++r) {
-        if (!dhc_is_finite(s->p_mm[r])) {
-            return DHC_ERR_NONFINITE;
-        }
-        if (s->kind == (uint8_t)DHC_MEAS_POSE) {
-            for (size_t c = 0U; c < 3U; ++c) {
-                if (!dhc_is_finite(s->rot.m[r][c])) {
-                    return DHC_ERR_NONFINITE;
-                }
-            }
-        }
-    }
-    return DHC_OK;
-}
-
-/* Residual from an already computed model pose. */
-static void residual_from_pose(const dhc_sample *s, const double p[3], const dhc_mat3 *rot,
-                               double w_mm_per_rad, double r[DHC_MAX_ROWS_PER_SAMPLE])
-{
-    dhc_vec3_sub(s->p_mm, p, r);
-    if (s->kind == (uint8_t)DHC_MEAS_POSE) {
-        dhc_mat3 err;
-        double w[3];
-        /* R_meas = exp([w]) R_model  =>  w = log(R_meas R_model^T) */
-        dhc_rot_mul_t(&s->rot, rot, &err);
-        dhc_rot_log(&err, w);
-        for (size_t k = 0U; k < 3U; ++k) {
-            r[3U + k] = w_mm_per_rad * w[k];
-        }
-    }
-}
-
-dhc_status dhc_calib_residual(const dhc_arm *arm, const dhc_sample *s, double weight_mm_per_rad,
-                              double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows)
-{
-    if (arm == NULL || s == NULL || r == NULL || rows == NULL) {
-        return DHC_ERR_ARGUMENT;
-    }
-    dhc_status st = check_sample(s, arm->n_joints);
-    if (st != DHC_OK) {
-        return st;
-    }
-    dhc_frame tool;
-    st = dhc_forward(arm, s->q_rad, DHC_MAX_JOINTS, &tool);
-    if (st != DHC_OK) {
-        return st;
-    }
-    residual_from_pose(s, tool.pos, &tool.rot, weight_mm_per_rad, r);
-    *rows = sample_rows(s);
-    return DHC_OK;
-}
-
 /* Everything one pass over the samples needs; kept together to keep signatures short. */
 typedef struct {
     const dhc_param_set *set;
@@ -110,6 +43,13 @@ typedef struct {
 } fit_context;
 
 typedef struct {
+    double temp_min_c;
+    double temp_max_c;
+    uint8_t dir_seen[DHC_MAX_JOINTS]; /* some sample knows joint i's approach direction */
+    size_t kind_count[3];             /* samples of each dhc_meas_kind */
+} data_traits;
+
+typedef struct {
     double ssr;
     double pos_ss;     /* sum of squared position errors, mm^2 */
     double rot_ss;     /* sum of squared orientation errors, rad^2 */
@@ -117,6 +57,7 @@ typedef struct {
     size_t samples;
     size_t pose_samples;
     size_t rows;
+    data_traits traits;
 } pass_totals;
 
 static double sq(double x)
@@ -124,14 +65,24 @@ static double sq(double x)
     return x * x;
 }
 
-/* One pass: SSR and error totals of `arm`; with accumulate, also the normal equations. */
-static dhc_status data_pass(const fit_context *fc, const dhc_arm *arm, int accumulate,
+static void note_traits(data_traits *t, const dhc_sample *s, size_t n_joints, int first)
+{
+    t->temp_min_c = first ? s->temp_c : fmin(t->temp_min_c, s->temp_c);
+    t->temp_max_c = first ? s->temp_c : fmax(t->temp_max_c, s->temp_c);
+    for (size_t j = 0U; j < n_joints; ++j) {
+        t->dir_seen[j] |= s->dir[j] != 0 ? 1U : 0U;
+    }
+    t->kind_count[s->kind]++;
+}
+
+/* One pass: SSR and error totals of `model`; with accumulate, also the normal equations. */
+static dhc_status data_pass(const fit_context *fc, const dhc_model *model, int accumulate,
                             pass_totals *tot)
 {
     dhc_calib_workspace *const ws = fc->ws;
     const size_t p = fc->set->count;
     const double w = fc->opt->orientation_weight_mm_per_rad;
-    *tot = (pass_totals){0};
+    memset(tot, 0, sizeof *tot);
     if (accumulate) {
         const dhc_status st = dhc_normal_eq_init(&ws->ne, p);
         if (st != DHC_OK) {
@@ -143,49 +94,31 @@ static dhc_status data_pass(const fit_context *fc, const dhc_arm *arm, int accum
             continue;
         }
         dhc_status st = fc->read(fc->ctx, i, &ws->sample);
+        if (st == DHC_OK) {
+            st = dhc_sample_check(model, &ws->sample);
+        }
         if (st != DHC_OK) {
             return st;
         }
         const dhc_sample *const s = &ws->sample;
-        st = check_sample(s, arm->n_joints);
-        if (st != DHC_OK) {
-            return st;
-        }
-        const size_t rows = sample_rows(s);
+        const size_t rows = dhc_sample_rows(s);
         double r[DHC_MAX_ROWS_PER_SAMPLE];
-        double pos[3];
-        dhc_mat3 rot;
-        dhc_mat jac;
-        if (accumulate) {
+        size_t got_rows;
+        st = dhc_model_residual(model, s, w, r, &got_rows);
+        if (st == DHC_OK && accumulate) {
+            dhc_mat jac;
             st = dhc_mat_init(&jac, rows, p, ws->jac_buf, DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS);
             if (st == DHC_OK) {
-                st = dhc_identification_jacobian(arm, fc->set, s->q_rad, DHC_MAX_JOINTS,
-                                                  rows == 6U, &jac, pos, &rot);
+                st = dhc_model_jacobian(model, fc->set, s, w, &jac, NULL);
             }
-        } else {
-            dhc_frame tool;
-            st = dhc_forward(arm, s->q_rad, DHC_MAX_JOINTS, &tool);
-            dhc_vec3_copy(tool.pos, pos);
-            rot = tool.rot;
+            if (st == DHC_OK) {
+                st = dhc_normal_eq_add(&ws->ne, &jac, r, NULL, rows);
+            }
         }
         if (st != DHC_OK) {
             return st;
         }
-        residual_from_pose(s, pos, &rot, w, r);
-        if (accumulate) {
-            if (rows == 6U) {
-                /* Orientation rows in mm-equivalent units, like their residuals. */
-                for (size_t k = 3U; k < 6U; ++k) {
-                    for (size_t c = 0U; c < p; ++c) {
-                        DHC_MAT_AT(&jac, k, c) *= w;
-                    }
-                }
-            }
-            st = dhc_normal_eq_add(&ws->ne, &jac, r, NULL, rows);
-            if (st != DHC_OK) {
-                return st;
-            }
-        }
+        note_traits(&tot->traits, s, model->arm.n_joints, tot->samples == 0U);
         const double e2 = sq(r[0]) + sq(r[1]) + sq(r[2]);
         tot->pos_ss += e2;
         tot->max_pos = fmax(tot->max_pos, sqrt(e2));
@@ -216,14 +149,28 @@ static double next_uniform(uint32_t *state)
     return (double)(x >> 8) / 16777216.0;
 }
 
+/* The measurement kind most samples have. */
+static uint8_t main_kind(const data_traits *t)
+{
+    uint8_t best = 0U;
+    for (uint8_t k = 1U; k < 3U; ++k) {
+        best = t->kind_count[k] > t->kind_count[best] ? k : best;
+    }
+    return best;
+}
+
 /* Rank the model itself allows: the same parameters at random poses spread over the joint
- * ranges. A data rank below it means the data, not the model, are short. */
-static dhc_status structural_rank(const fit_context *fc, const dhc_arm *arm, int pose_rows,
-                                  dhc_calib_report *rep)
+ * ranges, with the data's measurement kind, temperature span and direction information.
+ * A data rank below it means the data, not the model, are short. */
+static dhc_status structural_rank(const fit_context *fc, const dhc_model *model,
+                                  const data_traits *traits, dhc_calib_report *rep)
 {
     dhc_calib_workspace *const ws = fc->ws;
     const size_t p = fc->set->count;
-    const size_t rows = pose_rows ? 6U : 3U;
+    dhc_sample *const s = &ws->sample;
+    memset(s, 0, sizeof *s);
+    s->kind = main_kind(traits);
+    const size_t rows = dhc_sample_rows(s);
     const size_t poses = (p + rows - 1U) / rows + STRUCTURAL_EXTRA_POSES;
     const double w = fc->opt->orientation_weight_mm_per_rad;
     uint32_t state = fc->opt->structural_seed != 0U ? fc->opt->structural_seed : 1U;
@@ -232,24 +179,20 @@ static dhc_status structural_rank(const fit_context *fc, const dhc_arm *arm, int
         return st;
     }
     for (size_t k = 0U; k < poses; ++k) {
-        double q[DHC_MAX_JOINTS] = {0.0};
-        for (size_t i = 0U; i < arm->n_joints; ++i) {
-            const dhc_joint *const j = &arm->joint[i];
-            q[i] = j->min_rad + (j->max_rad - j->min_rad) * next_uniform(&state);
+        for (size_t i = 0U; i < model->arm.n_joints; ++i) {
+            const dhc_joint *const j = &model->arm.joint[i];
+            s->q_rad[i] = j->min_rad + (j->max_rad - j->min_rad) * next_uniform(&state);
+            s->dir[i] = traits->dir_seen[i] ? (next_uniform(&state) < 0.5 ? -1 : 1) : 0;
         }
+        s->temp_c = traits->temp_min_c +
+                    (traits->temp_max_c - traits->temp_min_c) * next_uniform(&state);
         dhc_mat jac;
         st = dhc_mat_init(&jac, rows, p, ws->jac_buf, DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS);
         if (st == DHC_OK) {
-            st = dhc_identification_jacobian(arm, fc->set, q, DHC_MAX_JOINTS, pose_rows, &jac,
-                                              NULL, NULL);
+            st = dhc_model_jacobian(model, fc->set, s, w, &jac, NULL);
         }
         if (st != DHC_OK) {
             return st;
-        }
-        for (size_t r = 3U; r < rows; ++r) {
-            for (size_t c = 0U; c < p; ++c) {
-                DHC_MAT_AT(&jac, r, c) *= w;
-            }
         }
         const double zero_r[DHC_MAX_ROWS_PER_SAMPLE] = {0.0};
         st = dhc_normal_eq_add(&ws->ne, &jac, zero_r, NULL, rows);
@@ -268,8 +211,8 @@ static dhc_status structural_rank(const fit_context *fc, const dhc_arm *arm, int
     return DHC_OK;
 }
 
-/* Sample position error (all rows, mm-equivalent) squared; used for outlier screening. */
-static dhc_status sample_error2(const fit_context *fc, const dhc_arm *arm, size_t i,
+/* Sample error (all rows, mm-equivalent) squared; used for outlier screening. */
+static dhc_status sample_error2(const fit_context *fc, const dhc_model *model, size_t i,
                                 double *e2, size_t *rows)
 {
     dhc_status st = fc->read(fc->ctx, i, &fc->ws->sample);
@@ -277,7 +220,8 @@ static dhc_status sample_error2(const fit_context *fc, const dhc_arm *arm, size_
         return st;
     }
     double r[DHC_MAX_ROWS_PER_SAMPLE];
-    st = dhc_calib_residual(arm, &fc->ws->sample, fc->opt->orientation_weight_mm_per_rad, r, rows);
+    st = dhc_model_residual(model, &fc->ws->sample, fc->opt->orientation_weight_mm_per_rad, r,
+                            rows);
     if (st != DHC_OK) {
         return st;
     }
@@ -291,7 +235,7 @@ static dhc_status sample_error2(const fit_context *fc, const dhc_arm *arm, size_
 
 /* Median of the squared sample errors by bisection on the value (each step one pass over
  * the data): the library keeps no per-sample storage, so no sort. */
-static dhc_status median_error2(const fit_context *fc, const dhc_arm *arm, size_t used,
+static dhc_status median_error2(const fit_context *fc, const dhc_model *model, size_t used,
                                 double max_e2, double *median)
 {
     double lo = 0.0;
@@ -306,7 +250,7 @@ static dhc_status median_error2(const fit_context *fc, const dhc_arm *arm, size_
             }
             double e2;
             size_t rows;
-            const dhc_status st = sample_error2(fc, arm, i, &e2, &rows);
+            const dhc_status st = sample_error2(fc, model, i, &e2, &rows);
             if (st != DHC_OK) {
                 return st;
             }
@@ -323,7 +267,7 @@ static dhc_status median_error2(const fit_context *fc, const dhc_arm *arm, size_
 }
 
 /* Flags samples whose error is many robust sigmas; returns how many were newly flagged. */
-static dhc_status flag_outliers(const fit_context *fc, const dhc_arm *arm, size_t *flagged)
+static dhc_status flag_outliers(const fit_context *fc, const dhc_model *model, size_t *flagged)
 {
     *flagged = 0U;
     if (fc->opt->outlier_threshold <= 0.0) {
@@ -338,7 +282,7 @@ static dhc_status flag_outliers(const fit_context *fc, const dhc_arm *arm, size_
         }
         double e2;
         size_t rows;
-        const dhc_status st = sample_error2(fc, arm, i, &e2, &rows);
+        const dhc_status st = sample_error2(fc, model, i, &e2, &rows);
         if (st != DHC_OK) {
             return st;
         }
@@ -350,7 +294,7 @@ static dhc_status flag_outliers(const fit_context *fc, const dhc_arm *arm, size_
         return DHC_OK;
     }
     double median;
-    const dhc_status st = median_error2(fc, arm, used, max_e2, &median);
+    const dhc_status st = median_error2(fc, model, used, max_e2, &median);
     if (st != DHC_OK) {
         return st;
     }
@@ -363,7 +307,7 @@ static dhc_status flag_outliers(const fit_context *fc, const dhc_arm *arm, size_
         }
         double e2;
         size_t rows;
-        const dhc_status st2 = sample_error2(fc, arm, i, &e2, &rows);
+        const dhc_status st2 = sample_error2(fc, model, i, &e2, &rows);
         if (st2 != DHC_OK) {
             return st2;
         }
@@ -496,37 +440,37 @@ static void fill_report(const fit_context *fc, const pass_totals *tot, dhc_calib
     }
 }
 
-dhc_status dhc_calib_fit(dhc_arm *arm, const dhc_param_set *set, dhc_sample_reader read,
+dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_reader read,
                          void *ctx, size_t n, uint8_t *flags, const dhc_calib_options *opt,
                          dhc_calib_workspace *ws, dhc_calib_report *rep)
 {
-    if (arm == NULL || set == NULL || read == NULL || flags == NULL || opt == NULL ||
+    if (model == NULL || set == NULL || read == NULL || flags == NULL || opt == NULL ||
         ws == NULL || rep == NULL) {
         return DHC_ERR_ARGUMENT;
     }
-    if (set->count == 0U || set->count > DHC_MAX_PARAMS || arm->n_joints == 0U ||
-        arm->n_joints > DHC_MAX_JOINTS) {
+    if (set->count == 0U || set->count > DHC_MAX_PARAMS || model->arm.n_joints == 0U ||
+        model->arm.n_joints > DHC_MAX_JOINTS) {
         return DHC_ERR_CAPACITY;
     }
     /* memset, not a compound literal: the report is ~5 KiB and M4 stacks are small. */
     memset(rep, 0, sizeof *rep);
     rep->n_params = set->count;
     const fit_context fc = {set, read, ctx, n, flags, opt, ws};
-    ws->current = *arm;
+    ws->current = *model;
 
-    dhc_status st = flag_out_of_range(&fc, arm);
+    dhc_status st = flag_out_of_range(&fc, &model->arm);
     if (st != DHC_OK) {
         return st;
     }
     pass_totals tot;
-    st = data_pass(&fc, arm, 0, &tot);
+    st = data_pass(&fc, model, 0, &tot);
     if (st != DHC_OK) {
         return st;
     }
     if (tot.samples == 0U) {
         return DHC_ERR_NO_DATA;
     }
-    st = structural_rank(&fc, arm, 2U * tot.pose_samples > tot.samples, rep);
+    st = structural_rank(&fc, model, &tot.traits, rep);
     if (st != DHC_OK) {
         return st;
     }
@@ -554,6 +498,6 @@ dhc_status dhc_calib_fit(dhc_arm *arm, const dhc_param_set *set, dhc_sample_read
     }
     fill_report(&fc, &tot, rep);
     rep->converged = converged;
-    *arm = ws->current;
+    *model = ws->current;
     return converged ? DHC_OK : DHC_ERR_NOT_CONVERGED;
 }

@@ -10,17 +10,6 @@
 
 #include <math.h>
 
-static void put_column(dhc_mat *jac, size_t col, const double dp[3], const double dw[3],
-                       int with_orientation)
-{
-    for (size_t r = 0U; r < 3U; ++r) {
-        DHC_MAT_AT(jac, r, col) = dp[r];
-        if (with_orientation) {
-            DHC_MAT_AT(jac, r + 3U, col) = dw[r];
-        }
-    }
-}
-
 static void rotation_column(const double axis[3], const double through[3], const double p[3],
                             double dp[3])
 {
@@ -54,20 +43,79 @@ static void compute_joint_axes(const dhc_frame *prev, const dhc_joint *j, double
     dhc_rot_apply(&prev->rot, v_local, ax->v);
 }
 
-static dhc_status check_shape(const dhc_arm *arm, const double *q_rad, size_t q_len,
-                              int with_orientation, const dhc_mat *jac, size_t cols)
+static int is_geometric(uint8_t kind)
 {
-    if (arm == NULL || q_rad == NULL || jac == NULL || jac->data == NULL) {
+    return kind <= (uint8_t)DHC_P_TOOL_Z;
+}
+
+/* Position and rotation derivative of the tool for one geometric parameter; f are the
+ * chain's frames at q, p the tool point. */
+static void geometric_column(const dhc_arm *arm, const dhc_frame *f, const double *q_rad,
+                             const double p[3], const dhc_param_id *id, double dp[3],
+                             double dw[3])
+{
+    dhc_vec3_set(dp, 0.0, 0.0, 0.0);
+    dhc_vec3_set(dw, 0.0, 0.0, 0.0);
+    if (id->kind <= (uint8_t)DHC_P_BETA) {
+        joint_axes ax;
+        compute_joint_axes(&f[id->joint], &arm->joint[id->joint], q_rad[id->joint], &ax);
+        const double *const o_prev = f[id->joint].pos;
+        const double *const o_next = f[id->joint + 1U].pos;
+        switch ((dhc_param_kind)id->kind) {
+        case DHC_P_THETA:
+            rotation_column(ax.z, o_prev, p, dp);
+            dhc_vec3_copy(ax.z, dw);
+            break;
+        case DHC_P_D: dhc_vec3_copy(ax.z, dp); break;
+        case DHC_P_A: dhc_vec3_copy(ax.u, dp); break;
+        case DHC_P_ALPHA:
+            rotation_column(ax.u, o_next, p, dp);
+            dhc_vec3_copy(ax.u, dw);
+            break;
+        case DHC_P_BETA:
+        default:
+            rotation_column(ax.v, o_next, p, dp);
+            dhc_vec3_copy(ax.v, dw);
+            break;
+        }
+    } else if (id->kind <= (uint8_t)DHC_P_BASE_Z) {
+        dp[id->kind - (uint8_t)DHC_P_BASE_X] = 1.0;
+    } else if (id->kind <= (uint8_t)DHC_P_BASE_RZ) {
+        dw[id->kind - (uint8_t)DHC_P_BASE_RX] = 1.0;
+        rotation_column(dw, arm->base.pos, p, dp);
+    } else {
+        dhc_rot_column(&f[arm->n_joints].rot, (size_t)(id->kind - (uint8_t)DHC_P_TOOL_X), dp);
+    }
+}
+
+static void put_column(dhc_mat *jac, size_t col, const double dp[3], const double dw[3],
+                       int with_orientation, double w_scale)
+{
+    for (size_t r = 0U; r < 3U; ++r) {
+        DHC_MAT_AT(jac, r, col) = dp[r];
+        if (with_orientation) {
+            DHC_MAT_AT(jac, r + 3U, col) = w_scale * dw[r];
+        }
+    }
+}
+
+static dhc_status check_arm(const dhc_arm *arm)
+{
+    if (arm == NULL) {
         return DHC_ERR_ARGUMENT;
     }
     if (arm->n_joints == 0U || arm->n_joints > DHC_MAX_JOINTS) {
         return DHC_ERR_CAPACITY;
     }
-    const size_t rows = with_orientation ? 6U : 3U;
-    if (q_len < arm->n_joints || jac->rows != rows || jac->cols != cols) {
-        return DHC_ERR_DIMENSION;
-    }
     return DHC_OK;
+}
+
+static dhc_status check_jac(const dhc_mat *jac, size_t rows, size_t cols)
+{
+    if (jac == NULL || jac->data == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    return jac->rows == rows && jac->cols == cols ? DHC_OK : DHC_ERR_DIMENSION;
 }
 
 dhc_status dhc_identification_jacobian(const dhc_arm *arm, const dhc_param_set *set,
@@ -75,68 +123,152 @@ dhc_status dhc_identification_jacobian(const dhc_arm *arm, const dhc_param_set *
                                        dhc_mat *jac, double tool_world_mm[3],
                                        dhc_mat3 *tool_rot)
 {
-    if (set == NULL) {
+    if (set == NULL || q_rad == NULL) {
         return DHC_ERR_ARGUMENT;
     }
-    dhc_status st = check_shape(arm, q_rad, q_len, with_orientation, jac, set->count);
+    dhc_status st = check_arm(arm);
+    if (st == DHC_OK) {
+        st = check_jac(jac, with_orientation ? 6U : 3U, set->count);
+    }
     if (st != DHC_OK) {
         return st;
     }
-    const size_t n = arm->n_joints;
+    if (q_len < arm->n_joints) {
+        return DHC_ERR_DIMENSION;
+    }
+    for (size_t k = 0U; k < set->count; ++k) {
+        const dhc_param_id *id = &set->id[k];
+        if (!is_geometric(id->kind) ||
+            (id->kind <= (uint8_t)DHC_P_BETA && id->joint >= arm->n_joints)) {
+            return DHC_ERR_ARGUMENT;
+        }
+    }
     dhc_frame f[DHC_MAX_JOINTS + 1U];
     double p[3];
     st = dhc_forward_frames(arm, q_rad, q_len, f, DHC_MAX_JOINTS + 1U, p);
     if (st != DHC_OK) {
         return st;
     }
-    static const double zero[3] = {0.0, 0.0, 0.0};
     for (size_t k = 0U; k < set->count; ++k) {
-        const dhc_param_id id = set->id[k];
         double dp[3];
-        double dw[3] = {0.0, 0.0, 0.0};
-        if (id.kind <= (uint8_t)DHC_P_BETA) {
-            if (id.joint >= n) {
-                return DHC_ERR_ARGUMENT;
-            }
-            joint_axes ax;
-            compute_joint_axes(&f[id.joint], &arm->joint[id.joint], q_rad[id.joint], &ax);
-            const double *const o_prev = f[id.joint].pos;
-            const double *const o_next = f[id.joint + 1U].pos;
-            switch ((dhc_param_kind)id.kind) {
-            case DHC_P_THETA:
-                rotation_column(ax.z, o_prev, p, dp);
-                dhc_vec3_copy(ax.z, dw);
-                break;
-            case DHC_P_D: dhc_vec3_copy(ax.z, dp); break;
-            case DHC_P_A: dhc_vec3_copy(ax.u, dp); break;
-            case DHC_P_ALPHA:
-                rotation_column(ax.u, o_next, p, dp);
-                dhc_vec3_copy(ax.u, dw);
-                break;
-            case DHC_P_BETA:
-            default:
-                rotation_column(ax.v, o_next, p, dp);
-                dhc_vec3_copy(ax.v, dw);
-                break;
-            }
-        } else if (id.kind <= (uint8_t)DHC_P_BASE_Z) {
-            dhc_vec3_copy(zero, dp);
-            dp[id.kind - (uint8_t)DHC_P_BASE_X] = 1.0;
-        } else if (id.kind <= (uint8_t)DHC_P_BASE_RZ) {
-            dw[id.kind - (uint8_t)DHC_P_BASE_RX] = 1.0;
-            rotation_column(dw, arm->base.pos, p, dp);
-        } else if (id.kind <= (uint8_t)DHC_P_TOOL_Z) {
-            dhc_rot_column(&f[n].rot, (size_t)(id.kind - (uint8_t)DHC_P_TOOL_X), dp);
-        } else {
-            return DHC_ERR_ARGUMENT;
-        }
-        put_column(jac, k, dp, dw, with_orientation);
+        double dw[3];
+        geometric_column(arm, f, q_rad, p, &set->id[k], dp, dw);
+        put_column(jac, k, dp, dw, with_orientation, 1.0);
     }
     if (tool_world_mm != NULL) {
         dhc_vec3_copy(p, tool_world_mm);
     }
     if (tool_rot != NULL) {
-        *tool_rot = f[n].rot;
+        *tool_rot = f[arm->n_joints].rot;
+    }
+    return DHC_OK;
+}
+
+static int set_has_compliance(const dhc_param_set *set)
+{
+    for (size_t k = 0U; k < set->count; ++k) {
+        if (set->id[k].kind == (uint8_t)DHC_P_COMPLIANCE) {
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* Factor by which a joint effect parameter scales its joint's column: d(dq_i)/d(param). */
+static double joint_effect_factor(const dhc_param_id *id, const dhc_sample *s,
+                                  const double *tau_row)
+{
+    const double q = s->q_rad[id->joint];
+    switch ((dhc_param_kind)id->kind) {
+    case DHC_P_JOINT_SCALE: return q;
+    case DHC_P_HARMONIC_SIN: return sin(q);
+    case DHC_P_HARMONIC_COS: return cos(q);
+    case DHC_P_BACKLASH: return 0.5 * (double)s->dir[id->joint];
+    case DHC_P_COMPLIANCE: return tau_row[id->aux];
+    default: return 0.0;
+    }
+}
+
+/* Derivative of the three wire lengths for a column, from the tool-point derivative dp. */
+static void wire_rows(const dhc_model *model, const dhc_param_id *id, const double p[3],
+                      const double dp[3], double out[3])
+{
+    const dhc_measurer_model *m = &model->measurer;
+    for (size_t k = 0U; k < 3U; ++k) {
+        double anchor[3];
+        double d[3];
+        dhc_measurer_anchor_world(m, k, anchor);
+        dhc_vec3_sub(p, anchor, d);
+        const double len = dhc_vec3_norm(d);
+        double u[3];
+        dhc_vec3_scale(d, len > 0.0 ? 1.0 / len : 0.0, u);
+        switch ((dhc_param_kind)id->kind) {
+        case DHC_P_MEAS_SCALE: out[k] = len; break;
+        case DHC_P_MEAS_OFFSET: out[k] = id->aux == k ? 1.0 : 0.0; break;
+        case DHC_P_MEAS_ANCHOR: {
+            /* moving anchor k along its own axis shortens wire k by u . (R e_axis) */
+            double e[3];
+            dhc_rot_column(&m->frame.rot, (size_t)id->aux % 3U, e);
+            out[k] = (size_t)id->aux / 3U == k ? -(1.0 + m->scale) * dhc_vec3_dot(u, e) : 0.0;
+            break;
+        }
+        default: out[k] = (1.0 + m->scale) * dhc_vec3_dot(u, dp); break;
+        }
+    }
+}
+
+dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set,
+                              const dhc_sample *s, double weight_mm_per_rad, dhc_mat *jac,
+                              dhc_prediction *pred)
+{
+    if (model == NULL || set == NULL || s == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    dhc_status st = check_jac(jac, dhc_sample_rows(s), set->count);
+    if (st != DHC_OK) {
+        return st;
+    }
+    dhc_prediction local;
+    dhc_prediction *const pr = pred != NULL ? pred : &local;
+    dhc_model_eval ev;
+    st = dhc_model_evaluate(model, s, set_has_compliance(set), &ev, pr);
+    if (st != DHC_OK) {
+        return st;
+    }
+    const dhc_arm *const arm = &model->arm;
+    const double dtemp = s->temp_c - model->thermal_ref_c;
+    const int with_orientation = s->kind == (uint8_t)DHC_MEAS_POSE;
+    for (size_t k = 0U; k < set->count; ++k) {
+        const dhc_param_id *id = &set->id[k];
+        double dp[3] = {0.0, 0.0, 0.0};
+        double dw[3] = {0.0, 0.0, 0.0};
+        if (is_geometric(id->kind)) {
+            geometric_column(arm, ev.frames, pr->q_eff_rad, pr->p_mm, id, dp, dw);
+            /* lengths are stored unscaled; the chain used them times the thermal factor */
+            if (id->kind == (uint8_t)DHC_P_D || id->kind == (uint8_t)DHC_P_A ||
+                id->kind >= (uint8_t)DHC_P_TOOL_X) {
+                dhc_vec3_scale(dp, ev.length_scale, dp);
+            }
+        } else if (id->kind <= (uint8_t)DHC_P_COMPLIANCE) {
+            const dhc_param_id joint_theta = {(uint8_t)DHC_P_THETA, id->joint, 0U};
+            const double factor = joint_effect_factor(id, s, ev.tau[id->joint]);
+            geometric_column(arm, ev.frames, pr->q_eff_rad, pr->p_mm, &joint_theta, dp, dw);
+            dhc_vec3_scale(dp, factor, dp);
+            dhc_vec3_scale(dw, factor, dw);
+        } else if (id->kind == (uint8_t)DHC_P_THERMAL) {
+            /* scaling every length scales the tool point about the base origin */
+            dhc_vec3_sub(pr->p_mm, arm->base.pos, dp);
+            dhc_vec3_scale(dp, dtemp / ev.length_scale, dp);
+        }
+        if (s->kind == (uint8_t)DHC_MEAS_WIRES) {
+            double col[3];
+            wire_rows(model, id, pr->p_mm, dp, col);
+            for (size_t r = 0U; r < 3U; ++r) {
+                DHC_MAT_AT(jac, r, k) = col[r];
+            }
+        } else {
+            put_column(jac, k, dp, dw, with_orientation, weight_mm_per_rad);
+        }
     }
     return DHC_OK;
 }
@@ -144,10 +276,18 @@ dhc_status dhc_identification_jacobian(const dhc_arm *arm, const dhc_param_set *
 dhc_status dhc_joint_jacobian(const dhc_arm *arm, const double *q_rad, size_t q_len,
                               int with_orientation, dhc_mat *jac)
 {
-    dhc_status st = check_shape(arm, q_rad, q_len, with_orientation, jac,
-                                arm != NULL ? arm->n_joints : 0U);
+    dhc_status st = check_arm(arm);
+    if (st == DHC_OK) {
+        st = check_jac(jac, with_orientation ? 6U : 3U, arm->n_joints);
+    }
     if (st != DHC_OK) {
         return st;
+    }
+    if (q_rad == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    if (q_len < arm->n_joints) {
+        return DHC_ERR_DIMENSION;
     }
     dhc_frame f[DHC_MAX_JOINTS + 1U];
     double p[3];
@@ -156,11 +296,11 @@ dhc_status dhc_joint_jacobian(const dhc_arm *arm, const double *q_rad, size_t q_
         return st;
     }
     for (size_t i = 0U; i < arm->n_joints; ++i) {
-        double z[3];
+        const dhc_param_id theta = {(uint8_t)DHC_P_THETA, (uint8_t)i, 0U};
         double dp[3];
-        dhc_rot_column(&f[i].rot, 2U, z);
-        rotation_column(z, f[i].pos, p, dp);
-        put_column(jac, i, dp, z, with_orientation);
+        double dw[3];
+        geometric_column(arm, f, q_rad, p, &theta, dp, dw);
+        put_column(jac, i, dp, dw, with_orientation, 1.0);
     }
     return DHC_OK;
 }

@@ -41,7 +41,8 @@ void dhc_arm_choose_conventions(dhc_arm *arm, double parallel_tol)
     }
 }
 
-static void joint_transform(const dhc_joint *j, double q_rad, dhc_frame *out)
+static void joint_transform(const dhc_joint *j, double q_rad, double length_scale,
+                            dhc_frame *out)
 {
     const double phi = q_rad + j->theta_offset_rad;
     dhc_mat3 rz;
@@ -53,9 +54,9 @@ static void joint_transform(const dhc_joint *j, double q_rad, dhc_frame *out)
     dhc_rot_y(j->beta_rad, &ry);
     dhc_rot_mul(&rz, &rx, &rzx);
     dhc_rot_mul(&rzx, &ry, &out->rot);
-    out->pos[0] = j->a_mm * cos(phi);
-    out->pos[1] = j->a_mm * sin(phi);
-    out->pos[2] = j->d_mm;
+    out->pos[0] = length_scale * j->a_mm * cos(phi);
+    out->pos[1] = length_scale * j->a_mm * sin(phi);
+    out->pos[2] = length_scale * j->d_mm;
 }
 
 dhc_status dhc_joint_transform(const dhc_arm *arm, size_t i, double q_rad, dhc_frame *out)
@@ -66,12 +67,19 @@ dhc_status dhc_joint_transform(const dhc_arm *arm, size_t i, double q_rad, dhc_f
     if (!dhc_is_finite(q_rad)) {
         return DHC_ERR_NONFINITE;
     }
-    joint_transform(&arm->joint[i], q_rad, out);
+    joint_transform(&arm->joint[i], q_rad, 1.0, out);
     return DHC_OK;
 }
 
 dhc_status dhc_forward_frames(const dhc_arm *arm, const double *q_rad, size_t q_len,
                               dhc_frame *frames, size_t frames_len, double tool_world_mm[3])
+{
+    return dhc_forward_frames_scaled(arm, 1.0, q_rad, q_len, frames, frames_len, tool_world_mm);
+}
+
+dhc_status dhc_forward_frames_scaled(const dhc_arm *arm, double length_scale,
+                                     const double *q_rad, size_t q_len, dhc_frame *frames,
+                                     size_t frames_len, double tool_world_mm[3])
 {
     if (arm == NULL || q_rad == NULL || frames == NULL) {
         return DHC_ERR_ARGUMENT;
@@ -91,11 +99,13 @@ dhc_status dhc_forward_frames(const dhc_arm *arm, const double *q_rad, size_t q_
     frames[0] = arm->base;
     for (size_t i = 0U; i < n; ++i) {
         dhc_frame a;
-        joint_transform(&arm->joint[i], q_rad[i], &a);
+        joint_transform(&arm->joint[i], q_rad[i], length_scale, &a);
         dhc_frame_mul(&frames[i], &a, &frames[i + 1U]);
     }
     if (tool_world_mm != NULL) {
-        dhc_frame_apply(&frames[n], arm->tool_mm, tool_world_mm);
+        double tool[3];
+        dhc_vec3_scale(arm->tool_mm, length_scale, tool);
+        dhc_frame_apply(&frames[n], tool, tool_world_mm);
     }
     return DHC_OK;
 }

@@ -1,9 +1,33 @@
-/* dhc_params.c - the identification parameter vector and how it maps onto the arm. */
+/* dhc_params.c - the identification parameter vector and how it maps onto the model. */
 #include "dhcal/dhc_params.h"
 
-static int is_joint_kind(unsigned kind)
+#include <string.h>
+
+typedef enum { SCOPE_NONE, SCOPE_JOINT, SCOPE_JOINT_PAIR, SCOPE_WIRE, SCOPE_ANCHOR } scope;
+
+static scope kind_scope(unsigned kind)
 {
-    return kind <= (unsigned)DHC_P_BETA;
+    switch ((dhc_param_kind)kind) {
+    case DHC_P_THETA:
+    case DHC_P_D:
+    case DHC_P_A:
+    case DHC_P_ALPHA:
+    case DHC_P_BETA:
+    case DHC_P_JOINT_SCALE:
+    case DHC_P_HARMONIC_SIN:
+    case DHC_P_HARMONIC_COS:
+    case DHC_P_BACKLASH: return SCOPE_JOINT;
+    case DHC_P_COMPLIANCE: return SCOPE_JOINT_PAIR;
+    case DHC_P_MEAS_OFFSET: return SCOPE_WIRE;
+    case DHC_P_MEAS_ANCHOR: return SCOPE_ANCHOR;
+    default: return SCOPE_NONE;
+    }
+}
+
+static int needs_measurer(unsigned kind)
+{
+    return kind == (unsigned)DHC_P_MEAS_SCALE || kind == (unsigned)DHC_P_MEAS_OFFSET ||
+           kind == (unsigned)DHC_P_MEAS_ANCHOR;
 }
 
 void dhc_params_clear(dhc_param_set *set)
@@ -12,18 +36,30 @@ void dhc_params_clear(dhc_param_set *set)
     set->count = 0U;
 }
 
-dhc_status dhc_params_add(dhc_param_set *set, const dhc_arm *arm, dhc_param_kind kind,
-                          size_t joint)
+static int indices_fit(const dhc_model *model, unsigned kind, size_t joint, size_t aux)
 {
-    if (set == NULL || arm == NULL || (unsigned)kind >= (unsigned)DHC_P_KIND_COUNT) {
-        return DHC_ERR_ARGUMENT;
+    const size_t n = model->arm.n_joints;
+    switch (kind_scope(kind)) {
+    case SCOPE_JOINT: return joint < n && aux == 0U;
+    case SCOPE_JOINT_PAIR: return joint < n && aux >= joint && aux < n;
+    case SCOPE_WIRE: return joint == 0U && aux < 3U;
+    case SCOPE_ANCHOR: return joint == 0U && aux < 9U;
+    case SCOPE_NONE:
+    default: return joint == 0U && aux == 0U;
     }
-    const int joint_kind = is_joint_kind((unsigned)kind);
-    if (joint_kind ? joint >= arm->n_joints : joint != 0U) {
+}
+
+dhc_status dhc_params_add(dhc_param_set *set, const dhc_model *model, dhc_param_kind kind,
+                          size_t joint, size_t aux)
+{
+    if (set == NULL || model == NULL || (unsigned)kind >= (unsigned)DHC_P_KIND_COUNT ||
+        !indices_fit(model, (unsigned)kind, joint, aux) ||
+        (needs_measurer((unsigned)kind) && !model->measurer.present)) {
         return DHC_ERR_ARGUMENT;
     }
     for (size_t k = 0U; k < set->count; ++k) {
-        if (set->id[k].kind == (uint8_t)kind && set->id[k].joint == (uint8_t)joint) {
+        const dhc_param_id *id = &set->id[k];
+        if (id->kind == (uint8_t)kind && id->joint == (uint8_t)joint && id->aux == (uint8_t)aux) {
             return DHC_ERR_ARGUMENT;
         }
     }
@@ -32,22 +68,23 @@ dhc_status dhc_params_add(dhc_param_set *set, const dhc_arm *arm, dhc_param_kind
     }
     set->id[set->count].kind = (uint8_t)kind;
     set->id[set->count].joint = (uint8_t)joint;
+    set->id[set->count].aux = (uint8_t)aux;
     set->count++;
     return DHC_OK;
 }
 
-dhc_status dhc_params_base_model(dhc_param_set *set, const dhc_arm *arm)
+dhc_status dhc_params_base_model(dhc_param_set *set, const dhc_model *model)
 {
-    if (set == NULL || arm == NULL) {
+    if (set == NULL || model == NULL) {
         return DHC_ERR_ARGUMENT;
     }
     dhc_params_clear(set);
-    for (size_t i = 0U; i < arm->n_joints; ++i) {
-        const int hayati = arm->joint[i].convention == DHC_CONV_HAYATI;
+    for (size_t i = 0U; i < model->arm.n_joints; ++i) {
+        const int hayati = model->arm.joint[i].convention == DHC_CONV_HAYATI;
         const dhc_param_kind kinds[4] = {DHC_P_THETA, hayati ? DHC_P_BETA : DHC_P_D, DHC_P_A,
                                          DHC_P_ALPHA};
         for (size_t k = 0U; k < 4U; ++k) {
-            const dhc_status st = dhc_params_add(set, arm, kinds[k], i);
+            const dhc_status st = dhc_params_add(set, model, kinds[k], i, 0U);
             if (st != DHC_OK) {
                 return st;
             }
@@ -56,11 +93,11 @@ dhc_status dhc_params_base_model(dhc_param_set *set, const dhc_arm *arm)
     return DHC_OK;
 }
 
-static dhc_status add_range(dhc_param_set *set, const dhc_arm *arm, dhc_param_kind first,
-                            dhc_param_kind last)
+static dhc_status add_run(dhc_param_set *set, const dhc_model *model, dhc_param_kind kind,
+                          size_t joint, size_t aux_first, size_t aux_end)
 {
-    for (unsigned k = (unsigned)first; k <= (unsigned)last; ++k) {
-        const dhc_status st = dhc_params_add(set, arm, (dhc_param_kind)k, 0U);
+    for (size_t aux = aux_first; aux < aux_end; ++aux) {
+        const dhc_status st = dhc_params_add(set, model, kind, joint, aux);
         if (st != DHC_OK) {
             return st;
         }
@@ -68,45 +105,188 @@ static dhc_status add_range(dhc_param_set *set, const dhc_arm *arm, dhc_param_ki
     return DHC_OK;
 }
 
-dhc_status dhc_params_add_base_frame(dhc_param_set *set, const dhc_arm *arm)
+static dhc_status add_kinds(dhc_param_set *set, const dhc_model *model, dhc_param_kind first,
+                            dhc_param_kind last, size_t joint)
 {
-    return add_range(set, arm, DHC_P_BASE_X, DHC_P_BASE_RZ);
+    for (unsigned k = (unsigned)first; k <= (unsigned)last; ++k) {
+        const dhc_status st = dhc_params_add(set, model, (dhc_param_kind)k, joint, 0U);
+        if (st != DHC_OK) {
+            return st;
+        }
+    }
+    return DHC_OK;
 }
 
-dhc_status dhc_params_add_tool(dhc_param_set *set, const dhc_arm *arm)
+dhc_status dhc_params_add_effect(dhc_param_set *set, const dhc_model *model, dhc_effect effect,
+                                 size_t joint)
 {
-    return add_range(set, arm, DHC_P_TOOL_X, DHC_P_TOOL_Z);
+    if (set == NULL || model == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    if (dhc_effect_is_per_joint(effect) && joint >= model->arm.n_joints) {
+        return DHC_ERR_ARGUMENT;
+    }
+    const size_t before = set->count;
+    const size_t j = dhc_effect_is_per_joint(effect) ? joint : 0U;
+    dhc_status st;
+    switch (effect) {
+    case DHC_EFFECT_BASE_FRAME: st = add_kinds(set, model, DHC_P_BASE_X, DHC_P_BASE_RZ, 0U); break;
+    case DHC_EFFECT_TOOL_OFFSET: st = add_kinds(set, model, DHC_P_TOOL_X, DHC_P_TOOL_Z, 0U); break;
+    case DHC_EFFECT_JOINT_SCALE: st = dhc_params_add(set, model, DHC_P_JOINT_SCALE, j, 0U); break;
+    case DHC_EFFECT_JOINT_HARMONIC:
+        st = add_kinds(set, model, DHC_P_HARMONIC_SIN, DHC_P_HARMONIC_COS, j);
+        break;
+    case DHC_EFFECT_JOINT_BACKLASH: st = dhc_params_add(set, model, DHC_P_BACKLASH, j, 0U); break;
+    case DHC_EFFECT_JOINT_COMPLIANCE:
+        st = add_run(set, model, DHC_P_COMPLIANCE, j, j, model->arm.n_joints);
+        break;
+    case DHC_EFFECT_MEASURER_SCALE: st = dhc_params_add(set, model, DHC_P_MEAS_SCALE, 0U, 0U); break;
+    case DHC_EFFECT_MEASURER_OFFSET: st = add_run(set, model, DHC_P_MEAS_OFFSET, 0U, 0U, 3U); break;
+    case DHC_EFFECT_MEASURER_ANCHORS: st = add_run(set, model, DHC_P_MEAS_ANCHOR, 0U, 0U, 9U); break;
+    case DHC_EFFECT_THERMAL_SCALE: st = dhc_params_add(set, model, DHC_P_THERMAL, 0U, 0U); break;
+    case DHC_EFFECT_COUNT:
+    default: st = DHC_ERR_ARGUMENT; break;
+    }
+    if (st != DHC_OK) {
+        set->count = before;
+    }
+    return st;
 }
 
-double dhc_params_value(const dhc_param_set *set, const dhc_arm *arm, size_t k)
+static const char *const effect_names[DHC_EFFECT_COUNT] = {
+    "base_frame",       "tool_offset",     "joint_scale",     "joint_harmonic",
+    "joint_backlash",   "joint_compliance", "measurer_scale", "measurer_offset",
+    "measurer_anchors", "thermal_scale"};
+
+const char *dhc_effect_name(dhc_effect effect)
 {
-    DHC_ASSERT(set != NULL && arm != NULL && k < set->count);
-    const dhc_param_id id = set->id[k];
-    const dhc_joint *const j = &arm->joint[id.joint];
-    switch ((dhc_param_kind)id.kind) {
-    case DHC_P_THETA: return j->theta_offset_rad;
-    case DHC_P_D: return j->d_mm;
-    case DHC_P_A: return j->a_mm;
-    case DHC_P_ALPHA: return j->alpha_rad;
-    case DHC_P_BETA: return j->beta_rad;
-    case DHC_P_BASE_X: return arm->base.pos[0];
-    case DHC_P_BASE_Y: return arm->base.pos[1];
-    case DHC_P_BASE_Z: return arm->base.pos[2];
-    case DHC_P_TOOL_X: return arm->tool_mm[0];
-    case DHC_P_TOOL_Y: return arm->tool_mm[1];
-    case DHC_P_TOOL_Z: return arm->tool_mm[2];
+    return (unsigned)effect < (unsigned)DHC_EFFECT_COUNT ? effect_names[effect] : NULL;
+}
+
+int dhc_effect_is_per_joint(dhc_effect effect)
+{
+    return effect == DHC_EFFECT_JOINT_SCALE || effect == DHC_EFFECT_JOINT_HARMONIC ||
+           effect == DHC_EFFECT_JOINT_BACKLASH || effect == DHC_EFFECT_JOINT_COMPLIANCE;
+}
+
+dhc_status dhc_effect_parse(const char *text, size_t len, size_t n_joints, dhc_effect *effect,
+                            size_t *joint)
+{
+    if (text == NULL || effect == NULL || joint == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    size_t name_len = 0U;
+    while (name_len < len && text[name_len] != ':') {
+        ++name_len;
+    }
+    for (unsigned e = 0U; e < (unsigned)DHC_EFFECT_COUNT; ++e) {
+        const char *name = effect_names[e];
+        if (strlen(name) != name_len || memcmp(name, text, name_len) != 0) {
+            continue;
+        }
+        const int per_joint = dhc_effect_is_per_joint((dhc_effect)e);
+        if (!per_joint) {
+            if (name_len != len) {
+                return DHC_ERR_ARGUMENT;
+            }
+            *effect = (dhc_effect)e;
+            *joint = 0U;
+            return DHC_OK;
+        }
+        /* ":i" with a 1-based decimal joint number, no sign, no leading zero */
+        if (name_len + 1U >= len || text[name_len + 1U] == '0') {
+            return DHC_ERR_ARGUMENT;
+        }
+        size_t number = 0U;
+        for (size_t k = name_len + 1U; k < len; ++k) {
+            if (text[k] < '0' || text[k] > '9' || number > 1000U) {
+                return DHC_ERR_ARGUMENT;
+            }
+            number = number * 10U + (size_t)(text[k] - '0');
+        }
+        if (number < 1U || number > n_joints) {
+            return DHC_ERR_ARGUMENT;
+        }
+        *effect = (dhc_effect)e;
+        *joint = number - 1U;
+        return DHC_OK;
+    }
+    return DHC_ERR_ARGUMENT;
+}
+
+dhc_effect dhc_params_effect_of(const dhc_param_id *id)
+{
+    switch ((dhc_param_kind)id->kind) {
+    case DHC_P_BASE_X:
+    case DHC_P_BASE_Y:
+    case DHC_P_BASE_Z:
+    case DHC_P_BASE_RX:
+    case DHC_P_BASE_RY:
+    case DHC_P_BASE_RZ: return DHC_EFFECT_BASE_FRAME;
+    case DHC_P_TOOL_X:
+    case DHC_P_TOOL_Y:
+    case DHC_P_TOOL_Z: return DHC_EFFECT_TOOL_OFFSET;
+    case DHC_P_JOINT_SCALE: return DHC_EFFECT_JOINT_SCALE;
+    case DHC_P_HARMONIC_SIN:
+    case DHC_P_HARMONIC_COS: return DHC_EFFECT_JOINT_HARMONIC;
+    case DHC_P_BACKLASH: return DHC_EFFECT_JOINT_BACKLASH;
+    case DHC_P_COMPLIANCE: return DHC_EFFECT_JOINT_COMPLIANCE;
+    case DHC_P_MEAS_SCALE: return DHC_EFFECT_MEASURER_SCALE;
+    case DHC_P_MEAS_OFFSET: return DHC_EFFECT_MEASURER_OFFSET;
+    case DHC_P_MEAS_ANCHOR: return DHC_EFFECT_MEASURER_ANCHORS;
+    case DHC_P_THERMAL: return DHC_EFFECT_THERMAL_SCALE;
+    default: return DHC_EFFECT_COUNT;
+    }
+}
+
+/* The model quantity a parameter stands for; NULL for the base rotations, which are
+ * perturbations composed by dhc_params_apply. */
+static double *param_slot(dhc_model *model, const dhc_param_id *id)
+{
+    dhc_joint *const j = &model->arm.joint[id->joint];
+    dhc_joint_effects *const fx = &model->effect[id->joint];
+    dhc_measurer_model *const m = &model->measurer;
+    switch ((dhc_param_kind)id->kind) {
+    case DHC_P_THETA: return &j->theta_offset_rad;
+    case DHC_P_D: return &j->d_mm;
+    case DHC_P_A: return &j->a_mm;
+    case DHC_P_ALPHA: return &j->alpha_rad;
+    case DHC_P_BETA: return &j->beta_rad;
+    case DHC_P_BASE_X: return &model->arm.base.pos[0];
+    case DHC_P_BASE_Y: return &model->arm.base.pos[1];
+    case DHC_P_BASE_Z: return &model->arm.base.pos[2];
+    case DHC_P_TOOL_X: return &model->arm.tool_mm[0];
+    case DHC_P_TOOL_Y: return &model->arm.tool_mm[1];
+    case DHC_P_TOOL_Z: return &model->arm.tool_mm[2];
+    case DHC_P_JOINT_SCALE: return &fx->scale;
+    case DHC_P_HARMONIC_SIN: return &fx->harmonic_sin_rad;
+    case DHC_P_HARMONIC_COS: return &fx->harmonic_cos_rad;
+    case DHC_P_BACKLASH: return &fx->backlash_rad;
+    case DHC_P_COMPLIANCE: return &fx->compliance[id->aux];
+    case DHC_P_MEAS_SCALE: return &m->scale;
+    case DHC_P_MEAS_OFFSET: return &m->offset_mm[id->aux];
+    case DHC_P_MEAS_ANCHOR: return &m->anchor_mm[id->aux / 3U][id->aux % 3U];
+    case DHC_P_THERMAL: return &model->thermal_per_k;
     case DHC_P_BASE_RX:
     case DHC_P_BASE_RY:
     case DHC_P_BASE_RZ:
     case DHC_P_KIND_COUNT:
-    default: return 0.0;
+    default: return NULL;
     }
 }
 
-dhc_status dhc_params_apply(const dhc_param_set *set, dhc_arm *arm, const double *delta,
+double dhc_params_value(const dhc_param_set *set, const dhc_model *model, size_t k)
+{
+    DHC_ASSERT(set != NULL && model != NULL && k < set->count);
+    /* param_slot only hands out addresses; reading through it does not modify. */
+    const double *slot = param_slot((dhc_model *)(uintptr_t)model, &set->id[k]);
+    return slot != NULL ? *slot : 0.0;
+}
+
+dhc_status dhc_params_apply(const dhc_param_set *set, dhc_model *model, const double *delta,
                             size_t len)
 {
-    if (set == NULL || arm == NULL || delta == NULL) {
+    if (set == NULL || model == NULL || delta == NULL) {
         return DHC_ERR_ARGUMENT;
     }
     if (len != set->count) {
@@ -116,29 +296,18 @@ dhc_status dhc_params_apply(const dhc_param_set *set, dhc_arm *arm, const double
         if (!dhc_is_finite(delta[k])) {
             return DHC_ERR_NONFINITE;
         }
+        if (set->id[k].kind >= (uint8_t)DHC_P_KIND_COUNT) {
+            return DHC_ERR_ARGUMENT;
+        }
     }
     double base_rot[3] = {0.0, 0.0, 0.0};
     for (size_t k = 0U; k < len; ++k) {
-        const dhc_param_id id = set->id[k];
-        dhc_joint *const j = &arm->joint[id.joint];
-        const double v = delta[k];
-        switch ((dhc_param_kind)id.kind) {
-        case DHC_P_THETA: j->theta_offset_rad += v; break;
-        case DHC_P_D: j->d_mm += v; break;
-        case DHC_P_A: j->a_mm += v; break;
-        case DHC_P_ALPHA: j->alpha_rad += v; break;
-        case DHC_P_BETA: j->beta_rad += v; break;
-        case DHC_P_BASE_X: arm->base.pos[0] += v; break;
-        case DHC_P_BASE_Y: arm->base.pos[1] += v; break;
-        case DHC_P_BASE_Z: arm->base.pos[2] += v; break;
-        case DHC_P_BASE_RX: base_rot[0] = v; break;
-        case DHC_P_BASE_RY: base_rot[1] = v; break;
-        case DHC_P_BASE_RZ: base_rot[2] = v; break;
-        case DHC_P_TOOL_X: arm->tool_mm[0] += v; break;
-        case DHC_P_TOOL_Y: arm->tool_mm[1] += v; break;
-        case DHC_P_TOOL_Z: arm->tool_mm[2] += v; break;
-        case DHC_P_KIND_COUNT:
-        default: return DHC_ERR_ARGUMENT;
+        const dhc_param_id *id = &set->id[k];
+        double *slot = param_slot(model, id);
+        if (slot != NULL) {
+            *slot += delta[k];
+        } else {
+            base_rot[id->kind - (uint8_t)DHC_P_BASE_RX] = delta[k];
         }
     }
     /* The Jacobian treats the three base rotations as one small rotation vector about the
@@ -146,8 +315,8 @@ dhc_status dhc_params_apply(const dhc_param_set *set, dhc_arm *arm, const double
     dhc_mat3 r;
     dhc_mat3 rotated;
     dhc_rot_exp(base_rot, &r);
-    dhc_rot_mul(&r, &arm->base.rot, &rotated);
-    arm->base.rot = rotated;
+    dhc_rot_mul(&r, &model->arm.base.rot, &rotated);
+    model->arm.base.rot = rotated;
     return DHC_OK;
 }
 
@@ -184,8 +353,12 @@ static size_t put_uint(char *buf, size_t cap, size_t pos, unsigned v)
 size_t dhc_params_name(const dhc_param_set *set, size_t k, char *buf, size_t cap)
 {
     static const char *const names[DHC_P_KIND_COUNT] = {
-        "theta", "d", "a", "alpha", "beta", "base_x", "base_y", "base_z",
-        "base_rx", "base_ry", "base_rz", "tool_x", "tool_y", "tool_z"};
+        "theta",        "d",            "a",           "alpha",          "beta",
+        "base_x",       "base_y",       "base_z",      "base_rx",        "base_ry",
+        "base_rz",      "tool_x",       "tool_y",      "tool_z",         "scale",
+        "harmonic_sin", "harmonic_cos", "backlash",    "compliance",     "measurer_scale",
+        "measurer_offset", "anchor",    "thermal_scale"};
+    static const char axes[3] = {'x', 'y', 'z'};
     if (set == NULL || buf == NULL || cap == 0U || k >= set->count ||
         set->id[k].kind >= (uint8_t)DHC_P_KIND_COUNT) {
         if (buf != NULL && cap > 0U) {
@@ -195,8 +368,22 @@ size_t dhc_params_name(const dhc_param_set *set, size_t k, char *buf, size_t cap
     }
     const dhc_param_id id = set->id[k];
     size_t pos = put_str(buf, cap, 0U, names[id.kind]);
-    if (is_joint_kind(id.kind)) {
+    switch (kind_scope(id.kind)) {
+    case SCOPE_JOINT: pos = put_uint(buf, cap, pos, (unsigned)id.joint + 1U); break;
+    case SCOPE_JOINT_PAIR:
         pos = put_uint(buf, cap, pos, (unsigned)id.joint + 1U);
+        pos = put_str(buf, cap, pos, "_");
+        pos = put_uint(buf, cap, pos, (unsigned)id.aux + 1U);
+        break;
+    case SCOPE_WIRE: pos = put_uint(buf, cap, pos, (unsigned)id.aux + 1U); break;
+    case SCOPE_ANCHOR: {
+        const char axis[3] = {'_', axes[id.aux % 3U], '\0'};
+        pos = put_uint(buf, cap, pos, (unsigned)id.aux / 3U + 1U);
+        pos = put_str(buf, cap, pos, axis);
+        break;
+    }
+    case SCOPE_NONE:
+    default: break;
     }
     buf[pos < cap ? pos : cap - 1U] = '\0';
     return pos;
@@ -211,7 +398,10 @@ int dhc_params_is_angle(const dhc_param_set *set, size_t k)
     case DHC_P_BETA:
     case DHC_P_BASE_RX:
     case DHC_P_BASE_RY:
-    case DHC_P_BASE_RZ: return 1;
+    case DHC_P_BASE_RZ:
+    case DHC_P_HARMONIC_SIN:
+    case DHC_P_HARMONIC_COS:
+    case DHC_P_BACKLASH: return 1;
     default: return 0;
     }
 }

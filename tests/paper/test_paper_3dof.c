@@ -29,11 +29,14 @@ static dhc_status calibrate(dhc_arm *arm, size_t poses, uint64_t seed)
     paper_arms(&truth, &nominal);
     test_rng rng = {seed};
     test_measure(&data, &truth, poses, DHC_MEAS_POSITION, &rng);
-    *arm = nominal;
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, arm));
+    dhc_model model = test_model_of(&nominal);
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &model));
     dhc_calib_options opt;
     dhc_calib_default_options(&opt);
-    return dhc_calib_fit(arm, &set, test_read_sample, &data, data.n, data.flags, &opt, &ws, &rep);
+    const dhc_status st =
+        dhc_calib_fit(&model, &set, test_read_sample, &data, data.n, data.flags, &opt, &ws, &rep);
+    *arm = model.arm;
+    return st;
 }
 
 static void test_ten_positions_reproduce_the_true_tool_point_everywhere(void)
@@ -114,13 +117,14 @@ static void test_tool_point_trades_off_against_link_parameters(void)
     dhc_vec3_set(truth.tool_mm, 20.0, 5.0, -3.0);
     test_rng rng = {99ULL};
     test_measure(&data, &truth, 40U, DHC_MEAS_POSITION, &rng);
-    dhc_arm cal = nominal;
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &cal));
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_tool(&set, &cal));
+    dhc_model model = test_model_of(&nominal);
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &model));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(&set, &model, DHC_EFFECT_TOOL_OFFSET, 0U));
     dhc_calib_options opt;
     dhc_calib_default_options(&opt);
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_calib_fit(&cal, &set, test_read_sample, &data, data.n,
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_calib_fit(&model, &set, test_read_sample, &data, data.n,
                                             data.flags, &opt, &ws, &rep));
+    const dhc_arm cal = model.arm;
     TEST_ASSERT_EQUAL(15U, rep.n_params);
     TEST_ASSERT_EQUAL(rep.structural_rank, rep.rank);
     /* Counted by hand: theta1 d1 a1 alpha1 place axis 2, theta2 beta2 a2 alpha2 place axis 3

@@ -30,11 +30,14 @@ static dhc_status calibrate(dhc_arm *arm, size_t poses, uint64_t seed)
     paper_arms(&truth, &nominal);
     test_rng rng = {seed};
     test_measure(&data, &truth, poses, DHC_MEAS_POSE, &rng);
-    *arm = nominal;
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, arm));
+    dhc_model model = test_model_of(&nominal);
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &model));
     dhc_calib_options opt;
     dhc_calib_default_options(&opt);
-    return dhc_calib_fit(arm, &set, test_read_sample, &data, data.n, data.flags, &opt, &ws, &rep);
+    const dhc_status st =
+        dhc_calib_fit(&model, &set, test_read_sample, &data, data.n, data.flags, &opt, &ws, &rep);
+    *arm = model.arm;
+    return st;
 }
 
 static void test_ten_poses_reproduce_the_true_arm_everywhere(void)

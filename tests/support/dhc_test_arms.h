@@ -6,7 +6,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "dhcal/dhc_kinematics.h"
+#include "dhcal/dhc_model.h"
 
 #define TEST_PI 3.14159265358979323846
 #define TEST_DEG (TEST_PI / 180.0)
@@ -59,6 +59,15 @@ static inline double test_uniform(test_rng *r)
 static inline double test_range(test_rng *r, double lo, double hi)
 {
     return lo + (hi - lo) * test_uniform(r);
+}
+
+/* A model with no effects around an arm. */
+static inline dhc_model test_model_of(const dhc_arm *arm)
+{
+    dhc_model m;
+    (void)dhc_model_init(&m, arm->n_joints);
+    m.arm = *arm;
+    return m;
 }
 
 /* Random joint angles uniform over each joint's range. */

@@ -3,6 +3,7 @@
 #define DHC_TEST_SAMPLES_H
 
 #include <math.h>
+#include <string.h>
 
 #include "dhc_test_arms.h"
 #include "dhcal/dhc_calib.h"
@@ -26,25 +27,36 @@ static inline dhc_status test_read_sample(void *ctx, size_t index, dhc_sample *o
     return DHC_OK;
 }
 
-/* n noise-free measurements of the true arm at random poses (position or full pose). */
-static inline void test_measure(test_dataset *d, const dhc_arm *truth, size_t n, dhc_meas_kind kind,
-                         test_rng *rng)
+/* n noise-free measurements of the true model at random poses and approach directions. */
+static inline void test_measure_model(test_dataset *d, const dhc_model *truth, size_t n,
+                                      dhc_meas_kind kind, test_rng *rng)
 {
     TEST_ASSERT_TRUE(n <= TEST_MAX_SAMPLES);
     d->n = n;
     for (size_t k = 0U; k < n; ++k) {
         dhc_sample *s = &d->s[k];
-        for (size_t i = 0U; i < DHC_MAX_JOINTS; ++i) {
-            s->q_rad[i] = 0.0;
+        memset(s, 0, sizeof *s);
+        test_random_q(rng, &truth->arm, s->q_rad);
+        for (size_t i = 0U; i < truth->arm.n_joints; ++i) {
+            s->dir[i] = test_uniform(rng) < 0.5 ? -1 : 1;
         }
-        test_random_q(rng, truth, s->q_rad);
-        dhc_frame pose;
-        TEST_ASSERT_EQUAL(DHC_OK, dhc_forward(truth, s->q_rad, DHC_MAX_JOINTS, &pose));
-        dhc_vec3_copy(pose.pos, s->p_mm);
-        s->rot = pose.rot;
+        s->temp_c = truth->thermal_ref_c;
         s->kind = (uint8_t)kind;
+        dhc_prediction pred;
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_model_predict(truth, s, &pred));
+        dhc_vec3_copy(pred.p_mm, s->p_mm);
+        s->rot = pred.rot;
+        dhc_vec3_copy(pred.wire_mm, s->wire_mm);
         d->flags[k] = (uint8_t)DHC_SAMPLE_USED;
     }
+}
+
+/* The same for an arm without effects. */
+static inline void test_measure(test_dataset *d, const dhc_arm *truth, size_t n,
+                                dhc_meas_kind kind, test_rng *rng)
+{
+    const dhc_model m = test_model_of(truth);
+    test_measure_model(d, &m, n, kind, rng);
 }
 
 /* Largest position (mm) and orientation (rad) difference of two arms over fresh poses. */
@@ -75,7 +87,8 @@ static inline void test_compare_arms(const dhc_arm *a, const dhc_arm *b, size_t 
 static inline size_t test_param_index(const dhc_param_set *set, dhc_param_kind kind, size_t joint)
 {
     for (size_t k = 0U; k < set->count; ++k) {
-        if (set->id[k].kind == (uint8_t)kind && set->id[k].joint == (uint8_t)joint) {
+        if (set->id[k].kind == (uint8_t)kind && set->id[k].joint == (uint8_t)joint &&
+            set->id[k].aux == 0U) {
             return k;
         }
     }

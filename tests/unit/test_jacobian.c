@@ -39,14 +39,15 @@ static void random_arm(dhc_arm *arm, size_t n)
  * convention: the Jacobian must be right for each, the fit chooses among them). */
 static void full_param_set(dhc_param_set *set, const dhc_arm *arm)
 {
+    const dhc_model m = test_model_of(arm);
     dhc_params_clear(set);
     for (size_t i = 0U; i < arm->n_joints; ++i) {
         for (unsigned k = DHC_P_THETA; k <= DHC_P_BETA; ++k) {
-            TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add(set, arm, (dhc_param_kind)k, i));
+            TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add(set, &m, (dhc_param_kind)k, i, 0U));
         }
     }
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_base_frame(set, arm));
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_tool(set, arm));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(set, &m, DHC_EFFECT_BASE_FRAME, 0U));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(set, &m, DHC_EFFECT_TOOL_OFFSET, 0U));
 }
 
 /* Tool pose of the arm with parameter k moved by h. */
@@ -57,9 +58,9 @@ static void perturbed_pose(const dhc_param_set *set, const dhc_arm *arm, size_t 
     for (size_t m = 0U; m < set->count; ++m) {
         delta[m] = m == k ? h : 0.0;
     }
-    dhc_arm moved = *arm;
+    dhc_model moved = test_model_of(arm);
     TEST_ASSERT_EQUAL(DHC_OK, dhc_params_apply(set, &moved, delta, set->count));
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_forward(&moved, q, DHC_MAX_JOINTS, pose));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_forward(&moved.arm, q, DHC_MAX_JOINTS, pose));
 }
 
 /* Central difference of position and of orientation (as the rotation vector of
@@ -215,7 +216,8 @@ static void test_rejects_bad_shapes_and_non_finite_angles(void)
     dhc_arm arm;
     random_arm(&arm, 3U);
     static dhc_param_set set;
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &arm));
+    const dhc_model m = test_model_of(&arm);
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &m));
     static double buf[6 * DHC_MAX_PARAMS];
     dhc_mat jac;
     double q[DHC_MAX_JOINTS] = {0.1, 0.2, 0.3};

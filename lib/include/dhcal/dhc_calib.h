@@ -7,12 +7,12 @@
  * Usage:
  *     static dhc_calib_workspace ws;                 // large: keep off small stacks
  *     dhc_calib_options opt; dhc_calib_default_options(&opt);
- *     dhc_param_set set; dhc_params_base_model(&set, &arm);
+ *     dhc_param_set set; dhc_params_base_model(&set, &model);
  *     dhc_calib_report rep;
- *     dhc_status st = dhc_calib_fit(&arm, &set, read_sample, ctx, n, flags, &opt, &ws, &rep);
+ *     dhc_status st = dhc_calib_fit(&model, &set, read_sample, ctx, n, flags, &opt, &ws, &rep);
  *
- * On DHC_OK the arm holds the calibrated parameters; unidentifiable parameters keep their
- * input (nominal) values. On any error the arm is unchanged.
+ * On DHC_OK the model holds the calibrated parameters; unidentifiable parameters keep their
+ * input (nominal) values. On any error the model is unchanged.
  */
 #ifndef DHC_CALIB_H
 #define DHC_CALIB_H
@@ -21,22 +21,10 @@
 #include <stdint.h>
 
 #include "dhc_config.h"
-#include "dhc_kinematics.h"
 #include "dhc_lsq.h"
+#include "dhc_model.h"
 #include "dhc_params.h"
 #include "dhc_status.h"
-
-typedef enum {
-    DHC_MEAS_POSITION = 0, /* tool point, 3 rows */
-    DHC_MEAS_POSE = 1      /* tool point and last-link orientation, 6 rows */
-} dhc_meas_kind;
-
-typedef struct {
-    double q_rad[DHC_MAX_JOINTS]; /* measured joint angles (encoder, never commanded) */
-    double p_mm[3];               /* measured tool point, world frame */
-    dhc_mat3 rot;                 /* measured orientation (DHC_MEAS_POSE only) */
-    uint8_t kind;                 /* dhc_meas_kind */
-} dhc_sample;
 
 /* Fills *out with measurement `index` (0-based, < n). Any status other than DHC_OK aborts
  * the fit with that status. */
@@ -71,8 +59,9 @@ typedef struct {
     size_t rank;            /* parameters identified from the data */
     size_t structural_rank; /* parameters the model could identify from rich data */
     size_t outliers;        /* samples flagged DHC_SAMPLE_OUTLIER */
-    double rms_mm;          /* sqrt(mean |position error|^2) over used samples */
-    double max_mm;          /* largest position error over used samples */
+    double rms_mm;          /* sqrt(mean |position error|^2) over used samples; for wire
+                               samples the error is the vector of 3 wire residuals */
+    double max_mm;          /* largest such error over used samples */
     double rms_rad;         /* same for orientation (0 without pose samples) */
     double sigma;           /* residual standard deviation per row, sqrt(SSR / (rows - rank)) */
     double condition;       /* condition estimate of the scaled identifiable block */
@@ -88,8 +77,8 @@ typedef struct {
 typedef struct {
     dhc_normal_eq ne;
     dhc_lsq_factor fac;
-    dhc_arm current;
-    dhc_arm trial;
+    dhc_model current;
+    dhc_model trial;
     dhc_sample sample;
     double delta[DHC_MAX_PARAMS];
     double jac_buf[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS];
@@ -97,20 +86,16 @@ typedef struct {
 
 void dhc_calib_default_options(dhc_calib_options *opt);
 
-/* Residual of one sample against the arm: r = measured - model, position rows (mm) then,
- * for pose samples, weighted orientation rows (mm-equivalent). *rows = 3 or 6.
- * DHC_ERR_NONFINITE for non-finite sample values. */
-dhc_status dhc_calib_residual(const dhc_arm *arm, const dhc_sample *s, double weight_mm_per_rad,
-                              double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows);
-
 /* Fits the parameters of set to the samples. flags (n bytes) marks samples the caller
  * excludes; the fit adds DHC_SAMPLE_OUTLIER marks and refits without them.
- * Returns DHC_OK (converged), DHC_ERR_NOT_CONVERGED (arm holds the best iterate, report
+ * Returns DHC_OK (converged), DHC_ERR_NOT_CONVERGED (model holds the best iterate, report
  * filled), DHC_ERR_UNDERDETERMINED (fewer independent equations than the model can
- * identify: the arm is unchanged, the report says rank and structural_rank),
+ * identify from data like these: the model is unchanged, the report says rank and
+ * structural_rank). The structural rank comes from random poses over the joint ranges with
+ * the data's measurement kind, temperature span and approach directions.
  * DHC_ERR_NO_DATA, DHC_ERR_CAPACITY, DHC_ERR_NONFINITE or the reader's status.
  * Cost per iteration: 2 passes over the data, O(n P^2) + O(P^3). */
-dhc_status dhc_calib_fit(dhc_arm *arm, const dhc_param_set *set, dhc_sample_reader read,
+dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_reader read,
                          void *ctx, size_t n, uint8_t *flags, const dhc_calib_options *opt,
                          dhc_calib_workspace *ws, dhc_calib_report *rep);
 

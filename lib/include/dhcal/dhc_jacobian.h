@@ -1,14 +1,22 @@
 /* dhc_jacobian.h - the identification Jacobian (paper eq. 22-28, base-frame form).
  *
- * For a joint configuration q and a parameter set, fills the derivative of the measured
- * quantities with respect to every parameter of the set:
+ * dhc_identification_jacobian: the paper's Jacobian of the arm alone. For a joint
+ * configuration q and a set of geometric parameters (theta, d, a, alpha, beta, base frame,
+ * tool) it fills the derivative of
  *   rows 0-2: tool point in the world, mm per unit parameter;
  *   rows 3-5 (with_orientation): small rotation of the last link frame, world axes, rad per
  *            unit parameter (the rotation error w with R_meas = exp([w]) R_model).
  * The columns are the paper's THF, LDF, LAF, ALPF expressed in world axes: a joint offset
  * turns everything beyond joint i about axis i; d moves along axis i; a moves along the
  * common normal; alpha (beta) turns about x (y) of the intermediate frame of joint i.
- * Cost O(N + P) after one forward pass; no scratch beyond the stack (< 1 KiB).
+ *
+ * dhc_model_jacobian: the same for the full model (dhc_model.h) and one sample: effects
+ * that act through a joint angle are chain-rule multiples of that joint's column; wire
+ * samples get rows in wire-length space. Compliance moments are evaluated at the measured
+ * angles and held fixed: their dependence on geometry and thermal scale (compliance times
+ * a geometry error) is second order and left out of those columns; LM still converges to
+ * the exact minimum because the residuals are exact.
+ * Cost O(N + P) after one forward pass (O(N^2) with compliance); stack < 1.5 KiB.
  */
 #ifndef DHC_JACOBIAN_H
 #define DHC_JACOBIAN_H
@@ -17,20 +25,29 @@
 
 #include "dhc_kinematics.h"
 #include "dhc_linalg.h"
+#include "dhc_model.h"
 #include "dhc_params.h"
 #include "dhc_status.h"
 
-/* jac must be (3 or 6) x set->count. tool_world_mm (may be NULL) receives the tool point,
- * tool_rot (may be NULL) the last link's orientation.
+/* jac must be (3 or 6) x set->count; every parameter must be geometric (theta..tool_z).
+ * tool_world_mm / tool_rot (may be NULL) receive the tool point and last-link orientation.
  * DHC_ERR_DIMENSION for a wrong jac shape or q_len < n_joints; DHC_ERR_NONFINITE for a
- * non-finite q. */
+ * non-finite q; DHC_ERR_ARGUMENT for a non-geometric parameter. */
 dhc_status dhc_identification_jacobian(const dhc_arm *arm, const dhc_param_set *set,
                                        const double *q_rad, size_t q_len, int with_orientation,
                                        dhc_mat *jac, double tool_world_mm[3],
                                        dhc_mat3 *tool_rot);
 
+/* Jacobian of dhc_model_residual's prediction for sample s: jac is dhc_sample_rows(s) x
+ * set->count; orientation rows are multiplied by weight_mm_per_rad like the residual's.
+ * pred (may be NULL) receives the prediction. Errors of dhc_sample_check and
+ * DHC_ERR_DIMENSION for a wrong jac shape. */
+dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set,
+                              const dhc_sample *s, double weight_mm_per_rad, dhc_mat *jac,
+                              dhc_prediction *pred);
+
 /* d(tool point)/d(q_i) and d(rotation)/d(q_i) for every joint: the ordinary manipulator
- * Jacobian, (3 or 6) x n_joints. Effects that act through joint angles chain-rule onto it. */
+ * Jacobian, (3 or 6) x n_joints. */
 dhc_status dhc_joint_jacobian(const dhc_arm *arm, const double *q_rad, size_t q_len,
                               int with_orientation, dhc_mat *jac);
 

@@ -63,6 +63,12 @@ dhc_status dhc_joint_transform(const dhc_arm *arm, size_t i, double q_rad, dhc_f
 dhc_status dhc_forward_frames(const dhc_arm *arm, const double *q_rad, size_t q_len,
                               dhc_frame *frames, size_t frames_len, double tool_world_mm[3]);
 
+/* The same with every link length (a, d, tool) multiplied by length_scale: thermal
+ * expansion without copying the arm. */
+dhc_status dhc_forward_frames_scaled(const dhc_arm *arm, double length_scale,
+                                     const double *q_rad, size_t q_len, dhc_frame *frames,
+                                     size_t frames_len, double tool_world_mm[3]);
+
 /* Tool pose in the world: position of the tool point and orientation of the last link.
  * Same errors as dhc_forward_frames. */
 dhc_status dhc_forward(const dhc_arm *arm, const double *q_rad, size_t q_len, dhc_frame *tool);

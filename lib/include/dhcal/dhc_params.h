@@ -1,9 +1,11 @@
 /* dhc_params.h - the identification parameter vector: which model quantities a fit adjusts.
  *
- * A parameter set is an ordered list of (kind, joint) pairs; the fit's Jacobian has one
- * column per entry, in that order. Geometry enters the arm (dhc_arm) directly; the base
- * frame is perturbed about its own origin with world-frame axes.
- * Units of parameter values: mm for lengths, rad for angles.
+ * A parameter set is an ordered list of (kind, joint, aux) triples; the fit's Jacobian has
+ * one column per entry, in that order. Parameters are grouped into the effects of
+ * DESIGN.md section 3 ("joint_compliance:2" adds c_2j for every j >= 2, ...).
+ * The base frame is perturbed about its own origin with world-frame axes.
+ * Units of parameter values: mm for lengths, rad for angles, 1 for scales, rad/mm for
+ * compliances, 1/K for thermal expansion.
  */
 #ifndef DHC_PARAMS_H
 #define DHC_PARAMS_H
@@ -12,7 +14,7 @@
 #include <stdint.h>
 
 #include "dhc_config.h"
-#include "dhc_kinematics.h"
+#include "dhc_model.h"
 #include "dhc_status.h"
 
 typedef enum {
@@ -30,12 +32,37 @@ typedef enum {
     DHC_P_TOOL_X, /* tool point in the last link frame, mm */
     DHC_P_TOOL_Y,
     DHC_P_TOOL_Z,
+    DHC_P_JOINT_SCALE,   /* s_i (joint) */
+    DHC_P_HARMONIC_SIN,  /* A_i, rad (joint) */
+    DHC_P_HARMONIC_COS,  /* B_i, rad (joint) */
+    DHC_P_BACKLASH,      /* b_i, rad (joint) */
+    DHC_P_COMPLIANCE,    /* c_ij, rad/mm (joint i, aux j >= i) */
+    DHC_P_MEAS_SCALE,    /* s_m */
+    DHC_P_MEAS_OFFSET,   /* o_k, mm (aux k = 0..2) */
+    DHC_P_MEAS_ANCHOR,   /* anchor coordinate, mm (aux = 3 k + axis) */
+    DHC_P_THERMAL,       /* k, 1/K */
     DHC_P_KIND_COUNT
 } dhc_param_kind;
 
+/* The effects of DESIGN.md section 3 that a fit can add to the base model. */
+typedef enum {
+    DHC_EFFECT_BASE_FRAME = 0,
+    DHC_EFFECT_TOOL_OFFSET,
+    DHC_EFFECT_JOINT_SCALE,
+    DHC_EFFECT_JOINT_HARMONIC,
+    DHC_EFFECT_JOINT_BACKLASH,
+    DHC_EFFECT_JOINT_COMPLIANCE,
+    DHC_EFFECT_MEASURER_SCALE,
+    DHC_EFFECT_MEASURER_OFFSET,
+    DHC_EFFECT_MEASURER_ANCHORS,
+    DHC_EFFECT_THERMAL_SCALE,
+    DHC_EFFECT_COUNT
+} dhc_effect;
+
 typedef struct {
     uint8_t kind;  /* dhc_param_kind */
-    uint8_t joint; /* 0-based joint index for the joint kinds, 0 otherwise */
+    uint8_t joint; /* 0-based joint index for per-joint kinds, 0 otherwise */
+    uint8_t aux;   /* second index (compliance j, measurer wire/axis), 0 otherwise */
 } dhc_param_id;
 
 typedef struct {
@@ -46,33 +73,48 @@ typedef struct {
 /* Empties the set. */
 void dhc_params_clear(dhc_param_set *set);
 
-/* Appends one parameter. DHC_ERR_CAPACITY when full, DHC_ERR_ARGUMENT for an unknown kind,
- * a joint index outside the arm, or a parameter already in the set. */
-dhc_status dhc_params_add(dhc_param_set *set, const dhc_arm *arm, dhc_param_kind kind,
-                          size_t joint);
+/* Appends one parameter. DHC_ERR_CAPACITY when full; DHC_ERR_ARGUMENT for an unknown kind,
+ * a joint or aux index that does not fit the model, or a parameter already in the set. */
+dhc_status dhc_params_add(dhc_param_set *set, const dhc_model *model, dhc_param_kind kind,
+                          size_t joint, size_t aux);
 
 /* The paper's base model: for every joint its four link parameters in the joint's
- * convention (DH: theta, d, a, alpha; Hayati: theta, a, alpha, beta). Clears the set first. */
-dhc_status dhc_params_base_model(dhc_param_set *set, const dhc_arm *arm);
+ * convention (DH: theta, d, a, alpha; Hayati: theta, beta, a, alpha). Clears the set. */
+dhc_status dhc_params_base_model(dhc_param_set *set, const dhc_model *model);
 
-/* Appends the 6 base-frame parameters / the 3 tool parameters. */
-dhc_status dhc_params_add_base_frame(dhc_param_set *set, const dhc_arm *arm);
-dhc_status dhc_params_add_tool(dhc_param_set *set, const dhc_arm *arm);
+/* Appends the parameters of one effect (joint: 0-based, ignored for effects that are not
+ * per joint). All-or-nothing: on error the set is unchanged. DHC_ERR_ARGUMENT also when
+ * the effect needs what the model lacks (measurer effects without a measurer). */
+dhc_status dhc_params_add_effect(dhc_param_set *set, const dhc_model *model, dhc_effect effect,
+                                 size_t joint);
 
-/* Current value of parameter k (base-frame parameters read 0: they are perturbations). */
-double dhc_params_value(const dhc_param_set *set, const dhc_arm *arm, size_t k);
+/* "joint_compliance" etc. (DESIGN.md names); NULL for an unknown value. */
+const char *dhc_effect_name(dhc_effect effect);
+/* 1 when the effect is written "name:i" (per joint). */
+int dhc_effect_is_per_joint(dhc_effect effect);
+/* Parses "name" or "name:i" (i 1-based) of length len. DHC_ERR_ARGUMENT for an unknown
+ * name, a missing or extra ":i", or i outside 1..n_joints. joint is 0-based. */
+dhc_status dhc_effect_parse(const char *text, size_t len, size_t n_joints, dhc_effect *effect,
+                            size_t *joint);
+/* The effect a parameter belongs to; base-model kinds (theta..beta) give DHC_EFFECT_COUNT. */
+dhc_effect dhc_params_effect_of(const dhc_param_id *id);
 
-/* Adds delta[k] to every parameter of the set in the arm. Base-frame rotations compose
+/* Current value of parameter k (base-frame rotations read 0: they are perturbations). */
+double dhc_params_value(const dhc_param_set *set, const dhc_model *model, size_t k);
+
+/* Adds delta[k] to every parameter of the set in the model. Base-frame rotations compose
  * exactly (Rodrigues) about the base origin. DHC_ERR_DIMENSION when len != set->count,
- * DHC_ERR_NONFINITE for a non-finite delta (arm untouched). */
-dhc_status dhc_params_apply(const dhc_param_set *set, dhc_arm *arm, const double *delta,
+ * DHC_ERR_NONFINITE for a non-finite delta (model untouched). */
+dhc_status dhc_params_apply(const dhc_param_set *set, dhc_model *model, const double *delta,
                             size_t len);
 
-/* A stable name for reports, e.g. "theta3", "beta2", "base_rx", "tool_z" (joint 1-based).
- * Writes at most cap bytes including the terminator; returns the number of characters. */
+/* A stable name for reports, e.g. "theta3", "beta2", "base_rx", "tool_z", "scale2",
+ * "harmonic_sin2", "backlash1", "compliance2_3", "measurer_scale", "measurer_offset1",
+ * "anchor2_y", "thermal_scale" (joints and wires 1-based). Writes at most cap bytes
+ * including the terminator; returns the length of the full name. */
 size_t dhc_params_name(const dhc_param_set *set, size_t k, char *buf, size_t cap);
 
-/* 1 when the parameter is an angle (reported in degrees by front ends), 0 for a length. */
+/* 1 when the parameter is an angle (front ends show degrees), 0 otherwise. */
 int dhc_params_is_angle(const dhc_param_set *set, size_t k);
 
 #endif /* DHC_PARAMS_H */

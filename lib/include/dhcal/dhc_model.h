@@ -1,0 +1,126 @@
+/* dhc_model.h - the full measurement model: the arm's geometry plus the physical effects
+ * that act through the joint angles, the draw-wire measurer, and thermal expansion.
+ *
+ * For a sample with encoder angles q, approach directions dir and temperature T:
+ *   q_eff_i = q_i + dq_i,
+ *   dq_i    = s_i q_i                         joint_scale      (gear ratio / resolution)
+ *           + A_i sin q_i + B_i cos q_i       joint_harmonic   (eccentricity)
+ *           + (b_i / 2) dir_i                 joint_backlash
+ *           + sum_{j>=i} c_ij tau_ij(q)       joint_compliance (stiffness under gravity)
+ * where tau_ij = z_{i-1} . ((o_j - o_{i-1}) x g) is the gravity moment about axis i of a unit
+ * weight at the origin of frame j (mm, g a unit vector), evaluated on the arm at the measured q.
+ * All link lengths (a, d, tool) scale by 1 + k (T - T0) (thermal_scale).
+ * The tool point p = FK(q_eff). A wire-length sample sees
+ *   L_k = (1 + s_m) |p - P_k| + o_k,   P_k = T_meas * anchor_k.
+ * Units: mm, rad; c_ij in rad per mm of gravity moment arm.
+ */
+#ifndef DHC_MODEL_H
+#define DHC_MODEL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "dhc_config.h"
+#include "dhc_kinematics.h"
+#include "dhc_linalg.h"
+#include "dhc_status.h"
+
+typedef struct {
+    double scale;               /* s_i */
+    double harmonic_sin_rad;    /* A_i */
+    double harmonic_cos_rad;    /* B_i */
+    double backlash_rad;        /* b_i: full play; each direction sees half */
+    double compliance[DHC_MAX_JOINTS]; /* c_ij for j = index >= i, rad/mm */
+} dhc_joint_effects;
+
+typedef struct {
+    int present;
+    double anchor_mm[3][3];  /* anchors in the measurer frame (paper: P1, P2, P3) */
+    dhc_frame frame;         /* T_Meas: measurer frame in the world */
+    double scale;            /* s_m: wheel radius error, one for all wires */
+    double offset_mm[3];     /* o_k: zero reference of each wire */
+} dhc_measurer_model;
+
+typedef struct {
+    dhc_arm arm;
+    dhc_joint_effects effect[DHC_MAX_JOINTS];
+    double gravity[3];        /* unit vector, world frame */
+    dhc_measurer_model measurer;
+    double thermal_per_k;     /* k */
+    double thermal_ref_c;     /* T0 */
+} dhc_model;
+
+typedef enum {
+    DHC_MEAS_POSITION = 0, /* tool point, 3 rows (mm) */
+    DHC_MEAS_POSE = 1,     /* tool point and last-link orientation, 6 rows */
+    DHC_MEAS_WIRES = 2     /* raw draw-wire lengths L1..L3, 3 rows (mm) */
+} dhc_meas_kind;
+
+typedef struct {
+    double q_rad[DHC_MAX_JOINTS]; /* measured joint angles (encoder, never commanded) */
+    int8_t dir[DHC_MAX_JOINTS];   /* last approach direction, -1 or +1 (0: unknown) */
+    double temp_c;                /* temperature; T0 when not measured */
+    double p_mm[3];               /* measured tool point, world (POSITION, POSE) */
+    dhc_mat3 rot;                 /* measured orientation (POSE) */
+    double wire_mm[3];            /* measured wire lengths (WIRES) */
+    uint8_t kind;                 /* dhc_meas_kind */
+} dhc_sample;
+
+/* What the model predicts for a sample. */
+typedef struct {
+    double q_eff_rad[DHC_MAX_JOINTS];
+    double p_mm[3];
+    dhc_mat3 rot;
+    double wire_mm[3]; /* WIRES samples only */
+} dhc_prediction;
+
+/* A model around an arm of n_joints joints: no effects, gravity -z, no measurer,
+ * thermal reference 20 C. DHC_ERR_CAPACITY for a bad joint count. */
+dhc_status dhc_model_init(dhc_model *model, size_t n_joints);
+
+/* Rows a sample contributes: 3 or 6. */
+size_t dhc_sample_rows(const dhc_sample *s);
+
+/* Checks a sample for non-finite values, kinds and directions against the model.
+ * DHC_ERR_NONFINITE, DHC_ERR_ARGUMENT (unknown kind, dir not in {-1,0,1}, wires without a
+ * measurer in the model). */
+dhc_status dhc_sample_check(const dhc_model *model, const dhc_sample *s);
+
+/* Factor 1 + k (T - T0) by which thermal expansion scales every link length. */
+double dhc_model_length_scale(const dhc_model *model, double temp_c);
+
+/* Gravity moments tau_ij (row i, column j, j >= i; others 0) at joint angles q, with link
+ * lengths scaled by length_scale. */
+dhc_status dhc_model_gravity_moments(const dhc_model *model, double length_scale,
+                                     const double *q_rad,
+                                     double tau[DHC_MAX_JOINTS][DHC_MAX_JOINTS]);
+
+/* Scratch of one evaluation, shared by prediction and Jacobian so neither copies the arm
+ * (about 1.2 KiB: keep it off small stacks when calling in a loop). */
+typedef struct {
+    double length_scale;
+    int has_moments;
+    double tau[DHC_MAX_JOINTS][DHC_MAX_JOINTS];
+    dhc_frame frames[DHC_MAX_JOINTS + 1U]; /* at the effective angles on return */
+} dhc_model_eval;
+
+/* Prediction for one sample, leaving the frames (and, when need_moments or the model has
+ * compliance, the gravity moments at the measured angles) in ev. Errors as
+ * dhc_model_predict. */
+dhc_status dhc_model_evaluate(const dhc_model *model, const dhc_sample *s, int need_moments,
+                              dhc_model_eval *ev, dhc_prediction *out);
+
+/* World position of anchor k (0..2). */
+void dhc_measurer_anchor_world(const dhc_measurer_model *m, size_t k, double out[3]);
+
+/* Prediction for one sample. Errors of dhc_sample_check, and DHC_ERR_NONFINITE when the
+ * result is not finite. O(N^2) for compliance, O(N) otherwise. */
+dhc_status dhc_model_predict(const dhc_model *model, const dhc_sample *s, dhc_prediction *out);
+
+/* Residual r = measured - predicted, rows as dhc_sample_rows; orientation rows are
+ * weighted into mm-equivalents with weight_mm_per_rad. */
+dhc_status dhc_model_residual(const dhc_model *model, const dhc_sample *s,
+                              double weight_mm_per_rad, double r[DHC_MAX_ROWS_PER_SAMPLE],
+                              size_t *rows);
+
+#endif /* DHC_MODEL_H */

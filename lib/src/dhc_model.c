@@ -1,0 +1,221 @@
+/* dhc_model.c - predictions of the full measurement model (geometry + physical effects). */
+#include "dhcal/dhc_model.h"
+
+#include <math.h>
+#include <string.h>
+
+dhc_status dhc_model_init(dhc_model *model, size_t n_joints)
+{
+    if (model == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    /* memset first: every effect and measurer field starts at exactly zero. */
+    memset(model, 0, sizeof *model);
+    const dhc_status st = dhc_arm_init(&model->arm, n_joints);
+    if (st != DHC_OK) {
+        return st;
+    }
+    dhc_vec3_set(model->gravity, 0.0, 0.0, -1.0);
+    dhc_frame_identity(&model->measurer.frame);
+    model->thermal_ref_c = 20.0;
+    return DHC_OK;
+}
+
+size_t dhc_sample_rows(const dhc_sample *s)
+{
+    return s->kind == (uint8_t)DHC_MEAS_POSE ? 6U : 3U;
+}
+
+dhc_status dhc_sample_check(const dhc_model *model, const dhc_sample *s)
+{
+    if (model == NULL || s == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    if (s->kind > (uint8_t)DHC_MEAS_WIRES ||
+        (s->kind == (uint8_t)DHC_MEAS_WIRES && !model->measurer.present)) {
+        return DHC_ERR_ARGUMENT;
+    }
+    if (!dhc_is_finite(s->temp_c)) {
+        return DHC_ERR_NONFINITE;
+    }
+    for (size_t i = 0U; i < model->arm.n_joints; ++i) {
+        if (!dhc_is_finite(s->q_rad[i])) {
+            return DHC_ERR_NONFINITE;
+        }
+        if (s->dir[i] < -1 || s->dir[i] > 1) {
+            return DHC_ERR_ARGUMENT;
+        }
+    }
+    for (size_t r = 0U; r < 3U; ++r) {
+        const double v = s->kind == (uint8_t)DHC_MEAS_WIRES ? s->wire_mm[r] : s->p_mm[r];
+        if (!dhc_is_finite(v)) {
+            return DHC_ERR_NONFINITE;
+        }
+        for (size_t c = 0U; s->kind == (uint8_t)DHC_MEAS_POSE && c < 3U; ++c) {
+            if (!dhc_is_finite(s->rot.m[r][c])) {
+                return DHC_ERR_NONFINITE;
+            }
+        }
+    }
+    return DHC_OK;
+}
+
+double dhc_model_length_scale(const dhc_model *model, double temp_c)
+{
+    return 1.0 + model->thermal_per_k * (temp_c - model->thermal_ref_c);
+}
+
+/* tau from frames already computed at the measured angles. */
+static void moments_from_frames(const dhc_model *model, const dhc_frame *f,
+                                double tau[DHC_MAX_JOINTS][DHC_MAX_JOINTS])
+{
+    const size_t n = model->arm.n_joints;
+    for (size_t i = 0U; i < DHC_MAX_JOINTS; ++i) {
+        for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
+            tau[i][j] = 0.0;
+        }
+    }
+    for (size_t i = 0U; i < n; ++i) {
+        double z[3];
+        dhc_rot_column(&f[i].rot, 2U, z);
+        for (size_t j = i; j < n; ++j) {
+            /* moment of the unit weight g at o_{j+1} about axis i: z . (lever x g) */
+            double lever[3];
+            double m[3];
+            dhc_vec3_sub(f[j + 1U].pos, f[i].pos, lever);
+            dhc_vec3_cross(lever, model->gravity, m);
+            tau[i][j] = dhc_vec3_dot(z, m);
+        }
+    }
+}
+
+dhc_status dhc_model_gravity_moments(const dhc_model *model, double length_scale,
+                                     const double *q_rad,
+                                     double tau[DHC_MAX_JOINTS][DHC_MAX_JOINTS])
+{
+    if (model == NULL || q_rad == NULL || tau == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    dhc_frame f[DHC_MAX_JOINTS + 1U];
+    const dhc_status st = dhc_forward_frames_scaled(&model->arm, length_scale, q_rad,
+                                                    DHC_MAX_JOINTS, f, DHC_MAX_JOINTS + 1U, NULL);
+    if (st == DHC_OK) {
+        moments_from_frames(model, f, tau);
+    }
+    return st;
+}
+
+static int has_compliance(const dhc_model *model)
+{
+    for (size_t i = 0U; i < model->arm.n_joints; ++i) {
+        for (size_t j = i; j < model->arm.n_joints; ++j) {
+            if (fabs(model->effect[i].compliance[j]) > 0.0) {
+                return 1;
+            }
+        }
+    }
+    return 0;
+}
+
+void dhc_measurer_anchor_world(const dhc_measurer_model *m, size_t k, double out[3])
+{
+    dhc_frame_apply(&m->frame, m->anchor_mm[k], out);
+}
+
+dhc_status dhc_model_evaluate(const dhc_model *model, const dhc_sample *s, int need_moments,
+                              dhc_model_eval *ev, dhc_prediction *out)
+{
+    if (ev == NULL || out == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    dhc_status st = dhc_sample_check(model, s);
+    if (st != DHC_OK) {
+        return st;
+    }
+    const size_t n = model->arm.n_joints;
+    ev->length_scale = dhc_model_length_scale(model, s->temp_c);
+    const int compliant = has_compliance(model);
+    ev->has_moments = compliant || need_moments;
+    if (ev->has_moments) {
+        st = dhc_forward_frames_scaled(&model->arm, ev->length_scale, s->q_rad, DHC_MAX_JOINTS,
+                                       ev->frames, DHC_MAX_JOINTS + 1U, NULL);
+        if (st != DHC_OK) {
+            return st;
+        }
+        moments_from_frames(model, ev->frames, ev->tau);
+    }
+    for (size_t i = 0U; i < DHC_MAX_JOINTS; ++i) {
+        out->q_eff_rad[i] = 0.0;
+    }
+    for (size_t i = 0U; i < n; ++i) {
+        const dhc_joint_effects *fx = &model->effect[i];
+        const double q = s->q_rad[i];
+        double dq = fx->scale * q + fx->harmonic_sin_rad * sin(q) +
+                    fx->harmonic_cos_rad * cos(q) + 0.5 * fx->backlash_rad * (double)s->dir[i];
+        for (size_t j = i; compliant && j < n; ++j) {
+            dq += fx->compliance[j] * ev->tau[i][j];
+        }
+        out->q_eff_rad[i] = q + dq;
+    }
+    st = dhc_forward_frames_scaled(&model->arm, ev->length_scale, out->q_eff_rad, DHC_MAX_JOINTS,
+                                   ev->frames, DHC_MAX_JOINTS + 1U, out->p_mm);
+    if (st != DHC_OK) {
+        return st;
+    }
+    out->rot = ev->frames[n].rot;
+    dhc_vec3_set(out->wire_mm, 0.0, 0.0, 0.0);
+    if (s->kind == (uint8_t)DHC_MEAS_WIRES) {
+        const dhc_measurer_model *m = &model->measurer;
+        for (size_t k = 0U; k < 3U; ++k) {
+            double anchor[3];
+            double d[3];
+            dhc_measurer_anchor_world(m, k, anchor);
+            dhc_vec3_sub(out->p_mm, anchor, d);
+            out->wire_mm[k] = (1.0 + m->scale) * dhc_vec3_norm(d) + m->offset_mm[k];
+        }
+    }
+    for (size_t r = 0U; r < 3U; ++r) {
+        if (!dhc_is_finite(out->p_mm[r]) || !dhc_is_finite(out->wire_mm[r])) {
+            return DHC_ERR_NONFINITE;
+        }
+    }
+    return DHC_OK;
+}
+
+dhc_status dhc_model_predict(const dhc_model *model, const dhc_sample *s, dhc_prediction *out)
+{
+    dhc_model_eval ev;
+    return dhc_model_evaluate(model, s, 0, &ev, out);
+}
+
+dhc_status dhc_model_residual(const dhc_model *model, const dhc_sample *s,
+                              double weight_mm_per_rad, double r[DHC_MAX_ROWS_PER_SAMPLE],
+                              size_t *rows)
+{
+    if (r == NULL || rows == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    dhc_prediction pred;
+    memset(&pred, 0, sizeof pred);
+    const dhc_status st = dhc_model_predict(model, s, &pred);
+    if (st != DHC_OK) {
+        return st;
+    }
+    if (s->kind == (uint8_t)DHC_MEAS_WIRES) {
+        dhc_vec3_sub(s->wire_mm, pred.wire_mm, r);
+    } else {
+        dhc_vec3_sub(s->p_mm, pred.p_mm, r);
+    }
+    if (s->kind == (uint8_t)DHC_MEAS_POSE) {
+        /* R_meas = exp([w]) R_model  =>  w = log(R_meas R_model^T) */
+        dhc_mat3 err;
+        double w[3];
+        dhc_rot_mul_t(&s->rot, &pred.rot, &err);
+        dhc_rot_log(&err, w);
+        for (size_t k = 0U; k < 3U; ++k) {
+            r[3U + k] = weight_mm_per_rad * w[k];
+        }
+    }
+    *rows = dhc_sample_rows(s);
+    return DHC_OK;
+}
