@@ -14,6 +14,9 @@
 #define LAMBDA_START 1e-3
 #define LAMBDA_MAX 1e12
 #define MEDIAN_BISECTIONS 64U
+/* The robust sigma needs the median only to a per cent (sigma to half that) against a
+ * threshold of several sigma: more bisection passes buy nothing. */
+#define MEDIAN_REL_PRECISION 1e-2
 #define STRUCTURAL_EXTRA_POSES 8U
 
 void dhc_calib_default_options(dhc_calib_options *opt)
@@ -21,7 +24,7 @@ void dhc_calib_default_options(dhc_calib_options *opt)
     DHC_ASSERT(opt != NULL);
     opt->max_iterations = 100U;
     opt->rank_rel_tol = 1e-10;
-    opt->ssr_rel_tol = 1e-14;
+    opt->ssr_rel_tol = 1e-10;
     opt->step_rel_tol = 1e-12;
     opt->orientation_weight_mm_per_rad = 1000.0;
     opt->outlier_threshold = 6.0;
@@ -241,7 +244,7 @@ static dhc_status median_error2(const fit_context *fc, const dhc_model *model, s
     double lo = 0.0;
     double hi = max_e2;
     const size_t half = (used + 1U) / 2U;
-    for (size_t it = 0U; it < MEDIAN_BISECTIONS && hi > lo; ++it) {
+    for (size_t it = 0U; it < MEDIAN_BISECTIONS && hi - lo > MEDIAN_REL_PRECISION * hi; ++it) {
         const double mid = 0.5 * (lo + hi);
         size_t below = 0U;
         for (size_t i = 0U; i < fc->n; ++i) {

@@ -40,7 +40,7 @@ enum {
 typedef struct {
     size_t max_iterations;       /* LM iterations per fit round (default 100) */
     double rank_rel_tol;         /* pivot tolerance on the scaled normal matrix (1e-10) */
-    double ssr_rel_tol;          /* stop when SSR falls by less than this share (1e-14) */
+    double ssr_rel_tol;          /* stop when SSR falls by less than this share (1e-10) */
     double step_rel_tol;         /* ... or the scaled step is below this (1e-12) */
     double orientation_weight_mm_per_rad; /* rad residuals count as this many mm (1000) */
     double outlier_threshold;    /* |error| / robust sigma above this is an outlier (6); 0 off */

@@ -1,0 +1,121 @@
+/* dhc_diagnose.h - which physical effect is missing from a fitted model (score test).
+ *
+ * After a fit of the parameters in `base`, every candidate effect C is scored without
+ * refitting: with J the base model's identifiable columns, r the residuals, M = I - J(J'J)^-1 J',
+ *   explained(C) = r' M C (C' M C)^+ C' M r          (sum of squares C would remove)
+ *   score(C)     = explained(C) / sigma^2 ~ chi^2(k) (Lagrange-multiplier test),
+ * k the rank of C' M C, i.e. the number of the candidate's directions the base model does
+ * not already have. A candidate with k = 0 looks exactly like geometry the fit already
+ * adjusts: the data cannot see it. Candidates are ranked by their p-value (most
+ * significant first) and marked significant by Holm's step-down procedure at level alpha,
+ * which bounds the chance of any false alarm on data with no missing effect.
+ *
+ * The normal-equation blocks [J C]'[J C] and [J C]' r are accumulated while streaming the
+ * samples, in batches of candidates that fit DHC_MAX_PARAMS columns (one data pass each).
+ * Memory O(P^2) in the workspace; no heap, no I/O.
+ */
+#ifndef DHC_DIAGNOSE_H
+#define DHC_DIAGNOSE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "dhc_calib.h"
+#include "dhc_config.h"
+#include "dhc_lsq.h"
+#include "dhc_model.h"
+#include "dhc_params.h"
+#include "dhc_status.h"
+
+#ifndef DHC_MAX_CANDIDATES
+#define DHC_MAX_CANDIDATES 48U
+#endif
+
+/* Most parameters one candidate effect brings (measurer anchors: 9). */
+#define DHC_MAX_CANDIDATE_PARAMS 9U
+
+typedef struct {
+    dhc_effect effect;
+    size_t joint; /* 0-based; 0 for effects that are not per joint */
+} dhc_candidate;
+
+typedef struct {
+    dhc_effect effect;
+    size_t joint;
+    size_t n_params;       /* parameters the effect adds */
+    size_t rank;           /* of them, directions the base model does not have (dof) */
+    double explained_ss;   /* residual sum of squares the candidate would remove */
+    double explained;      /* explained_ss / SSR of the fit, 0..1 */
+    double score;          /* explained_ss / sigma^2 */
+    double log10_p;        /* log10 of the chi^2(rank) upper tail of score; 0 when rank 0 */
+    int significant;       /* Holm step-down at alpha over all candidates */
+    double value[DHC_MAX_CANDIDATE_PARAMS]; /* one-step estimate of its parameters */
+    size_t lookalike;      /* index (in the result list) of a candidate it cannot be told
+                              apart from, or DHC_MAX_CANDIDATES */
+} dhc_candidate_result;
+
+typedef struct {
+    size_t count;
+    dhc_candidate_result c[DHC_MAX_CANDIDATES]; /* best first */
+    double ssr;
+    double sigma2;
+    size_t rows;
+} dhc_diagnosis;
+
+typedef struct {
+    double alpha;          /* family-wise false alarm level (default 1e-3) */
+    double separable_tol;  /* a candidate direction whose share outside the base model's
+                              span is below this is not separable (default 1e-6) */
+    double lookalike_ratio;/* two candidates whose union explains less than this factor
+                              more than the better one are look-alikes (default 1.02) */
+    double orientation_weight_mm_per_rad; /* as in the fit (1000) */
+} dhc_diagnose_options;
+
+/* Scratch of dhc_diagnose (about 10 * DHC_MAX_PARAMS^2 bytes; keep it static). Every array
+ * lives here so the call stays within a small embedded stack. */
+typedef struct {
+    dhc_normal_eq ne;
+    dhc_param_set set;    /* base + the batch's candidate columns */
+    double factor[DHC_MAX_PARAMS * DHC_MAX_PARAMS];   /* base block, pivoted Cholesky */
+    double work[DHC_MAX_PARAMS * 2U * DHC_MAX_CANDIDATE_PARAMS]; /* A^-1 B_c */
+    double schur[4U * DHC_MAX_CANDIDATE_PARAMS * DHC_MAX_CANDIDATE_PARAMS];
+    double rhs[DHC_MAX_PARAMS];
+    double gb[DHC_MAX_PARAMS];
+    double y[DHC_MAX_PARAMS];
+    double scale[DHC_MAX_PARAMS];
+    size_t base_col[DHC_MAX_PARAMS];
+    size_t perm[DHC_MAX_PARAMS];
+    size_t range_first[DHC_MAX_CANDIDATES];
+    size_t range_count[DHC_MAX_CANDIDATES];
+    size_t rival[DHC_MAX_CANDIDATES];
+    dhc_sample sample;
+    double jac_buf[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS];
+} dhc_diagnose_workspace;
+
+void dhc_diagnose_default_options(dhc_diagnose_options *opt);
+
+/* Every candidate the model can express that is not already in base: per-joint effects on
+ * every joint, base_frame, tool_offset, thermal_scale when the samples' temperatures vary
+ * (temp_span_c > 0), measurer effects when the model has a measurer and wire samples are
+ * used (wires). Returns the number written (at most cap). */
+size_t dhc_diagnose_candidates(const dhc_model *model, const dhc_param_set *base, int wires,
+                               double temp_span_c, dhc_candidate *out, size_t cap);
+
+/* Scores the candidates against the fitted model. base and identifiable are the fit's
+ * parameter set and its identifiable flags (dhc_calib_report), sigma2 its noise variance per
+ * row and flags its sample flags (only DHC_SAMPLE_USED rows count).
+ * DHC_ERR_CAPACITY when base alone leaves no room for a candidate's columns;
+ * DHC_ERR_ARGUMENT for sigma2 <= 0 or a candidate the model cannot take; errors of the
+ * reader and of dhc_model_jacobian. O(passes * n * P^2 + candidates * P^2 k). */
+dhc_status dhc_diagnose(const dhc_model *model, const dhc_param_set *base,
+                        const uint8_t *identifiable, double sigma2,
+                        const dhc_candidate *candidates, size_t n_candidates,
+                        dhc_sample_reader read, void *ctx, size_t n, const uint8_t *flags,
+                        const dhc_diagnose_options *opt, dhc_diagnose_workspace *ws,
+                        dhc_diagnosis *out);
+
+/* log10 of the upper tail P(X > x) of chi-square with dof degrees of freedom, accurate far
+ * into the tail (no underflow to -inf before ~1e300). dof >= 1, x >= 0. */
+double dhc_chi2_log10_sf(double x, size_t dof);
+
+#endif /* DHC_DIAGNOSE_H */

@@ -1,0 +1,231 @@
+/* test_diagnose.c - score tests of candidate effects: chi-square tails against closed forms,
+ * the explained sum of squares against an actual refit, and the ranking on simulated arms
+ * with one hidden effect. */
+#include <math.h>
+#include <string.h>
+
+#include "dhc_test_arms.h"
+#include "dhc_test_samples.h"
+#include "dhcal/dhc_diagnose.h"
+#include "unity.h"
+
+void setUp(void) {}
+void tearDown(void) {}
+
+static test_dataset data;
+static dhc_calib_workspace cws;
+static dhc_calib_report rep;
+static dhc_diagnose_workspace dws;
+static dhc_diagnosis diag;
+static dhc_param_set set;
+
+static void test_chi2_tail_matches_closed_forms(void)
+{
+    /* 2 dof: P(X > x) = exp(-x/2); 4 dof: exp(-x/2)(1 + x/2); 1 dof: erfc(sqrt(x/2)). */
+    const double xs[6] = {0.01, 0.5, 3.0, 10.0, 80.0, 2000.0};
+    for (size_t i = 0U; i < 6U; ++i) {
+        const double x = xs[i];
+        TEST_ASSERT_DOUBLE_WITHIN(1e-9 * (1.0 + x), -x / 2.0 / log(10.0), dhc_chi2_log10_sf(x, 2U));
+        TEST_ASSERT_DOUBLE_WITHIN(1e-9 * (1.0 + x), (-x / 2.0 + log1p(x / 2.0)) / log(10.0),
+                                  dhc_chi2_log10_sf(x, 4U));
+        if (x < 500.0) {
+            TEST_ASSERT_DOUBLE_WITHIN(1e-9 * (1.0 + x), log10(erfc(sqrt(x / 2.0))),
+                                      dhc_chi2_log10_sf(x, 1U));
+        }
+    }
+    TEST_ASSERT_DOUBLE_WITHIN(1e-4, log10(0.05), dhc_chi2_log10_sf(3.841458820694124, 1U));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-4, log10(0.01), dhc_chi2_log10_sf(16.811893829770927, 6U));
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, dhc_chi2_log10_sf(0.0, 3U));
+}
+
+static test_rng noise_rng = {0x1234ULL};
+
+static double gauss(void)
+{
+    const double u1 = fmax(test_uniform(&noise_rng), 1e-300);
+    const double u2 = test_uniform(&noise_rng);
+    return sqrt(-2.0 * log(u1)) * cos(2.0 * TEST_PI * u2);
+}
+
+static dhc_model nominal_model(void)
+{
+    dhc_arm arm;
+    test_arm_from_table(&arm, TEST_TABLE3, 3U, 0.0);
+    dhc_arm_choose_conventions(&arm, 1e-3);
+    const double lo[3] = {-170.0, -10.0, -150.0};
+    const double hi[3] = {170.0, 170.0, 150.0};
+    for (size_t i = 0U; i < 3U; ++i) {
+        arm.joint[i].min_rad = lo[i] * TEST_DEG;
+        arm.joint[i].max_rad = hi[i] * TEST_DEG;
+    }
+    return test_model_of(&arm);
+}
+
+/* True arm: nominal with small geometric errors plus the effect set up by the caller. */
+static dhc_model true_model(void)
+{
+    dhc_model m = nominal_model();
+    m.arm.joint[0].theta_offset_rad = 0.2 * TEST_DEG;
+    m.arm.joint[0].d_mm += 0.4;
+    m.arm.joint[1].a_mm += -0.3;
+    m.arm.joint[1].beta_rad = 0.05 * TEST_DEG;
+    m.arm.joint[2].a_mm += 0.5;
+    m.arm.joint[2].alpha_rad = 0.1 * TEST_DEG;
+    return m;
+}
+
+static void simulate(const dhc_model *truth, uint64_t seed)
+{
+    test_rng rng = {seed};
+    test_measure_model(&data, truth, 60U, DHC_MEAS_POSITION, &rng);
+    for (size_t k = 0U; k < data.n; ++k) {
+        for (size_t c = 0U; c < 3U; ++c) {
+            data.s[k].p_mm[c] += 0.05 * gauss();
+        }
+    }
+}
+
+/* Fits the base model to `data`, then scores every candidate. */
+static void fit_and_diagnose(dhc_model *fitted)
+{
+    *fitted = nominal_model();
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, fitted));
+    dhc_calib_options opt;
+    dhc_calib_default_options(&opt);
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_calib_fit(fitted, &set, test_read_sample, &data, data.n,
+                                            data.flags, &opt, &cws, &rep));
+    dhc_candidate cands[DHC_MAX_CANDIDATES];
+    const size_t nc = dhc_diagnose_candidates(fitted, &set, 0, 0.0, cands, DHC_MAX_CANDIDATES);
+    dhc_diagnose_options dopt;
+    dhc_diagnose_default_options(&dopt);
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_diagnose(fitted, &set, rep.identifiable, rep.sigma * rep.sigma,
+                                           cands, nc, test_read_sample, &data, data.n,
+                                           data.flags, &dopt, &dws, &diag));
+    TEST_ASSERT_EQUAL(nc, diag.count);
+}
+
+static void test_clean_data_flag_no_candidate(void)
+{
+    const dhc_model truth = true_model();
+    simulate(&truth, 101ULL);
+    dhc_model fitted;
+    fit_and_diagnose(&fitted);
+    for (size_t i = 0U; i < diag.count; ++i) {
+        TEST_ASSERT_FALSE(diag.c[i].significant);
+    }
+}
+
+static void expect_top(dhc_effect effect, size_t joint)
+{
+    TEST_ASSERT_EQUAL(effect, diag.c[0].effect);
+    TEST_ASSERT_EQUAL(joint, diag.c[0].joint);
+    TEST_ASSERT_TRUE(diag.c[0].significant);
+    TEST_ASSERT_TRUE(diag.c[0].explained > 0.5);
+}
+
+static void test_hidden_compliance_of_the_shoulder_is_named_first(void)
+{
+    dhc_model truth = true_model();
+    truth.effect[1].compliance[1] = 1.5e-6;
+    truth.effect[1].compliance[2] = 1.5e-6;
+    simulate(&truth, 202ULL);
+    dhc_model fitted;
+    fit_and_diagnose(&fitted);
+    expect_top(DHC_EFFECT_JOINT_COMPLIANCE, 1U);
+    /* Axis 1 is vertical: gravity has no moment about it, the data cannot see it. */
+    for (size_t i = 0U; i < diag.count; ++i) {
+        if (diag.c[i].effect == DHC_EFFECT_JOINT_COMPLIANCE && diag.c[i].joint == 0U) {
+            TEST_ASSERT_EQUAL(0U, diag.c[i].rank);
+            TEST_ASSERT_FALSE(diag.c[i].significant);
+        }
+    }
+}
+
+static void test_hidden_joint_scale_is_named_first(void)
+{
+    dhc_model truth = true_model();
+    truth.effect[0].scale = 2e-3;
+    simulate(&truth, 303ULL);
+    dhc_model fitted;
+    fit_and_diagnose(&fitted);
+    expect_top(DHC_EFFECT_JOINT_SCALE, 0U);
+    /* The one-step estimate of the hidden parameter is close to the truth. */
+    TEST_ASSERT_DOUBLE_WITHIN(2e-4, 2e-3, diag.c[0].value[0]);
+}
+
+static void test_hidden_backlash_is_named_first(void)
+{
+    dhc_model truth = true_model();
+    truth.effect[2].backlash_rad = 0.3 * TEST_DEG;
+    simulate(&truth, 404ULL);
+    dhc_model fitted;
+    fit_and_diagnose(&fitted);
+    expect_top(DHC_EFFECT_JOINT_BACKLASH, 2U);
+}
+
+/* The score's explained sum of squares is what adding the effect and refitting removes
+ * (exactly for a linear model; to a few per cent here). */
+static void test_explained_sum_matches_the_ssr_drop_of_a_refit(void)
+{
+    dhc_model truth = true_model();
+    truth.effect[1].harmonic_sin_rad = 1e-3;
+    truth.effect[1].harmonic_cos_rad = -8e-4;
+    simulate(&truth, 505ULL);
+    dhc_model fitted;
+    fit_and_diagnose(&fitted);
+    expect_top(DHC_EFFECT_JOINT_HARMONIC, 1U);
+    const double ssr_base = rep.sigma * rep.sigma * (double)(rep.rows - rep.rank);
+    const double predicted_drop = diag.c[0].explained_ss;
+
+    dhc_model refit = nominal_model();
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &refit));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(&set, &refit, DHC_EFFECT_JOINT_HARMONIC, 1U));
+    dhc_calib_options opt;
+    dhc_calib_default_options(&opt);
+    for (size_t k = 0U; k < data.n; ++k) {
+        data.flags[k] = (uint8_t)DHC_SAMPLE_USED;
+    }
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_calib_fit(&refit, &set, test_read_sample, &data, data.n,
+                                            data.flags, &opt, &cws, &rep));
+    const double ssr_with = rep.sigma * rep.sigma * (double)(rep.rows - rep.rank);
+    TEST_ASSERT_DOUBLE_WITHIN(0.05 * predicted_drop, ssr_base - ssr_with, predicted_drop);
+}
+
+static void test_bad_arguments_are_refused(void)
+{
+    dhc_model m = nominal_model();
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &m));
+    uint8_t ident[DHC_MAX_PARAMS] = {0};
+    dhc_candidate c = {DHC_EFFECT_JOINT_SCALE, 0U};
+    dhc_diagnose_options dopt;
+    dhc_diagnose_default_options(&dopt);
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_diagnose(&m, &set, ident, 0.0, &c, 1U, test_read_sample,
+                                                     &data, data.n, data.flags, &dopt, &dws, &diag));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_diagnose(&m, &set, ident, NAN, &c, 1U, test_read_sample,
+                                                     &data, data.n, data.flags, &dopt, &dws, &diag));
+    /* A candidate already in the base set is a caller error. */
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(&set, &m, DHC_EFFECT_JOINT_SCALE, 0U));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_diagnose(&m, &set, ident, 1.0, &c, 1U, test_read_sample,
+                                                     &data, data.n, data.flags, &dopt, &dws, &diag));
+    /* ... and the candidate list leaves it out. */
+    dhc_candidate cands[DHC_MAX_CANDIDATES];
+    const size_t nc = dhc_diagnose_candidates(&m, &set, 0, 0.0, cands, DHC_MAX_CANDIDATES);
+    for (size_t i = 0U; i < nc; ++i) {
+        TEST_ASSERT_FALSE(cands[i].effect == DHC_EFFECT_JOINT_SCALE && cands[i].joint == 0U);
+        TEST_ASSERT_TRUE(cands[i].effect != DHC_EFFECT_MEASURER_SCALE); /* no wire data */
+        TEST_ASSERT_TRUE(cands[i].effect != DHC_EFFECT_THERMAL_SCALE);  /* no temperature span */
+    }
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_chi2_tail_matches_closed_forms);
+    RUN_TEST(test_clean_data_flag_no_candidate);
+    RUN_TEST(test_hidden_compliance_of_the_shoulder_is_named_first);
+    RUN_TEST(test_hidden_joint_scale_is_named_first);
+    RUN_TEST(test_hidden_backlash_is_named_first);
+    RUN_TEST(test_explained_sum_matches_the_ssr_drop_of_a_refit);
+    RUN_TEST(test_bad_arguments_are_refused);
+    return UNITY_END();
+}

@@ -1,0 +1,164 @@
+/* dhcal_analysis.c - fit and diagnose over loaded samples. */
+#include "dhcal_analysis.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define PI 3.14159265358979323846
+
+/* Big library workspaces: static, this is a single-threaded command-line program. */
+static dhc_calib_workspace calib_ws;
+static dhc_diagnose_workspace diag_ws;
+
+int dhcal_parse_effects(const char *list, const dhc_model *model, dhc_param_set *set,
+                        dhcal_error *err)
+{
+    if (list == NULL) {
+        return DHCAL_IO_OK;
+    }
+    const char *p = list;
+    while (*p != '\0') {
+        const char *end = strchr(p, ',');
+        const size_t len = end != NULL ? (size_t)(end - p) : strlen(p);
+        dhc_effect effect;
+        size_t joint;
+        if (dhc_effect_parse(p, len, model->arm.n_joints, &effect, &joint) != DHC_OK) {
+            snprintf(err->msg, sizeof err->msg,
+                     "--effects: '%.*s' is not an effect of this model (names: base_frame, "
+                     "tool_offset, joint_scale:i, joint_harmonic:i, joint_backlash:i, "
+                     "joint_compliance:i with 1 <= i <= %zu, measurer_scale, "
+                     "measurer_offset, measurer_anchors, thermal_scale)",
+                     (int)(len > 60U ? 60U : len), p, model->arm.n_joints);
+            return DHCAL_IO_BAD_INPUT;
+        }
+        const dhc_status st = dhc_params_add_effect(set, model, effect, joint);
+        if (st != DHC_OK) {
+            snprintf(err->msg, sizeof err->msg, "--effects: cannot add '%.*s': %s%s",
+                     (int)(len > 60U ? 60U : len), p,
+                     st == DHC_ERR_CAPACITY ? "too many parameters" : "given twice",
+                     st != DHC_ERR_CAPACITY && !model->measurer.present &&
+                             (effect == DHC_EFFECT_MEASURER_SCALE ||
+                              effect == DHC_EFFECT_MEASURER_OFFSET ||
+                              effect == DHC_EFFECT_MEASURER_ANCHORS)
+                         ? " or the model has no 'measurer'"
+                         : "");
+            return DHCAL_IO_BAD_INPUT;
+        }
+        p += len;
+        if (*p == ',') {
+            ++p;
+        }
+    }
+    return DHCAL_IO_OK;
+}
+
+int dhcal_run_fit(const dhc_model *nominal, const char *effects, dhcal_samples *s,
+                  const dhcal_samples *held, dhcal_fit *out, dhcal_error *err)
+{
+    memset(out, 0, sizeof *out);
+    out->model = *nominal;
+    if (dhc_params_base_model(&out->set, &out->model) != DHC_OK) {
+        snprintf(err->msg, sizeof err->msg, "too many joints for the parameter limit");
+        return DHCAL_IO_BAD_INPUT;
+    }
+    int rc = dhcal_parse_effects(effects, &out->model, &out->set, err);
+    if (rc != DHCAL_IO_OK) {
+        return rc;
+    }
+    dhc_calib_options opt;
+    dhc_calib_default_options(&opt);
+    out->status = dhc_calib_fit(&out->model, &out->set, dhcal_samples_read, s, s->n, s->flags,
+                                &opt, &calib_ws, &out->rep);
+    if (out->status == DHC_ERR_UNDERDETERMINED) {
+        snprintf(err->msg, sizeof err->msg,
+                 "the data under-determine the model: %zu equations from %zu rows identify %zu "
+                 "of the %zu parameters the model could identify from rich data; measure more "
+                 "poses, spread over the joint ranges",
+                 out->rep.rows, out->rep.samples_used, out->rep.rank, out->rep.structural_rank);
+        return DHCAL_IO_FAILED;
+    }
+    if (out->status != DHC_OK && out->status != DHC_ERR_NOT_CONVERGED) {
+        snprintf(err->msg, sizeof err->msg, "fit failed: %s", dhc_status_str(out->status));
+        return DHCAL_IO_FAILED;
+    }
+    if (held != NULL) {
+        double *e = calloc(held->n > 0U ? held->n : 1U, sizeof *e);
+        rc = e != NULL ? dhcal_samples_errors(&out->model, held, NULL, e, &out->heldout_rms_mm,
+                                              &out->heldout_max_mm)
+                       : DHCAL_IO_FAILED;
+        free(e);
+        if (rc != DHCAL_IO_OK) {
+            snprintf(err->msg, sizeof err->msg, "%s: evaluation failed", held->path);
+            return DHCAL_IO_FAILED;
+        }
+        out->have_heldout = 1;
+    }
+    return DHCAL_IO_OK;
+}
+
+int dhcal_run_diagnose(const dhcal_fit *fit, const dhcal_samples *s, dhc_diagnosis *out,
+                       dhcal_error *err)
+{
+    double tmin = 0.0;
+    double tmax = 0.0;
+    for (size_t i = 0U; i < s->n; ++i) {
+        const double t = s->samples[i].temp_c;
+        tmin = i == 0U ? t : fmin(tmin, t);
+        tmax = i == 0U ? t : fmax(tmax, t);
+    }
+    dhc_candidate cands[DHC_MAX_CANDIDATES];
+    const size_t nc = dhc_diagnose_candidates(&fit->model, &fit->set, s->wires, tmax - tmin,
+                                              cands, DHC_MAX_CANDIDATES);
+    dhc_diagnose_options opt;
+    dhc_diagnose_default_options(&opt);
+    const double sigma2 = fit->rep.sigma * fit->rep.sigma;
+    if (!(sigma2 > 0.0)) {
+        snprintf(err->msg, sizeof err->msg,
+                 "the fit leaves no residual (no redundancy or noise-free data): nothing to "
+                 "diagnose");
+        return DHCAL_IO_FAILED;
+    }
+    const dhc_status st =
+        dhc_diagnose(&fit->model, &fit->set, fit->rep.identifiable, sigma2, cands, nc,
+                     dhcal_samples_read, (void *)(uintptr_t)s, s->n, s->flags, &opt, &diag_ws, out);
+    if (st != DHC_OK) {
+        snprintf(err->msg, sizeof err->msg, "diagnosis failed: %s", dhc_status_str(st));
+        return DHCAL_IO_FAILED;
+    }
+    return DHCAL_IO_OK;
+}
+
+void dhcal_effect_label(dhc_effect effect, size_t joint, char *buf, size_t cap)
+{
+    if (dhc_effect_is_per_joint(effect)) {
+        snprintf(buf, cap, "%s:%zu", dhc_effect_name(effect), joint + 1U);
+    } else {
+        snprintf(buf, cap, "%s", dhc_effect_name(effect));
+    }
+}
+
+const char *dhcal_effect_signature(dhc_effect effect)
+{
+    switch (effect) {
+    case DHC_EFFECT_BASE_FRAME: return "a constant shift and a rotation growing with distance (robot or measurer placement)";
+    case DHC_EFFECT_TOOL_OFFSET: return "an error vector that turns with the last link (tool point unknown)";
+    case DHC_EFFECT_JOINT_SCALE: return "a joint error growing in proportion to the joint angle (gear ratio or encoder resolution)";
+    case DHC_EFFECT_JOINT_HARMONIC: return "a joint error periodic in the joint angle (encoder or gear eccentricity)";
+    case DHC_EFFECT_JOINT_BACKLASH: return "a joint error that splits by approach direction (gear backlash)";
+    case DHC_EFFECT_JOINT_COMPLIANCE: return "a joint error that follows the gravity torque (joint stiffness)";
+    case DHC_EFFECT_MEASURER_SCALE: return "wire errors growing with wire length (friction-wheel radius)";
+    case DHC_EFFECT_MEASURER_OFFSET: return "a constant error on each wire (wire zero reference)";
+    case DHC_EFFECT_MEASURER_ANCHORS: return "errors pointing at the measurer's anchors (measurer built off its drawing)";
+    case DHC_EFFECT_THERMAL_SCALE: return "lengths growing with temperature (thermal expansion)";
+    case DHC_EFFECT_COUNT:
+    default: return "an unknown pattern";
+    }
+}
+
+double dhcal_param_display(const dhc_param_set *set, size_t k, double value)
+{
+    const int degrees = dhc_params_is_angle(set, k) || set->id[k].kind == (uint8_t)DHC_P_COMPLIANCE;
+    return degrees ? value * 180.0 / PI : value;
+}

@@ -1,0 +1,45 @@
+/* dhcal_analysis.h - what the commands compute: a fit of the base model plus chosen
+ * effects, and the ranking of the effects still missing. Host code (heap allowed). */
+#ifndef DHCAL_ANALYSIS_H
+#define DHCAL_ANALYSIS_H
+
+#include "dhcal/dhc_diagnose.h"
+#include "dhcal_data.h"
+#include "dhcal_io.h"
+
+typedef struct {
+    dhc_model model;      /* calibrated (nominal when the fit failed) */
+    dhc_param_set set;    /* base model + effects */
+    dhc_calib_report rep;
+    dhc_status status;
+    int have_heldout;
+    double heldout_rms_mm;
+    double heldout_max_mm;
+} dhcal_fit;
+
+/* Adds the effects of a comma-separated list ("joint_compliance:2,base_frame") to set.
+ * DHCAL_IO_BAD_INPUT naming the offending item. NULL or "" adds nothing. */
+int dhcal_parse_effects(const char *list, const dhc_model *model, dhc_param_set *set,
+                        dhcal_error *err);
+
+/* Fits nominal + effects to s (flags updated with outliers); evaluates held (may be NULL).
+ * DHCAL_IO_OK when the library returned DHC_OK or DHC_ERR_NOT_CONVERGED (see out->status),
+ * DHCAL_IO_FAILED with a plain-words message otherwise (under-determined data included),
+ * DHCAL_IO_BAD_INPUT for a bad effects list. */
+int dhcal_run_fit(const dhc_model *nominal, const char *effects, dhcal_samples *s,
+                  const dhcal_samples *held, dhcal_fit *out, dhcal_error *err);
+
+/* Ranks every candidate effect the fit's model can take against its residuals. */
+int dhcal_run_diagnose(const dhcal_fit *fit, const dhcal_samples *s, dhc_diagnosis *out,
+                       dhcal_error *err);
+
+/* "joint_compliance:2" / "measurer_scale" for a candidate (joint 0-based in, 1-based out). */
+void dhcal_effect_label(dhc_effect effect, size_t joint, char *buf, size_t cap);
+
+/* What the effect looks like in the residual, in plain words. */
+const char *dhcal_effect_signature(dhc_effect effect);
+
+/* A parameter value in file units: angles and compliances in degrees, the rest as is. */
+double dhcal_param_display(const dhc_param_set *set, size_t k, double value);
+
+#endif /* DHCAL_ANALYSIS_H */

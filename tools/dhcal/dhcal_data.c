@@ -1,0 +1,105 @@
+/* dhcal_data.c - measurement rows to library samples. */
+#include "dhcal_data.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+int dhcal_samples_build(const dhc_model *model, const dhcal_dataset *data, const char *path,
+                        dhcal_samples *out, dhcal_error *err)
+{
+    memset(out, 0, sizeof *out);
+    out->source = data;
+    out->path = path;
+    const size_t cap = data->n_rows > 0U ? data->n_rows : 1U;
+    out->samples = calloc(cap, sizeof *out->samples);
+    out->flags = calloc(cap, 1U);
+    if (out->samples == NULL || out->flags == NULL) {
+        dhcal_samples_free(out);
+        snprintf(err->msg, sizeof err->msg, "%s: out of memory for %zu rows", path, data->n_rows);
+        return DHCAL_IO_FAILED;
+    }
+    out->n = data->n_rows;
+    out->wires = data->has_wires && model->measurer.present;
+    if (!out->wires && !data->has_xyz) {
+        const size_t line = data->n_rows > 0U ? data->rows[0].line : 1U;
+        dhcal_samples_free(out);
+        snprintf(err->msg, sizeof err->msg,
+                 "%s:%zu: wire lengths L1..L3 need a model with a 'measurer' block", path, line);
+        return DHCAL_IO_BAD_INPUT;
+    }
+    for (size_t i = 0U; i < data->n_rows; ++i) {
+        const dhcal_row *row = &data->rows[i];
+        dhc_sample *s = &out->samples[i];
+        for (size_t j = 0U; j < data->n_joints && j < DHC_MAX_JOINTS; ++j) {
+            s->q_rad[j] = row->q_rad[j];
+            s->dir[j] = data->has_dir ? (int8_t)row->dir[j] : 0;
+        }
+        s->temp_c = data->has_temp ? row->temp_c : model->thermal_ref_c;
+        if (out->wires) {
+            memcpy(s->wire_mm, row->wires_mm, sizeof s->wire_mm);
+            s->kind = (uint8_t)DHC_MEAS_WIRES;
+        } else {
+            memcpy(s->p_mm, row->xyz_mm, sizeof s->p_mm);
+            s->kind = (uint8_t)DHC_MEAS_POSITION;
+            if (data->has_quat) {
+                if (dhc_rot_from_quat(row->quat, &s->rot) != DHC_OK) {
+                    snprintf(err->msg, sizeof err->msg, "%s:%zu: quaternion is not a rotation",
+                             path, row->line);
+                    dhcal_samples_free(out);
+                    return DHCAL_IO_BAD_INPUT;
+                }
+                s->kind = (uint8_t)DHC_MEAS_POSE;
+            }
+        }
+        out->flags[i] = (uint8_t)DHC_SAMPLE_USED;
+    }
+    return DHCAL_IO_OK;
+}
+
+void dhcal_samples_free(dhcal_samples *s)
+{
+    free(s->samples);
+    free(s->flags);
+    s->samples = NULL;
+    s->flags = NULL;
+    s->n = 0U;
+}
+
+dhc_status dhcal_samples_read(void *ctx, size_t index, dhc_sample *out)
+{
+    const dhcal_samples *s = ctx;
+    if (index >= s->n) {
+        return DHC_ERR_ARGUMENT;
+    }
+    *out = s->samples[index];
+    return DHC_OK;
+}
+
+int dhcal_samples_errors(const dhc_model *model, const dhcal_samples *s, double *resid,
+                         double *err_mm, double *rms_mm, double *max_mm)
+{
+    double ss = 0.0;
+    double mx = 0.0;
+    size_t used = 0U;
+    for (size_t i = 0U; i < s->n; ++i) {
+        double r[DHC_MAX_ROWS_PER_SAMPLE];
+        size_t rows;
+        if (dhc_model_residual(model, &s->samples[i], 1000.0, r, &rows) != DHC_OK) {
+            return DHCAL_IO_FAILED;
+        }
+        if (resid != NULL) {
+            memcpy(resid + 3U * i, r, 3U * sizeof r[0]);
+        }
+        err_mm[i] = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+        if (s->flags[i] == (uint8_t)DHC_SAMPLE_USED) {
+            ss += err_mm[i] * err_mm[i];
+            mx = fmax(mx, err_mm[i]);
+            used++;
+        }
+    }
+    *rms_mm = used > 0U ? sqrt(ss / (double)used) : 0.0;
+    *max_mm = mx;
+    return DHCAL_IO_OK;
+}

@@ -1,0 +1,40 @@
+/* dhcal_data.h - turning loaded measurement rows into library samples for one model. */
+#ifndef DHCAL_DATA_H
+#define DHCAL_DATA_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "dhcal/dhc_calib.h"
+#include "dhcal_io.h"
+
+/* Samples of a dataset, in file row order, ready for dhc_calib_fit (heap). */
+typedef struct {
+    size_t n;
+    dhc_sample *samples;
+    uint8_t *flags;
+    const dhcal_dataset *source; /* rows, for line numbers in reports */
+    const char *path;
+    int wires; /* samples are raw wire lengths (fit in wire-length space) */
+} dhcal_samples;
+
+/* Builds samples. Raw wire lengths L1..L3 are used as they are (residuals in wire-length
+ * space, where noise is independent and equal) whenever the model has a measurer;
+ * otherwise the tool point x,y,z (with qw..qz: a pose). Directions default to 0
+ * (unknown), temperature to the model's thermal reference.
+ * DHCAL_IO_BAD_INPUT (message names file and line) for wire-only data and a model without
+ * a measurer. */
+int dhcal_samples_build(const dhc_model *model, const dhcal_dataset *data, const char *path,
+                        dhcal_samples *out, dhcal_error *err);
+void dhcal_samples_free(dhcal_samples *s);
+
+/* dhc_sample_reader over dhcal_samples. */
+dhc_status dhcal_samples_read(void *ctx, size_t index, dhc_sample *out);
+
+/* Residual of every sample (3 values per row: position or wire lengths, mm) into resid
+ * (may be NULL), its norm into err_mm (n entries), and the RMS and maximum of the norm
+ * over samples whose flag is DHC_SAMPLE_USED. */
+int dhcal_samples_errors(const dhc_model *model, const dhcal_samples *s, double *resid,
+                         double *err_mm, double *rms_mm, double *max_mm);
+
+#endif /* DHCAL_DATA_H */

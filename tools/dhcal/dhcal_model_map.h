@@ -1,0 +1,31 @@
+/* dhcal_model_map.h - the model file's representation (dhcal_model) to and from the
+ * library's measurement model (dhc_model).
+ *
+ * Effects in the file's "effects" object (units as in every file: mm and degrees):
+ *   "joint_scale:i":      [s]                              (unitless)
+ *   "joint_harmonic:i":   [A_deg, B_deg]                   dq = A sin q + B cos q
+ *   "joint_backlash:i":   [b_deg]                          full play
+ *   "joint_compliance:i": [c_ii, c_i(i+1), ..., c_iN]      deg per mm of gravity moment arm
+ *   "measurer_scale":     [s]
+ *   "measurer_offset":    [o1_mm, o2_mm, o3_mm]
+ *   "thermal_scale":      [k_per_K] or [k_per_K, T0_C]     (T0 default 20 C)
+ * base_frame, tool_offset and measurer_anchors have no entry here: they are the model's
+ * "base", "tool_mm" and "measurer.anchors_mm".
+ */
+#ifndef DHCAL_MODEL_MAP_H
+#define DHCAL_MODEL_MAP_H
+
+#include "dhcal/dhc_model.h"
+#include "dhcal_io.h"
+
+/* DHCAL_IO_BAD_INPUT with "<path>: effects.<name>: ..." for a wrong value count or an
+ * entry that belongs elsewhere. */
+int dhcal_model_to_lib(const dhcal_model *file, const char *path, dhc_model *out,
+                       dhcal_error *err);
+
+/* The file representation of a fitted model: geometry, base, tool, measurer anchors and
+ * every non-zero effect; name, gravity and beta flags taken from template. */
+void dhcal_model_from_lib(const dhc_model *m, const dhcal_model *template_model,
+                          dhcal_model *out);
+
+#endif /* DHCAL_MODEL_MAP_H */

@@ -1,0 +1,988 @@
+/* dhcal_plot.c - the pictures of a fit as hand-written SVG 1.1: residuals against each joint
+ * angle, the per-row error before and after an effect, the diagnosis' candidate shares.
+ *
+ * Every input is checked before anything touches the disk. Each document is built whole in
+ * a heap buffer, then written to a temporary file beside its target and renamed over it, so
+ * a reader never sees half a picture. Numbers go out as %.6g through fin(), text through
+ * put_text() (escaped, valid UTF-8 only), so every file parses as XML whatever the labels.
+ * Layout uses an estimated glyph advance (PLOT_CHAR_EM): no font metrics are available.
+ */
+/* POSIX.1-2008: mkdir, stat, open/fsync/rename, getpid. */
+#ifndef _POSIX_C_SOURCE
+#define _POSIX_C_SOURCE 200809L
+#endif
+#include "dhcal_plot.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#if defined(__GNUC__)
+#define PLOT_PRINTF(fmt_index, first_arg) __attribute__((format(printf, fmt_index, first_arg)))
+#else
+#define PLOT_PRINTF(fmt_index, first_arg)
+#endif
+
+/* |value| beyond this (mm or degrees) is no measurement; refusing it also keeps every range,
+ * span and pixel coordinate below finite (no overflow to inf in hi - lo). */
+#define PLOT_MAX_ABS 1e12
+/* Advance of an average glyph of a sans-serif font, in ems (DejaVu Sans ~0.55-0.63), and of
+ * the bold title's. */
+#define PLOT_CHAR_EM 0.62
+#define PLOT_BOLD_EM 0.78
+#define PLOT_MAX_TICKS 64U
+/* Characters of the model name and of labels drawn before they are cut with "...". */
+#define PLOT_TITLE_ATTR_MAX 1000U
+
+#define COLOR_X "#1f77b4"
+#define COLOR_Y "#ff7f0e"
+#define COLOR_Z "#2ca02c"
+#define COLOR_BEFORE "#9e9e9e"
+#define COLOR_BEFORE_LINE "#555555"
+#define COLOR_AFTER "#1f77b4"
+#define COLOR_SIGNIFICANT "#c62828"
+#define COLOR_OTHER "#bdbdbd"
+#define COLOR_GRID "#e6e6e6"
+#define COLOR_FRAME "#999999"
+#define COLOR_TEXT "#222222"
+#define COLOR_MUTED "#666666"
+
+static const char *const component_color[3] = {COLOR_X, COLOR_Y, COLOR_Z};
+
+/* ------------------------------------------------------------------ messages */
+
+static int set_error(dhcal_error *err, int code, const char *fmt, ...) PLOT_PRINTF(3, 4);
+static int set_error(dhcal_error *err, int code, const char *fmt, ...)
+{
+    if (err != NULL) {
+        va_list ap;
+        va_start(ap, fmt);
+        (void)vsnprintf(err->msg, sizeof err->msg, fmt, ap);
+        va_end(ap);
+    }
+    return code;
+}
+
+/* ------------------------------------------------------------------ growing text buffer */
+
+typedef struct {
+    char *p;
+    size_t len;
+    size_t cap;
+    int failed; /* out of memory (or a printf failure): the document is lost */
+} svgbuf;
+
+static void sb_reserve(svgbuf *b, size_t extra)
+{
+    if (b->failed) {
+        return;
+    }
+    if (extra > SIZE_MAX - b->len - 1U) {
+        b->failed = 1;
+        return;
+    }
+    const size_t want = b->len + extra + 1U;
+    if (want <= b->cap) {
+        return;
+    }
+    size_t cap = b->cap == 0U ? 4096U : b->cap;
+    while (cap < want) {
+        cap = cap > SIZE_MAX / 2U ? want : cap * 2U;
+    }
+    char *const p = realloc(b->p, cap);
+    if (p == NULL) {
+        b->failed = 1;
+        return;
+    }
+    b->p = p;
+    b->cap = cap;
+}
+
+static void sb_put(svgbuf *b, const char *s, size_t n)
+{
+    sb_reserve(b, n);
+    if (!b->failed) {
+        memcpy(b->p + b->len, s, n);
+        b->len += n;
+        b->p[b->len] = '\0';
+    }
+}
+
+static void sb_str(svgbuf *b, const char *s)
+{
+    sb_put(b, s, strlen(s));
+}
+
+static void sb_printf(svgbuf *b, const char *fmt, ...) PLOT_PRINTF(2, 3);
+static void sb_printf(svgbuf *b, const char *fmt, ...)
+{
+    char small[256];
+    va_list ap;
+    va_start(ap, fmt);
+    const int n = vsnprintf(small, sizeof small, fmt, ap);
+    va_end(ap);
+    if (n < 0) {
+        b->failed = 1;
+        return;
+    }
+    if ((size_t)n < sizeof small) {
+        sb_put(b, small, (size_t)n);
+        return;
+    }
+    sb_reserve(b, (size_t)n);
+    if (b->failed) {
+        return;
+    }
+    va_start(ap, fmt);
+    (void)vsnprintf(b->p + b->len, (size_t)n + 1U, fmt, ap);
+    va_end(ap);
+    b->len += (size_t)n;
+}
+
+/* Every number printed goes through here: inputs are checked finite, so a non-finite value
+ * would be a bug in the layout arithmetic; 0 keeps the file valid all the same. */
+static double fin(double v)
+{
+    return isfinite(v) ? v : 0.0;
+}
+
+/* ------------------------------------------------------------------ text */
+
+/* Bytes of the character at s (n > 0 bytes left) if it is well-formed UTF-8 and a character
+ * XML 1.0 allows; 0 otherwise (C0 controls, overlong forms, surrogates, U+FFFE/U+FFFF). */
+static size_t xml_char_len(const unsigned char *s, size_t n)
+{
+    const unsigned c = s[0];
+    if (c < 0x80U) {
+        return c >= 0x20U || c == 0x09U || c == 0x0AU || c == 0x0DU ? 1U : 0U;
+    }
+    size_t len;
+    unsigned long cp;
+    if (c >= 0xC2U && c <= 0xDFU) {
+        len = 2U;
+        cp = c & 0x1FU;
+    } else if (c >= 0xE0U && c <= 0xEFU) {
+        len = 3U;
+        cp = c & 0x0FU;
+    } else if (c >= 0xF0U && c <= 0xF4U) {
+        len = 4U;
+        cp = c & 0x07U;
+    } else {
+        return 0U;
+    }
+    if (n < len) {
+        return 0U;
+    }
+    for (size_t i = 1U; i < len; ++i) {
+        if ((s[i] & 0xC0U) != 0x80U) {
+            return 0U;
+        }
+        cp = (cp << 6U) | (s[i] & 0x3FUL);
+    }
+    if ((len == 3U && cp < 0x800UL) || (len == 4U && (cp < 0x10000UL || cp > 0x10FFFFUL))) {
+        return 0U;
+    }
+    if ((cp >= 0xD800UL && cp <= 0xDFFFUL) || cp == 0xFFFEUL || cp == 0xFFFFUL) {
+        return 0U;
+    }
+    return len;
+}
+
+/* Characters put_text() draws for s[0..n): what the layout measures. */
+static size_t text_chars(const char *s, size_t n)
+{
+    const unsigned char *const u = (const unsigned char *)s;
+    size_t chars = 0U;
+    for (size_t i = 0U; i < n; ++chars) {
+        const size_t k = xml_char_len(u + i, n - i);
+        i += k > 0U ? k : 1U;
+    }
+    return chars;
+}
+
+/* s[0..n) as XML character data: & < > " ' escaped; tab and line breaks become a space (one
+ * line of text), anything else XML cannot carry becomes '?'. At most max_chars characters:
+ * a longer text is cut and ends in "...". */
+static void put_text(svgbuf *b, const char *s, size_t n, size_t max_chars)
+{
+    const unsigned char *const u = (const unsigned char *)s;
+    const size_t total = text_chars(s, n);
+    const size_t keep = total <= max_chars ? total : (max_chars > 3U ? max_chars - 3U : 0U);
+    size_t i = 0U;
+    for (size_t c = 0U; c < keep && i < n; ++c) {
+        const size_t k = xml_char_len(u + i, n - i);
+        if (k == 0U) {
+            sb_put(b, "?", 1U);
+            i++;
+            continue;
+        }
+        switch (u[i]) {
+        case '&': sb_str(b, "&amp;"); break;
+        case '<': sb_str(b, "&lt;"); break;
+        case '>': sb_str(b, "&gt;"); break;
+        case '"': sb_str(b, "&quot;"); break;
+        case '\'': sb_str(b, "&apos;"); break;
+        case '\t':
+        case '\n':
+        case '\r': sb_put(b, " ", 1U); break;
+        default: sb_put(b, s + i, k); break;
+        }
+        i += k;
+    }
+    if (keep < total) {
+        sb_str(b, "...");
+    }
+}
+
+/* <text x y attrs>s</text>, s cut to max_chars. attrs: literal attribute text, no user data. */
+static void text_el(svgbuf *b, double x, double y, const char *attrs, const char *s, size_t n,
+                    size_t max_chars)
+{
+    sb_printf(b, "<text x=\"%.6g\" y=\"%.6g\"%s%s>", fin(x), fin(y), attrs[0] != '\0' ? " " : "",
+              attrs);
+    put_text(b, s, n, max_chars);
+    sb_str(b, "</text>\n");
+}
+
+static void text_str(svgbuf *b, double x, double y, const char *attrs, const char *s)
+{
+    text_el(b, x, y, attrs, s, strlen(s), SIZE_MAX);
+}
+
+/* Estimated width in px of `chars` characters at font size `size_px`. */
+static double text_w(size_t chars, double size_px)
+{
+    return (double)chars * size_px * PLOT_CHAR_EM;
+}
+
+/* How many characters fit into width_px at size_px (at least 4, room for "x..."). */
+static size_t chars_fit(double width_px, double size_px)
+{
+    const double c = floor(width_px / (size_px * PLOT_CHAR_EM));
+    return c < 4.0 ? 4U : (c > 1e6 ? 1000000U : (size_t)c);
+}
+
+/* ------------------------------------------------------------------ axes */
+
+typedef struct {
+    double lo, hi; /* drawn range: the data range widened to multiples of step */
+    double step;
+    size_t n_ticks;
+} axis;
+
+/* 1, 2 or 5 times a power of ten, the smallest not below raw (> 0). */
+static double nice_step(double raw)
+{
+    const double p = pow(10.0, floor(log10(raw)));
+    const double f = raw / p;
+    const double m = f <= 1.0 ? 1.0 : (f <= 2.0 ? 2.0 : (f <= 5.0 ? 5.0 : 10.0));
+    return m * p;
+}
+
+/* Widens [lo, hi] by a fraction of its span on each side, so points do not sit on the frame. */
+static void pad_range(double *lo, double *hi, double frac_lo, double frac_hi)
+{
+    const double span = *hi - *lo;
+    *lo -= span * frac_lo;
+    *hi += span * frac_hi;
+}
+
+/* An axis over [lo, hi] (finite, lo <= hi, |.| <= PLOT_MAX_ABS) with about `target`
+ * intervals. Constant data (a span below 1e-9 of the magnitude, or below 1e-12 absolute)
+ * gets a window around the value instead of a zero range. `integer`: steps of at least 1. */
+static axis make_axis(double lo, double hi, double target, int integer)
+{
+    const double mag = fmax(fabs(lo), fabs(hi));
+    if (!(hi - lo > fmax(mag * 1e-9, 1e-12))) {
+        const double c = 0.5 * (lo + hi);
+        const double half = fabs(c) > 1e-9 ? fabs(c) * 0.1 : 1.0;
+        lo = c - half;
+        hi = c + half;
+    }
+    double step = nice_step((hi - lo) / (target >= 1.0 ? target : 1.0));
+    if (integer && step < 1.0) {
+        step = 1.0;
+    }
+    axis a;
+    a.step = step;
+    a.lo = floor(lo / step) * step;
+    a.hi = ceil(hi / step) * step;
+    if (!(a.hi > a.lo)) {
+        a.hi = a.lo + step;
+    }
+    const double intervals = floor((a.hi - a.lo) / step + 0.5);
+    a.n_ticks = intervals + 1.0 > (double)PLOT_MAX_TICKS ? PLOT_MAX_TICKS
+                                                          : (size_t)intervals + 1U;
+    return a;
+}
+
+static double tick_value(const axis *a, size_t i)
+{
+    const double t = a->lo + (double)i * a->step;
+    return fabs(t) < a->step * 1e-6 ? 0.0 : t; /* 0, not 1.4e-17 or -0 */
+}
+
+/* Characters of the widest tick label. */
+static size_t tick_label_chars(const axis *a)
+{
+    size_t w = 1U;
+    for (size_t i = 0U; i < a->n_ticks; ++i) {
+        char s[40];
+        const int n = snprintf(s, sizeof s, "%.6g", tick_value(a, i));
+        if (n > 0 && (size_t)n > w) {
+            w = (size_t)n;
+        }
+    }
+    return w;
+}
+
+/* The axis with the most ticks (at most about 5 intervals) whose labels do not collide:
+ * labels need label_px(axis) of room each along length_px. horizontal: labels side by side
+ * (their width counts), else stacked (their height counts). */
+static axis fit_axis(double lo, double hi, double length_px, double font_px, int horizontal,
+                     int integer)
+{
+    axis a = make_axis(lo, hi, 5.0, integer);
+    for (double target = 4.0; target >= 1.0; target -= 1.0) {
+        const double need =
+            horizontal ? text_w(tick_label_chars(&a), font_px) + 10.0 : font_px * 1.8;
+        if (a.n_ticks < 2U || length_px / (double)(a.n_ticks - 1U) >= need) {
+            break;
+        }
+        a = make_axis(lo, hi, target, integer);
+    }
+    return a;
+}
+
+/* A plot area in px and the data ranges it shows. */
+typedef struct {
+    double x, y, w, h;
+    axis ax, ay;
+} frame;
+
+static double px_x(const frame *f, double v)
+{
+    return f->x + (v - f->ax.lo) / (f->ax.hi - f->ax.lo) * f->w;
+}
+
+static double px_y(const frame *f, double v)
+{
+    return f->y + f->h - (v - f->ay.lo) / (f->ay.hi - f->ay.lo) * f->h;
+}
+
+/* White plot area, grid lines at the ticks, tick labels (groups "axis-x"/"axis-y" hold
+ * nothing but the numeric labels: tests/tools/check_svg.py checks they are round numbers). */
+static void draw_frame(svgbuf *b, const frame *f, int x_grid)
+{
+    sb_printf(b, "<rect x=\"%.6g\" y=\"%.6g\" width=\"%.6g\" height=\"%.6g\" fill=\"#ffffff\" "
+                 "stroke=\"" COLOR_FRAME "\"/>\n",
+              fin(f->x), fin(f->y), fin(f->w), fin(f->h));
+    sb_str(b, "<g stroke=\"" COLOR_GRID "\" stroke-width=\"1\">\n");
+    for (size_t i = 0U; i < f->ay.n_ticks; ++i) {
+        const double y = px_y(f, tick_value(&f->ay, i));
+        sb_printf(b, "<line x1=\"%.6g\" y1=\"%.6g\" x2=\"%.6g\" y2=\"%.6g\"/>\n", fin(f->x),
+                  fin(y), fin(f->x + f->w), fin(y));
+    }
+    for (size_t i = 0U; x_grid && i < f->ax.n_ticks; ++i) {
+        const double x = px_x(f, tick_value(&f->ax, i));
+        sb_printf(b, "<line x1=\"%.6g\" y1=\"%.6g\" x2=\"%.6g\" y2=\"%.6g\"/>\n", fin(x),
+                  fin(f->y), fin(x), fin(f->y + f->h));
+    }
+    sb_str(b, "</g>\n");
+    if (f->ay.n_ticks > 0U) {
+        sb_str(b, "<g class=\"axis-y\" font-size=\"11\" text-anchor=\"end\" fill=\"" COLOR_TEXT
+                  "\">\n");
+        for (size_t i = 0U; i < f->ay.n_ticks; ++i) {
+            const double v = tick_value(&f->ay, i);
+            sb_printf(b, "<text x=\"%.6g\" y=\"%.6g\">%.6g</text>\n", fin(f->x - 6.0),
+                      fin(px_y(f, v) + 4.0), fin(v));
+        }
+        sb_str(b, "</g>\n");
+    }
+    sb_str(b, "<g class=\"axis-x\" font-size=\"11\" text-anchor=\"middle\" fill=\"" COLOR_TEXT
+              "\">\n");
+    for (size_t i = 0U; i < f->ax.n_ticks; ++i) {
+        const double v = tick_value(&f->ax, i);
+        sb_printf(b, "<text x=\"%.6g\" y=\"%.6g\">%.6g</text>\n", fin(px_x(f, v)),
+                  fin(f->y + f->h + 15.0), fin(v));
+    }
+    sb_str(b, "</g>\n");
+}
+
+/* Axis titles: below the plot area, and rotated along its left side at x_left. */
+static void draw_axis_titles(svgbuf *b, const frame *f, const char *x_title, double x_left,
+                             const char *y_title)
+{
+    text_str(b, f->x + 0.5 * f->w, f->y + f->h + 33.0,
+             "font-size=\"12\" text-anchor=\"middle\" fill=\"" COLOR_TEXT "\"", x_title);
+    const double yc = f->y + 0.5 * f->h;
+    sb_printf(b,
+              "<text x=\"%.6g\" y=\"%.6g\" transform=\"rotate(-90 %.6g %.6g)\" font-size=\"12\" "
+              "text-anchor=\"middle\" fill=\"" COLOR_TEXT "\">",
+              fin(x_left), fin(yc), fin(x_left), fin(yc));
+    put_text(b, y_title, strlen(y_title), SIZE_MAX);
+    sb_str(b, "</text>\n");
+}
+
+/* In the upper part of the plot area: the middle is where the zero line runs. */
+static void no_data_note(svgbuf *b, const frame *f, const char *what)
+{
+    text_str(b, f->x + 0.5 * f->w, f->y + fmax(0.3 * f->h, 16.0),
+             "font-size=\"13\" text-anchor=\"middle\" fill=\"" COLOR_MUTED "\"", what);
+}
+
+/* ------------------------------------------------------------------ documents */
+
+static void doc_begin(svgbuf *b, double w, double h, const char *title, size_t title_len)
+{
+    sb_printf(b,
+              "<?xml version=\"1.0\" encoding=\"UTF-8\" standalone=\"no\"?>\n"
+              "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"%.6g\" "
+              "height=\"%.6g\" viewBox=\"0 0 %.6g %.6g\" "
+              "font-family=\"DejaVu Sans, Helvetica, Arial, sans-serif\">\n<title>",
+              fin(w), fin(h), fin(w), fin(h));
+    put_text(b, title, title_len, PLOT_TITLE_ATTR_MAX);
+    sb_printf(b, "</title>\n<rect x=\"0\" y=\"0\" width=\"%.6g\" height=\"%.6g\" fill=\"#ffffff\"/>\n",
+              fin(w), fin(h));
+    text_el(b, 20.0, 28.0, "font-size=\"16\" font-weight=\"bold\" fill=\"" COLOR_TEXT "\"", title,
+            title_len, chars_fit(w - 40.0, 16.0 * PLOT_BOLD_EM / PLOT_CHAR_EM));
+}
+
+static void doc_end(svgbuf *b)
+{
+    sb_str(b, "</svg>\n");
+}
+
+/* "<prefix><model name>" into t (the name may be anything: put_text() escapes it later). */
+static void title_text(svgbuf *t, const char *prefix, const dhcal_plot_data *d)
+{
+    sb_str(t, prefix);
+    sb_str(t, d->title[0] != '\0' ? d->title : "(unnamed model)");
+}
+
+/* A legend entry: a colour swatch (a square, or a circle of class "legend" so that data points
+ * stay countable) and its text, cut to max_chars; returns the x after it. */
+static double legend_item(svgbuf *b, double x, double y, const char *color, int round,
+                          const char *label, size_t max_chars)
+{
+    if (round) {
+        sb_printf(b, "<circle class=\"legend\" cx=\"%.6g\" cy=\"%.6g\" r=\"4\" fill=\"%s\"/>\n",
+                  fin(x + 5.0), fin(y - 4.0), color);
+    } else {
+        sb_printf(b, "<rect x=\"%.6g\" y=\"%.6g\" width=\"10\" height=\"10\" fill=\"%s\"/>\n",
+                  fin(x), fin(y - 9.0), color);
+    }
+    const size_t n = strlen(label);
+    text_el(b, x + 15.0, y, "font-size=\"12\" fill=\"" COLOR_TEXT "\"", label, n, max_chars);
+    const size_t chars = text_chars(label, n);
+    return x + 15.0 + text_w(chars < max_chars ? chars : max_chars, 12.0) + 18.0;
+}
+
+static void residuals_svg(svgbuf *b, const dhcal_plot_data *d)
+{
+    const size_t n = d->n_rows;
+    const size_t nj = d->n_joints;
+    /* Every panel shows the same residuals, against a different joint: one y scale for all,
+     * so the panels compare at a glance. Zero is always in range (the zero line). */
+    double ylo = 0.0;
+    double yhi = 0.0;
+    for (size_t i = 0U; i < 3U * n; ++i) {
+        ylo = fmin(ylo, d->resid_before[i]);
+        yhi = fmax(yhi, d->resid_before[i]);
+    }
+    pad_range(&ylo, &yhi, 0.05, 0.05);
+    const double plot_w = 380.0;
+    const double plot_h = 190.0;
+    const axis ay = fit_axis(ylo, yhi, plot_h, 11.0, 0, 0);
+    const double left = 24.0 + text_w(tick_label_chars(&ay), 11.0) + 12.0;
+    const double cell_w = left + plot_w + 24.0;
+    const double cell_h = 30.0 + plot_h + 50.0;
+    const size_t cols = nj >= 2U ? 2U : 1U;
+    const size_t rows = (nj + cols - 1U) / cols;
+    const double top = 72.0;
+    /* one column: wide enough for a title with the model name in it */
+    const double width = fmax(640.0, 20.0 + (double)cols * cell_w);
+    const double height = top + (double)rows * cell_h + 6.0;
+
+    svgbuf t = {NULL, 0U, 0U, 0};
+    title_text(&t, "Residuals vs joint angle: ", d);
+    doc_begin(b, width, height, t.failed ? "" : t.p, t.failed ? 0U : t.len);
+    b->failed |= t.failed;
+    free(t.p);
+
+    static const char *const xyz[3] = {"x", "y", "z"};
+    static const char *const wires[3] = {"L1", "L2", "L3"};
+    const char *const *const names = d->wires ? wires : xyz;
+    double lx = 20.0;
+    for (size_t k = 0U; k < 3U; ++k) {
+        lx = legend_item(b, lx, 52.0, component_color[k], 0, names[k], SIZE_MAX);
+    }
+    char note[160];
+    (void)snprintf(note, sizeof note, "%zu rows; residual in mm (%s), the same in every panel",
+                   n, d->wires ? "wire lengths" : "position");
+    if (lx + text_w(strlen(note), 12.0) <= width - 10.0) {
+        text_str(b, lx, 52.0, "font-size=\"12\" fill=\"" COLOR_MUTED "\"", note);
+    }
+
+    for (size_t j = 0U; j < nj; ++j) {
+        const double cx = 10.0 + (double)(j % cols) * cell_w;
+        const double cy = top + (double)(j / cols) * cell_h;
+        double xlo = -180.0;
+        double xhi = 180.0;
+        if (n > 0U) {
+            xlo = xhi = d->q_deg[j];
+            for (size_t i = 1U; i < n; ++i) {
+                xlo = fmin(xlo, d->q_deg[i * nj + j]);
+                xhi = fmax(xhi, d->q_deg[i * nj + j]);
+            }
+            pad_range(&xlo, &xhi, 0.03, 0.03);
+        }
+        frame f = {cx + left, cy + 30.0, plot_w, plot_h, make_axis(0.0, 1.0, 5.0, 0), ay};
+        f.ax = fit_axis(xlo, xhi, plot_w, 11.0, 1, 0);
+        sb_printf(b, "<g class=\"panel\" id=\"joint%zu\">\n", j + 1U);
+        draw_frame(b, &f, 1);
+        if (f.ay.lo < 0.0 && f.ay.hi > 0.0) {
+            const double y0 = px_y(&f, 0.0);
+            sb_printf(b, "<line x1=\"%.6g\" y1=\"%.6g\" x2=\"%.6g\" y2=\"%.6g\" stroke=\"#444444\" "
+                         "stroke-width=\"1\"/>\n",
+                      fin(f.x), fin(y0), fin(f.x + f.w), fin(y0));
+        }
+        for (size_t k = 0U; k < 3U; ++k) {
+            sb_printf(b, "<g class=\"series-%s\" fill=\"%s\" fill-opacity=\"0.7\">\n", names[k],
+                      component_color[k]);
+            for (size_t i = 0U; i < n; ++i) {
+                sb_printf(b, "<circle cx=\"%.6g\" cy=\"%.6g\" r=\"2.2\"/>\n",
+                          fin(px_x(&f, d->q_deg[i * nj + j])),
+                          fin(px_y(&f, d->resid_before[3U * i + k])));
+            }
+            sb_str(b, "</g>\n");
+        }
+        if (n == 0U) {
+            no_data_note(b, &f, "no rows");
+        }
+        char s[48];
+        (void)snprintf(s, sizeof s, "joint %zu", j + 1U);
+        text_str(b, f.x, f.y - 8.0, "font-size=\"13\" font-weight=\"bold\" fill=\"" COLOR_TEXT "\"",
+                 s);
+        (void)snprintf(s, sizeof s, "q%zu [deg]", j + 1U);
+        draw_axis_titles(b, &f, s, cx + 16.0, "residual [mm]");
+        sb_str(b, "</g>\n");
+    }
+    doc_end(b);
+}
+
+/* An RMS value for a label: 3 decimals in the usual range, 3 significant digits outside. */
+static void fmt_mm(char *s, size_t cap, double v)
+{
+    const double a = fabs(v);
+    (void)snprintf(s, cap, a >= 0.01 && a < 1e5 ? "%.3f" : "%.3g", fin(v));
+}
+
+/* Places two labels by their lines' pixel heights (upper = smaller y), each just above
+ * (-5) or below (+15) its line or stacked beside the other: the first arrangement that keeps
+ * both baselines inside [y_min + 11, y_max] and 15 px apart; stacked at the top when none
+ * does (a plot area too small to matter). */
+static void place_labels(double py_up, double py_low, double y_min, double y_max,
+                         double *ty_up, double *ty_low)
+{
+    const double cand[6][2] = {
+        {py_up - 5.0, py_low - 5.0},  {py_up - 5.0, py_low + 15.0},
+        {py_low - 20.0, py_low - 5.0}, {py_up + 15.0, py_up + 30.0},
+        {py_up + 15.0, py_low + 15.0}, {py_up - 20.0, py_up - 5.0},
+    };
+    for (size_t c = 0U; c < 6U; ++c) {
+        const double a = cand[c][0];
+        const double l = cand[c][1];
+        if (a - 11.0 >= y_min && l - 11.0 >= y_min && a <= y_max && l <= y_max &&
+            fabs(a - l) >= 15.0) {
+            *ty_up = a;
+            *ty_low = l;
+            return;
+        }
+    }
+    *ty_up = y_min + 12.0;
+    *ty_low = y_min + 28.0;
+}
+
+/* A label over a translucent white box, right-aligned at x_right (the box is an estimate
+ * of the text's extent: no font metrics). */
+static void boxed_label(svgbuf *b, double x_right, double y, const char *color, const char *s,
+                        size_t max_chars)
+{
+    const size_t chars = text_chars(s, strlen(s));
+    const double w = text_w(chars < max_chars ? chars : max_chars, 12.0) + 6.0;
+    sb_printf(b, "<rect x=\"%.6g\" y=\"%.6g\" width=\"%.6g\" height=\"15\" fill=\"#ffffff\" "
+                 "fill-opacity=\"0.85\"/>\n",
+              fin(x_right - w + 3.0), fin(y - 11.5), fin(w));
+    sb_printf(b, "<text x=\"%.6g\" y=\"%.6g\" font-size=\"12\" text-anchor=\"end\" fill=\"%s\">",
+              fin(x_right), fin(y), color);
+    put_text(b, s, strlen(s), max_chars);
+    sb_str(b, "</text>\n");
+}
+
+static void errors_svg(svgbuf *b, const dhcal_plot_data *d)
+{
+    const size_t n = d->n_rows;
+    const int named = d->effect[0] != '\0';
+    double yhi = fmax(0.0, fmax(d->rms_before_mm, d->rms_after_mm));
+    double ylo = fmin(0.0, fmin(d->rms_before_mm, d->rms_after_mm));
+    for (size_t i = 0U; i < n; ++i) {
+        yhi = fmax(yhi, fmax(d->err_before[i], d->err_after[i]));
+        ylo = fmin(ylo, fmin(d->err_before[i], d->err_after[i]));
+    }
+    pad_range(&ylo, &yhi, ylo < 0.0 ? 0.05 : 0.0, 0.05);
+    if (!(yhi > ylo)) {
+        yhi = ylo + 1.0; /* all zero: [0, 1], not the window around 0 make_axis() would choose */
+    }
+    const double width = 960.0;
+    const double plot_h = 300.0;
+    const axis ay = fit_axis(ylo, yhi, plot_h, 11.0, 0, 0);
+    const double left = 24.0 + text_w(tick_label_chars(&ay), 11.0) + 12.0;
+    const double xhi = n > 1U ? (double)(n - 1U) : 1.0;
+    frame f = {left, 72.0, width - left - 24.0, plot_h, make_axis(0.0, 1.0, 5.0, 0), ay};
+    f.ax = fit_axis(0.0, xhi, f.w, 11.0, 1, 1);
+    const double height = f.y + f.h + 48.0;
+
+    svgbuf t = {NULL, 0U, 0U, 0};
+    title_text(&t, "Error per row, before and after: ", d);
+    doc_begin(b, width, height, t.failed ? "" : t.p, t.failed ? 0U : t.len);
+    b->failed |= t.failed;
+    free(t.p);
+
+    /* The labels, built once: the legend and the RMS lines say the same thing. */
+    svgbuf after = {NULL, 0U, 0U, 0};
+    sb_str(&after, "after (");
+    if (named) {
+        sb_str(&after, "+");
+        sb_str(&after, d->effect);
+    } else {
+        sb_str(&after, "no effect named");
+    }
+    sb_str(&after, ")");
+    char num[48];
+    char before_rms[80];
+    fmt_mm(num, sizeof num, d->rms_before_mm);
+    (void)snprintf(before_rms, sizeof before_rms, "before RMS %s mm", num);
+    svgbuf after_rms = {NULL, 0U, 0U, 0};
+    fmt_mm(num, sizeof num, d->rms_after_mm);
+    if (!after.failed) {
+        sb_put(&after_rms, after.p, after.len);
+    }
+    sb_printf(&after_rms, " RMS %s mm", num);
+    b->failed |= after.failed | after_rms.failed;
+    const char *const after_label = after.failed ? "after" : after.p;
+    const char *const after_rms_label = after_rms.failed ? "after" : after_rms.p;
+
+    /* Legend: round swatches, like the points they stand for. */
+    const double lx = legend_item(b, 20.0, 52.0, COLOR_BEFORE, 1, "before (base fit)", SIZE_MAX);
+    (void)legend_item(b, lx, 52.0, COLOR_AFTER, 1, after_label, chars_fit(width - lx - 40.0, 12.0));
+
+    draw_frame(b, &f, 0);
+    sb_str(b, "<g class=\"series-before\" fill=\"" COLOR_BEFORE "\" fill-opacity=\"0.8\">\n");
+    for (size_t i = 0U; i < n; ++i) {
+        sb_printf(b, "<circle cx=\"%.6g\" cy=\"%.6g\" r=\"2\"/>\n", fin(px_x(&f, (double)i)),
+                  fin(px_y(&f, d->err_before[i])));
+    }
+    sb_str(b, "</g>\n<g class=\"series-after\" fill=\"" COLOR_AFTER "\" fill-opacity=\"0.8\">\n");
+    for (size_t i = 0U; i < n; ++i) {
+        sb_printf(b, "<circle cx=\"%.6g\" cy=\"%.6g\" r=\"2\"/>\n", fin(px_x(&f, (double)i)),
+                  fin(px_y(&f, d->err_after[i])));
+    }
+    sb_str(b, "</g>\n");
+    if (n == 0U) {
+        no_data_note(b, &f, "no rows");
+    }
+
+    const double py_b = px_y(&f, d->rms_before_mm);
+    const double py_a = px_y(&f, d->rms_after_mm);
+    sb_printf(b, "<line class=\"rms-before\" x1=\"%.6g\" y1=\"%.6g\" x2=\"%.6g\" y2=\"%.6g\" "
+                 "stroke=\"" COLOR_BEFORE_LINE "\" stroke-width=\"1.5\" stroke-dasharray=\"6 4\"/>\n",
+              fin(f.x), fin(py_b), fin(f.x + f.w), fin(py_b));
+    sb_printf(b, "<line class=\"rms-after\" x1=\"%.6g\" y1=\"%.6g\" x2=\"%.6g\" y2=\"%.6g\" "
+                 "stroke=\"" COLOR_AFTER "\" stroke-width=\"1.5\" stroke-dasharray=\"6 4\"/>\n",
+              fin(f.x), fin(py_a), fin(f.x + f.w), fin(py_a));
+    double ty_b;
+    double ty_a;
+    if (py_b <= py_a) {
+        place_labels(py_b, py_a, f.y + 2.0, f.y + f.h - 3.0, &ty_b, &ty_a);
+    } else {
+        place_labels(py_a, py_b, f.y + 2.0, f.y + f.h - 3.0, &ty_a, &ty_b);
+    }
+    const size_t max_chars = chars_fit(f.w - 12.0, 12.0);
+    boxed_label(b, f.x + f.w - 6.0, ty_b, COLOR_BEFORE_LINE, before_rms, max_chars);
+    boxed_label(b, f.x + f.w - 6.0, ty_a, COLOR_AFTER, after_rms_label, max_chars);
+    free(after.p);
+    free(after_rms.p);
+
+    draw_axis_titles(b, &f, "row (data order)", 18.0, "error [mm]");
+    doc_end(b);
+}
+
+static size_t label_len(const dhcal_plot_candidate *c)
+{
+    const void *const nul = memchr(c->label, '\0', sizeof c->label);
+    return nul != NULL ? (size_t)((const char *)nul - c->label) : sizeof c->label;
+}
+
+static void candidates_svg(svgbuf *b, const dhcal_plot_data *d)
+{
+    const size_t nc = d->n_candidates;
+    size_t label_chars = 10U;
+    for (size_t i = 0U; i < nc; ++i) {
+        const size_t c = text_chars(d->candidates[i].label, label_len(&d->candidates[i]));
+        label_chars = c > label_chars ? c : label_chars;
+    }
+    const double label_w = text_w(label_chars, 12.0) + 14.0;
+    const double row_h = 24.0;
+    frame f = {20.0 + label_w, 72.0, 480.0, row_h * (double)(nc > 0U ? nc : 1U),
+               make_axis(0.0, 100.0, 5.0, 0), make_axis(0.0, 1.0, 1.0, 0)};
+    f.ay.n_ticks = 0U; /* categories, not numbers: no y ticks */
+    const double width = f.x + f.w + 170.0;
+    const double height = f.y + f.h + 48.0;
+
+    svgbuf t = {NULL, 0U, 0U, 0};
+    title_text(&t, "Candidate effects: ", d);
+    doc_begin(b, width, height, t.failed ? "" : t.p, t.failed ? 0U : t.len);
+    b->failed |= t.failed;
+    free(t.p);
+    const double lx = legend_item(b, 20.0, 52.0, COLOR_SIGNIFICANT, 0, "significant", SIZE_MAX);
+    (void)legend_item(b, lx, 52.0, COLOR_OTHER, 0, "not significant", SIZE_MAX);
+
+    draw_frame(b, &f, 1);
+    for (size_t i = 0U; i < nc; ++i) {
+        const dhcal_plot_candidate *const c = &d->candidates[i];
+        const double share = fmin(1.0, fmax(0.0, c->explained));
+        const double y = f.y + row_h * (double)i;
+        const char *const color = c->significant ? COLOR_SIGNIFICANT : COLOR_OTHER;
+        text_el(b, f.x - 8.0, y + 16.0, "font-size=\"12\" text-anchor=\"end\" fill=\"" COLOR_TEXT "\"",
+                c->label, label_len(c), SIZE_MAX);
+        sb_printf(b, "<rect class=\"bar\" x=\"%.6g\" y=\"%.6g\" width=\"%.6g\" height=\"16\" "
+                     "fill=\"%s\"/>\n",
+                  fin(f.x), fin(y + 4.0), fin(share * f.w), color);
+        char pct[80];
+        (void)snprintf(pct, sizeof pct, "%.1f %%%s", fin(100.0 * c->explained),
+                       c->significant ? " significant" : "");
+        text_str(b, f.x + share * f.w + 6.0, y + 16.0,
+                 c->significant ? "font-size=\"12\" font-weight=\"bold\" fill=\"" COLOR_SIGNIFICANT
+                                  "\""
+                                : "font-size=\"12\" fill=\"" COLOR_MUTED "\"",
+                 pct);
+    }
+    if (nc == 0U) {
+        no_data_note(b, &f, "no candidates");
+    }
+    text_str(b, f.x + 0.5 * f.w, f.y + f.h + 33.0,
+             "font-size=\"12\" text-anchor=\"middle\" fill=\"" COLOR_TEXT "\"",
+             "share of the residual explained [%]");
+    doc_end(b);
+}
+
+/* ------------------------------------------------------------------ checks */
+
+/* Checks n values; on the first non-finite or implausibly large one writes the message.
+ * cols > 0: a matrix (row, column in the message); cols == 0: a vector. */
+static int check_values(const double *v, size_t n, size_t cols, const char *name,
+                        const char *unit, dhcal_error *err)
+{
+    for (size_t i = 0U; i < n; ++i) {
+        if (isfinite(v[i]) && fabs(v[i]) <= PLOT_MAX_ABS) {
+            continue;
+        }
+        char where[64];
+        if (cols > 0U) {
+            (void)snprintf(where, sizeof where, "%s[%zu][%zu]", name, i / cols, i % cols);
+        } else {
+            (void)snprintf(where, sizeof where, "%s[%zu]", name, i);
+        }
+        if (!isfinite(v[i])) {
+            return set_error(err, DHCAL_IO_BAD_INPUT, "plot: %s is %s, not a finite number", where,
+                             isnan(v[i]) ? "NaN" : "infinite");
+        }
+        return set_error(err, DHCAL_IO_BAD_INPUT, "plot: %s = %g %s is beyond +-%g", where, v[i],
+                         unit, PLOT_MAX_ABS);
+    }
+    return DHCAL_IO_OK;
+}
+
+static int check_data(const dhcal_plot_data *d, dhcal_error *err)
+{
+    if (d->title == NULL || d->effect == NULL || (d->n_candidates > 0U && d->candidates == NULL)) {
+        return set_error(err, DHCAL_IO_FAILED, "plot: title, effect or candidates missing");
+    }
+    if (d->n_joints < 1U || d->n_joints > DHC_MAX_JOINTS) {
+        return set_error(err, DHCAL_IO_FAILED, "plot: %zu joints (1..%u)", d->n_joints,
+                         (unsigned)DHC_MAX_JOINTS);
+    }
+    const size_t n = d->n_rows;
+    if (n > SIZE_MAX / 64U / DHC_MAX_JOINTS) {
+        return set_error(err, DHCAL_IO_FAILED, "plot: %zu rows: too many", n);
+    }
+    if (n > 0U && (d->q_deg == NULL || d->resid_before == NULL || d->resid_after == NULL ||
+                   d->err_before == NULL || d->err_after == NULL)) {
+        return set_error(err, DHCAL_IO_FAILED, "plot: data arrays missing");
+    }
+    int rc = DHCAL_IO_OK;
+    if (n > 0U) {
+        rc = check_values(d->q_deg, n * d->n_joints, d->n_joints, "q_deg", "deg", err);
+        rc = rc != DHCAL_IO_OK ? rc : check_values(d->resid_before, 3U * n, 3U, "resid_before", "mm", err);
+        rc = rc != DHCAL_IO_OK ? rc : check_values(d->resid_after, 3U * n, 3U, "resid_after", "mm", err);
+        rc = rc != DHCAL_IO_OK ? rc : check_values(d->err_before, n, 0U, "err_before", "mm", err);
+        rc = rc != DHCAL_IO_OK ? rc : check_values(d->err_after, n, 0U, "err_after", "mm", err);
+    }
+    rc = rc != DHCAL_IO_OK ? rc : check_values(&d->rms_before_mm, 1U, 0U, "rms_before_mm", "mm", err);
+    rc = rc != DHCAL_IO_OK ? rc : check_values(&d->rms_after_mm, 1U, 0U, "rms_after_mm", "mm", err);
+    for (size_t i = 0U; rc == DHCAL_IO_OK && i < d->n_candidates; ++i) {
+        if (!isfinite(d->candidates[i].explained)) {
+            rc = set_error(err, DHCAL_IO_BAD_INPUT,
+                           "plot: candidates[%zu].explained is not a finite number", i);
+        }
+    }
+    return rc;
+}
+
+/* ------------------------------------------------------------------ files */
+
+/* dir and its missing parents (mkdir -p), mode 0777 less the umask. */
+static int make_dir(const char *dir, dhcal_error *err)
+{
+    struct stat st;
+    if (stat(dir, &st) == 0) {
+        return S_ISDIR(st.st_mode) ? DHCAL_IO_OK
+                                   : set_error(err, DHCAL_IO_FAILED,
+                                               "%s: exists and is not a directory", dir);
+    }
+    const size_t len = strlen(dir);
+    char *const p = malloc(len + 1U);
+    if (p == NULL) {
+        return set_error(err, DHCAL_IO_FAILED, "%s: cannot create directory: out of memory", dir);
+    }
+    memcpy(p, dir, len + 1U);
+    int rc = DHCAL_IO_OK;
+    for (size_t i = 1U; i <= len && rc == DHCAL_IO_OK; ++i) {
+        if (p[i] != '/' && p[i] != '\0') {
+            continue;
+        }
+        const char c = p[i];
+        p[i] = '\0';
+        if (mkdir(p, 0777) != 0 && errno != EEXIST) {
+            rc = set_error(err, DHCAL_IO_FAILED, "%s: cannot create directory '%s': %s", dir, p,
+                           strerror(errno));
+        }
+        p[i] = c;
+    }
+    free(p);
+    if (rc == DHCAL_IO_OK && (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))) {
+        rc = set_error(err, DHCAL_IO_FAILED, "%s: exists and is not a directory", dir);
+    }
+    return rc;
+}
+
+static int write_all(int fd, const char *p, size_t n)
+{
+    while (n > 0U) {
+        const ssize_t w = write(fd, p, n);
+        if (w < 0) {
+            if (errno == EINTR) {
+                continue;
+            }
+            return -1;
+        }
+        p += (size_t)w;
+        n -= (size_t)w;
+    }
+    return 0;
+}
+
+/* dir/name := b, through "dir/name.tmp.<pid>.<k>" (O_EXCL: never follows or clobbers
+ * another file), fsync and rename; the temporary file is removed on every failure. */
+static int write_file(const char *dir, const char *name, const svgbuf *b, dhcal_error *err)
+{
+    const size_t dlen = strlen(dir);
+    const int slash = dlen > 0U && dir[dlen - 1U] == '/';
+    const size_t cap = dlen + strlen(name) + 64U;
+    char *const path = malloc(cap);
+    char *const tmp = malloc(cap);
+    if (path == NULL || tmp == NULL) {
+        free(path);
+        free(tmp);
+        return set_error(err, DHCAL_IO_FAILED, "%s/%s: not written: out of memory", dir, name);
+    }
+    (void)snprintf(path, cap, "%s%s%s", dir, slash ? "" : "/", name);
+    int fd = -1;
+    for (unsigned k = 0U; k < 100U && fd < 0; ++k) {
+        (void)snprintf(tmp, cap, "%s.tmp.%ld.%u", path, (long)getpid(), k);
+        fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        if (fd < 0 && errno != EEXIST) {
+            break;
+        }
+    }
+    int rc = DHCAL_IO_OK;
+    if (fd < 0) {
+        rc = set_error(err, DHCAL_IO_FAILED, "%s: cannot create temporary file '%s': %s", path,
+                       tmp, strerror(errno));
+    } else {
+        int saved = 0;
+        if (write_all(fd, b->p, b->len) != 0 || fsync(fd) != 0) {
+            saved = errno;
+        }
+        if (close(fd) != 0 && saved == 0) {
+            saved = errno;
+        }
+        if (saved != 0) {
+            rc = set_error(err, DHCAL_IO_FAILED, "%s: cannot write temporary file '%s': %s",
+                           path, tmp, strerror(saved));
+        } else if (rename(tmp, path) != 0) {
+            rc = set_error(err, DHCAL_IO_FAILED, "%s: cannot replace it with '%s': %s", path,
+                           tmp, strerror(errno));
+        }
+        if (rc != DHCAL_IO_OK) {
+            (void)unlink(tmp);
+        }
+    }
+    free(path);
+    free(tmp);
+    return rc;
+}
+
+int dhcal_plot_write(const char *dir, const dhcal_plot_data *d, dhcal_error *err)
+{
+    if (err != NULL) {
+        err->msg[0] = '\0';
+    }
+    if (dir == NULL || d == NULL) {
+        return set_error(err, DHCAL_IO_FAILED, "plot: no directory or no data");
+    }
+    if (dir[0] == '\0') {
+        return set_error(err, DHCAL_IO_FAILED, "plot: empty directory name");
+    }
+    int rc = check_data(d, err);
+    if (rc != DHCAL_IO_OK) {
+        return rc;
+    }
+    static const char *const names[3] = {"residuals.svg", "errors.svg", "candidates.svg"};
+    svgbuf doc[3] = {{NULL, 0U, 0U, 0}, {NULL, 0U, 0U, 0}, {NULL, 0U, 0U, 0}};
+    residuals_svg(&doc[0], d);
+    errors_svg(&doc[1], d);
+    candidates_svg(&doc[2], d);
+    for (size_t k = 0U; k < 3U && rc == DHCAL_IO_OK; ++k) {
+        if (doc[k].failed) {
+            rc = set_error(err, DHCAL_IO_FAILED, "%s/%s: not written: out of memory", dir,
+                           names[k]);
+        }
+    }
+    rc = rc != DHCAL_IO_OK ? rc : make_dir(dir, err);
+    for (size_t k = 0U; k < 3U && rc == DHCAL_IO_OK; ++k) {
+        rc = write_file(dir, names[k], &doc[k], err);
+    }
+    for (size_t k = 0U; k < 3U; ++k) {
+        free(doc[k].p);
+    }
+    return rc;
+}

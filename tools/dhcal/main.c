@@ -1,0 +1,672 @@
+/* dhcal - the command line: compare a model with measurements, fit it, find the missing
+ * physical effect, plot it. Contract: DESIGN.md section 3 (flags, exit codes, JSON keys). */
+#ifndef _POSIX_C_SOURCE
+#define _POSIX_C_SOURCE 200809L
+#endif
+
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dhcal_analysis.h"
+#include "dhcal_data.h"
+#include "dhcal_io.h"
+#include "dhcal_model_map.h"
+#include "dhcal_plot.h"
+
+#define EXIT_COMPUTE 1
+#define EXIT_USAGE 2
+
+typedef struct {
+    const char *command;
+    const char *model;
+    const char *data;
+    const char *heldout;
+    const char *out;
+    const char *effects;
+    int json;
+} options;
+
+static const char *const common_help =
+    "  --model M.json     nominal model (DESIGN.md section 3)\n"
+    "  --data D.csv       measurements: q1..qN in deg; x,y,z in mm or raw wire lengths\n"
+    "                     L1,L2,L3 (fitted in wire-length space when the model has a\n"
+    "                     measurer); optional dir1..dirN, temp_c, qw,qx,qy,qz\n"
+    "  --effects LIST     effects to fit besides joint offsets and link geometry, comma\n"
+    "                     separated: base_frame, tool_offset, joint_scale:i,\n"
+    "                     joint_harmonic:i, joint_backlash:i, joint_compliance:i,\n"
+    "                     measurer_scale, measurer_offset, measurer_anchors, thermal_scale\n"
+    "  --heldout H.csv    rows not used in the fit; their RMS error is reported\n"
+    "  --json             one JSON object on stdout instead of text\n";
+
+static const char *const usage_text =
+    "usage: dhcal <command> --model M.json --data D.csv [options]\n"
+    "commands:\n"
+    "  compare    the model against the measurements, no fitting: per-row error, RMS, max\n"
+    "  fit        least-squares calibration of the model\n"
+    "  diagnose   fit, then rank the physical effects the model still misses\n"
+    "  plot       residual and error plots (SVG) of a fit and its diagnosis\n"
+    "'dhcal <command> --help' describes each.\n"
+    "exit codes: 0 success, 1 computation failed, 2 bad input or usage\n";
+
+static void print_command_help(const char *command)
+{
+    if (strcmp(command, "compare") == 0) {
+        printf("usage: dhcal compare --model M.json --data D.csv [--json]\n"
+               "The model's prediction for every row against its measurement, without\n"
+               "fitting: per-row error, RMS and maximum (mm; wire-length space for L1..L3).\n");
+    } else if (strcmp(command, "fit") == 0) {
+        printf("usage: dhcal fit --model M.json --data D.csv [--effects LIST] [--heldout H.csv]\n"
+               "                 [--out C.json] [--json]\n"
+               "Fits joint offsets and link geometry (Hayati's beta where consecutive axes\n"
+               "are nominally parallel) plus --effects. Reports parameters with standard\n"
+               "errors, parameters the data cannot identify and what they trade off with,\n"
+               "and outlier rows (left out). --out writes the calibrated model (same schema;\n"
+               "it loads again as --model) only when the fit succeeds.\n");
+    } else if (strcmp(command, "diagnose") == 0) {
+        printf("usage: dhcal diagnose --model M.json --data D.csv [--effects LIST] [--json]\n"
+               "Fits, then scores every effect the model does not have yet against the\n"
+               "remaining residual (score test, Holm-corrected at 0.1 %%): the share of the\n"
+               "residual each would explain, whether that is significant, and look-alikes.\n");
+    } else if (strcmp(command, "plot") == 0) {
+        printf("usage: dhcal plot --model M.json --data D.csv --out DIR [--effects LIST]\n"
+               "Writes SVG files into DIR: residual components against each joint angle\n"
+               "(where a missing effect shows its shape), per-row error before and after\n"
+               "adding the effect the diagnosis names, and the candidate ranking.\n");
+    } else {
+        fputs(usage_text, stdout);
+        return;
+    }
+    printf("options:\n%s", common_help);
+    if (strcmp(command, "plot") == 0) {
+        printf("  --out DIR          directory for the SVG files (created if missing)\n");
+    }
+}
+
+static int usage_error(const char *msg)
+{
+    fprintf(stderr, "dhcal: %s\n%s", msg, usage_text);
+    return EXIT_USAGE;
+}
+
+/* Returns 0, EXIT_USAGE, or -1 when help was printed. */
+static int parse_args(int argc, char **argv, options *o)
+{
+    memset(o, 0, sizeof *o);
+    if (argc < 2) {
+        return usage_error("no command given");
+    }
+    o->command = argv[1];
+    if (strcmp(o->command, "--help") == 0 || strcmp(o->command, "-h") == 0) {
+        fputs(usage_text, stdout);
+        return -1;
+    }
+    for (int i = 2; i < argc; ++i) {
+        const char *a = argv[i];
+        const char **slot = NULL;
+        if (strcmp(a, "--json") == 0) {
+            o->json = 1;
+            continue;
+        }
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            print_command_help(o->command);
+            return -1;
+        }
+        if (strcmp(a, "--model") == 0) {
+            slot = &o->model;
+        } else if (strcmp(a, "--data") == 0) {
+            slot = &o->data;
+        } else if (strcmp(a, "--heldout") == 0) {
+            slot = &o->heldout;
+        } else if (strcmp(a, "--out") == 0) {
+            slot = &o->out;
+        } else if (strcmp(a, "--effects") == 0) {
+            slot = &o->effects;
+        } else {
+            char msg[300];
+            snprintf(msg, sizeof msg, "unknown option '%.200s'", a);
+            return usage_error(msg);
+        }
+        if (i + 1 >= argc) {
+            char msg[300];
+            snprintf(msg, sizeof msg, "option '%s' needs a value", a);
+            return usage_error(msg);
+        }
+        if (*slot != NULL) {
+            char msg[300];
+            snprintf(msg, sizeof msg, "option '%s' given twice", a);
+            return usage_error(msg);
+        }
+        *slot = argv[++i];
+    }
+    const char *known[4] = {"compare", "fit", "diagnose", "plot"};
+    int ok = 0;
+    for (size_t k = 0U; k < 4U; ++k) {
+        ok |= strcmp(o->command, known[k]) == 0;
+    }
+    if (!ok) {
+        char msg[300];
+        snprintf(msg, sizeof msg, "unknown command '%.200s'", o->command);
+        return usage_error(msg);
+    }
+    if (o->model == NULL || o->data == NULL) {
+        return usage_error("--model and --data are required");
+    }
+    if (strcmp(o->command, "plot") == 0 && o->out == NULL) {
+        return usage_error("plot needs --out DIR");
+    }
+    if (o->out != NULL && strcmp(o->command, "fit") != 0 && strcmp(o->command, "plot") != 0) {
+        return usage_error("--out is for fit (calibrated model) and plot (directory)");
+    }
+    return 0;
+}
+
+/* Everything a command works on, loaded and checked. */
+typedef struct {
+    dhcal_model file_model;
+    dhc_model model;
+    dhcal_dataset data;
+    dhcal_samples samples;
+    dhcal_dataset held_data;
+    dhcal_samples held;
+    int have_held;
+} session;
+
+static int load_session(const options *o, session *s)
+{
+    dhcal_error err;
+    memset(&err, 0, sizeof err);
+    memset(s, 0, sizeof *s);
+    int rc = dhcal_model_load(o->model, &s->file_model, &err);
+    if (rc == DHCAL_IO_OK) {
+        rc = dhcal_model_to_lib(&s->file_model, o->model, &s->model, &err);
+    }
+    if (rc == DHCAL_IO_OK) {
+        rc = dhcal_csv_load(o->data, s->model.arm.n_joints, &s->data, &err);
+    }
+    if (rc == DHCAL_IO_OK) {
+        rc = dhcal_samples_build(&s->model, &s->data, o->data, &s->samples, &err);
+    }
+    if (rc == DHCAL_IO_OK && o->heldout != NULL) {
+        rc = dhcal_csv_load(o->heldout, s->model.arm.n_joints, &s->held_data, &err);
+        if (rc == DHCAL_IO_OK) {
+            rc = dhcal_samples_build(&s->model, &s->held_data, o->heldout, &s->held, &err);
+            s->have_held = rc == DHCAL_IO_OK;
+        }
+        if (rc == DHCAL_IO_OK && s->held.wires != s->samples.wires) {
+            snprintf(err.msg, sizeof err.msg,
+                     "%s: held-out rows must be measured like the training rows (x,y,z vs "
+                     "L1..L3)",
+                     o->heldout);
+            rc = DHCAL_IO_BAD_INPUT;
+        }
+    }
+    if (rc != DHCAL_IO_OK) {
+        fprintf(stderr, "dhcal: %s\n", err.msg);
+        return rc == DHCAL_IO_BAD_INPUT ? EXIT_USAGE : EXIT_COMPUTE;
+    }
+    return 0;
+}
+
+static void free_session(session *s)
+{
+    dhcal_samples_free(&s->samples);
+    dhcal_samples_free(&s->held);
+    dhcal_dataset_free(&s->data);
+    dhcal_dataset_free(&s->held_data);
+}
+
+static int print_json(cJSON *obj)
+{
+    char *text = cJSON_PrintUnformatted(obj);
+    cJSON_Delete(obj);
+    if (text == NULL) {
+        fprintf(stderr, "dhcal: out of memory\n");
+        return EXIT_COMPUTE;
+    }
+    puts(text);
+    free(text);
+    return 0;
+}
+
+static int cmd_compare(const options *o, session *s)
+{
+    const size_t n = s->samples.n;
+    double *err_mm = calloc(n > 0U ? n : 1U, sizeof *err_mm);
+    double rms = 0.0;
+    double mx = 0.0;
+    if (err_mm == NULL ||
+        dhcal_samples_errors(&s->model, &s->samples, NULL, err_mm, &rms, &mx) != DHCAL_IO_OK) {
+        free(err_mm);
+        fprintf(stderr, "dhcal: compare failed\n");
+        return EXIT_COMPUTE;
+    }
+    if (o->json) {
+        cJSON *obj = cJSON_CreateObject();
+        cJSON_AddNumberToObject(obj, "rms_mm", rms);
+        cJSON_AddNumberToObject(obj, "max_mm", mx);
+        cJSON *rows = cJSON_AddArrayToObject(obj, "rows");
+        for (size_t i = 0U; i < n; ++i) {
+            cJSON *r = cJSON_CreateObject();
+            cJSON_AddNumberToObject(r, "row", (double)(i + 1U));
+            cJSON_AddNumberToObject(r, "error_mm", err_mm[i]);
+            cJSON_AddItemToArray(rows, r);
+        }
+        free(err_mm);
+        return print_json(obj);
+    }
+    printf("model '%s' against %s: %zu rows (%s)\n", s->file_model.name, o->data, n,
+           s->samples.wires ? "wire lengths" : "tool points");
+    printf("%6s %8s %12s\n", "row", "line", "error_mm");
+    for (size_t i = 0U; i < n; ++i) {
+        printf("%6zu %8zu %12.4f\n", i + 1U, s->data.rows[i].line, err_mm[i]);
+    }
+    printf("RMS %.4f mm, max %.4f mm\n", rms, mx);
+    free(err_mm);
+    return 0;
+}
+
+/* ---------------------------------------------------------------- fit reporting */
+
+static void json_fit(cJSON *obj, const dhcal_fit *f, const session *s, const double *row_err)
+{
+    cJSON_AddNumberToObject(obj, "rms_mm", f->rep.rms_mm);
+    cJSON_AddNumberToObject(obj, "max_mm", f->rep.max_mm);
+    if (f->have_heldout) {
+        cJSON_AddNumberToObject(obj, "heldout_rms_mm", f->heldout_rms_mm);
+    }
+    cJSON_AddNumberToObject(obj, "iterations", (double)f->rep.iterations);
+    cJSON_AddBoolToObject(obj, "converged", f->rep.converged);
+    cJSON_AddNumberToObject(obj, "sigma_mm", f->rep.sigma);
+    cJSON *params = cJSON_AddArrayToObject(obj, "parameters");
+    cJSON *unid = cJSON_AddArrayToObject(obj, "unidentifiable");
+    char name[48];
+    for (size_t k = 0U; k < f->set.count; ++k) {
+        (void)dhc_params_name(&f->set, k, name, sizeof name);
+        if (f->rep.identifiable[k]) {
+            cJSON *p = cJSON_CreateObject();
+            cJSON_AddStringToObject(p, "name", name);
+            cJSON_AddNumberToObject(p, "value", dhcal_param_display(&f->set, k, f->rep.value[k]));
+            cJSON_AddNumberToObject(p, "std", dhcal_param_display(&f->set, k, f->rep.std_err[k]));
+            cJSON_AddItemToArray(params, p);
+            continue;
+        }
+        cJSON *u = cJSON_CreateObject();
+        cJSON_AddStringToObject(u, "param", name);
+        cJSON *with = cJSON_AddArrayToObject(u, "confounded_with");
+        for (size_t m = 0U; m < f->set.count; ++m) {
+            if (f->rep.confounded[k][m]) {
+                char other[48];
+                (void)dhc_params_name(&f->set, m, other, sizeof other);
+                cJSON_AddItemToArray(with, cJSON_CreateString(other));
+            }
+        }
+        cJSON_AddItemToArray(unid, u);
+    }
+    cJSON *outl = cJSON_AddArrayToObject(obj, "outliers");
+    for (size_t i = 0U; i < s->samples.n; ++i) {
+        if (s->samples.flags[i] == (uint8_t)DHC_SAMPLE_OUTLIER) {
+            cJSON *r = cJSON_CreateObject();
+            cJSON_AddNumberToObject(r, "row", (double)(i + 1U));
+            cJSON_AddNumberToObject(r, "error_mm", row_err[i]);
+            cJSON_AddItemToArray(outl, r);
+        }
+    }
+}
+
+static void text_fit(const dhcal_fit *f, const session *s, const options *o, const double *row_err)
+{
+    const dhc_calib_report *rep = &f->rep;
+    printf("fit of '%s' to %s: %zu rows used, %zu outliers left out\n", s->file_model.name,
+           o->data, rep->samples_used, rep->outliers);
+    printf("%s after %zu iterations: RMS %.4f mm, max %.4f mm%s", rep->converged ? "converged" : "NOT converged",
+           rep->iterations, rep->rms_mm, rep->max_mm, s->samples.wires ? " (wire lengths)" : "");
+    if (f->have_heldout) {
+        printf("; held-out RMS %.4f mm", f->heldout_rms_mm);
+    }
+    printf("\n%zu parameters, %zu identified from the data\n", rep->n_params, rep->rank);
+    for (size_t i = 0U; i < f->model.arm.n_joints; ++i) {
+        if (f->model.arm.joint[i].convention == DHC_CONV_HAYATI) {
+            printf("joint %zu: axes %zu and %zu are nominally parallel: Hayati's beta%zu is fitted "
+                   "in place of d%zu\n",
+                   i + 1U, i + 1U, i + 2U, i + 1U, i + 1U);
+        }
+    }
+    printf("%-18s %16s %12s\n", "parameter", "value", "std");
+    char name[48];
+    for (size_t k = 0U; k < f->set.count; ++k) {
+        if (!rep->identifiable[k]) {
+            continue;
+        }
+        (void)dhc_params_name(&f->set, k, name, sizeof name);
+        const int degrees = dhc_params_is_angle(&f->set, k);
+        const int compliance = f->set.id[k].kind == (uint8_t)DHC_P_COMPLIANCE;
+        printf("%-18s %16.8g %12.3g %s\n", name, dhcal_param_display(&f->set, k, rep->value[k]),
+               dhcal_param_display(&f->set, k, rep->std_err[k]),
+               degrees ? "deg" : compliance ? "deg/mm" : f->set.id[k].kind == (uint8_t)DHC_P_JOINT_SCALE ||
+                                                           f->set.id[k].kind == (uint8_t)DHC_P_MEAS_SCALE
+                                                       ? ""
+                                                       : f->set.id[k].kind == (uint8_t)DHC_P_THERMAL ? "1/K" : "mm");
+    }
+    for (size_t k = 0U; k < f->set.count; ++k) {
+        if (rep->identifiable[k]) {
+            continue;
+        }
+        (void)dhc_params_name(&f->set, k, name, sizeof name);
+        printf("not identifiable: %s (kept at nominal)", name);
+        size_t partners = 0U;
+        for (size_t m = 0U; m < f->set.count; ++m) {
+            if (rep->confounded[k][m]) {
+                char other[48];
+                (void)dhc_params_name(&f->set, m, other, sizeof other);
+                printf("%s%s", partners++ == 0U ? ": trades off with " : ", ", other);
+            }
+        }
+        printf("%s\n", partners == 0U ? ": does not change what was measured" : "");
+    }
+    for (size_t i = 0U; i < s->samples.n; ++i) {
+        if (s->samples.flags[i] == (uint8_t)DHC_SAMPLE_OUTLIER) {
+            printf("outlier: row %zu (line %zu), error %.4f mm, left out\n", i + 1U,
+                   s->data.rows[i].line, row_err[i]);
+        }
+    }
+}
+
+/* Runs the fit; on success fills row_err (caller frees). */
+static int do_fit(const options *o, session *s, dhcal_fit *fit, double **row_err)
+{
+    dhcal_error err;
+    memset(&err, 0, sizeof err);
+    const int rc = dhcal_run_fit(&s->model, o->effects, &s->samples, s->have_held ? &s->held : NULL,
+                                 fit, &err);
+    if (rc != DHCAL_IO_OK) {
+        fprintf(stderr, "dhcal: %s\n", err.msg);
+        return rc == DHCAL_IO_BAD_INPUT ? EXIT_USAGE : EXIT_COMPUTE;
+    }
+    *row_err = calloc(s->samples.n > 0U ? s->samples.n : 1U, sizeof **row_err);
+    double rms;
+    double mx;
+    if (*row_err == NULL ||
+        dhcal_samples_errors(&fit->model, &s->samples, NULL, *row_err, &rms, &mx) != DHCAL_IO_OK) {
+        fprintf(stderr, "dhcal: evaluation failed\n");
+        return EXIT_COMPUTE;
+    }
+    return 0;
+}
+
+static int cmd_fit(const options *o, session *s)
+{
+    static dhcal_fit fit;
+    double *row_err = NULL;
+    int rc = do_fit(o, s, &fit, &row_err);
+    if (rc == 0 && o->out != NULL && fit.status == DHC_OK) {
+        static dhcal_model out;
+        dhcal_model_from_lib(&fit.model, &s->file_model, &out);
+        dhcal_error err;
+        memset(&err, 0, sizeof err);
+        if (dhcal_model_save(o->out, &out, &err) != DHCAL_IO_OK) {
+            fprintf(stderr, "dhcal: %s\n", err.msg);
+            rc = EXIT_COMPUTE;
+        }
+    }
+    if (rc == 0) {
+        if (o->json) {
+            cJSON *obj = cJSON_CreateObject();
+            json_fit(obj, &fit, s, row_err);
+            rc = print_json(obj);
+        } else {
+            text_fit(&fit, s, o, row_err);
+        }
+        if (fit.status != DHC_OK) {
+            fprintf(stderr, "dhcal: the fit did not converge in %zu iterations%s\n",
+                    fit.rep.iterations, o->out != NULL ? "; --out not written" : "");
+            rc = EXIT_COMPUTE;
+        }
+    }
+    free(row_err);
+    return rc;
+}
+
+/* ---------------------------------------------------------------- diagnose */
+
+static void candidate_params(const dhcal_fit *fit, const dhc_candidate_result *c, cJSON *arr)
+{
+    dhc_param_set one;
+    dhc_params_clear(&one);
+    if (dhc_params_add_effect(&one, &fit->model, c->effect, c->joint) != DHC_OK) {
+        return;
+    }
+    char name[48];
+    for (size_t k = 0U; k < one.count && k < DHC_MAX_CANDIDATE_PARAMS; ++k) {
+        (void)dhc_params_name(&one, k, name, sizeof name);
+        cJSON *p = cJSON_CreateObject();
+        cJSON_AddStringToObject(p, "name", name);
+        cJSON_AddNumberToObject(p, "value", dhcal_param_display(&one, k, c->value[k]));
+        cJSON_AddItemToArray(arr, p);
+    }
+}
+
+static void text_diagnosis(const dhcal_fit *fit, const dhc_diagnosis *d)
+{
+    char label[64];
+    printf("\ndiagnosis: %zu candidate effects scored against the remaining residual "
+           "(noise estimate %.4f mm per coordinate)\n",
+           d->count, sqrt(d->sigma2));
+    const dhc_candidate_result *top = d->count > 0U ? &d->c[0] : NULL;
+    if (top == NULL || !top->significant) {
+        printf("no missing effect found: nothing explains a significant share of the residual; "
+               "the model fits these data to their noise level\n");
+    } else {
+        dhcal_effect_label(top->effect, top->joint, label, sizeof label);
+        printf("found %s: add '%s' (explains %.0f%% of the residual, significant)\n",
+               dhcal_effect_signature(top->effect), label, 100.0 * top->explained);
+        if (top->lookalike < d->count) {
+            char other[64];
+            const dhc_candidate_result *l = &d->c[top->lookalike];
+            dhcal_effect_label(l->effect, l->joint, other, sizeof other);
+            printf("caution: '%s' explains the residual about as well (%.0f%%); these data "
+                   "cannot tell the two apart\n",
+                   other, 100.0 * l->explained);
+        }
+        printf("next: dhcal fit --effects %s ... and compare the held-out error\n", label);
+    }
+    printf("%-22s %6s %10s %12s %s\n", "candidate", "params", "explained", "log10(p)", "");
+    size_t unseen = 0U;
+    for (size_t i = 0U; i < d->count; ++i) {
+        const dhc_candidate_result *c = &d->c[i];
+        if (c->rank == 0U) {
+            unseen++;
+            continue;
+        }
+        dhcal_effect_label(c->effect, c->joint, label, sizeof label);
+        printf("%-22s %6zu %9.1f%% %12.1f %s\n", label, c->rank, 100.0 * c->explained, c->log10_p,
+               c->significant ? "significant" : "");
+    }
+    if (unseen > 0U) {
+        printf("cannot be seen in these data (looks exactly like what the fit already adjusts):");
+        for (size_t i = 0U; i < d->count; ++i) {
+            if (d->c[i].rank == 0U) {
+                dhcal_effect_label(d->c[i].effect, d->c[i].joint, label, sizeof label);
+                printf(" %s", label);
+            }
+        }
+        printf("\n");
+    }
+    (void)fit;
+}
+
+static int cmd_diagnose(const options *o, session *s)
+{
+    static dhcal_fit fit;
+    static dhc_diagnosis diag;
+    double *row_err = NULL;
+    int rc = do_fit(o, s, &fit, &row_err);
+    dhcal_error err;
+    memset(&err, 0, sizeof err);
+    if (rc == 0 && dhcal_run_diagnose(&fit, &s->samples, &diag, &err) != DHCAL_IO_OK) {
+        fprintf(stderr, "dhcal: %s\n", err.msg);
+        rc = EXIT_COMPUTE;
+    }
+    if (rc == 0) {
+        if (o->json) {
+            cJSON *obj = cJSON_CreateObject();
+            json_fit(obj, &fit, s, row_err);
+            cJSON *cands = cJSON_AddArrayToObject(obj, "candidates");
+            for (size_t i = 0U; i < diag.count; ++i) {
+                const dhc_candidate_result *c = &diag.c[i];
+                cJSON *j = cJSON_CreateObject();
+                cJSON_AddStringToObject(j, "effect", dhc_effect_name(c->effect));
+                if (dhc_effect_is_per_joint(c->effect)) {
+                    cJSON_AddNumberToObject(j, "joint", (double)(c->joint + 1U));
+                } else {
+                    cJSON_AddNullToObject(j, "joint");
+                }
+                cJSON_AddNumberToObject(j, "explained", c->explained);
+                cJSON_AddBoolToObject(j, "significant", c->significant);
+                cJSON_AddNumberToObject(j, "log10_p", c->rank > 0U ? c->log10_p : 0.0);
+                cJSON_AddNumberToObject(j, "dof", (double)c->rank);
+                candidate_params(&fit, c, cJSON_AddArrayToObject(j, "params"));
+                if (c->lookalike < diag.count) {
+                    char label[64];
+                    dhcal_effect_label(diag.c[c->lookalike].effect, diag.c[c->lookalike].joint,
+                                       label, sizeof label);
+                    cJSON_AddStringToObject(j, "lookalike", label);
+                }
+                cJSON_AddItemToArray(cands, j);
+            }
+            rc = print_json(obj);
+        } else {
+            text_fit(&fit, s, o, row_err);
+            text_diagnosis(&fit, &diag);
+        }
+    }
+    free(row_err);
+    return rc;
+}
+
+/* ---------------------------------------------------------------- plot */
+
+static int cmd_plot(const options *o, session *s)
+{
+    static dhcal_fit before;
+    static dhcal_fit after;
+    static dhc_diagnosis diag;
+    double *row_err = NULL;
+    int rc = do_fit(o, s, &before, &row_err);
+    free(row_err);
+    if (rc != 0) {
+        return rc;
+    }
+    dhcal_error err;
+    memset(&err, 0, sizeof err);
+    if (dhcal_run_diagnose(&before, &s->samples, &diag, &err) != DHCAL_IO_OK) {
+        fprintf(stderr, "dhcal: %s\n", err.msg);
+        return EXIT_COMPUTE;
+    }
+    const size_t n = s->samples.n;
+    const size_t nj = s->model.arm.n_joints;
+    double *q_deg = calloc(n * nj + 1U, sizeof *q_deg);
+    double *res_before = calloc(3U * n + 1U, sizeof *res_before);
+    double *res_after = calloc(3U * n + 1U, sizeof *res_after);
+    double *err_before = calloc(n + 1U, sizeof *err_before);
+    double *err_after = calloc(n + 1U, sizeof *err_after);
+    rc = q_deg && res_before && res_after && err_before && err_after ? 0 : EXIT_COMPUTE;
+    double rms_b = 0.0;
+    double rms_a = 0.0;
+    double mx;
+    char label[64] = "";
+    if (rc == 0) {
+        rc = dhcal_samples_errors(&before.model, &s->samples, res_before, err_before, &rms_b, &mx);
+    }
+    /* "after": the effect the diagnosis names, added to whatever --effects gave */
+    if (rc == 0 && diag.count > 0U && diag.c[0].significant) {
+        dhcal_effect_label(diag.c[0].effect, diag.c[0].joint, label, sizeof label);
+        char list[600];
+        snprintf(list, sizeof list, "%s%s%s", o->effects != NULL ? o->effects : "",
+                 o->effects != NULL ? "," : "", label);
+        for (size_t i = 0U; i < n; ++i) {
+            s->samples.flags[i] = (uint8_t)DHC_SAMPLE_USED;
+        }
+        rc = dhcal_run_fit(&s->model, list, &s->samples, NULL, &after, &err) == DHCAL_IO_OK ? 0 : EXIT_COMPUTE;
+    } else if (rc == 0) {
+        after = before;
+    }
+    if (rc == 0) {
+        rc = dhcal_samples_errors(&after.model, &s->samples, res_after, err_after, &rms_a, &mx);
+    }
+    for (size_t i = 0U; rc == 0 && i < n; ++i) {
+        for (size_t j = 0U; j < nj; ++j) {
+            q_deg[i * nj + j] = s->samples.samples[i].q_rad[j] * 180.0 / 3.14159265358979323846;
+        }
+    }
+    dhcal_plot_candidate cands[DHC_MAX_CANDIDATES];
+    size_t nc = 0U;
+    for (size_t i = 0U; i < diag.count; ++i) {
+        if (diag.c[i].rank == 0U) {
+            continue;
+        }
+        dhcal_effect_label(diag.c[i].effect, diag.c[i].joint, cands[nc].label, sizeof cands[nc].label);
+        cands[nc].explained = diag.c[i].explained;
+        cands[nc].significant = diag.c[i].significant;
+        nc++;
+    }
+    if (rc == 0) {
+        const dhcal_plot_data d = {s->file_model.name, n, nj, q_deg, res_before, res_after,
+                                   err_before, err_after, rms_b, rms_a,
+                                   s->samples.wires, label, cands, nc};
+        rc = dhcal_plot_write(o->out, &d, &err) == DHCAL_IO_OK ? 0 : EXIT_COMPUTE;
+        if (rc != 0) {
+            fprintf(stderr, "dhcal: %s\n", err.msg);
+        } else if (!o->json) {
+            printf("wrote %s/residuals.svg, %s/errors.svg, %s/candidates.svg\n", o->out, o->out, o->out);
+            printf("RMS before %.4f mm, after %s %.4f mm\n", rms_b, label[0] != '\0' ? label : "(no effect named)", rms_a);
+        } else {
+            cJSON *obj = cJSON_CreateObject();
+            cJSON_AddNumberToObject(obj, "rms_before_mm", rms_b);
+            cJSON_AddNumberToObject(obj, "rms_after_mm", rms_a);
+            cJSON_AddStringToObject(obj, "effect", label);
+            cJSON *files = cJSON_AddArrayToObject(obj, "files");
+            const char *names[3] = {"residuals.svg", "errors.svg", "candidates.svg"};
+            for (size_t k = 0U; k < 3U; ++k) {
+                char path[4200];
+                snprintf(path, sizeof path, "%s/%s", o->out, names[k]);
+                cJSON_AddItemToArray(files, cJSON_CreateString(path));
+            }
+            rc = print_json(obj);
+        }
+    } else {
+        fprintf(stderr, "dhcal: plot failed: %s\n", err.msg[0] != '\0' ? err.msg : "evaluation");
+    }
+    free(q_deg);
+    free(res_before);
+    free(res_after);
+    free(err_before);
+    free(err_after);
+    return rc;
+}
+
+int main(int argc, char **argv)
+{
+    options o;
+    int rc = parse_args(argc, argv, &o);
+    if (rc != 0) {
+        return rc < 0 ? 0 : rc;
+    }
+    static session s;
+    rc = load_session(&o, &s);
+    if (rc == 0) {
+        if (strcmp(o.command, "compare") == 0) {
+            rc = cmd_compare(&o, &s);
+        } else if (strcmp(o.command, "fit") == 0) {
+            rc = cmd_fit(&o, &s);
+        } else if (strcmp(o.command, "diagnose") == 0) {
+            rc = cmd_diagnose(&o, &s);
+        } else {
+            rc = cmd_plot(&o, &s);
+        }
+    }
+    free_session(&s);
+    return rc;
+}
