@@ -1,0 +1,203 @@
+#!/usr/bin/env python3
+"""The dhcal program as a person runs it: exit codes, messages naming file and line, and
+--out never created, truncated or overwritten by a failed run (DESIGN.md section 3).
+
+Usage: test_cli.py --dhcal PATH   (the data come from examples/ and are written per case)
+"""
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+EXAMPLE = os.path.join(ROOT, 'examples', 'data', 'compliance')
+DHCAL = None
+
+GOOD_MODEL = open(os.path.join(EXAMPLE, 'model.json')).read()
+GOOD_CSV = open(os.path.join(EXAMPLE, 'train.csv')).read()
+HEADER = 'q1,q2,q3,x,y,z'
+
+
+class Cli(unittest.TestCase):
+    def setUp(self):
+        self.dir = tempfile.mkdtemp(prefix='dhcal-cli-')
+        self.model = self.write('model.json', GOOD_MODEL)
+        self.data = self.write('train.csv', GOOD_CSV)
+        self.out = os.path.join(self.dir, 'calibrated.json')
+
+    def tearDown(self):
+        shutil.rmtree(self.dir)
+
+    def write(self, name, text, mode='w'):
+        path = os.path.join(self.dir, name)
+        with open(path, mode) as f:
+            f.write(text)
+        return path
+
+    def run_dhcal(self, *args):
+        return subprocess.run([DHCAL, *args], capture_output=True, text=True, errors='replace',
+                              timeout=120)
+
+    def fit(self, model=None, data=None, *extra):
+        return self.run_dhcal('fit', '--model', model or self.model, '--data', data or self.data,
+                              '--out', self.out, *extra)
+
+    def assert_bad_input(self, result, *must_contain):
+        self.assertEqual(result.returncode, 2, result.stderr)
+        lines = [l for l in result.stderr.splitlines() if l.startswith('dhcal: ')]
+        self.assertEqual(len(lines), 1, result.stderr)
+        for text in must_contain:
+            self.assertIn(text, lines[0])
+
+    def assert_out_untouched(self, before):
+        if before is None:
+            self.assertFalse(os.path.exists(self.out), 'a failed run created --out')
+            leftovers = [f for f in os.listdir(self.dir) if f.startswith('calibrated')]
+            self.assertEqual(leftovers, [], 'a failed run left a temporary file')
+        else:
+            with open(self.out) as f:
+                self.assertEqual(f.read(), before, 'a failed run changed --out')
+
+    # ---- bad CSV: each gets exit 2, one message with file and line, --out untouched
+    def check_bad_csv(self, text, line, *words, binary=False):
+        for existing in (None, '{"keep": "me"}\n'):
+            if existing is None:
+                if os.path.exists(self.out):
+                    os.remove(self.out)
+            else:
+                self.write('calibrated.json', existing)
+            data = self.write('bad.csv', text, 'wb' if binary else 'w')
+            result = self.fit(None, data)
+            self.assert_bad_input(result, 'bad.csv:%d' % line if line else 'bad.csv', *words)
+            self.assert_out_untouched(existing)
+
+    def test_empty_file(self):
+        self.check_bad_csv('', 0)
+
+    def test_header_without_rows(self):
+        self.check_bad_csv('# only a header\n' + HEADER + '\n', 0)
+
+    def test_short_row(self):
+        self.check_bad_csv(HEADER + '\n1,2,3,4,5,6\n1,2,3,4,5\n', 3)
+
+    def test_not_a_number(self):
+        self.check_bad_csv(HEADER + '\n1,2,abc,4,5,6\n', 2, 'q3')
+
+    def test_nan_and_inf(self):
+        self.check_bad_csv(HEADER + '\n1,2,3,nan,5,6\n', 2, 'x')
+        self.check_bad_csv(HEADER + '\n1,2,3,4,-inf,6\n', 2, 'y')
+        self.check_bad_csv(HEADER + '\n1,2,3,4,5,1e999\n', 2, 'z')
+
+    def test_values_beyond_physical_range(self):
+        self.check_bad_csv(HEADER + '\n1,2,3000,4,5,6\n', 2, 'q3')
+        self.check_bad_csv(HEADER + '\n1,2,3,4,5,6e9\n', 2, 'z')
+
+    def test_unknown_and_repeated_columns(self):
+        self.check_bad_csv('q1,q2,q3,x,y,z,colour\n1,2,3,4,5,6,7\n', 1, 'colour')
+        self.check_bad_csv('q1,q2,q3,x,y,z,x\n1,2,3,4,5,6,7\n', 1, "'x'")
+
+    def test_missing_joint_column_and_joint_beyond_the_model(self):
+        self.check_bad_csv('q1,q3,x,y,z\n1,3,4,5,6\n', 1, 'q2')
+        self.check_bad_csv('q1,q2,q3,q4,x,y,z\n1,2,3,4,5,6,7\n', 1, 'q4')
+
+    def test_binary_garbage(self):
+        self.check_bad_csv(b'q1,q2,q3,x,y,z\n\x00\x01\xff\xfe garbage\n', 2, binary=True)
+
+    def test_one_megabyte_line(self):
+        self.check_bad_csv(HEADER + '\n' + '1' * (1 << 20) + '\n', 2)
+
+    # ---- bad model JSON: exit 2, file and JSON path or line:column
+    def check_bad_model(self, text, *words):
+        self.write('calibrated.json', 'previous calibration\n')
+        model = self.write('bad.json', text)
+        result = self.fit(model)
+        self.assert_bad_input(result, 'bad.json', *words)
+        self.assert_out_untouched('previous calibration\n')
+
+    def test_broken_json(self):
+        self.check_bad_model('{"joints": [ {"alpha_deg": 90, ', )
+
+    def test_wrong_json_types(self):
+        model = json.loads(GOOD_MODEL)
+        model['joints'][1]['a_mm'] = "four hundred"
+        self.check_bad_model(json.dumps(model), 'joints[1].a_mm')
+
+    def test_joint_count_above_the_limit(self):
+        model = json.loads(GOOD_MODEL)
+        model['joints'] = [model['joints'][0]] * 8
+        self.check_bad_model(json.dumps(model), 'joints')
+
+    def test_effect_values_of_the_wrong_count(self):
+        model = json.loads(GOOD_MODEL)
+        model['effects'] = {'joint_compliance:2': [1e-4]}
+        self.check_bad_model(json.dumps(model), 'joint_compliance:2')
+
+    # ---- usage errors
+    def test_usage_errors_exit_2(self):
+        for args in (['fit'], ['fly', '--model', self.model, '--data', self.data],
+                     ['fit', '--model', self.model, '--data', self.data, '--bogus'],
+                     ['fit', '--model', self.model, '--data', self.data, '--effects', 'gremlins'],
+                     ['fit', '--model', self.model, '--data', self.data, '--effects',
+                      'joint_scale:9']):
+            self.assertEqual(self.run_dhcal(*args).returncode, 2, args)
+
+    def test_help_on_every_command(self):
+        for cmd in ('compare', 'fit', 'diagnose', 'plot'):
+            r = self.run_dhcal(cmd, '--help')
+            self.assertEqual(r.returncode, 0)
+            self.assertIn('usage: dhcal ' + cmd, r.stdout)
+
+    # ---- a computation that fails: exit 1, --out untouched
+    def test_under_determined_data_fail_with_exit_1(self):
+        rows = GOOD_CSV.splitlines()
+        header = [l for l in rows if not l.startswith('#')][0]
+        few = self.write('few.csv', header + '\n' + '\n'.join(
+            [l for l in rows if not l.startswith('#')][1:4]) + '\n')
+        self.write('calibrated.json', 'previous calibration\n')
+        r = self.fit(None, few)
+        self.assertEqual(r.returncode, 1, r.stderr)
+        self.assertIn('under-determine', r.stderr)
+        self.assert_out_untouched('previous calibration\n')
+
+    # ---- success: --out replaced atomically and loads again
+    def test_successful_fit_writes_a_model_that_loads_again(self):
+        self.write('calibrated.json', 'previous calibration\n')
+        r = self.fit(None, None, '--effects', 'joint_compliance:2', '--json')
+        self.assertEqual(r.returncode, 0, r.stderr)
+        fit = json.loads(r.stdout)
+        again = self.run_dhcal('compare', '--model', self.out, '--data', self.data, '--json')
+        self.assertEqual(again.returncode, 0, again.stderr)
+        # The saved model (effects included) reproduces the fit's residual.
+        self.assertAlmostEqual(json.loads(again.stdout)['rms_mm'], fit['rms_mm'], places=6)
+        with open(self.out) as f:
+            saved = json.load(f)
+        self.assertIn('joint_compliance:2', saved['effects'])
+
+    def test_json_keys_follow_the_design(self):
+        r = self.run_dhcal('diagnose', '--model', self.model, '--data', self.data, '--json')
+        self.assertEqual(r.returncode, 0, r.stderr)
+        d = json.loads(r.stdout)
+        for key in ('rms_mm', 'max_mm', 'iterations', 'converged', 'parameters',
+                    'unidentifiable', 'outliers', 'candidates'):
+            self.assertIn(key, d)
+        c = d['candidates'][0]
+        for key in ('effect', 'joint', 'explained', 'significant', 'params'):
+            self.assertIn(key, c)
+        self.assertEqual((c['effect'], c['joint'], c['significant']),
+                         ('joint_compliance', 2, True))
+        self.assertTrue(0.0 <= c['explained'] <= 1.0)
+        p = d['parameters'][0]
+        self.assertEqual(sorted(p), ['name', 'std', 'value'])
+
+
+if __name__ == '__main__':
+    if '--dhcal' not in sys.argv:
+        sys.exit('usage: test_cli.py --dhcal PATH')
+    i = sys.argv.index('--dhcal')
+    DHCAL = os.path.abspath(sys.argv[i + 1])
+    del sys.argv[i:i + 2]
+    unittest.main(verbosity=1)
