@@ -300,6 +300,30 @@ static size_t count(const char *s, const char *what)
     return n;
 }
 
+#define PLOT_TEST_MAX_TICKS 64U
+
+/* The tick labels of the first <g class="cls"> of a file, as numbers; returns how many. */
+static size_t axis_ticks(const char *name, const char *cls, double ticks[PLOT_TEST_MAX_TICKS])
+{
+    char *const s = slurp(out_path(name));
+    char open[64];
+    (void)snprintf(open, sizeof open, "<g class=\"%s\"", cls);
+    const char *p = strstr(s, open);
+    TEST_ASSERT_NOT_NULL_MESSAGE(p, open);
+    const char *const end = strstr(p, "</g>");
+    size_t k = 0U;
+    for (p = strstr(p, "<text "); p != NULL && p < end; p = strstr(p, "<text ")) {
+        const char *const text = strchr(p, '>') + 1;
+        char *stop = NULL;
+        TEST_ASSERT_TRUE(k < PLOT_TEST_MAX_TICKS);
+        ticks[k++] = strtod(text, &stop);
+        TEST_ASSERT_EQUAL_STRING_LEN("</text>", stop, 7U); /* the whole label is the number */
+        p = stop;
+    }
+    free(s);
+    return k;
+}
+
 /* The file is well-formed SVG with `points` data points and `bars` bars; returns its text. */
 static char *check_svg(const char *name, size_t points, size_t bars)
 {
@@ -460,7 +484,7 @@ static void test_every_non_finite_input_is_bad_input_and_writes_nothing(void)
     const char *const names[] = {"q_deg[1][1]", "resid_before[2][1]", "resid_after[9][2]",
                                  "err_before[9]", "err_after[0]", "rms_before_mm",
                                  "rms_after_mm", "candidates[2].explained"};
-    const double bad[3] = {NAN, INFINITY, -INFINITY};
+    const double bad[3] = {(double)NAN, (double)INFINITY, -(double)INFINITY};
     for (size_t f = 0U; f < sizeof fields / sizeof fields[0]; ++f) {
         for (size_t b = 0U; b < 3U; ++b) {
             fill(10U, 3U);
@@ -502,7 +526,8 @@ static void test_zero_rows_still_writes_valid_files(void)
 
 static void test_constant_data_has_finite_ranges(void)
 {
-    for (size_t i = 0U; i < 10U * 3U; ++i) {
+    /* 10 rows x 3 joints of angles, 10 rows x 3 components of residuals */
+    for (size_t i = 0U; i < 30U; ++i) {
         g_q[i] = 42.0;
         g_rb[i] = 0.0;
         g_ra[i] = 0.0;
@@ -526,6 +551,12 @@ static void test_constant_data_has_finite_ranges(void)
     char *const e = slurp(out_path("errors.svg"));
     TEST_ASSERT_NOT_NULL(strstr(e, "after (no effect named) RMS "));
     free(e);
+    /* A window around the constant, not a range that starts at it: 42 deg mid-axis. */
+    double ticks[PLOT_TEST_MAX_TICKS];
+    const size_t n = axis_ticks("residuals.svg", "axis-x", ticks);
+    TEST_ASSERT_TRUE(n >= 3U);
+    TEST_ASSERT_TRUE(ticks[0] < 40.0 && ticks[n - 1U] > 44.0);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 42.0, 0.5 * (ticks[0] + ticks[n - 1U]));
     if (python_available()) {
         TEST_ASSERT_TRUE(python_check("residuals.svg errors.svg candidates.svg"));
     }
@@ -536,6 +567,13 @@ static void test_one_row_one_joint(void)
     fill(1U, 1U);
     TEST_ASSERT_EQUAL_INT(DHCAL_IO_OK, dhcal_plot_write(g_out, &g_d, &g_err));
     check_all(1U, 1U, 3U);
+    /* the row axis counts rows: no "0.2" row even when there is one */
+    double ticks[PLOT_TEST_MAX_TICKS];
+    const size_t n = axis_ticks("errors.svg", "axis-x", ticks);
+    TEST_ASSERT_TRUE(n >= 2U);
+    for (size_t i = 0U; i < n; ++i) {
+        TEST_ASSERT_DOUBLE_WITHIN(1e-12, floor(ticks[i] + 0.5), ticks[i]);
+    }
     if (python_available()) {
         TEST_ASSERT_TRUE(python_check("residuals.svg errors.svg candidates.svg"));
     }
@@ -577,23 +615,10 @@ static void test_significant_candidates_are_marked(void)
 static void test_tick_labels_are_round_numbers(void)
 {
     TEST_ASSERT_EQUAL_INT(DHCAL_IO_OK, dhcal_plot_write(g_out, &g_d, &g_err));
-    char *const r = slurp(out_path("residuals.svg"));
-    const char *p = strstr(r, "<g class=\"axis-y\"");
-    TEST_ASSERT_NOT_NULL(p);
-    const char *const end = strstr(p, "</g>");
-    static const char *const want[] = {"-0.6", "-0.4", "-0.2", "0", "0.2", "0.4", "0.6"};
-    size_t k = 0U;
-    for (p = strstr(p, "<text "); p != NULL && p < end; p = strstr(p, "<text ")) {
-        const char *const open_end = strchr(p, '>') + 1;
-        const char *const close = strstr(open_end, "</text>");
-        TEST_ASSERT_TRUE(k < 7U);
-        TEST_ASSERT_EQUAL_size_t(strlen(want[k]), (size_t)(close - open_end));
-        TEST_ASSERT_EQUAL_MEMORY(want[k], open_end, strlen(want[k]));
-        k++;
-        p = close;
-    }
-    TEST_ASSERT_EQUAL_size_t(7U, k);
-    free(r);
+    double ticks[PLOT_TEST_MAX_TICKS];
+    TEST_ASSERT_EQUAL_size_t(7U, axis_ticks("residuals.svg", "axis-y", ticks));
+    const double want[7] = {-0.6, -0.4, -0.2, 0.0, 0.2, 0.4, 0.6};
+    TEST_ASSERT_EQUAL_DOUBLE_ARRAY(want, ticks, 7U);
 }
 
 static void test_existing_file_is_replaced_by_rename(void)

@@ -38,7 +38,8 @@
 #define PLOT_CHAR_EM 0.62
 #define PLOT_BOLD_EM 0.78
 #define PLOT_MAX_TICKS 64U
-/* Characters of the model name and of labels drawn before they are cut with "...". */
+/* Characters of the <title> element (tooltip, accessible name) before it is cut with "...";
+ * the drawn title is cut to the picture's width. */
 #define PLOT_TITLE_ATTR_MAX 1000U
 
 #define COLOR_X "#1f77b4"
@@ -314,12 +315,16 @@ static axis make_axis(double lo, double hi, double target, int integer)
     a.step = step;
     a.lo = floor(lo / step) * step;
     a.hi = ceil(hi / step) * step;
-    if (!(a.hi > a.lo)) {
-        a.hi = a.lo + step;
-    }
     const double intervals = floor((a.hi - a.lo) / step + 0.5);
-    a.n_ticks = intervals + 1.0 > (double)PLOT_MAX_TICKS ? PLOT_MAX_TICKS
-                                                          : (size_t)intervals + 1U;
+    if (!(intervals >= 1.0 && intervals < (double)PLOT_MAX_TICKS)) {
+        /* unreachable with the span guaranteed above; never a zero or NaN step */
+        a.lo = lo;
+        a.hi = lo + 1.0;
+        a.step = 1.0;
+        a.n_ticks = 2U;
+        return a;
+    }
+    a.n_ticks = (size_t)intervals + 1U;
     return a;
 }
 
@@ -343,20 +348,20 @@ static size_t tick_label_chars(const axis *a)
     return w;
 }
 
-/* The axis with the most ticks (at most about 5 intervals) whose labels do not collide:
- * labels need label_px(axis) of room each along length_px. horizontal: labels side by side
- * (their width counts), else stacked (their height counts). */
+/* The axis with the most ticks (about 5 intervals at most) whose labels do not collide
+ * along length_px: horizontal, labels side by side (their estimated width counts); else
+ * stacked (their height counts). */
 static axis fit_axis(double lo, double hi, double length_px, double font_px, int horizontal,
                      int integer)
 {
     axis a = make_axis(lo, hi, 5.0, integer);
-    for (double target = 4.0; target >= 1.0; target -= 1.0) {
+    for (unsigned target = 4U; target >= 1U; --target) {
         const double need =
             horizontal ? text_w(tick_label_chars(&a), font_px) + 10.0 : font_px * 1.8;
         if (a.n_ticks < 2U || length_px / (double)(a.n_ticks - 1U) >= need) {
             break;
         }
-        a = make_axis(lo, hi, target, integer);
+        a = make_axis(lo, hi, (double)target, integer);
     }
     return a;
 }
@@ -532,8 +537,10 @@ static void residuals_svg(svgbuf *b, const dhcal_plot_data *d)
     }
 
     for (size_t j = 0U; j < nj; ++j) {
-        const double cx = 10.0 + (double)(j % cols) * cell_w;
-        const double cy = top + (double)(j / cols) * cell_h;
+        const size_t grid_col = j % cols;
+        const size_t grid_row = j / cols;
+        const double cx = 10.0 + (double)grid_col * cell_w;
+        const double cy = top + (double)grid_row * cell_h;
         double xlo = -180.0;
         double xhi = 180.0;
         if (n > 0U) {
@@ -544,8 +551,8 @@ static void residuals_svg(svgbuf *b, const dhcal_plot_data *d)
             }
             pad_range(&xlo, &xhi, 0.03, 0.03);
         }
-        frame f = {cx + left, cy + 30.0, plot_w, plot_h, make_axis(0.0, 1.0, 5.0, 0), ay};
-        f.ax = fit_axis(xlo, xhi, plot_w, 11.0, 1, 0);
+        const frame f = {cx + left, cy + 30.0, plot_w, plot_h,
+                         fit_axis(xlo, xhi, plot_w, 11.0, 1, 0), ay};
         sb_printf(b, "<g class=\"panel\" id=\"joint%zu\">\n", j + 1U);
         draw_frame(b, &f, 1);
         if (f.ay.lo < 0.0 && f.ay.hi > 0.0) {
@@ -646,8 +653,8 @@ static void errors_svg(svgbuf *b, const dhcal_plot_data *d)
     const axis ay = fit_axis(ylo, yhi, plot_h, 11.0, 0, 0);
     const double left = 24.0 + text_w(tick_label_chars(&ay), 11.0) + 12.0;
     const double xhi = n > 1U ? (double)(n - 1U) : 1.0;
-    frame f = {left, 72.0, width - left - 24.0, plot_h, make_axis(0.0, 1.0, 5.0, 0), ay};
-    f.ax = fit_axis(0.0, xhi, f.w, 11.0, 1, 1);
+    const double plot_w = width - left - 24.0;
+    const frame f = {left, 72.0, plot_w, plot_h, fit_axis(0.0, xhi, plot_w, 11.0, 1, 1), ay};
     const double height = f.y + f.h + 48.0;
 
     svgbuf t = {NULL, 0U, 0U, 0};
@@ -741,9 +748,10 @@ static void candidates_svg(svgbuf *b, const dhcal_plot_data *d)
     }
     const double label_w = text_w(label_chars, 12.0) + 14.0;
     const double row_h = 24.0;
-    frame f = {20.0 + label_w, 72.0, 480.0, row_h * (double)(nc > 0U ? nc : 1U),
-               make_axis(0.0, 100.0, 5.0, 0), make_axis(0.0, 1.0, 1.0, 0)};
-    f.ay.n_ticks = 0U; /* categories, not numbers: no y ticks */
+    axis categories = make_axis(0.0, 1.0, 1.0, 0);
+    categories.n_ticks = 0U; /* the y axis holds names, not numbers: no ticks */
+    const frame f = {20.0 + label_w, 72.0, 480.0, row_h * (double)(nc > 0U ? nc : 1U),
+                     make_axis(0.0, 100.0, 5.0, 0), categories};
     const double width = f.x + f.w + 170.0;
     const double height = f.y + f.h + 48.0;
 
