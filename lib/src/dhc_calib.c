@@ -236,30 +236,58 @@ static dhc_status sample_error2(const fit_context *fc, const dhc_model *model, s
     return DHC_OK;
 }
 
+/* What one scan of the used samples' squared errors e2 found. */
+typedef struct {
+    size_t used;
+    size_t pose;      /* pose samples among them */
+    size_t at_most;   /* samples with e2 <= the scan's limit */
+    double max_e2;
+} error_scan;
+
+/* One pass over the used samples; with flag_above, samples with e2 above limit2 are
+ * flagged as outliers. */
+static dhc_status scan_errors(const fit_context *fc, const dhc_model *model, double limit2,
+                              int flag_above, error_scan *out)
+{
+    memset(out, 0, sizeof *out);
+    for (size_t i = 0U; i < fc->n; ++i) {
+        if (fc->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
+            continue;
+        }
+        double e2;
+        size_t rows;
+        const dhc_status st = sample_error2(fc, model, i, &e2, &rows);
+        if (st != DHC_OK) {
+            return st;
+        }
+        out->used++;
+        out->pose += rows == 6U ? 1U : 0U;
+        out->max_e2 = fmax(out->max_e2, e2);
+        if (e2 <= limit2) {
+            out->at_most++;
+        } else if (flag_above) {
+            fc->flags[i] = (uint8_t)DHC_SAMPLE_OUTLIER;
+        }
+    }
+    return DHC_OK;
+}
+
 /* Median of the squared sample errors by bisection on the value (each step one pass over
  * the data): the library keeps no per-sample storage, so no sort. */
-static dhc_status median_error2(const fit_context *fc, const dhc_model *model, size_t used,
-                                double max_e2, double *median)
+static dhc_status median_error2(const fit_context *fc, const dhc_model *model,
+                                const error_scan *all, double *median)
 {
     double lo = 0.0;
-    double hi = max_e2;
-    const size_t half = (used + 1U) / 2U;
+    double hi = all->max_e2;
+    const size_t half = (all->used + 1U) / 2U;
     for (size_t it = 0U; it < MEDIAN_BISECTIONS && hi - lo > MEDIAN_REL_PRECISION * hi; ++it) {
         const double mid = 0.5 * (lo + hi);
-        size_t below = 0U;
-        for (size_t i = 0U; i < fc->n; ++i) {
-            if (fc->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
-                continue;
-            }
-            double e2;
-            size_t rows;
-            const dhc_status st = sample_error2(fc, model, i, &e2, &rows);
-            if (st != DHC_OK) {
-                return st;
-            }
-            below += e2 <= mid ? 1U : 0U;
+        error_scan scan;
+        const dhc_status st = scan_errors(fc, model, mid, 0, &scan);
+        if (st != DHC_OK) {
+            return st;
         }
-        if (below >= half) {
+        if (scan.at_most >= half) {
             hi = mid;
         } else {
             lo = mid;
@@ -276,50 +304,22 @@ static dhc_status flag_outliers(const fit_context *fc, const dhc_model *model, s
     if (fc->opt->outlier_threshold <= 0.0) {
         return DHC_OK;
     }
-    size_t used = 0U;
-    size_t pose = 0U;
-    double max_e2 = 0.0;
-    for (size_t i = 0U; i < fc->n; ++i) {
-        if (fc->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
-            continue;
-        }
-        double e2;
-        size_t rows;
-        const dhc_status st = sample_error2(fc, model, i, &e2, &rows);
-        if (st != DHC_OK) {
-            return st;
-        }
-        max_e2 = fmax(max_e2, e2);
-        used++;
-        pose += rows == 6U ? 1U : 0U;
-    }
-    if (used < 3U) {
-        return DHC_OK;
+    error_scan all;
+    dhc_status st = scan_errors(fc, model, HUGE_VAL, 0, &all);
+    if (st != DHC_OK || all.used < 3U) {
+        return st;
     }
     double median;
-    const dhc_status st = median_error2(fc, model, used, max_e2, &median);
+    st = median_error2(fc, model, &all, &median);
     if (st != DHC_OK) {
         return st;
     }
-    const double chi2_median = 2U * pose > used ? CHI2_MEDIAN_6DOF : CHI2_MEDIAN_3DOF;
+    const double chi2_median = 2U * all.pose > all.used ? CHI2_MEDIAN_6DOF : CHI2_MEDIAN_3DOF;
     const double sigma = fmax(sqrt(median / chi2_median), fc->opt->outlier_floor_mm);
-    const double limit2 = sq(fc->opt->outlier_threshold * sigma);
-    for (size_t i = 0U; i < fc->n; ++i) {
-        if (fc->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
-            continue;
-        }
-        double e2;
-        size_t rows;
-        const dhc_status st2 = sample_error2(fc, model, i, &e2, &rows);
-        if (st2 != DHC_OK) {
-            return st2;
-        }
-        if (e2 > limit2) {
-            fc->flags[i] = (uint8_t)DHC_SAMPLE_OUTLIER;
-            (*flagged)++;
-        }
-    }
-    return DHC_OK;
+    error_scan kept;
+    st = scan_errors(fc, model, sq(fc->opt->outlier_threshold * sigma), 1, &kept);
+    *flagged = kept.used - kept.at_most;
+    return st;
 }
 
 /* Samples whose joint angles lie far outside the model's ranges are not this arm's poses. */

@@ -8,8 +8,9 @@
 #include "dhcal/dhc_lsq.h"
 #include "unity.h"
 
-#define GUARD ((size_t)4)
-#define SENTINEL (-7777.25)
+#define TEST_RNG_SEED 0x2545F4914F6CDD1DULL
+#include "dhc_test_guard.h"
+
 #define MAXP ((size_t)8)
 #define MAXM ((size_t)64)
 
@@ -18,45 +19,6 @@ void tearDown(void) {}
 
 /* ---------------------------------------------------------------- helpers */
 
-/* xorshift64: deterministic on every platform. */
-static uint64_t rng_state = 0x2545F4914F6CDD1DULL;
-
-static double uniform(double lo, double hi)
-{
-    rng_state ^= rng_state << 13;
-    rng_state ^= rng_state >> 7;
-    rng_state ^= rng_state << 17;
-    return lo + (hi - lo) * ((double)(rng_state >> 11) * (1.0 / 9007199254740992.0));
-}
-
-static double nan_value(void)
-{
-    return (double)NAN;
-}
-
-static int same_bits(double a, double b)
-{
-    return memcmp(&a, &b, sizeof a) == 0;
-}
-
-static void fill_sentinel(double *x, size_t n)
-{
-    for (size_t i = 0U; i < n; ++i) {
-        x[i] = SENTINEL;
-    }
-}
-
-static void assert_sentinel(const double *x, size_t n)
-{
-    for (size_t i = 0U; i < n; ++i) {
-        TEST_ASSERT_TRUE_MESSAGE(same_bits(SENTINEL, x[i]), "write outside the output");
-    }
-}
-
-static void assert_close(double expected, double actual, double abs_tol, double rel_tol)
-{
-    TEST_ASSERT_DOUBLE_WITHIN(abs_tol + rel_tol * fabs(expected), expected, actual);
-}
 
 static void assert_exact_zero(double x)
 {
