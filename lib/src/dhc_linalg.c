@@ -306,57 +306,17 @@ dhc_status dhc_rot_from_quat(const double q[4], dhc_mat3 *r)
 
 void dhc_quat_from_rot(const dhc_mat3 *r, double q[4])
 {
-    /* Shepperd: solve for the largest component first so no division is by a small number. */
-    const double m00 = r->m[0][0];
-    const double m11 = r->m[1][1];
-    const double m22 = r->m[2][2];
-    const double cand[4] = {1.0 + m00 + m11 + m22, 1.0 + m00 - m11 - m22,
-                            1.0 - m00 + m11 - m22, 1.0 - m00 - m11 + m22};
-    size_t k = 0U;
-    for (size_t i = 1U; i < 4U; ++i) {
-        if (cand[i] > cand[k]) {
-            k = i;
-        }
-    }
-    const double big = 0.5 * sqrt(cand[k]);
-    const double f = 0.25 / big;
-    const double d10 = r->m[2][1] - r->m[1][2]; /* 4 w x */
-    const double d20 = r->m[0][2] - r->m[2][0]; /* 4 w y */
-    const double d30 = r->m[1][0] - r->m[0][1]; /* 4 w z */
-    const double s12 = r->m[0][1] + r->m[1][0]; /* 4 x y */
-    const double s13 = r->m[0][2] + r->m[2][0]; /* 4 x z */
-    const double s23 = r->m[1][2] + r->m[2][1]; /* 4 y z */
-    switch (k) {
-    case 0U:
-        q[0] = big;
-        q[1] = d10 * f;
-        q[2] = d20 * f;
-        q[3] = d30 * f;
-        break;
-    case 1U:
-        q[0] = d10 * f;
-        q[1] = big;
-        q[2] = s12 * f;
-        q[3] = s13 * f;
-        break;
-    case 2U:
-        q[0] = d20 * f;
-        q[1] = s12 * f;
-        q[2] = big;
-        q[3] = s23 * f;
-        break;
-    default:
-        q[0] = d30 * f;
-        q[1] = s13 * f;
-        q[2] = s23 * f;
-        q[3] = big;
-        break;
-    }
-    const double n = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-    const double g = q[0] < 0.0 ? -1.0 / n : 1.0 / n;
-    for (size_t i = 0U; i < 4U; ++i) {
-        q[i] *= g;
-    }
+    /* Through the rotation vector: dhc_rot_log is accurate near 0 and near pi, so one
+     * formula serves every angle, and the angle in [0, pi] gives w >= 0 by construction. */
+    double w[3];
+    dhc_rot_log(r, w);
+    const double angle = dhc_vec3_norm(w);
+    const double half = 0.5 * angle;
+    const double s = angle > 0.0 ? sin(half) / angle : 0.5; /* sin(a/2)/a -> 1/2 */
+    q[0] = cos(half);
+    q[1] = s * w[0];
+    q[2] = s * w[1];
+    q[3] = s * w[2];
 }
 
 /* ---------------------------------------------------------------- frames */
@@ -748,59 +708,6 @@ dhc_status dhc_chol_solve(const dhc_mat *l, size_t k, const double *b, double *x
     copy_vec(b, x, k);
     lower_solve(l, k, x);
     lower_t_solve(l, k, x);
-    return DHC_OK;
-}
-
-dhc_status dhc_chol_inverse(const dhc_mat *l, size_t k, dhc_mat *out)
-{
-    if (!mat_valid(out) || (mat_valid(l) && out->data == l->data)) {
-        return DHC_ERR_ARGUMENT;
-    }
-    dhc_status st = check_lower_shape(l, k);
-    if (st == DHC_OK && (out->rows != k || out->cols != k)) {
-        st = DHC_ERR_DIMENSION;
-    }
-    if (st == DHC_OK) {
-        st = check_lower_values(l, k);
-    }
-    if (st != DHC_OK) {
-        return st;
-    }
-    /* X = L^-1 into the lower triangle of out, one column at a time. */
-    for (size_t j = 0U; j < k; ++j) {
-        DHC_MAT_AT(out, j, j) = 1.0 / DHC_MAT_AT(l, j, j);
-        for (size_t i = j + 1U; i < k; ++i) {
-            double s = 0.0;
-            for (size_t m = j; m < i; ++m) {
-                s += DHC_MAT_AT(l, i, m) * DHC_MAT_AT(out, m, j);
-            }
-            DHC_MAT_AT(out, i, j) = -s / DHC_MAT_AT(l, i, i);
-        }
-    }
-    /* (L L^T)^-1 = X^T X, entry (i, j) = sum over m >= max(i, j) of X_mi X_mj. The strict upper
-     * triangle is free, so it is filled first; each diagonal then needs only its own column
-     * of X, and the lower triangle is mirrored last. */
-    for (size_t i = 0U; i < k; ++i) {
-        for (size_t j = i + 1U; j < k; ++j) {
-            double s = 0.0;
-            for (size_t m = j; m < k; ++m) {
-                s += DHC_MAT_AT(out, m, i) * DHC_MAT_AT(out, m, j);
-            }
-            DHC_MAT_AT(out, i, j) = s;
-        }
-    }
-    for (size_t i = 0U; i < k; ++i) {
-        double s = 0.0;
-        for (size_t m = i; m < k; ++m) {
-            s += DHC_MAT_AT(out, m, i) * DHC_MAT_AT(out, m, i);
-        }
-        DHC_MAT_AT(out, i, i) = s;
-    }
-    for (size_t i = 0U; i < k; ++i) {
-        for (size_t j = 0U; j < i; ++j) {
-            DHC_MAT_AT(out, i, j) = DHC_MAT_AT(out, j, i);
-        }
-    }
     return DHC_OK;
 }
 

@@ -1120,74 +1120,6 @@ static void test_triangular_solves_report_every_error(void)
     assert_sentinel(x + 1U, 2U + GUARD);
 }
 
-static void test_chol_inverse_times_matrix_is_identity(void)
-{
-    for (size_t n = 1U; n <= MAXN; ++n) {
-        static double orig_buf[MAXN * MAXN];
-        dhc_mat a;
-        dhc_mat orig;
-        dhc_mat inv;
-        TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&a, n, n, buf_a, MAXN * MAXN));
-        TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&orig, n, n, orig_buf, MAXN * MAXN));
-        TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&inv, n, n, buf_c, MAXN * MAXN));
-        random_psd(&orig, n, n + 3U);
-        copy_mat(&orig, &a);
-        size_t perm[MAXN];
-        size_t rank = 0U;
-        TEST_ASSERT_EQUAL(DHC_OK, dhc_chol_pivoted(&a, perm, MAXN, 1e-12, &rank));
-        fill_sentinel(buf_c, n * n + GUARD);
-        TEST_ASSERT_EQUAL(DHC_OK, dhc_chol_inverse(&a, n, &inv));
-        assert_sentinel(buf_c + n * n, GUARD);
-        for (size_t i = 0U; i < n; ++i) {
-            for (size_t j = 0U; j < n; ++j) {
-                TEST_ASSERT_TRUE(same_bits(DHC_MAT_AT(&inv, i, j), DHC_MAT_AT(&inv, j, i)));
-                double s = 0.0;
-                for (size_t m = 0U; m < n; ++m) {
-                    s += DHC_MAT_AT(&inv, i, m) * DHC_MAT_AT(&orig, perm[m], perm[j]);
-                }
-                TEST_ASSERT_DOUBLE_WITHIN(1e-9, i == j ? 1.0 : 0.0, s);
-            }
-        }
-    }
-}
-
-static void test_chol_inverse_of_hand_factor(void)
-{
-    /* L = [2 0; 1 3]: L L^T = [4 2; 2 10], inverse = [10 -2; -2 4] / 36. */
-    static double l_buf[4] = {2.0, 0.0, 1.0, 3.0};
-    dhc_mat l;
-    dhc_mat inv;
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&l, 2U, 2U, l_buf, 4U));
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&inv, 2U, 2U, buf_c, 4U));
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_chol_inverse(&l, 2U, &inv));
-    TEST_ASSERT_DOUBLE_WITHIN(1e-16, 10.0 / 36.0, buf_c[0]);
-    TEST_ASSERT_DOUBLE_WITHIN(1e-16, -2.0 / 36.0, buf_c[1]);
-    TEST_ASSERT_DOUBLE_WITHIN(1e-16, -2.0 / 36.0, buf_c[2]);
-    TEST_ASSERT_DOUBLE_WITHIN(1e-16, 4.0 / 36.0, buf_c[3]);
-}
-
-static void test_chol_inverse_reports_every_error(void)
-{
-    static double l_buf[9] = {2.0, 0.0, 0.0, 1.0, 4.0, 0.0, -1.0, 2.0, 5.0};
-    dhc_mat l;
-    dhc_mat out;
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&l, 3U, 3U, l_buf, 9U));
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&out, 2U, 2U, buf_c, 4U));
-    fill_sentinel(buf_c, 9U + GUARD);
-    TEST_ASSERT_EQUAL(DHC_ERR_DIMENSION, dhc_chol_inverse(&l, 3U, &out));
-    TEST_ASSERT_EQUAL(DHC_ERR_DIMENSION, dhc_chol_inverse(&l, 4U, &out));
-    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_chol_inverse(NULL, 2U, &out));
-    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_chol_inverse(&l, 2U, NULL));
-    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_chol_inverse(&l, 3U, &l));
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&out, 3U, 3U, buf_c, 9U));
-    l_buf[8] = nan_value();
-    TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, dhc_chol_inverse(&l, 3U, &out));
-    l_buf[8] = 0.0;
-    TEST_ASSERT_EQUAL(DHC_ERR_SINGULAR, dhc_chol_inverse(&l, 3U, &out));
-    l_buf[8] = 5.0;
-    assert_sentinel(buf_c, 9U + GUARD);
-}
-
 static void test_condition_estimate_is_squared_diagonal_ratio(void)
 {
     static double l_buf[9] = {10.0, 0.0, 0.0, 3.0, 1.0, 0.0, 7.0, -2.0, 0.1};
@@ -1258,9 +1190,6 @@ int main(void)
     RUN_TEST(test_chol_solve_on_leading_block);
     RUN_TEST(test_triangular_solves_match_hand_values);
     RUN_TEST(test_triangular_solves_report_every_error);
-    RUN_TEST(test_chol_inverse_times_matrix_is_identity);
-    RUN_TEST(test_chol_inverse_of_hand_factor);
-    RUN_TEST(test_chol_inverse_reports_every_error);
     RUN_TEST(test_condition_estimate_is_squared_diagonal_ratio);
     RUN_TEST(test_is_finite_classifies_special_values);
     return UNITY_END();

@@ -151,11 +151,6 @@ dhc_status dhc_tri_lower_solve(const dhc_mat *l, size_t k, const double *b, doub
 dhc_status dhc_tri_lower_t_solve(const dhc_mat *l, size_t k, const double *y, double *x,
                                  size_t len);
 
-/* (L L^T)^-1 of the leading k x k block into out (exactly k x k, symmetric, both triangles
- * written).
- * For covariance reporting only; never used to solve. O(k^3). */
-dhc_status dhc_chol_inverse(const dhc_mat *l, size_t k, dhc_mat *out);
-
 /* Estimate of the 1-norm condition number of L L^T (leading k x k block) from the ratio of
  * the largest to smallest squared diagonal of L; a cheap lower bound, reported not used.
  * 1 for k = 0; HUGE_VAL for a zero diagonal or arguments that do not fit. */
