@@ -239,21 +239,17 @@ void dhc_rot_log(const dhc_mat3 *r, double w_rad[3])
 
 void dhc_rot_from_rpy(const double rpy_rad[3], dhc_mat3 *r)
 {
-    const double cr = cos(rpy_rad[0]);
-    const double sr = sin(rpy_rad[0]);
-    const double cp = cos(rpy_rad[1]);
-    const double sp = sin(rpy_rad[1]);
-    const double cy = cos(rpy_rad[2]);
-    const double sy = sin(rpy_rad[2]);
-    r->m[0][0] = cy * cp;
-    r->m[0][1] = cy * sp * sr - sy * cr;
-    r->m[0][2] = cy * sp * cr + sy * sr;
-    r->m[1][0] = sy * cp;
-    r->m[1][1] = sy * sp * sr + cy * cr;
-    r->m[1][2] = sy * sp * cr - cy * sr;
-    r->m[2][0] = -sp;
-    r->m[2][1] = cp * sr;
-    r->m[2][2] = cp * cr;
+    /* R = Rz(yaw) Ry(pitch) Rx(roll), composed from the elementary rotations: one
+     * definition of each axis rotation in the library. */
+    dhc_mat3 rz;
+    dhc_mat3 ry;
+    dhc_mat3 rx;
+    dhc_mat3 zy;
+    dhc_rot_z(rpy_rad[2], &rz);
+    dhc_rot_y(rpy_rad[1], &ry);
+    dhc_rot_x(rpy_rad[0], &rx);
+    dhc_rot_mul(&rz, &ry, &zy);
+    dhc_rot_mul(&zy, &rx, r);
 }
 
 void dhc_rot_to_rpy(const dhc_mat3 *r, double rpy_rad[3])
@@ -286,21 +282,13 @@ dhc_status dhc_rot_from_quat(const double q[4], dhc_mat3 *r)
     if (!(n2 >= 1e-18)) {
         return DHC_ERR_ARGUMENT;
     }
-    /* Dividing by n2 once normalises every product q_i q_j. */
-    const double k = 2.0 / n2;
-    const double w = q[0];
-    const double x = q[1];
-    const double y = q[2];
-    const double z = q[3];
-    r->m[0][0] = 1.0 - k * (y * y + z * z);
-    r->m[0][1] = k * (x * y - w * z);
-    r->m[0][2] = k * (x * z + w * y);
-    r->m[1][0] = k * (x * y + w * z);
-    r->m[1][1] = 1.0 - k * (x * x + z * z);
-    r->m[1][2] = k * (y * z - w * x);
-    r->m[2][0] = k * (x * z - w * y);
-    r->m[2][1] = k * (y * z + w * x);
-    r->m[2][2] = 1.0 - k * (x * x + y * y);
+    /* Angle 2 atan2(|v|, w) about v/|v|: exact for any scale of q, through the one
+     * Rodrigues implementation. */
+    const double vn = sqrt(q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    const double angle = 2.0 * atan2(vn, q[0]);
+    const double k = vn > 0.0 ? angle / vn : 0.0;
+    const double w[3] = {k * q[1], k * q[2], k * q[3]};
+    dhc_rot_exp(w, r);
     return DHC_OK;
 }
 
