@@ -1,4 +1,4 @@
-/* test_dhcal_plot.c - the SVG pictures of `dhcal plot`: three well-formed files with one
+/* test_dhcal_plot.c - the SVG pictures of `dhcal plot`: four well-formed files with one
  * point per value, markup in labels escaped, round tick labels, nothing written for bad
  * input, files replaced by rename, directory errors named. Every file is checked by a small
  * well-formedness checker here and, when python3 is available, by tests/tools/check_svg.py
@@ -35,6 +35,9 @@ static double g_rb[MAX_ROWS * 3U];
 static double g_ra[MAX_ROWS * 3U];
 static double g_eb[MAX_ROWS];
 static double g_ea[MAX_ROWS];
+static double g_je[MAX_ROWS * NJ_MAX];
+static double g_mo[MAX_ROWS * NJ_MAX];
+static signed char g_appr[MAX_ROWS * NJ_MAX];
 static dhcal_plot_candidate g_cand[3];
 static dhcal_plot_data g_d;
 
@@ -106,7 +109,10 @@ static void write_text(const char *path, const char *text)
     TEST_ASSERT_EQUAL_INT(0, fclose(f));
 }
 
-/* n rows of an nj-joint arm: z residual a cos(q2) wave, x two backlash clusters. */
+/* n rows of an nj-joint arm: z residual a cos(q2) wave, x two backlash clusters. Apparent
+ * joint errors: joint 1 vertical (no gravity moment) with +-0.05 deg of backlash by
+ * direction (millidegrees), joint 2 compliance 0.002 deg/mm against its moment, the rest a
+ * 0.3 deg harmonic. Directions cycle unknown, +1, -1. */
 static void fill(size_t n, size_t nj)
 {
     TEST_ASSERT_TRUE(n <= MAX_ROWS && nj <= NJ_MAX);
@@ -115,6 +121,15 @@ static void fill(size_t n, size_t nj)
     for (size_t i = 0U; i < n; ++i) {
         for (size_t j = 0U; j < nj; ++j) {
             g_q[i * nj + j] = -170.0 + fmod(37.0 * (double)i + 53.0 * (double)j, 340.0);
+        }
+        for (size_t j = 0U; j < nj; ++j) {
+            const size_t k = i * nj + j;
+            const double q = g_q[k] * 3.14159265358979323846 / 180.0;
+            g_appr[k] = (signed char)(i % 3U == 0U ? 0 : (i % 3U == 1U ? 1 : -1));
+            g_mo[k] = j == 0U ? 0.0 : 300.0 * cos(q);
+            g_je[k] = j == 0U   ? 0.05 * (double)g_appr[k]
+                      : j == 1U ? 0.002 * g_mo[k]
+                                : 0.3 * sin(q);
         }
         const double q2 = g_q[i * nj + (nj > 1U ? 1U : 0U)] * 3.14159265358979323846 / 180.0;
         const double bl = (i % 2U) != 0U ? 0.1 : -0.1;
@@ -141,7 +156,7 @@ static void fill(size_t n, size_t nj)
     const dhcal_plot_data d = {"test arm", n, nj, g_q, g_rb, g_ra, g_eb, g_ea,
                                n > 0U ? sqrt(sb / (double)n) : 0.0,
                                n > 0U ? sqrt(sa / (double)n) : 0.0,
-                               0, "joint_compliance:2", g_cand, 3U};
+                               0, "joint_compliance:2", g_cand, 3U, g_je, g_mo, g_appr};
     g_d = d;
 }
 
@@ -302,13 +317,18 @@ static size_t count(const char *s, const char *what)
 
 #define PLOT_TEST_MAX_TICKS 64U
 
-/* The tick labels of the first <g class="cls"> of a file, as numbers; returns how many. */
-static size_t axis_ticks(const char *name, const char *cls, double ticks[PLOT_TEST_MAX_TICKS])
+/* The tick labels of the nth (0-based) <g class="cls"> of a file, as numbers; returns how
+ * many. */
+static size_t axis_ticks_nth(const char *name, const char *cls, size_t nth,
+                             double ticks[PLOT_TEST_MAX_TICKS])
 {
     char *const s = slurp(out_path(name));
     char open[64];
     (void)snprintf(open, sizeof open, "<g class=\"%s\"", cls);
     const char *p = strstr(s, open);
+    for (size_t k = 0U; k < nth && p != NULL; ++k) {
+        p = strstr(p + 1, open);
+    }
     TEST_ASSERT_NOT_NULL_MESSAGE(p, open);
     const char *const end = strstr(p, "</g>");
     size_t k = 0U;
@@ -322,6 +342,11 @@ static size_t axis_ticks(const char *name, const char *cls, double ticks[PLOT_TE
     }
     free(s);
     return k;
+}
+
+static size_t axis_ticks(const char *name, const char *cls, double ticks[PLOT_TEST_MAX_TICKS])
+{
+    return axis_ticks_nth(name, cls, 0U, ticks);
 }
 
 /* The file is well-formed SVG with `points` data points and `bars` bars; returns its text. */
@@ -340,9 +365,16 @@ static char *check_svg(const char *name, size_t points, size_t bars)
     return s;
 }
 
+/* Points of joints.svg for fill(n, nj): two per value, none in joint 1's moment panel. */
+static size_t joint_points(size_t n, size_t nj)
+{
+    return 2U * n * nj - (n > 0U ? n : 0U);
+}
+
 static void check_all(size_t n, size_t nj, size_t n_cand)
 {
     free(check_svg("residuals.svg", 3U * n * nj, 0U));
+    free(check_svg("joints.svg", joint_points(n, nj), 0U));
     free(check_svg("errors.svg", 2U * n, 0U));
     free(check_svg("candidates.svg", 0U, n_cand));
 }
@@ -377,7 +409,7 @@ static int python_check(const char *args)
 
 /* ------------------------------------------------------------------ tests */
 
-static void test_writes_three_well_formed_files_with_one_point_per_value(void)
+static void test_writes_four_well_formed_files_with_one_point_per_value(void)
 {
     TEST_ASSERT_EQUAL_INT(DHCAL_IO_OK, dhcal_plot_write(g_out, &g_d, &g_err));
     check_all(10U, 3U, 3U);
@@ -397,6 +429,7 @@ static void test_python_xml_parser_accepts_the_files(void)
     fill(40U, 6U);
     TEST_ASSERT_EQUAL_INT(DHCAL_IO_OK, dhcal_plot_write(g_out, &g_d, &g_err));
     TEST_ASSERT_TRUE(python_check("--circles 720 --text 'test arm' residuals.svg "
+                                  "--circles 440 --text 'test arm' joints.svg "
                                   "--circles 80 --text 'before RMS' errors.svg "
                                   "--bars 3 --text joint_compliance:2 candidates.svg"));
 }
@@ -433,7 +466,8 @@ static void test_markup_in_labels_is_escaped(void)
     TEST_ASSERT_NOT_NULL(strstr(c, ">c&lt;&amp;&gt;&quot;&apos;</text>"));
     free(c);
     if (python_available()) {
-        TEST_ASSERT_TRUE(python_check("--text 'A&B <x> \"q\"' residuals.svg --text 'eff&<>' "
+        TEST_ASSERT_TRUE(python_check("--text 'A&B <x> \"q\"' residuals.svg --text 'A&B <x>' "
+                                      "joints.svg --text 'eff&<>' "
                                       "errors.svg --text 'c<&>' candidates.svg"));
     }
 }
@@ -447,7 +481,7 @@ static void test_control_bytes_and_broken_utf8_do_not_break_the_xml(void)
     TEST_ASSERT_NOT_NULL(strstr(r, "caf\xc3\xa9")); /* valid UTF-8 kept */
     free(r);
     if (python_available()) {
-        TEST_ASSERT_TRUE(python_check("residuals.svg errors.svg candidates.svg"));
+        TEST_ASSERT_TRUE(python_check("residuals.svg joints.svg errors.svg candidates.svg"));
     }
 }
 
@@ -479,11 +513,14 @@ static void test_candidate_label_filling_its_array_is_read_to_the_end_only(void)
 
 static void test_every_non_finite_input_is_bad_input_and_writes_nothing(void)
 {
-    double *const fields[] = {&g_q[4], &g_rb[7], &g_ra[29], &g_eb[9], &g_ea[0],
-                              &g_d.rms_before_mm, &g_d.rms_after_mm, &g_cand[2].explained};
-    const char *const names[] = {"q_deg[1][1]", "resid_before[2][1]", "resid_after[9][2]",
-                                 "err_before[9]", "err_after[0]", "rms_before_mm",
-                                 "rms_after_mm", "candidates[2].explained"};
+    double *const fields[] = {&g_q[4],    &g_rb[7],           &g_ra[29],
+                              &g_eb[9],   &g_ea[0],           &g_je[5],
+                              &g_mo[28],  &g_d.rms_before_mm, &g_d.rms_after_mm,
+                              &g_cand[2].explained};
+    const char *const names[] = {"q_deg[1][1]",    "resid_before[2][1]", "resid_after[9][2]",
+                                 "err_before[9]",  "err_after[0]",       "joint_err_deg[1][2]",
+                                 "moment_mm[9][1]", "rms_before_mm",     "rms_after_mm",
+                                 "candidates[2].explained"};
     const double bad[3] = {(double)NAN, (double)INFINITY, -(double)INFINITY};
     for (size_t f = 0U; f < sizeof fields / sizeof fields[0]; ++f) {
         for (size_t b = 0U; b < 3U; ++b) {
@@ -511,6 +548,8 @@ static void test_zero_rows_still_writes_valid_files(void)
     fill(0U, 2U);
     g_d.q_deg = NULL;
     g_d.resid_before = g_d.resid_after = g_d.err_before = g_d.err_after = NULL;
+    g_d.joint_err_deg = g_d.moment_mm = NULL;
+    g_d.dir = NULL;
     g_d.n_candidates = 0U;
     g_d.candidates = NULL;
     TEST_ASSERT_EQUAL_INT(DHCAL_IO_OK, dhcal_plot_write(g_out, &g_d, &g_err));
@@ -518,8 +557,12 @@ static void test_zero_rows_still_writes_valid_files(void)
     char *const r = slurp(out_path("residuals.svg"));
     TEST_ASSERT_NOT_NULL(strstr(r, ">no rows</text>"));
     free(r);
+    char *const jt = slurp(out_path("joints.svg"));
+    TEST_ASSERT_EQUAL_size_t(4U, count(jt, ">no rows</text>")); /* 2 joints x 2 panels */
+    free(jt);
     if (python_available()) {
-        TEST_ASSERT_TRUE(python_check("--circles 0 residuals.svg --circles 0 errors.svg "
+        TEST_ASSERT_TRUE(python_check("--circles 0 residuals.svg --circles 0 --text 'no rows' "
+                                      "joints.svg --circles 0 errors.svg "
                                       "--bars 0 --text 'no candidates' candidates.svg"));
     }
 }
@@ -541,8 +584,8 @@ static void test_constant_data_has_finite_ranges(void)
     g_d.effect = "";
     TEST_ASSERT_EQUAL_INT(DHCAL_IO_OK, dhcal_plot_write(g_out, &g_d, &g_err));
     check_all(10U, 3U, 3U);
-    const char *const names[3] = {"residuals.svg", "errors.svg", "candidates.svg"};
-    for (size_t k = 0U; k < 3U; ++k) {
+    const char *const names[4] = {"residuals.svg", "joints.svg", "errors.svg", "candidates.svg"};
+    for (size_t k = 0U; k < 4U; ++k) {
         char *const s = slurp(out_path(names[k]));
         TEST_ASSERT_NULL_MESSAGE(strstr(s, "nan"), names[k]);
         TEST_ASSERT_NULL_MESSAGE(strstr(s, "inf"), names[k]);
@@ -558,7 +601,7 @@ static void test_constant_data_has_finite_ranges(void)
     TEST_ASSERT_TRUE(ticks[0] < 40.0 && ticks[n - 1U] > 44.0);
     TEST_ASSERT_DOUBLE_WITHIN(1e-9, 42.0, 0.5 * (ticks[0] + ticks[n - 1U]));
     if (python_available()) {
-        TEST_ASSERT_TRUE(python_check("residuals.svg errors.svg candidates.svg"));
+        TEST_ASSERT_TRUE(python_check("residuals.svg joints.svg errors.svg candidates.svg"));
     }
 }
 
@@ -575,7 +618,7 @@ static void test_one_row_one_joint(void)
         TEST_ASSERT_DOUBLE_WITHIN(1e-12, floor(ticks[i] + 0.5), ticks[i]);
     }
     if (python_available()) {
-        TEST_ASSERT_TRUE(python_check("residuals.svg errors.svg candidates.svg"));
+        TEST_ASSERT_TRUE(python_check("residuals.svg joints.svg errors.svg candidates.svg"));
     }
 }
 
@@ -634,7 +677,7 @@ static void test_existing_file_is_replaced_by_rename(void)
     char *const k = slurp(keep);
     TEST_ASSERT_EQUAL_STRING("old picture", k);
     free(k);
-    TEST_ASSERT_EQUAL_size_t(4U, count_entries(g_out)); /* no temporary file left */
+    TEST_ASSERT_EQUAL_size_t(5U, count_entries(g_out)); /* no temporary file left */
 }
 
 static void test_failed_rename_leaves_no_temporary_file(void)
@@ -681,7 +724,7 @@ static void test_missing_directories_are_created_with_the_umask(void)
     TEST_ASSERT_EQUAL_UINT(0750U, (unsigned)(st.st_mode & 0777U));
     TEST_ASSERT_EQUAL_INT(0, stat(g_out, &st));
     TEST_ASSERT_EQUAL_UINT(0750U, (unsigned)(st.st_mode & 0777U));
-    TEST_ASSERT_EQUAL_size_t(3U, count_entries(sub));
+    TEST_ASSERT_EQUAL_size_t(4U, count_entries(sub));
 }
 
 static void test_caller_errors_are_failed(void)
@@ -695,16 +738,221 @@ static void test_caller_errors_are_failed(void)
     g_d.resid_after = NULL;
     TEST_ASSERT_EQUAL_INT(DHCAL_IO_FAILED, dhcal_plot_write(g_out, &g_d, &g_err));
     g_d.resid_after = g_ra;
+    g_d.joint_err_deg = NULL;
+    TEST_ASSERT_EQUAL_INT(DHCAL_IO_FAILED, dhcal_plot_write(g_out, &g_d, &g_err));
+    g_d.joint_err_deg = g_je;
+    g_d.moment_mm = NULL;
+    TEST_ASSERT_EQUAL_INT(DHCAL_IO_FAILED, dhcal_plot_write(g_out, &g_d, &g_err));
+    g_d.moment_mm = g_mo;
+    g_d.dir = NULL;
+    TEST_ASSERT_EQUAL_INT(DHCAL_IO_FAILED, dhcal_plot_write(g_out, &g_d, &g_err));
+    g_d.dir = g_appr;
     g_d.title = NULL;
     TEST_ASSERT_EQUAL_INT(DHCAL_IO_FAILED, dhcal_plot_write(g_out, &g_d, &g_err));
     struct stat st;
     TEST_ASSERT_NOT_EQUAL_INT(0, stat(g_out, &st));
 }
 
+/* ------------------------------------------------------------------ joints.svg */
+
+/* Heap copy of s[from .. the next `to` or the end), from the first `from`; fails when absent. */
+static char *section(const char *s, const char *from, const char *to)
+{
+    const char *const a = strstr(s, from);
+    TEST_ASSERT_NOT_NULL_MESSAGE(a, from);
+    const char *const e = to != NULL ? strstr(a + 1, to) : NULL;
+    const size_t n = e != NULL ? (size_t)(e - a) : strlen(a);
+    char *const c = malloc(n + 1U);
+    TEST_ASSERT_NOT_NULL(c);
+    memcpy(c, a, n);
+    c[n] = '\0';
+    return c;
+}
+
+/* Data points inside every <g class="cls" ...> ... </g> of s. */
+static size_t points_in_groups(const char *s, const char *cls)
+{
+    char open[64];
+    (void)snprintf(open, sizeof open, "<g class=\"%s\"", cls);
+    size_t n = 0U;
+    for (const char *p = strstr(s, open); p != NULL; p = strstr(p + 1, open)) {
+        const char *const end = strstr(p, "</g>");
+        TEST_ASSERT_NOT_NULL(end);
+        for (const char *c = strstr(p, "<circle cx="); c != NULL && c < end;
+             c = strstr(c + 1, "<circle cx=")) {
+            n++;
+        }
+    }
+    return n;
+}
+
+static void test_joints_svg_has_two_panels_per_joint_and_none_for_a_vertical_axis(void)
+{
+    TEST_ASSERT_EQUAL_INT(DHCAL_IO_OK, dhcal_plot_write(g_out, &g_d, &g_err));
+    char *const s = check_svg("joints.svg", 50U, 0U); /* 10 rows x 3 joints x 2, less joint 1's */
+    TEST_ASSERT_EQUAL_size_t(6U, count(s, "<g class=\"panel\""));
+    TEST_ASSERT_NOT_NULL(strstr(s, "Apparent joint error: test arm"));
+    TEST_ASSERT_NOT_NULL(strstr(s, ">joint 2 vs angle</text>"));
+    TEST_ASSERT_NOT_NULL(strstr(s, ">joint 3 vs gravity moment</text>"));
+    TEST_ASSERT_NOT_NULL(strstr(s, ">q3 [deg]</text>"));
+    TEST_ASSERT_EQUAL_size_t(3U, count(s, ">gravity moment [mm]</text>"));
+    TEST_ASSERT_EQUAL_size_t(1U, count(s, ">no gravity moment about this joint</text>"));
+    /* joint 1's moment panel: the note, no points and no numbers on a moment axis */
+    char *const m1 = section(s, "id=\"joint1-moment\"", "<g class=\"panel\"");
+    TEST_ASSERT_NOT_NULL(strstr(m1, "no gravity moment about this joint"));
+    TEST_ASSERT_EQUAL_size_t(0U, count(m1, "<circle cx="));
+    TEST_ASSERT_NULL(strstr(m1, "axis-x"));
+    TEST_ASSERT_NOT_NULL(strstr(m1, "axis-y"));
+    free(m1);
+    char *const m2 = section(s, "id=\"joint2-moment\"", "<g class=\"panel\"");
+    TEST_ASSERT_EQUAL_size_t(10U, count(m2, "<circle cx="));
+    TEST_ASSERT_NOT_NULL(strstr(m2, "axis-x"));
+    free(m2);
+    free(s);
+    if (python_available()) {
+        TEST_ASSERT_TRUE(python_check("--circles 50 --text 'no gravity moment about this joint' "
+                                      "joints.svg"));
+    }
+}
+
+static void test_joints_svg_with_no_moment_anywhere_is_still_valid(void)
+{
+    for (size_t i = 0U; i < 30U; ++i) {
+        g_mo[i] = (i % 2U) != 0U ? 1e-9 : -1e-9; /* rounding noise of a vertical axis */
+    }
+    TEST_ASSERT_EQUAL_INT(DHCAL_IO_OK, dhcal_plot_write(g_out, &g_d, &g_err));
+    char *const s = check_svg("joints.svg", 30U, 0U);
+    TEST_ASSERT_EQUAL_size_t(3U, count(s, ">no gravity moment about this joint</text>"));
+    free(s);
+    if (python_available()) {
+        TEST_ASSERT_TRUE(python_check("--circles 30 joints.svg"));
+    }
+}
+
+/* Joint 1's errors are +-0.05 deg: its rows read in millidegrees, the others in degrees. */
+static void test_joint_errors_below_a_tenth_of_a_degree_are_drawn_in_millidegrees(void)
+{
+    TEST_ASSERT_EQUAL_INT(DHCAL_IO_OK, dhcal_plot_write(g_out, &g_d, &g_err));
+    char *const s = check_svg("joints.svg", 50U, 0U);
+    TEST_ASSERT_EQUAL_size_t(2U, count(s, ">dq1 [mdeg]</text>")); /* both panels */
+    TEST_ASSERT_EQUAL_size_t(2U, count(s, ">dq2 [deg]</text>"));
+    TEST_ASSERT_EQUAL_size_t(2U, count(s, ">dq3 [deg]</text>"));
+    free(s);
+    double ticks[PLOT_TEST_MAX_TICKS];
+    size_t n = axis_ticks("joints.svg", "axis-y", ticks); /* joint 1, angle panel */
+    TEST_ASSERT_TRUE(n >= 3U);
+    TEST_ASSERT_TRUE(ticks[0] <= -50.0 && ticks[0] >= -100.0); /* -50..50 mdeg, padded */
+    TEST_ASSERT_TRUE(ticks[n - 1U] >= 50.0 && ticks[n - 1U] <= 100.0);
+
+    /* just below the switch: still millidegrees; at it: degrees */
+    g_je[3] = 0.0999;
+    TEST_ASSERT_EQUAL_INT(DHCAL_IO_OK, dhcal_plot_write(g_out, &g_d, &g_err));
+    char *const below = slurp(out_path("joints.svg"));
+    TEST_ASSERT_EQUAL_size_t(2U, count(below, ">dq1 [mdeg]</text>"));
+    free(below);
+    g_je[3] = -0.1;
+    TEST_ASSERT_EQUAL_INT(DHCAL_IO_OK, dhcal_plot_write(g_out, &g_d, &g_err));
+    char *const at = check_svg("joints.svg", 50U, 0U);
+    TEST_ASSERT_NULL(strstr(at, "mdeg"));
+    TEST_ASSERT_EQUAL_size_t(2U, count(at, ">dq1 [deg]</text>"));
+    free(at);
+    n = axis_ticks("joints.svg", "axis-y", ticks);
+    TEST_ASSERT_TRUE(n >= 2U);
+    TEST_ASSERT_TRUE(ticks[0] <= -0.1 && ticks[0] > -1.0);
+    if (python_available()) {
+        TEST_ASSERT_TRUE(python_check("joints.svg"));
+    }
+}
+
+/* fill(10, 3): rows 0, 3, 6, 9 unknown, 1, 4, 7 approach +, 2, 5, 8 approach -. */
+static void test_joint_points_are_coloured_by_approach_direction(void)
+{
+    TEST_ASSERT_EQUAL_INT(DHCAL_IO_OK, dhcal_plot_write(g_out, &g_d, &g_err));
+    char *const s = check_svg("joints.svg", 50U, 0U);
+    TEST_ASSERT_EQUAL_size_t(5U, count(s, "<g class=\"dir-plus\" fill=\"#1f77b4\""));
+    TEST_ASSERT_EQUAL_size_t(5U, count(s, "<g class=\"dir-minus\" fill=\"#ff7f0e\""));
+    TEST_ASSERT_EQUAL_size_t(5U, count(s, "<g class=\"dir-unknown\" fill=\"#9e9e9e\""));
+    TEST_ASSERT_EQUAL_size_t(15U, points_in_groups(s, "dir-plus"));
+    TEST_ASSERT_EQUAL_size_t(15U, points_in_groups(s, "dir-minus"));
+    TEST_ASSERT_EQUAL_size_t(20U, points_in_groups(s, "dir-unknown"));
+    TEST_ASSERT_NOT_NULL(strstr(s, ">approach +</text>"));
+    TEST_ASSERT_NOT_NULL(strstr(s, ">approach -</text>"));
+    TEST_ASSERT_NOT_NULL(strstr(s, ">direction unknown</text>"));
+    free(s);
+
+    /* one direction only: its colour, and no legend entry for the others */
+    for (size_t i = 0U; i < 30U; ++i) {
+        g_appr[i] = 1;
+    }
+    TEST_ASSERT_EQUAL_INT(DHCAL_IO_OK, dhcal_plot_write(g_out, &g_d, &g_err));
+    char *const one = check_svg("joints.svg", 50U, 0U);
+    TEST_ASSERT_EQUAL_size_t(50U, points_in_groups(one, "dir-plus"));
+    TEST_ASSERT_NULL(strstr(one, "dir-minus"));
+    TEST_ASSERT_NULL(strstr(one, "dir-unknown"));
+    TEST_ASSERT_NULL(strstr(one, ">approach -</text>"));
+    TEST_ASSERT_NULL(strstr(one, ">direction unknown</text>"));
+    free(one);
+}
+
+static void test_direction_other_than_minus_one_zero_plus_one_is_bad_input(void)
+{
+    g_appr[4] = 2;
+    TEST_ASSERT_EQUAL_INT(DHCAL_IO_BAD_INPUT, dhcal_plot_write(g_out, &g_d, &g_err));
+    TEST_ASSERT_NOT_NULL_MESSAGE(strstr(g_err.msg, "dir[1][1]"), g_err.msg);
+    g_appr[4] = -128;
+    TEST_ASSERT_EQUAL_INT(DHCAL_IO_BAD_INPUT, dhcal_plot_write(g_out, &g_d, &g_err));
+    struct stat st;
+    TEST_ASSERT_NOT_EQUAL_INT(0, stat(g_out, &st));
+}
+
+/* All four or none: a NaN joint error leaves an existing directory as it was. */
+static void test_nan_joint_error_writes_no_file(void)
+{
+    TEST_ASSERT_EQUAL_INT(0, mkdir(g_out, 0777));
+    write_text(out_path("joints.svg"), "old picture");
+    g_je[7] = (double)NAN;
+    TEST_ASSERT_EQUAL_INT(DHCAL_IO_BAD_INPUT, dhcal_plot_write(g_out, &g_d, &g_err));
+    TEST_ASSERT_NOT_NULL_MESSAGE(strstr(g_err.msg, "joint_err_deg[2][1] is NaN"), g_err.msg);
+    TEST_ASSERT_EQUAL_size_t(1U, count_entries(g_out));
+    char *const s = slurp(out_path("joints.svg"));
+    TEST_ASSERT_EQUAL_STRING("old picture", s);
+    free(s);
+}
+
+/* A near-singular pose multiplies its residual: one such row must not flatten the rest. */
+static void test_a_few_far_off_joint_errors_are_drawn_hollow_on_the_edge(void)
+{
+    fill(40U, 3U);
+    g_je[7U * 3U + 2U] = 50.0; /* joint 3 stays within 0.3 deg elsewhere */
+    TEST_ASSERT_EQUAL_INT(DHCAL_IO_OK, dhcal_plot_write(g_out, &g_d, &g_err));
+    char *const s = check_svg("joints.svg", joint_points(40U, 3U), 0U);
+    TEST_ASSERT_EQUAL_size_t(2U, count(s, "class=\"clipped\"")); /* both panels of joint 3 */
+    TEST_ASSERT_EQUAL_size_t(1U, count(s, ">1 point off scale (hollow)</text>"));
+    free(s);
+    double ticks[PLOT_TEST_MAX_TICKS];
+    const size_t n = axis_ticks_nth("joints.svg", "axis-y", 4U, ticks); /* joint 3, angle */
+    TEST_ASSERT_TRUE(n >= 3U);
+    TEST_ASSERT_TRUE(ticks[n - 1U] < 1.0);
+    if (python_available()) {
+        TEST_ASSERT_TRUE(python_check("joints.svg"));
+    }
+
+    /* more than 1 in 10 far off: they are the data, the axis spans them */
+    for (size_t i = 0U; i < 5U; ++i) {
+        g_je[(7U * i + 1U) * 3U + 2U] = 50.0;
+    }
+    TEST_ASSERT_EQUAL_INT(DHCAL_IO_OK, dhcal_plot_write(g_out, &g_d, &g_err));
+    char *const all = check_svg("joints.svg", joint_points(40U, 3U), 0U);
+    TEST_ASSERT_NULL(strstr(all, "clipped"));
+    free(all);
+    const size_t m = axis_ticks_nth("joints.svg", "axis-y", 4U, ticks);
+    TEST_ASSERT_TRUE(ticks[m - 1U] >= 50.0);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
-    RUN_TEST(test_writes_three_well_formed_files_with_one_point_per_value);
+    RUN_TEST(test_writes_four_well_formed_files_with_one_point_per_value);
     RUN_TEST(test_python_xml_parser_accepts_the_files);
     RUN_TEST(test_python_check_rejects_a_broken_file);
     RUN_TEST(test_markup_in_labels_is_escaped);
@@ -726,5 +974,12 @@ int main(void)
     RUN_TEST(test_parent_that_is_a_file_fails_naming_it);
     RUN_TEST(test_missing_directories_are_created_with_the_umask);
     RUN_TEST(test_caller_errors_are_failed);
+    RUN_TEST(test_joints_svg_has_two_panels_per_joint_and_none_for_a_vertical_axis);
+    RUN_TEST(test_joints_svg_with_no_moment_anywhere_is_still_valid);
+    RUN_TEST(test_joint_errors_below_a_tenth_of_a_degree_are_drawn_in_millidegrees);
+    RUN_TEST(test_joint_points_are_coloured_by_approach_direction);
+    RUN_TEST(test_direction_other_than_minus_one_zero_plus_one_is_bad_input);
+    RUN_TEST(test_nan_joint_error_writes_no_file);
+    RUN_TEST(test_a_few_far_off_joint_errors_are_drawn_hollow_on_the_edge);
     return UNITY_END();
 }

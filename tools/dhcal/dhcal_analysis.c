@@ -1,6 +1,8 @@
 /* dhcal_analysis.c - fit and diagnose over loaded samples. */
 #include "dhcal_analysis.h"
 
+#include "dhcal/dhc_jacobian.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -126,6 +128,70 @@ int dhcal_run_diagnose(const dhcal_fit *fit, const dhcal_samples *s, dhc_diagnos
     if (st != DHC_OK) {
         snprintf(err->msg, sizeof err->msg, "diagnosis failed: %s", dhc_status_str(st));
         return DHCAL_IO_FAILED;
+    }
+    return DHCAL_IO_OK;
+}
+
+int dhcal_apparent_joint_errors(const dhc_model *model, const dhcal_samples *s, int with_effects,
+                                double *dq_deg, double *moment_mm)
+{
+    static dhc_normal_eq ne;
+    static dhc_lsq_factor fac;
+    const size_t nj = model->arm.n_joints;
+    dhc_param_set offsets; /* theta_i: its column is joint i's column */
+    dhc_params_clear(&offsets);
+    for (size_t j = 0U; j < nj; ++j) {
+        if (dhc_params_add(&offsets, model, DHC_P_THETA, j, 0U) != DHC_OK) {
+            return DHCAL_IO_FAILED;
+        }
+    }
+    for (size_t i = 0U; i < s->n; ++i) {
+        const dhc_sample *smp = &s->samples[i];
+        double r[DHC_MAX_ROWS_PER_SAMPLE];
+        double jac_buf[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_JOINTS];
+        double tau[DHC_MAX_JOINTS][DHC_MAX_JOINTS];
+        double dq[DHC_MAX_JOINTS];
+        size_t rows;
+        dhc_mat jac;
+        /* position (or wire) rows only: an orientation row would weigh in at 1000 mm/rad */
+        dhc_status st = dhc_model_residual(model, smp, 1000.0, r, &rows);
+        if (st == DHC_OK) {
+            st = dhc_mat_init(&jac, dhc_sample_rows(smp), nj, jac_buf, sizeof jac_buf / sizeof jac_buf[0]);
+        }
+        dhc_prediction pred;
+        if (st == DHC_OK) {
+            st = dhc_model_jacobian(model, &offsets, smp, 1000.0, &jac, &pred);
+        }
+        if (st == DHC_OK) {
+            jac.rows = 3U;
+            st = dhc_normal_eq_init(&ne, nj);
+        }
+        if (st == DHC_OK) {
+            st = dhc_normal_eq_add(&ne, &jac, r, NULL, 3U);
+        }
+        /* least-norm where the joint Jacobian is short of rank (more joints than rows) */
+        if (st == DHC_OK) {
+            st = dhc_lsq_analyse(&ne, 1e-10, &fac);
+        }
+        if (st == DHC_OK) {
+            st = dhc_lsq_step(&ne, &fac, 0.0, dq, nj);
+        }
+        if (st == DHC_OK) {
+            st = dhc_model_gravity_moments(model, dhc_model_length_scale(model, smp->temp_c),
+                                           smp->q_rad, tau);
+        }
+        if (st != DHC_OK) {
+            return DHCAL_IO_FAILED;
+        }
+        for (size_t j = 0U; j < nj; ++j) {
+            double m = 0.0;
+            for (size_t k = j; k < nj; ++k) {
+                m += tau[j][k];
+            }
+            const double modelled = with_effects ? pred.q_eff_rad[j] - smp->q_rad[j] : 0.0;
+            dq_deg[i * nj + j] = (dq[j] + modelled) * 180.0 / PI;
+            moment_mm[i * nj + j] = m;
+        }
     }
     return DHCAL_IO_OK;
 }

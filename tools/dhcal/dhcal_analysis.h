@@ -33,6 +33,14 @@ int dhcal_run_fit(const dhc_model *nominal, const char *effects, dhcal_samples *
 int dhcal_run_diagnose(const dhcal_fit *fit, const dhcal_samples *s, dhc_diagnosis *out,
                        dhcal_error *err);
 
+/* Per row: the apparent joint error dq = pinv(J_q) r (degrees; J_q the joint Jacobian of
+ * what was measured, tool point or wire lengths) and the gravity moment about each joint
+ * (mm, summed over the frames beyond it). Both arrays n x n_joints. With with_effects, the
+ * dq the model's own effects apply is added: a component-plus-residual view, in which a
+ * fitted effect shows its full shape (a base fit alone absorbs part of it into geometry). */
+int dhcal_apparent_joint_errors(const dhc_model *model, const dhcal_samples *s, int with_effects,
+                                double *dq_deg, double *moment_mm);
+
 /* "joint_compliance:2" / "measurer_scale" for a candidate (joint 0-based in, 1-based out). */
 void dhcal_effect_label(dhc_effect effect, size_t joint, char *buf, size_t cap);
 

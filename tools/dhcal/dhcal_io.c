@@ -5,24 +5,19 @@
  * uses a fixed-size line buffer: CSV lines grow a heap buffer up to DHCAL_CSV_MAX_LINE,
  * the model file is read whole up to DHCAL_MODEL_MAX_BYTES.
  */
-/* POSIX.1-2008: open/fsync/rename for the atomic save. */
-#ifndef _POSIX_C_SOURCE
-#define _POSIX_C_SOURCE 200809L
-#endif
 #include "dhcal_io.h"
 
 #include <cjson/cJSON.h>
 #include <errno.h>
-#include <fcntl.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "dhcal/dhc_linalg.h"
+#include "dhcal_file.h"
 
 #define IO_PI 3.14159265358979323846
 #define DEG_TO_RAD (IO_PI / 180.0)
@@ -1563,52 +1558,6 @@ static int model_writable(const dhcal_model *m, char *where, size_t cap)
     return 1;
 }
 
-static int write_all(int fd, const char *p, size_t n)
-{
-    while (n > 0U) {
-        const ssize_t w = write(fd, p, n);
-        if (w < 0) {
-            if (errno == EINTR) {
-                continue;
-            }
-            return -1;
-        }
-        p += (size_t)w;
-        n -= (size_t)w;
-    }
-    return 0;
-}
-
-/* Best effort: makes the rename itself durable. Some file systems refuse fsync on a
- * directory; the file's data is already on disk then, so the error is ignored. */
-static void sync_parent_dir(const char *path)
-{
-    const char *const slash = strrchr(path, '/');
-    char *dir = NULL;
-    if (slash == NULL) {
-        dir = malloc(2U);
-        if (dir != NULL) {
-            memcpy(dir, ".", 2U);
-        }
-    } else {
-        const size_t n = slash == path ? 1U : (size_t)(slash - path);
-        dir = malloc(n + 1U);
-        if (dir != NULL) {
-            memcpy(dir, path, n);
-            dir[n] = '\0';
-        }
-    }
-    if (dir == NULL) {
-        return;
-    }
-    const int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    if (fd >= 0) {
-        (void)fsync(fd);
-        (void)close(fd);
-    }
-    free(dir);
-}
-
 int dhcal_model_save(const char *path, const dhcal_model *model, dhcal_error *err)
 {
     char where[256];
@@ -1617,47 +1566,11 @@ int dhcal_model_save(const char *path, const dhcal_model *model, dhcal_error *er
     }
     strbuf sb = {NULL, 0U, 0U, 0};
     format_model(&sb, model);
-    const size_t tmp_cap = strlen(path) + 48U;
-    char *const tmp = sb.oom ? NULL : malloc(tmp_cap);
-    if (tmp == NULL) {
+    if (sb.oom) {
         free(sb.p);
         return set_error(err, DHCAL_IO_FAILED, "%s: not written: out of memory", path);
     }
-    /* O_EXCL and a name nobody else uses: never follows or clobbers a stranger's file. */
-    int fd = -1;
-    for (unsigned k = 0U; k < 100U && fd < 0; ++k) {
-        (void)snprintf(tmp, tmp_cap, "%s.tmp.%ld.%u", path, (long)getpid(), k);
-        fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-        if (fd < 0 && errno != EEXIST) {
-            break;
-        }
-    }
-    int rc = DHCAL_IO_OK;
-    if (fd < 0) {
-        rc = set_error(err, DHCAL_IO_FAILED, "%s: cannot create temporary file '%s': %s", path,
-                       tmp, strerror(errno));
-    } else {
-        int saved = 0;
-        if (write_all(fd, sb.p, sb.len) != 0 || fsync(fd) != 0) {
-            saved = errno;
-        }
-        if (close(fd) != 0 && saved == 0) {
-            saved = errno;
-        }
-        if (saved != 0) {
-            rc = set_error(err, DHCAL_IO_FAILED, "%s: cannot write temporary file '%s': %s",
-                           path, tmp, strerror(saved));
-        } else if (rename(tmp, path) != 0) {
-            rc = set_error(err, DHCAL_IO_FAILED, "%s: cannot replace it with '%s': %s", path,
-                           tmp, strerror(errno));
-        } else {
-            sync_parent_dir(path);
-        }
-        if (rc != DHCAL_IO_OK) {
-            (void)unlink(tmp);
-        }
-    }
-    free(tmp);
+    const int rc = dhcal_file_write_atomic(path, sb.p, sb.len, err);
     free(sb.p);
     return rc;
 }

@@ -1,20 +1,21 @@
 /* dhcal_plot.c - the pictures of a fit as hand-written SVG 1.1: residuals against each joint
- * angle, the per-row error before and after an effect, the diagnosis' candidate shares.
+ * angle, the apparent joint errors against angle and gravity moment, the per-row error
+ * before and after an effect, the diagnosis' candidate shares.
  *
  * Every input is checked before anything touches the disk. Each document is built whole in
- * a heap buffer, then written to a temporary file beside its target and renamed over it, so
- * a reader never sees half a picture. Numbers go out as %.6g through fin(), text through
- * put_text() (escaped, valid UTF-8 only), so every file parses as XML whatever the labels.
+ * a heap buffer, then written through dhcal_file_write_atomic() (a temporary file beside
+ * its target, renamed over it), so a reader never sees half a picture. Numbers go out as
+ * %.6g through fin(), text through put_text() (escaped, valid UTF-8 only), so every file
+ * parses as XML whatever the labels.
  * Layout uses an estimated glyph advance (PLOT_CHAR_EM): no font metrics are available.
  */
-/* POSIX.1-2008: mkdir, stat, open/fsync/rename, getpid. */
+/* POSIX.1-2008: mkdir, stat. */
 #ifndef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 200809L
 #endif
 #include "dhcal_plot.h"
 
 #include <errno.h>
-#include <fcntl.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
@@ -22,7 +23,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <unistd.h>
+
+#include "dhcal_file.h"
 
 #if defined(__GNUC__)
 #define PLOT_PRINTF(fmt_index, first_arg) __attribute__((format(printf, fmt_index, first_arg)))
@@ -41,6 +43,13 @@
 /* Characters of the <title> element (tooltip, accessible name) before it is cut with "...";
  * the drawn title is cut to the picture's width. */
 #define PLOT_TITLE_ATTR_MAX 1000U
+/* A joint whose gravity moment stays below this (mm) in every row has none: a vertical axis,
+ * where the computed moment is rounding noise (~1e-13 mm for metre-long links). */
+#define PLOT_NO_MOMENT_MM 1e-6
+/* Apparent joint errors all below this (deg) are drawn in millidegrees: "0.02", not "2e-05". */
+#define PLOT_MDEG_BELOW_DEG 0.1
+/* Files dhcal_plot_write() writes. */
+#define PLOT_DOCS 4U
 
 #define COLOR_X "#1f77b4"
 #define COLOR_Y "#ff7f0e"
@@ -54,6 +63,10 @@
 #define COLOR_FRAME "#999999"
 #define COLOR_TEXT "#222222"
 #define COLOR_MUTED "#666666"
+#define COLOR_DIR_PLUS "#1f77b4"
+#define COLOR_DIR_MINUS "#ff7f0e"
+#define COLOR_DIR_UNKNOWN "#9e9e9e"
+#define COLOR_ZERO "#444444"
 
 static const char *const component_color[3] = {COLOR_X, COLOR_Y, COLOR_Z};
 
@@ -411,14 +424,16 @@ static void draw_frame(svgbuf *b, const frame *f, int x_grid)
         }
         sb_str(b, "</g>\n");
     }
-    sb_str(b, "<g class=\"axis-x\" font-size=\"11\" text-anchor=\"middle\" fill=\"" COLOR_TEXT
-              "\">\n");
-    for (size_t i = 0U; i < f->ax.n_ticks; ++i) {
-        const double v = tick_value(&f->ax, i);
-        sb_printf(b, "<text x=\"%.6g\" y=\"%.6g\">%.6g</text>\n", fin(px_x(f, v)),
-                  fin(f->y + f->h + 15.0), fin(v));
+    if (f->ax.n_ticks > 0U) {
+        sb_str(b, "<g class=\"axis-x\" font-size=\"11\" text-anchor=\"middle\" fill=\"" COLOR_TEXT
+                  "\">\n");
+        for (size_t i = 0U; i < f->ax.n_ticks; ++i) {
+            const double v = tick_value(&f->ax, i);
+            sb_printf(b, "<text x=\"%.6g\" y=\"%.6g\">%.6g</text>\n", fin(px_x(f, v)),
+                      fin(f->y + f->h + 15.0), fin(v));
+        }
+        sb_str(b, "</g>\n");
     }
-    sb_str(b, "</g>\n");
 }
 
 /* Axis titles: below the plot area, and rotated along its left side at x_left. */
@@ -490,6 +505,24 @@ static double legend_item(svgbuf *b, double x, double y, const char *color, int 
     return x + 15.0 + text_w(chars < max_chars ? chars : max_chars, 12.0) + 18.0;
 }
 
+/* Zero lines through the plot area: horizontal at y = 0, vertical at x = 0 (`vertical`),
+ * each only when 0 is inside the drawn range. */
+static void zero_lines(svgbuf *b, const frame *f, int vertical)
+{
+    if (f->ay.lo < 0.0 && f->ay.hi > 0.0) {
+        const double y0 = px_y(f, 0.0);
+        sb_printf(b, "<line x1=\"%.6g\" y1=\"%.6g\" x2=\"%.6g\" y2=\"%.6g\" stroke=\"" COLOR_ZERO
+                     "\" stroke-width=\"1\"/>\n",
+                  fin(f->x), fin(y0), fin(f->x + f->w), fin(y0));
+    }
+    if (vertical && f->ax.n_ticks > 0U && f->ax.lo < 0.0 && f->ax.hi > 0.0) {
+        const double x0 = px_x(f, 0.0);
+        sb_printf(b, "<line x1=\"%.6g\" y1=\"%.6g\" x2=\"%.6g\" y2=\"%.6g\" stroke=\"" COLOR_ZERO
+                     "\" stroke-width=\"1\"/>\n",
+                  fin(x0), fin(f->y), fin(x0), fin(f->y + f->h));
+    }
+}
+
 static void residuals_svg(svgbuf *b, const dhcal_plot_data *d)
 {
     const size_t n = d->n_rows;
@@ -555,12 +588,7 @@ static void residuals_svg(svgbuf *b, const dhcal_plot_data *d)
                          fit_axis(xlo, xhi, plot_w, 11.0, 1, 0), ay};
         sb_printf(b, "<g class=\"panel\" id=\"joint%zu\">\n", j + 1U);
         draw_frame(b, &f, 1);
-        if (f.ay.lo < 0.0 && f.ay.hi > 0.0) {
-            const double y0 = px_y(&f, 0.0);
-            sb_printf(b, "<line x1=\"%.6g\" y1=\"%.6g\" x2=\"%.6g\" y2=\"%.6g\" stroke=\"#444444\" "
-                         "stroke-width=\"1\"/>\n",
-                      fin(f.x), fin(y0), fin(f.x + f.w), fin(y0));
-        }
+        zero_lines(b, &f, 0);
         for (size_t k = 0U; k < 3U; ++k) {
             sb_printf(b, "<g class=\"series-%s\" fill=\"%s\" fill-opacity=\"0.7\">\n", names[k],
                       component_color[k]);
@@ -580,6 +608,257 @@ static void residuals_svg(svgbuf *b, const dhcal_plot_data *d)
                  s);
         (void)snprintf(s, sizeof s, "q%zu [deg]", j + 1U);
         draw_axis_titles(b, &f, s, cx + 16.0, "residual [mm]");
+        sb_str(b, "</g>\n");
+    }
+    doc_end(b);
+}
+
+/* Approach directions in drawing order: unknown underneath, the two bands on top. */
+static const signed char dir_value[3] = {0, 1, -1};
+static const char *const dir_class[3] = {"dir-unknown", "dir-plus", "dir-minus"};
+static const char *const dir_color[3] = {COLOR_DIR_UNKNOWN, COLOR_DIR_PLUS, COLOR_DIR_MINUS};
+
+/* Joint j's apparent errors (times y_scale) against x[i * nj + j], one group per approach
+ * direction that occurs. A value beyond the y axis is drawn hollow on the frame's edge (class
+ * "clipped"); returns how many were. */
+static size_t joint_points(svgbuf *b, const frame *f, const dhcal_plot_data *d, size_t j,
+                           const double *x, double y_scale)
+{
+    const size_t n = d->n_rows;
+    const size_t nj = d->n_joints;
+    size_t clipped = 0U;
+    for (size_t k = 0U; k < 3U; ++k) {
+        size_t count = 0U;
+        for (size_t i = 0U; i < n; ++i) {
+            count += d->dir[i * nj + j] == dir_value[k];
+        }
+        if (count == 0U) {
+            continue;
+        }
+        sb_printf(b, "<g class=\"%s\" fill=\"%s\" fill-opacity=\"0.75\">\n", dir_class[k],
+                  dir_color[k]);
+        for (size_t i = 0U; i < n; ++i) {
+            if (d->dir[i * nj + j] != dir_value[k]) {
+                continue;
+            }
+            const double px = px_x(f, x[i * nj + j]);
+            const double y = d->joint_err_deg[i * nj + j] * y_scale;
+            if (y >= f->ay.lo && y <= f->ay.hi) {
+                sb_printf(b, "<circle cx=\"%.6g\" cy=\"%.6g\" r=\"2.2\"/>\n", fin(px),
+                          fin(px_y(f, y)));
+            } else {
+                sb_printf(b, "<circle cx=\"%.6g\" cy=\"%.6g\" r=\"2.6\" class=\"clipped\" "
+                             "fill=\"#ffffff\" fill-opacity=\"1\" stroke=\"%s\" "
+                             "stroke-width=\"1.3\"/>\n",
+                          fin(px), fin(y < f->ay.lo ? f->y + f->h : f->y), dir_color[k]);
+                clipped++;
+            }
+        }
+        sb_str(b, "</g>\n");
+    }
+    return clipped;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    const double x = *(const double *)a;
+    const double y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The y range of joint j's panels (values times scale), zero included. Near a singular pose
+ * pinv(J_q) amplifies the residual many times (this arm: q3 near 0), and a handful of such
+ * rows would squeeze everyone else into a thin line. So when at most 1 in 10 values lie
+ * beyond Tukey's far fences [Q1 - 3 IQR, Q3 + 3 IQR] (about 4.7 sigma for normal data; both
+ * bands of a backlash stay inside), the range covers the rest only and joint_points() draws
+ * those few on the edge. (The paper's arm amplifies about 1/sin q3: more than 5 times for
+ * |q3| < 12 deg, 1 row in 12 of uniform poses over +-150 deg.)
+ * *ok = 0 when out of memory (the full range is returned then). */
+static void dq_range(const dhcal_plot_data *d, size_t j, double scale, double *lo, double *hi,
+                     int *ok)
+{
+    const size_t n = d->n_rows;
+    const size_t nj = d->n_joints;
+    *lo = 0.0;
+    *hi = 0.0;
+    *ok = 1;
+    for (size_t i = 0U; i < n; ++i) {
+        *lo = fmin(*lo, d->joint_err_deg[i * nj + j] * scale);
+        *hi = fmax(*hi, d->joint_err_deg[i * nj + j] * scale);
+    }
+    if (n < 10U) {
+        return; /* 1 in 10 of fewer rows is no row */
+    }
+    double *const v = malloc(n * sizeof *v);
+    if (v == NULL) {
+        *ok = 0;
+        return;
+    }
+    for (size_t i = 0U; i < n; ++i) {
+        v[i] = d->joint_err_deg[i * nj + j] * scale;
+    }
+    qsort(v, n, sizeof *v, cmp_double);
+    const double q1 = v[(n - 1U) / 4U];
+    const double q3 = v[3U * (n - 1U) / 4U];
+    const double fence_lo = q1 - 3.0 * (q3 - q1);
+    const double fence_hi = q3 + 3.0 * (q3 - q1);
+    double in_lo = 0.0;
+    double in_hi = 0.0;
+    size_t out = 0U;
+    for (size_t i = 0U; i < n; ++i) {
+        if (v[i] < fence_lo || v[i] > fence_hi) {
+            out++;
+        } else {
+            in_lo = fmin(in_lo, v[i]);
+            in_hi = fmax(in_hi, v[i]);
+        }
+    }
+    free(v);
+    if (out > 0U && out <= n / 10U) {
+        *lo = in_lo;
+        *hi = in_hi;
+    }
+}
+
+/* One row per joint: its apparent error against its angle (scale ramps, harmonics, backlash
+ * bands by approach direction) and against its gravity moment (compliance: a line through
+ * the origin). Both panels of a row share the y axis; each row has its own, in degrees or,
+ * when every value is small, in millidegrees. */
+static void joints_svg(svgbuf *b, const dhcal_plot_data *d)
+{
+    const size_t n = d->n_rows;
+    const size_t nj = d->n_joints;
+    const double plot_w = 360.0;
+    const double plot_h = 170.0;
+    axis ay[DHC_MAX_JOINTS];
+    double y_scale[DHC_MAX_JOINTS];
+    int no_moment[DHC_MAX_JOINTS];
+    size_t tick_chars = 1U;
+    for (size_t j = 0U; j < nj; ++j) {
+        double dq_max = 0.0;
+        double m_max = 0.0;
+        for (size_t i = 0U; i < n; ++i) {
+            dq_max = fmax(dq_max, fabs(d->joint_err_deg[i * nj + j]));
+            m_max = fmax(m_max, fabs(d->moment_mm[i * nj + j]));
+        }
+        y_scale[j] = dq_max < PLOT_MDEG_BELOW_DEG ? 1000.0 : 1.0;
+        no_moment[j] = n > 0U && m_max <= PLOT_NO_MOMENT_MM;
+        double lo;
+        double hi;
+        int ok;
+        dq_range(d, j, y_scale[j], &lo, &hi, &ok);
+        b->failed |= !ok;
+        pad_range(&lo, &hi, 0.05, 0.05);
+        ay[j] = fit_axis(lo, hi, plot_h, 11.0, 0, 0);
+        const size_t c = tick_label_chars(&ay[j]);
+        tick_chars = c > tick_chars ? c : tick_chars;
+    }
+    const double left = 24.0 + text_w(tick_chars, 11.0) + 12.0;
+    const double cell_w = left + plot_w + 24.0;
+    const double cell_h = 30.0 + plot_h + 50.0;
+    const double top = 72.0;
+    const double width = 20.0 + 2.0 * cell_w;
+    const double height = top + (double)nj * cell_h + 6.0;
+
+    svgbuf t = {NULL, 0U, 0U, 0};
+    title_text(&t, "Apparent joint error: ", d);
+    doc_begin(b, width, height, t.failed ? "" : t.p, t.failed ? 0U : t.len);
+    b->failed |= t.failed;
+    free(t.p);
+
+    /* Legend: the directions that occur (all three when there are no rows). */
+    static const char *const dir_label[3] = {"direction unknown", "approach +", "approach -"};
+    static const size_t legend_order[3] = {1U, 2U, 0U};
+    double lx = 20.0;
+    for (size_t k = 0U; k < 3U; ++k) {
+        const size_t o = legend_order[k];
+        int seen = n == 0U;
+        for (size_t i = 0U; i < n * nj && !seen; ++i) {
+            seen = d->dir[i] == dir_value[o];
+        }
+        if (seen) {
+            lx = legend_item(b, lx, 52.0, dir_color[o], 1, dir_label[o], SIZE_MAX);
+        }
+    }
+    char note[160];
+    (void)snprintf(note, sizeof note, "%zu rows; dq = pinv(J_q) r + the fitted effects' own dq", n);
+    if (lx + text_w(strlen(note), 12.0) <= width - 10.0) {
+        text_str(b, lx, 52.0, "font-size=\"12\" fill=\"" COLOR_MUTED "\"", note);
+    }
+
+    for (size_t j = 0U; j < nj; ++j) {
+        const double cy = top + (double)j * cell_h;
+        const char *const unit = y_scale[j] > 1.0 ? "mdeg" : "deg";
+        char y_title[48];
+        (void)snprintf(y_title, sizeof y_title, "dq%zu [%s]", j + 1U, unit);
+        char s[64];
+        sb_printf(b, "<g class=\"panel\" id=\"joint%zu-angle\">\n", j + 1U);
+        {
+            double xlo = -180.0;
+            double xhi = 180.0;
+            if (n > 0U) {
+                xlo = xhi = d->q_deg[j];
+                for (size_t i = 1U; i < n; ++i) {
+                    xlo = fmin(xlo, d->q_deg[i * nj + j]);
+                    xhi = fmax(xhi, d->q_deg[i * nj + j]);
+                }
+                pad_range(&xlo, &xhi, 0.03, 0.03);
+            }
+            const double cx = 10.0;
+            const frame f = {cx + left, cy + 30.0, plot_w, plot_h,
+                             fit_axis(xlo, xhi, plot_w, 11.0, 1, 0), ay[j]};
+            draw_frame(b, &f, 1);
+            zero_lines(b, &f, 0);
+            const size_t clipped = joint_points(b, &f, d, j, d->q_deg, y_scale[j]);
+            if (n == 0U) {
+                no_data_note(b, &f, "no rows");
+            }
+            (void)snprintf(s, sizeof s, "joint %zu vs angle", j + 1U);
+            text_str(b, f.x, f.y - 8.0,
+                     "font-size=\"13\" font-weight=\"bold\" fill=\"" COLOR_TEXT "\"", s);
+            if (clipped > 0U) { /* the same points are off scale in both panels */
+                (void)snprintf(s, sizeof s, "%zu point%s off scale (hollow)", clipped,
+                               clipped == 1U ? "" : "s");
+                text_str(b, f.x + f.w, f.y - 8.0,
+                         "class=\"clipped-note\" font-size=\"11\" text-anchor=\"end\" "
+                         "fill=\"" COLOR_MUTED "\"",
+                         s);
+            }
+            (void)snprintf(s, sizeof s, "q%zu [deg]", j + 1U);
+            draw_axis_titles(b, &f, s, cx + 16.0, y_title);
+        }
+        sb_str(b, "</g>\n");
+        sb_printf(b, "<g class=\"panel\" id=\"joint%zu-moment\">\n", j + 1U);
+        {
+            /* zero in range: compliance is a line through the origin */
+            double xlo = 0.0;
+            double xhi = 0.0;
+            for (size_t i = 0U; i < n; ++i) {
+                xlo = fmin(xlo, d->moment_mm[i * nj + j]);
+                xhi = fmax(xhi, d->moment_mm[i * nj + j]);
+            }
+            pad_range(&xlo, &xhi, xlo < 0.0 ? 0.05 : 0.0, xhi > 0.0 ? 0.05 : 0.0);
+            axis ax = fit_axis(xlo, xhi, plot_w, 11.0, 1, 0);
+            if (no_moment[j]) {
+                ax.n_ticks = 0U; /* the moment is no quantity here: no numbers on its axis */
+            }
+            const double cx = 10.0 + cell_w;
+            const frame f = {cx + left, cy + 30.0, plot_w, plot_h, ax, ay[j]};
+            draw_frame(b, &f, 1);
+            zero_lines(b, &f, 1);
+            if (no_moment[j]) {
+                no_data_note(b, &f, "no gravity moment about this joint");
+            } else {
+                (void)joint_points(b, &f, d, j, d->moment_mm, y_scale[j]);
+            }
+            if (n == 0U) {
+                no_data_note(b, &f, "no rows");
+            }
+            (void)snprintf(s, sizeof s, "joint %zu vs gravity moment", j + 1U);
+            text_str(b, f.x, f.y - 8.0,
+                     "font-size=\"13\" font-weight=\"bold\" fill=\"" COLOR_TEXT "\"", s);
+            draw_axis_titles(b, &f, "gravity moment [mm]", cx + 16.0, y_title);
+        }
         sb_str(b, "</g>\n");
     }
     doc_end(b);
@@ -833,7 +1112,8 @@ static int check_data(const dhcal_plot_data *d, dhcal_error *err)
         return set_error(err, DHCAL_IO_FAILED, "plot: %zu rows: too many", n);
     }
     if (n > 0U && (d->q_deg == NULL || d->resid_before == NULL || d->resid_after == NULL ||
-                   d->err_before == NULL || d->err_after == NULL)) {
+                   d->err_before == NULL || d->err_after == NULL || d->joint_err_deg == NULL ||
+                   d->moment_mm == NULL || d->dir == NULL)) {
         return set_error(err, DHCAL_IO_FAILED, "plot: data arrays missing");
     }
     int rc = DHCAL_IO_OK;
@@ -843,6 +1123,19 @@ static int check_data(const dhcal_plot_data *d, dhcal_error *err)
         rc = rc != DHCAL_IO_OK ? rc : check_values(d->resid_after, 3U * n, 3U, "resid_after", "mm", err);
         rc = rc != DHCAL_IO_OK ? rc : check_values(d->err_before, n, 0U, "err_before", "mm", err);
         rc = rc != DHCAL_IO_OK ? rc : check_values(d->err_after, n, 0U, "err_after", "mm", err);
+        const size_t nq = n * d->n_joints;
+        rc = rc != DHCAL_IO_OK ? rc
+                               : check_values(d->joint_err_deg, nq, d->n_joints, "joint_err_deg",
+                                              "deg", err);
+        rc = rc != DHCAL_IO_OK ? rc
+                               : check_values(d->moment_mm, nq, d->n_joints, "moment_mm", "mm",
+                                              err);
+        for (size_t i = 0U; rc == DHCAL_IO_OK && i < nq; ++i) {
+            if (d->dir[i] < -1 || d->dir[i] > 1) {
+                rc = set_error(err, DHCAL_IO_BAD_INPUT, "plot: dir[%zu][%zu] = %d, not -1, 0 or +1",
+                               i / d->n_joints, i % d->n_joints, (int)d->dir[i]);
+            }
+        }
     }
     rc = rc != DHCAL_IO_OK ? rc : check_values(&d->rms_before_mm, 1U, 0U, "rms_before_mm", "mm", err);
     rc = rc != DHCAL_IO_OK ? rc : check_values(&d->rms_after_mm, 1U, 0U, "rms_after_mm", "mm", err);
@@ -892,70 +1185,19 @@ static int make_dir(const char *dir, dhcal_error *err)
     return rc;
 }
 
-static int write_all(int fd, const char *p, size_t n)
-{
-    while (n > 0U) {
-        const ssize_t w = write(fd, p, n);
-        if (w < 0) {
-            if (errno == EINTR) {
-                continue;
-            }
-            return -1;
-        }
-        p += (size_t)w;
-        n -= (size_t)w;
-    }
-    return 0;
-}
-
-/* dir/name := b, through "dir/name.tmp.<pid>.<k>" (O_EXCL: never follows or clobbers
- * another file), fsync and rename; the temporary file is removed on every failure. */
+/* dir/name := b, atomically (dhcal_file.h). */
 static int write_file(const char *dir, const char *name, const svgbuf *b, dhcal_error *err)
 {
     const size_t dlen = strlen(dir);
     const int slash = dlen > 0U && dir[dlen - 1U] == '/';
-    const size_t cap = dlen + strlen(name) + 64U;
+    const size_t cap = dlen + strlen(name) + 2U;
     char *const path = malloc(cap);
-    char *const tmp = malloc(cap);
-    if (path == NULL || tmp == NULL) {
-        free(path);
-        free(tmp);
+    if (path == NULL) {
         return set_error(err, DHCAL_IO_FAILED, "%s/%s: not written: out of memory", dir, name);
     }
     (void)snprintf(path, cap, "%s%s%s", dir, slash ? "" : "/", name);
-    int fd = -1;
-    for (unsigned k = 0U; k < 100U && fd < 0; ++k) {
-        (void)snprintf(tmp, cap, "%s.tmp.%ld.%u", path, (long)getpid(), k);
-        fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-        if (fd < 0 && errno != EEXIST) {
-            break;
-        }
-    }
-    int rc = DHCAL_IO_OK;
-    if (fd < 0) {
-        rc = set_error(err, DHCAL_IO_FAILED, "%s: cannot create temporary file '%s': %s", path,
-                       tmp, strerror(errno));
-    } else {
-        int saved = 0;
-        if (write_all(fd, b->p, b->len) != 0 || fsync(fd) != 0) {
-            saved = errno;
-        }
-        if (close(fd) != 0 && saved == 0) {
-            saved = errno;
-        }
-        if (saved != 0) {
-            rc = set_error(err, DHCAL_IO_FAILED, "%s: cannot write temporary file '%s': %s",
-                           path, tmp, strerror(saved));
-        } else if (rename(tmp, path) != 0) {
-            rc = set_error(err, DHCAL_IO_FAILED, "%s: cannot replace it with '%s': %s", path,
-                           tmp, strerror(errno));
-        }
-        if (rc != DHCAL_IO_OK) {
-            (void)unlink(tmp);
-        }
-    }
+    const int rc = dhcal_file_write_atomic(path, b->p, b->len, err);
     free(path);
-    free(tmp);
     return rc;
 }
 
@@ -974,22 +1216,25 @@ int dhcal_plot_write(const char *dir, const dhcal_plot_data *d, dhcal_error *err
     if (rc != DHCAL_IO_OK) {
         return rc;
     }
-    static const char *const names[3] = {"residuals.svg", "errors.svg", "candidates.svg"};
-    svgbuf doc[3] = {{NULL, 0U, 0U, 0}, {NULL, 0U, 0U, 0}, {NULL, 0U, 0U, 0}};
+    static const char *const names[PLOT_DOCS] = {"residuals.svg", "joints.svg", "errors.svg",
+                                              "candidates.svg"};
+    svgbuf doc[PLOT_DOCS] = {{NULL, 0U, 0U, 0}, {NULL, 0U, 0U, 0}, {NULL, 0U, 0U, 0},
+                          {NULL, 0U, 0U, 0}};
     residuals_svg(&doc[0], d);
-    errors_svg(&doc[1], d);
-    candidates_svg(&doc[2], d);
-    for (size_t k = 0U; k < 3U && rc == DHCAL_IO_OK; ++k) {
+    joints_svg(&doc[1], d);
+    errors_svg(&doc[2], d);
+    candidates_svg(&doc[3], d);
+    for (size_t k = 0U; k < PLOT_DOCS && rc == DHCAL_IO_OK; ++k) {
         if (doc[k].failed) {
             rc = set_error(err, DHCAL_IO_FAILED, "%s/%s: not written: out of memory", dir,
                            names[k]);
         }
     }
     rc = rc != DHCAL_IO_OK ? rc : make_dir(dir, err);
-    for (size_t k = 0U; k < 3U && rc == DHCAL_IO_OK; ++k) {
+    for (size_t k = 0U; k < PLOT_DOCS && rc == DHCAL_IO_OK; ++k) {
         rc = write_file(dir, names[k], &doc[k], err);
     }
-    for (size_t k = 0U; k < 3U; ++k) {
+    for (size_t k = 0U; k < PLOT_DOCS; ++k) {
         free(doc[k].p);
     }
     return rc;

@@ -27,6 +27,14 @@ typedef struct {
     const char *effect;         /* effect added for "after"; "" when none was named */
     const dhcal_plot_candidate *candidates; /* best first */
     size_t n_candidates;
+    /* Apparent joint errors: dq = pinv(J_q) r per row, the joint error that would explain
+     * the residual (PHYSICS.md), plus the dq of the model's fitted effects (component plus
+     * residual). n_rows x n_joints each. */
+    const double *joint_err_deg;
+    const double *moment_mm; /* gravity moment about each joint of unit weights at the frames
+                                beyond it: compliance shows as a line through the origin */
+    const signed char *dir;  /* approach direction -1, 0 (unknown), +1: backlash shows as two
+                                bands */
 } dhcal_plot_data;
 
 /* Writes into dir (created if missing):
@@ -34,6 +42,8 @@ typedef struct {
  *                   against that joint's angle (where a missing effect shows its shape)
  *   errors.svg      per-row error before and after adding the effect, with both RMS lines
  *   candidates.svg  horizontal bars of the explained share, significant ones marked
+ *   joints.svg      per joint, the apparent joint error against the joint angle (points
+ *                   coloured by approach direction) and against the gravity moment
  * Each file is written to a temporary name and renamed, so a failure leaves no partial
  * file. DHCAL_IO_FAILED with a message naming the path on I/O errors; DHCAL_IO_BAD_INPUT
  * for non-finite data. */

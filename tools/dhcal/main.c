@@ -572,7 +572,12 @@ static int cmd_plot(const options *o, session *s)
     double *res_after = calloc(3U * n + 1U, sizeof *res_after);
     double *err_before = calloc(n + 1U, sizeof *err_before);
     double *err_after = calloc(n + 1U, sizeof *err_after);
-    rc = q_deg && res_before && res_after && err_before && err_after ? 0 : EXIT_COMPUTE;
+    double *joint_err = calloc(n * nj + 1U, sizeof *joint_err);
+    double *moment = calloc(n * nj + 1U, sizeof *moment);
+    signed char *dir = calloc(n * nj + 1U, sizeof *dir);
+    rc = q_deg && res_before && res_after && err_before && err_after && joint_err && moment && dir
+             ? 0
+             : EXIT_COMPUTE;
     double rms_b = 0.0;
     double rms_a = 0.0;
     double mx;
@@ -580,6 +585,7 @@ static int cmd_plot(const options *o, session *s)
     if (rc == 0) {
         rc = dhcal_samples_errors(&before.model, &s->samples, res_before, err_before, &rms_b, &mx);
     }
+
     /* "after": the effect the diagnosis names, added to whatever --effects gave */
     if (rc == 0 && diag.count > 0U && diag.c[0].significant) {
         dhcal_effect_label(diag.c[0].effect, diag.c[0].joint, label, sizeof label);
@@ -596,9 +602,15 @@ static int cmd_plot(const options *o, session *s)
     if (rc == 0) {
         rc = dhcal_samples_errors(&after.model, &s->samples, res_after, err_after, &rms_a, &mx);
     }
+    /* Joint view: the final model's residual plus the dq of its own effects, so the effect
+     * the diagnosis named appears with its full shape (component plus residual). */
+    if (rc == 0) {
+        rc = dhcal_apparent_joint_errors(&after.model, &s->samples, 1, joint_err, moment);
+    }
     for (size_t i = 0U; rc == 0 && i < n; ++i) {
         for (size_t j = 0U; j < nj; ++j) {
             q_deg[i * nj + j] = s->samples.samples[i].q_rad[j] * 180.0 / 3.14159265358979323846;
+            dir[i * nj + j] = (signed char)s->samples.samples[i].dir[j];
         }
     }
     dhcal_plot_candidate cands[DHC_MAX_CANDIDATES];
@@ -615,12 +627,13 @@ static int cmd_plot(const options *o, session *s)
     if (rc == 0) {
         const dhcal_plot_data d = {s->file_model.name, n, nj, q_deg, res_before, res_after,
                                    err_before, err_after, rms_b, rms_a,
-                                   s->samples.wires, label, cands, nc};
+                                   s->samples.wires, label, cands, nc, joint_err, moment, dir};
         rc = dhcal_plot_write(o->out, &d, &err) == DHCAL_IO_OK ? 0 : EXIT_COMPUTE;
         if (rc != 0) {
             fprintf(stderr, "dhcal: %s\n", err.msg);
         } else if (!o->json) {
-            printf("wrote %s/residuals.svg, %s/errors.svg, %s/candidates.svg\n", o->out, o->out, o->out);
+            printf("wrote %s/residuals.svg, %s/joints.svg, %s/errors.svg, %s/candidates.svg\n",
+                   o->out, o->out, o->out, o->out);
             printf("RMS before %.4f mm, after %s %.4f mm\n", rms_b, label[0] != '\0' ? label : "(no effect named)", rms_a);
         } else {
             cJSON *obj = cJSON_CreateObject();
@@ -628,8 +641,8 @@ static int cmd_plot(const options *o, session *s)
             cJSON_AddNumberToObject(obj, "rms_after_mm", rms_a);
             cJSON_AddStringToObject(obj, "effect", label);
             cJSON *files = cJSON_AddArrayToObject(obj, "files");
-            const char *names[3] = {"residuals.svg", "errors.svg", "candidates.svg"};
-            for (size_t k = 0U; k < 3U; ++k) {
+            const char *names[4] = {"residuals.svg", "joints.svg", "errors.svg", "candidates.svg"};
+            for (size_t k = 0U; k < 4U; ++k) {
                 char path[4200];
                 snprintf(path, sizeof path, "%s/%s", o->out, names[k]);
                 cJSON_AddItemToArray(files, cJSON_CreateString(path));
@@ -644,6 +657,9 @@ static int cmd_plot(const options *o, session *s)
     free(res_after);
     free(err_before);
     free(err_after);
+    free(joint_err);
+    free(moment);
+    free(dir);
     return rc;
 }
 
