@@ -110,7 +110,8 @@ static dhc_status data_pass(const fit_context *fc, const dhc_model *model, int a
         st = dhc_model_residual(model, s, w, r, &got_rows);
         if (st == DHC_OK && accumulate) {
             dhc_mat jac;
-            st = dhc_mat_init(&jac, rows, p, ws->jac_buf, DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS);
+            st = dhc_mat_init(&jac, rows, p, ws->jac_buf,
+                              sizeof ws->jac_buf / sizeof ws->jac_buf[0]);
             if (st == DHC_OK) {
                 st = dhc_model_jacobian(model, fc->set, s, w, &jac, NULL);
             }
@@ -185,12 +186,13 @@ static dhc_status structural_rank(const fit_context *fc, const dhc_model *model,
         for (size_t i = 0U; i < model->arm.n_joints; ++i) {
             const dhc_joint *const j = &model->arm.joint[i];
             s->q_rad[i] = j->min_rad + (j->max_rad - j->min_rad) * next_uniform(&state);
-            s->dir[i] = traits->dir_seen[i] ? (next_uniform(&state) < 0.5 ? -1 : 1) : 0;
+            s->dir[i] = (int8_t)(traits->dir_seen[i] ? (next_uniform(&state) < 0.5 ? -1 : 1) : 0);
         }
         s->temp_c = traits->temp_min_c +
                     (traits->temp_max_c - traits->temp_min_c) * next_uniform(&state);
         dhc_mat jac;
-        st = dhc_mat_init(&jac, rows, p, ws->jac_buf, DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS);
+        st = dhc_mat_init(&jac, rows, p, ws->jac_buf,
+                          sizeof ws->jac_buf / sizeof ws->jac_buf[0]);
         if (st == DHC_OK) {
             st = dhc_model_jacobian(model, fc->set, s, w, &jac, NULL);
         }

@@ -178,7 +178,8 @@ static dhc_status prepare_batch(batch_state *b)
         b->rank_a = 0U;
         return DHC_OK;
     }
-    dhc_status st = dhc_mat_init(&b->a, b->nb, b->nb, ws->factor, DHC_MAX_PARAMS * DHC_MAX_PARAMS);
+    dhc_status st = dhc_mat_init(&b->a, b->nb, b->nb, ws->factor,
+                                 sizeof ws->factor / sizeof ws->factor[0]);
     if (st != DHC_OK) {
         return st;
     }
@@ -214,7 +215,8 @@ static dhc_status score_columns(const batch_state *b, const size_t *cols, size_t
     }
     double h[KMAX];
     dhc_mat s;
-    dhc_status st = dhc_mat_init(&s, k, k, ws->schur, KMAX * KMAX);
+    dhc_status st = dhc_mat_init(&s, k, k, ws->schur,
+                                 sizeof ws->schur / sizeof ws->schur[0]);
     if (st != DHC_OK) {
         return st;
     }
@@ -293,7 +295,8 @@ static dhc_status accumulate(const dhc_model *model, dhc_sample_reader read, voi
         }
         dhc_mat jac;
         if (st == DHC_OK) {
-            st = dhc_mat_init(&jac, k, p, ws->jac_buf, DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS);
+            st = dhc_mat_init(&jac, k, p, ws->jac_buf,
+                              sizeof ws->jac_buf / sizeof ws->jac_buf[0]);
         }
         if (st == DHC_OK) {
             st = dhc_model_jacobian(model, &ws->set, &ws->sample, opt->orientation_weight_mm_per_rad,

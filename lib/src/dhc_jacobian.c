@@ -9,6 +9,7 @@
 #include "dhcal/dhc_jacobian.h"
 
 #include <math.h>
+#include <string.h>
 
 static void rotation_column(const double axis[3], const double through[3], const double p[3],
                             double dp[3])
@@ -110,6 +111,17 @@ static dhc_status check_arm(const dhc_arm *arm)
     return DHC_OK;
 }
 
+static int jac_finite(const dhc_mat *jac)
+{
+    const size_t entries = jac->rows * jac->cols;
+    for (size_t i = 0U; i < entries; ++i) {
+        if (!dhc_is_finite(jac->data[i])) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
 static dhc_status check_jac(const dhc_mat *jac, size_t rows, size_t cols)
 {
     if (jac == NULL || jac->data == NULL) {
@@ -154,6 +166,18 @@ dhc_status dhc_identification_jacobian(const dhc_arm *arm, const dhc_param_set *
         double dw[3];
         geometric_column(arm, f, q_rad, p, &set->id[k], dp, dw);
         put_column(jac, k, dp, dw, with_orientation, 1.0);
+    }
+    /* Finite angles on non-finite or overflowing geometry (found by fuzzing). */
+    int finite = jac_finite(jac);
+    for (size_t r = 0U; r < 3U; ++r) {
+        finite = finite && dhc_is_finite(p[r]);
+        for (size_t c = 0U; c < 3U; ++c) {
+            finite = finite && dhc_is_finite(f[arm->n_joints].rot.m[r][c]);
+        }
+    }
+    if (!finite) {
+        dhc_mat_fill(jac, 0.0);
+        return DHC_ERR_NONFINITE;
     }
     if (tool_world_mm != NULL) {
         dhc_vec3_copy(p, tool_world_mm);
@@ -229,6 +253,7 @@ dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set,
         return st;
     }
     dhc_prediction local;
+    memset(&local, 0, sizeof local); /* written before read; zeroed so no tool has to see it */
     dhc_prediction *const pr = pred != NULL ? pred : &local;
     dhc_model_eval ev;
     st = dhc_model_evaluate(model, s, set_has_compliance(set), &ev, pr);
@@ -269,6 +294,12 @@ dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set,
         } else {
             put_column(jac, k, dp, dw, with_orientation, weight_mm_per_rad);
         }
+    }
+    /* A finite prediction can still have infinite slopes: a thermal factor of 0 divides
+     * the thermal column by 0, a huge weight overflows the orientation rows (fuzzing). */
+    if (!jac_finite(jac)) {
+        dhc_mat_fill(jac, 0.0);
+        return DHC_ERR_NONFINITE;
     }
     return DHC_OK;
 }

@@ -157,10 +157,14 @@ dhc_status dhc_lsq_analyse(const dhc_normal_eq *ne, double rel_tol, dhc_lsq_fact
          * diagonal is a sum of squares, and below DBL_MIN its square root is not reliable. */
         fac->scale[i] = d > DBL_MIN ? 1.0 / sqrt(d) : 1.0;
     }
+    /* A column whose diagonal is at or below DBL_MIN is zero to the analysis: its sums are
+     * subnormal, where a pivot tolerance relative to them underflows to 0 and rounding can
+     * make a semi-definite block look indefinite or accept a pivot of noise (fuzzing). */
     for (size_t i = 0U; i < n; ++i) {
         for (size_t j = 0U; j < n; ++j) {
+            const int live = ne->jtj[i * n + i] > DBL_MIN && ne->jtj[j * n + j] > DBL_MIN;
             fac->factor[i * n + j] =
-                j <= i ? ne->jtj[i * n + j] * fac->scale[i] * fac->scale[j] : 0.0;
+                j <= i && live ? ne->jtj[i * n + j] * fac->scale[i] * fac->scale[j] : 0.0;
         }
     }
     dhc_mat m;
@@ -292,6 +296,13 @@ dhc_status dhc_lsq_std_errors(const dhc_lsq_factor *fac, double sigma2, double *
         }
         const size_t k = fac->perm[i];
         std[k] = fac->scale[k] * sqrt(sigma2 * sum);
+    }
+    /* A pivot barely above rel_tol can make |L^-1 e_i|^2 overflow (found by fuzzing). */
+    if (!finite_all(std, n)) {
+        for (size_t k = 0U; k < n; ++k) {
+            std[k] = 0.0;
+        }
+        return DHC_ERR_NONFINITE;
     }
     return DHC_OK;
 }

@@ -201,11 +201,13 @@ dhc_status dhc_model_residual(const dhc_model *model, const dhc_sample *s,
     if (st != DHC_OK) {
         return st;
     }
+    double out[DHC_MAX_ROWS_PER_SAMPLE];
     if (s->kind == (uint8_t)DHC_MEAS_WIRES) {
-        dhc_vec3_sub(s->wire_mm, pred.wire_mm, r);
+        dhc_vec3_sub(s->wire_mm, pred.wire_mm, out);
     } else {
-        dhc_vec3_sub(s->p_mm, pred.p_mm, r);
+        dhc_vec3_sub(s->p_mm, pred.p_mm, out);
     }
+    const size_t n = dhc_sample_rows(s);
     if (s->kind == (uint8_t)DHC_MEAS_POSE) {
         /* R_meas = exp([w]) R_model  =>  w = log(R_meas R_model^T) */
         dhc_mat3 err;
@@ -213,9 +215,18 @@ dhc_status dhc_model_residual(const dhc_model *model, const dhc_sample *s,
         dhc_rot_mul_t(&s->rot, &pred.rot, &err);
         dhc_rot_log(&err, w);
         for (size_t k = 0U; k < 3U; ++k) {
-            r[3U + k] = weight_mm_per_rad * w[k];
+            out[3U + k] = weight_mm_per_rad * w[k];
         }
     }
-    *rows = dhc_sample_rows(s);
+    /* Finite predictions, but a difference or a weight can still overflow (fuzzing). */
+    for (size_t k = 0U; k < n; ++k) {
+        if (!dhc_is_finite(out[k])) {
+            return DHC_ERR_NONFINITE;
+        }
+    }
+    for (size_t k = 0U; k < n; ++k) {
+        r[k] = out[k];
+    }
+    *rows = n;
     return DHC_OK;
 }

@@ -237,6 +237,40 @@ static void test_rejects_bad_shapes_and_non_finite_angles(void)
                       dhc_identification_jacobian(&arm, NULL, q, DHC_MAX_JOINTS, 1, &jac, NULL, NULL));
 }
 
+static void test_non_finite_geometry_is_reported_not_returned(void)
+{
+    /* Regression (fuzzing): finite angles on a NaN or overflowing arm gave NaN columns with
+     * DHC_OK. Now DHC_ERR_NONFINITE, jac all zero, tool outputs not written. */
+    dhc_arm arm;
+    random_arm(&arm, 3U);
+    static dhc_param_set set;
+    const dhc_model m = test_model_of(&arm);
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &m));
+    static double buf[6 * DHC_MAX_PARAMS];
+    dhc_mat jac;
+    const double q[DHC_MAX_JOINTS] = {0.1, 0.2, 0.3};
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&jac, 6U, set.count, buf, 6U * DHC_MAX_PARAMS));
+    for (size_t bad = 0U; bad < 2U; ++bad) {
+        dhc_arm broken = arm;
+        if (bad == 0U) {
+            broken.joint[1].alpha_rad = NAN;
+        } else {
+            broken.joint[0].a_mm = 1e308;
+            broken.joint[1].a_mm = 1e308;
+        }
+        double tool[3] = {-1.0, -1.0, -1.0};
+        TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, dhc_identification_jacobian(&broken, &set, q,
+                                                                         DHC_MAX_JOINTS, 1, &jac,
+                                                                         tool, NULL));
+        for (size_t k = 0U; k < 6U * set.count; ++k) {
+            TEST_ASSERT_TRUE(buf[k] >= 0.0 && buf[k] <= 0.0);
+        }
+        TEST_ASSERT_TRUE(tool[0] >= -1.0 && tool[0] <= -1.0);
+    }
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_identification_jacobian(&arm, &set, q, DHC_MAX_JOINTS, 1, &jac,
+                                                          NULL, NULL));
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -245,5 +279,6 @@ int main(void)
     RUN_TEST(test_position_only_rows_equal_the_first_three_pose_rows);
     RUN_TEST(test_joint_jacobian_matches_differences_in_q);
     RUN_TEST(test_rejects_bad_shapes_and_non_finite_angles);
+    RUN_TEST(test_non_finite_geometry_is_reported_not_returned);
     return UNITY_END();
 }

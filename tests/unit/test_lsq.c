@@ -1,6 +1,7 @@
 /* test_lsq.c - streaming normal equations, rank analysis, LM steps, standard errors and
  * confounding, against Gaussian elimination written here, closed-form simple linear
  * regression, and problems whose dependencies are built in by hand. */
+#include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include <string.h>
@@ -716,6 +717,74 @@ static void test_step_reports_indefinite_block_with_zero_step(void)
     assert_exact_zero(delta[1]);
 }
 
+static void test_columns_of_subnormal_sums_are_zero_to_the_analysis(void)
+{
+    /* Regression (fuzzing): sums below DBL_MIN left the pivot tolerance at rel_tol * dmax = 0
+     * and subnormal rounding either accepted pivots of noise or made the semi-definite block
+     * look indefinite (DHC_ERR_NOT_SPD). Such columns are zero: rank 0, nothing identifiable. */
+    const double rows[3][2] = {{1.4e-159, -1.2e-159}, {3e-160, 2.9e-160}, {-7e-161, 1e-160}};
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_normal_eq_init(&ne, 3U));
+    for (size_t e = 0U; e < 3U; ++e) {
+        dhc_mat jac;
+        const double row[3] = {0.0, rows[e][0], rows[e][1]};
+        double buf[3];
+        memcpy(buf, row, sizeof buf);
+        const double r = 1.0;
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&jac, 1U, 3U, buf, 3U));
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_normal_eq_add(&ne, &jac, &r, NULL, 1U));
+    }
+    TEST_ASSERT_TRUE(ne.jtj[4] > 0.0 && ne.jtj[4] < DBL_MIN);
+    for (size_t k = 0U; k < 2U; ++k) {
+        const double rel_tol = k == 0U ? 1e-10 : 1e-300;
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_lsq_analyse(&ne, rel_tol, &fac));
+        TEST_ASSERT_EQUAL_size_t(0U, fac.rank);
+        for (size_t i = 0U; i < 3U; ++i) {
+            TEST_ASSERT_EQUAL_UINT8(0U, fac.identifiable[i]);
+        }
+    }
+    /* One ordinary column beside them: it alone is identifiable. */
+    const double big[3] = {2.0, 1e-160, -1e-160};
+    double buf[3];
+    memcpy(buf, big, sizeof buf);
+    dhc_mat jac;
+    const double r = 4.0;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&jac, 1U, 3U, buf, 3U));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_normal_eq_add(&ne, &jac, &r, NULL, 1U));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_lsq_analyse(&ne, 1e-10, &fac));
+    TEST_ASSERT_EQUAL_size_t(1U, fac.rank);
+    TEST_ASSERT_EQUAL_UINT8(1U, fac.identifiable[0]);
+    double delta[3];
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_lsq_step(&ne, &fac, 0.0, delta, 3U));
+    assert_close(2.0, delta[0], 1e-15, 1e-15);
+    assert_exact_zero(delta[1]);
+    assert_exact_zero(delta[2]);
+}
+
+static void test_std_errors_that_overflow_are_reported_not_returned(void)
+{
+    /* Regression (fuzzing): sigma2 (N11^-1)_kk beyond DBL_MAX gave infinite standard
+     * errors with DHC_OK. Now DHC_ERR_NONFINITE and all zero. */
+    const size_t m = 10U;
+    const size_t p = 2U;
+    for (size_t e = 0U; e < m; ++e) {
+        jac_buf[e * p + 0U] = 1e-3;
+        jac_buf[e * p + 1U] = 1e-3 * (double)e;
+        res[e] = 1.0;
+    }
+    accumulate_all(&ne, m, p, NULL);
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_lsq_analyse(&ne, 1e-10, &fac));
+    TEST_ASSERT_EQUAL_size_t(2U, fac.rank);
+    double std[2 + GUARD];
+    fill_sentinel(std, p + GUARD);
+    TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, dhc_lsq_std_errors(&fac, DBL_MAX, std, p));
+    assert_exact_zero(std[0]);
+    assert_exact_zero(std[1]);
+    assert_sentinel(std + p, GUARD);
+    /* The same factor at a sane noise level is fine. */
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_lsq_std_errors(&fac, 1.0, std, p));
+    TEST_ASSERT_TRUE(dhc_is_finite(std[0]) && std[0] > 0.0);
+}
+
 static void test_step_leaves_the_analysis_intact(void)
 {
     /* The damped factor is built in the factor's spare triangle: the analysed L, perm,
@@ -808,6 +877,8 @@ int main(void)
     RUN_TEST(test_analyse_reports_every_error);
     RUN_TEST(test_step_reports_every_error_without_writing);
     RUN_TEST(test_step_reports_indefinite_block_with_zero_step);
+    RUN_TEST(test_columns_of_subnormal_sums_are_zero_to_the_analysis);
+    RUN_TEST(test_std_errors_that_overflow_are_reported_not_returned);
     RUN_TEST(test_step_leaves_the_analysis_intact);
     RUN_TEST(test_std_errors_report_every_error_without_writing);
     RUN_TEST(test_confounded_reports_every_error_without_writing);

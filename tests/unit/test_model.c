@@ -308,6 +308,47 @@ static void test_bad_samples_are_refused(void)
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_model_predict(&m, &s, &pred));
 }
 
+static void test_non_finite_slopes_and_residuals_are_reported(void)
+{
+    /* Regressions (fuzzing): finite predictions with non-finite derivatives or residuals
+     * came back with DHC_OK. */
+    dhc_model m = paper_model();
+    const double q[DHC_MAX_JOINTS] = {0.3, 1.1, -0.7};
+    static dhc_param_set set;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &m));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(&set, &m, DHC_EFFECT_THERMAL_SCALE, 0U));
+    static double buf[6 * DHC_MAX_PARAMS];
+    dhc_mat jac;
+    /* A thermal factor 1 + k (T - T0) of exactly 0 divides the thermal column by 0. */
+    m.thermal_per_k = -0.01;
+    dhc_sample s = sample_at(&m, q, DHC_MEAS_POSITION);
+    s.temp_c = m.thermal_ref_c + 100.0;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&jac, 3U, set.count, buf, 6U * DHC_MAX_PARAMS));
+    TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, dhc_model_jacobian(&m, &set, &s, 1.0, &jac, NULL));
+    for (size_t k = 0U; k < 3U * set.count; ++k) {
+        TEST_ASSERT_TRUE(buf[k] >= 0.0 && buf[k] <= 0.0);
+    }
+    /* An orientation weight that is not finite. */
+    m.thermal_per_k = 0.0;
+    s = sample_at(&m, q, DHC_MEAS_POSE);
+    const double w[3] = {0.1, -0.2, 0.3};
+    dhc_rot_exp(w, &s.rot);
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&jac, 6U, set.count, buf, 6U * DHC_MAX_PARAMS));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_model_jacobian(&m, &set, &s, 100.0, &jac, NULL));
+    TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, dhc_model_jacobian(&m, &set, &s, NAN, &jac, NULL));
+    TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, dhc_model_jacobian(&m, &set, &s, INFINITY, &jac, NULL));
+    double r[DHC_MAX_ROWS_PER_SAMPLE] = {-1.0, -1.0, -1.0, -1.0, -1.0, -1.0};
+    size_t rows = 99U;
+    TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, dhc_model_residual(&m, &s, NAN, r, &rows));
+    TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, dhc_model_residual(&m, &s, -INFINITY, r, &rows));
+    for (size_t k = 0U; k < DHC_MAX_ROWS_PER_SAMPLE; ++k) {
+        TEST_ASSERT_TRUE(r[k] >= -1.0 && r[k] <= -1.0); /* not written */
+    }
+    TEST_ASSERT_EQUAL_size_t(99U, rows);
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_model_residual(&m, &s, 100.0, r, &rows));
+    TEST_ASSERT_EQUAL_size_t(6U, rows);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -318,5 +359,6 @@ int main(void)
     RUN_TEST(test_model_jacobian_matches_central_differences_for_every_effect);
     RUN_TEST(test_effect_names_parse_and_print);
     RUN_TEST(test_bad_samples_are_refused);
+    RUN_TEST(test_non_finite_slopes_and_residuals_are_reported);
     return UNITY_END();
 }

@@ -114,8 +114,8 @@ dhc_status dhc_diagnose(const dhc_model *model, const dhc_param_set *base,
                         const dhc_diagnose_options *opt, dhc_diagnose_workspace *ws,
                         dhc_diagnosis *out);
 
-/* log10 of the upper tail P(X > x) of chi-square with dof degrees of freedom, accurate far
- * into the tail (no underflow to -inf before ~1e300). dof >= 1, x >= 0. */
-double dhc_chi2_log10_sf(double x, size_t dof);
+/* log10 of the upper tail P(X > chi2) of chi-square with dof degrees of freedom, accurate
+ * far into the tail (no underflow to -inf before ~1e300). dof >= 1, chi2 >= 0. */
+double dhc_chi2_log10_sf(double chi2, size_t dof);
 
 #endif /* DHC_DIAGNOSE_H */

@@ -32,7 +32,9 @@
 /* jac must be (3 or 6) x set->count; every parameter must be geometric (theta..tool_z).
  * tool_world_mm / tool_rot (may be NULL) receive the tool point and last-link orientation.
  * DHC_ERR_DIMENSION for a wrong jac shape or q_len < n_joints; DHC_ERR_NONFINITE for a
- * non-finite q; DHC_ERR_ARGUMENT for a non-geometric parameter. */
+ * non-finite q, or geometry that makes the tool pose or an entry of jac non-finite (jac is
+ * then all zero, the tool outputs not written); DHC_ERR_ARGUMENT for a non-geometric
+ * parameter. */
 dhc_status dhc_identification_jacobian(const dhc_arm *arm, const dhc_param_set *set,
                                        const double *q_rad, size_t q_len, int with_orientation,
                                        dhc_mat *jac, double tool_world_mm[3],
@@ -41,7 +43,9 @@ dhc_status dhc_identification_jacobian(const dhc_arm *arm, const dhc_param_set *
 /* Jacobian of dhc_model_residual's prediction for sample s: jac is dhc_sample_rows(s) x
  * set->count; orientation rows are multiplied by weight_mm_per_rad like the residual's.
  * pred (may be NULL) receives the prediction. Errors of dhc_sample_check and
- * DHC_ERR_DIMENSION for a wrong jac shape. */
+ * DHC_ERR_DIMENSION for a wrong jac shape; DHC_ERR_NONFINITE when the prediction or an
+ * entry of jac is not finite (a thermal factor 1 + k (T - T0) of 0, an overflowing weight
+ * or geometry): jac is then all zero. */
 dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set,
                               const dhc_sample *s, double weight_mm_per_rad, dhc_mat *jac,
                               dhc_prediction *pred);

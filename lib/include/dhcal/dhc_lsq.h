@@ -35,7 +35,9 @@ typedef struct {
     size_t n;
     size_t rank;
     size_t perm[DHC_MAX_PARAMS];       /* pivot order: perm[k] = parameter index */
-    double scale[DHC_MAX_PARAMS];      /* column scale: 1 / sqrt(diag(J^T W J)), 1 for 0 */
+    double scale[DHC_MAX_PARAMS];      /* column scale: 1 / sqrt(diag(J^T W J)); 1 for a
+                                          diagonal <= DBL_MIN, a column that then counts
+                                          as zero (never identifiable) */
     double factor[DHC_MAX_PARAMS * DHC_MAX_PARAMS]; /* L of the scaled, pivoted matrix */
     uint8_t identifiable[DHC_MAX_PARAMS];
     double condition;                  /* estimate for the identifiable block (scaled) */
@@ -57,8 +59,10 @@ dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double
  * double precision with condition numbers up to ~1e4 in J. O(n^3).
  * DHC_ERR_NONFINITE when the accumulator holds non-finite values; DHC_ERR_NO_DATA when
  * no rows were added; DHC_ERR_ARGUMENT for NULL or rel_tol outside (0, 1); DHC_ERR_NOT_SPD
- * only for an accumulator edited by hand into an indefinite matrix (fac is then left empty,
- * n = 0, and every later call on it returns DHC_ERR_ARGUMENT). */
+ * for an accumulator edited by hand into an indefinite matrix, or when rel_tol is below the
+ * rounding level of the sums, about (rows + n) n DBL_EPSILON (1e-10 is far above it for any
+ * realistic data): there rounding of a singular direction looks indefinite (fac is then
+ * left empty, n = 0, and every later call on it returns DHC_ERR_ARGUMENT). */
 dhc_status dhc_lsq_analyse(const dhc_normal_eq *ne, double rel_tol, dhc_lsq_factor *fac);
 
 /* Levenberg-Marquardt step on the identifiable parameters:
@@ -70,15 +74,18 @@ dhc_status dhc_lsq_analyse(const dhc_normal_eq *ne, double rel_tol, dhc_lsq_fact
  * may not be shared between concurrent steps. No n x n scratch beyond that.
  * DHC_ERR_ARGUMENT (NULL, lambda < 0, fac not analysed), DHC_ERR_DIMENSION (fac->n != ne->n,
  * len < n), DHC_ERR_NONFINITE (lambda not finite). DHC_ERR_NOT_SPD if the damped block fails
- * to factor (cannot happen for lambda > 0 on finite data): delta is then all zero. O(r^3). */
+ * to factor (cannot happen for lambda > 0 on finite data analysed with a rel_tol above the
+ * rounding level that dhc_lsq_analyse names: its pivots then stay far above the
+ * DBL_EPSILON-relative floor used here): delta is then all zero. O(r^3). */
 dhc_status dhc_lsq_step(const dhc_normal_eq *ne, dhc_lsq_factor *fac, double lambda,
                         double *delta, size_t len);
 
 /* Covariance of the identifiable parameters at noise variance sigma2 (per unit weight):
  * std[k] = sqrt(sigma2 * (N11^-1)_kk) for identifiable k, 0 otherwise; std has len >= n
  * entries, the first n written. DHC_ERR_ARGUMENT (NULL, sigma2 < 0, fac not analysed),
- * DHC_ERR_DIMENSION (len < n), DHC_ERR_NONFINITE (sigma2). O(r^3), uses the factor only,
- * one n-double stack array. */
+ * DHC_ERR_DIMENSION (len < n), DHC_ERR_NONFINITE (sigma2 not finite: nothing written; or a
+ * standard error that overflows, as a pivot just above rel_tol can give: std is then all
+ * zero). O(r^3), uses the factor only, one n-double stack array. */
 dhc_status dhc_lsq_std_errors(const dhc_lsq_factor *fac, double sigma2, double *std,
                               size_t len);
 

@@ -118,7 +118,9 @@ void dhc_measurer_anchor_world(const dhc_measurer_model *m, size_t k, double out
 dhc_status dhc_model_predict(const dhc_model *model, const dhc_sample *s, dhc_prediction *out);
 
 /* Residual r = measured - predicted, rows as dhc_sample_rows; orientation rows are
- * weighted into mm-equivalents with weight_mm_per_rad. */
+ * weighted into mm-equivalents with weight_mm_per_rad. Errors of dhc_model_predict, and
+ * DHC_ERR_NONFINITE when a residual is not finite (a non-finite or overflowing weight, a
+ * difference that overflows); r and rows are written only on success. */
 dhc_status dhc_model_residual(const dhc_model *model, const dhc_sample *s,
                               double weight_mm_per_rad, double r[DHC_MAX_ROWS_PER_SAMPLE],
                               size_t *rows);
