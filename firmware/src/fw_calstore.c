@@ -253,7 +253,7 @@ static int newer(uint32_t a, uint32_t b)
 /* Index (0 or 1) of the newest valid slot, -1 when none. */
 static fw_cal_status newest_slot(const fw_nvstore *nv, int *index, slot_info info[2])
 {
-    if (nv->size < 2U * FW_CAL_SLOT_SIZE) {
+    if (nv->size < (size_t)2U * FW_CAL_SLOT_SIZE) {
         return FW_CAL_ERR_TOO_SMALL;
     }
     for (size_t s = 0U; s < 2U; ++s) {

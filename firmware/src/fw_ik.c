@@ -96,7 +96,7 @@ fw_ik_status fw_ik_solve(const dhc_model *model, const dhc_sample *sample_templa
     s.kind = (uint8_t)DHC_MEAS_POSITION;
     double jac_buf[3U * DHC_MAX_JOINTS];
     dhc_mat jac;
-    if (dhc_mat_init(&jac, 3U, n, jac_buf, 3U * DHC_MAX_JOINTS) != DHC_OK) {
+    if (dhc_mat_init(&jac, 3U, n, jac_buf, sizeof jac_buf / sizeof jac_buf[0]) != DHC_OK) {
         return FW_IK_ERR_ARGUMENT;
     }
     double q[DHC_MAX_JOINTS];
@@ -119,7 +119,7 @@ fw_ik_status fw_ik_solve(const dhc_model *model, const dhc_sample *sample_templa
         size_t perm[DHC_MAX_JOINTS];
         size_t rank;
         dhc_mat a;
-        (void)dhc_mat_init(&a, n, n, a_buf, DHC_MAX_JOINTS * DHC_MAX_JOINTS);
+        (void)dhc_mat_init(&a, n, n, a_buf, sizeof a_buf / sizeof a_buf[0]);
         for (size_t i = 0U; i < n; ++i) {
             g[i] = 0.0;
             for (size_t r = 0U; r < 3U; ++r) {

@@ -122,9 +122,12 @@ int dhcal_run_diagnose(const dhcal_fit *fit, const dhcal_samples *s, dhc_diagnos
                  "diagnose");
         return DHCAL_IO_FAILED;
     }
+    /* The reader context is void * for generality; dhcal_samples_read only reads through it.
+     * NOLINTNEXTLINE(performance-no-int-to-ptr): a round trip of a valid pointer. */
+    void *const ctx = (void *)(uintptr_t)s;
     const dhc_status st =
         dhc_diagnose(&fit->model, &fit->set, fit->rep.identifiable, sigma2, cands, nc,
-                     dhcal_samples_read, (void *)(uintptr_t)s, s->n, s->flags, &opt, &diag_ws, out);
+                     dhcal_samples_read, ctx, s->n, s->flags, &opt, &diag_ws, out);
     if (st != DHC_OK) {
         snprintf(err->msg, sizeof err->msg, "diagnosis failed: %s", dhc_status_str(st));
         return DHCAL_IO_FAILED;
@@ -132,11 +135,50 @@ int dhcal_run_diagnose(const dhcal_fit *fit, const dhcal_samples *s, dhc_diagnos
     return DHCAL_IO_OK;
 }
 
-int dhcal_apparent_joint_errors(const dhc_model *model, const dhcal_samples *s, int with_effects,
-                                double *dq_deg, double *moment_mm)
+/* The joint error dq that best explains one sample's residual r (3 rows: tool point or
+ * wires): least squares on the joint columns, least-norm where they lack rank. */
+static dhc_status joint_error_of_sample(const dhc_model *model, const dhc_param_set *offsets,
+                                        const dhc_sample *smp, double *dq,
+                                        dhc_prediction *pred)
 {
     static dhc_normal_eq ne;
     static dhc_lsq_factor fac;
+    const size_t nj = model->arm.n_joints;
+    double r[DHC_MAX_ROWS_PER_SAMPLE];
+    /* jac below points into this buffer until the end of the function, which cppcheck's
+     * scope check does not follow. */
+    // cppcheck-suppress variableScope
+    double jac_buf[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_JOINTS];
+    size_t rows;
+    dhc_mat jac;
+    /* position (or wire) rows only: an orientation row would weigh in at 1000 mm/rad */
+    dhc_status st = dhc_model_residual(model, smp, 1000.0, r, &rows);
+    if (st == DHC_OK) {
+        st = dhc_mat_init(&jac, dhc_sample_rows(smp), nj, jac_buf,
+                          sizeof jac_buf / sizeof jac_buf[0]);
+    }
+    if (st == DHC_OK) {
+        st = dhc_model_jacobian(model, offsets, smp, 1000.0, &jac, pred);
+    }
+    if (st == DHC_OK) {
+        jac.rows = 3U;
+        st = dhc_normal_eq_init(&ne, nj);
+    }
+    if (st == DHC_OK) {
+        st = dhc_normal_eq_add(&ne, &jac, r, NULL, 3U);
+    }
+    if (st == DHC_OK) {
+        st = dhc_lsq_analyse(&ne, 1e-10, &fac);
+    }
+    if (st == DHC_OK) {
+        st = dhc_lsq_step(&ne, &fac, 0.0, dq, nj);
+    }
+    return st;
+}
+
+int dhcal_apparent_joint_errors(const dhc_model *model, const dhcal_samples *s, int with_effects,
+                                double *dq_deg, double *moment_mm)
+{
     const size_t nj = model->arm.n_joints;
     dhc_param_set offsets; /* theta_i: its column is joint i's column */
     dhc_params_clear(&offsets);
@@ -147,35 +189,10 @@ int dhcal_apparent_joint_errors(const dhc_model *model, const dhcal_samples *s, 
     }
     for (size_t i = 0U; i < s->n; ++i) {
         const dhc_sample *smp = &s->samples[i];
-        double r[DHC_MAX_ROWS_PER_SAMPLE];
-        double jac_buf[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_JOINTS];
-        double tau[DHC_MAX_JOINTS][DHC_MAX_JOINTS];
         double dq[DHC_MAX_JOINTS];
-        size_t rows;
-        dhc_mat jac;
-        /* position (or wire) rows only: an orientation row would weigh in at 1000 mm/rad */
-        dhc_status st = dhc_model_residual(model, smp, 1000.0, r, &rows);
-        if (st == DHC_OK) {
-            st = dhc_mat_init(&jac, dhc_sample_rows(smp), nj, jac_buf, sizeof jac_buf / sizeof jac_buf[0]);
-        }
+        double tau[DHC_MAX_JOINTS][DHC_MAX_JOINTS];
         dhc_prediction pred;
-        if (st == DHC_OK) {
-            st = dhc_model_jacobian(model, &offsets, smp, 1000.0, &jac, &pred);
-        }
-        if (st == DHC_OK) {
-            jac.rows = 3U;
-            st = dhc_normal_eq_init(&ne, nj);
-        }
-        if (st == DHC_OK) {
-            st = dhc_normal_eq_add(&ne, &jac, r, NULL, 3U);
-        }
-        /* least-norm where the joint Jacobian is short of rank (more joints than rows) */
-        if (st == DHC_OK) {
-            st = dhc_lsq_analyse(&ne, 1e-10, &fac);
-        }
-        if (st == DHC_OK) {
-            st = dhc_lsq_step(&ne, &fac, 0.0, dq, nj);
-        }
+        dhc_status st = joint_error_of_sample(model, &offsets, smp, dq, &pred);
         if (st == DHC_OK) {
             st = dhc_model_gravity_moments(model, dhc_model_length_scale(model, smp->temp_c),
                                            smp->q_rad, tau);

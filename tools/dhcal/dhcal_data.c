@@ -34,7 +34,7 @@ int dhcal_samples_build(const dhc_model *model, const dhcal_dataset *data, const
         dhc_sample *s = &out->samples[i];
         for (size_t j = 0U; j < data->n_joints && j < DHC_MAX_JOINTS; ++j) {
             s->q_rad[j] = row->q_rad[j];
-            s->dir[j] = data->has_dir ? (int8_t)row->dir[j] : 0;
+            s->dir[j] = (int8_t)(data->has_dir ? row->dir[j] : 0);
         }
         s->temp_c = data->has_temp ? row->temp_c : model->thermal_ref_c;
         if (out->wires) {

@@ -1370,10 +1370,19 @@ static void put_exact(strbuf *sb, double v)
     sb_printf(sb, "%s", num);
 }
 
-/* Angles: degrees to 15 digits, so that 90 deg stays "90" through rad and back. */
+/* Angles in degrees: the fewest digits (15 to 17) that load back to the same radians, so
+ * 90 deg stays "90" and two limits 1e-15 apart do not collapse into one on saving. */
 static void put_deg(strbuf *sb, double rad)
 {
-    sb_printf(sb, "%.15g", rad * RAD_TO_DEG + 0.0);
+    char num[40];
+    const double deg = rad * RAD_TO_DEG + 0.0; /* -0 becomes +0 */
+    for (int prec = 15; prec <= 17; ++prec) {
+        (void)snprintf(num, sizeof num, "%.*g", prec, deg);
+        if (same_double(strtod(num, NULL) * DEG_TO_RAD, rad)) {
+            break;
+        }
+    }
+    sb_printf(sb, "%s", num);
 }
 
 static void put_vec_mm(strbuf *sb, const double *v, size_t n)
