@@ -2,10 +2,14 @@
 """The dhcal program as a person runs it: exit codes, messages naming file and line, and
 --out never created, truncated or overwritten by a failed run (DESIGN.md section 3).
 
-Usage: test_cli.py --dhcal PATH   (the data come from examples/ and are written per case)
+Usage: test_cli.py --dhcal PATH [--wrapper 'CMD ARGS']
+  (the data come from examples/ and are written per case). --wrapper runs every dhcal
+  invocation under CMD, e.g. 'valgrind --error-exitcode=99 --leak-check=full': a wrapper
+  that reports through its own exit code then fails the case's exit-code assertion.
 """
 import json
 import os
+import shlex
 import shutil
 import subprocess
 import sys
@@ -16,6 +20,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 EXAMPLE = os.path.join(ROOT, 'examples', 'data', 'compliance')
 DHCAL = None
+WRAPPER = []
 
 GOOD_MODEL = open(os.path.join(EXAMPLE, 'model.json')).read()
 GOOD_CSV = open(os.path.join(EXAMPLE, 'train.csv')).read()
@@ -39,8 +44,8 @@ class Cli(unittest.TestCase):
         return path
 
     def run_dhcal(self, *args):
-        return subprocess.run([DHCAL, *args], capture_output=True, text=True, errors='replace',
-                              timeout=120)
+        return subprocess.run([*WRAPPER, DHCAL, *args], capture_output=True, text=True,
+                              errors='replace', timeout=600 if WRAPPER else 120)
 
     def fit(self, model=None, data=None, *extra):
         return self.run_dhcal('fit', '--model', model or self.model, '--data', data or self.data,
@@ -200,4 +205,8 @@ if __name__ == '__main__':
     i = sys.argv.index('--dhcal')
     DHCAL = os.path.abspath(sys.argv[i + 1])
     del sys.argv[i:i + 2]
+    if '--wrapper' in sys.argv:
+        i = sys.argv.index('--wrapper')
+        WRAPPER = shlex.split(sys.argv[i + 1])
+        del sys.argv[i:i + 2]
     unittest.main(verbosity=1)
