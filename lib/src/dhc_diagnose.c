@@ -426,7 +426,15 @@ static dhc_status find_lookalikes(const dhc_model *model, const dhc_param_set *b
         double joint_ss;
         size_t joint_rank;
         st = score_columns(&b, cols, k, &joint_ss, &joint_rank, NULL);
-        if (st == DHC_OK && joint_ss <= opt->lookalike_ratio * best->explained_ss) {
+        /* Look-alikes only if neither tells the data anything the other does not: the
+         * rival adds next to nothing to the best, and the best adds nothing significant
+         * to the rival (the nested score test at alpha). */
+        const dhc_candidate_result *rv = &out->c[rival[r]];
+        const double best_beyond_rival = (joint_ss - rv->explained_ss) / out->sigma2;
+        const int best_not_better =
+            dhc_chi2_log10_sf(best_beyond_rival, best->rank) > log10(opt->alpha);
+        if (st == DHC_OK && joint_ss <= opt->lookalike_ratio * best->explained_ss &&
+            best_not_better) {
             out->c[0].lookalike = rival[r];
             out->c[rival[r]].lookalike = 0U;
         }

@@ -66,8 +66,9 @@ typedef struct {
     double alpha;          /* family-wise false alarm level (default 1e-3) */
     double separable_tol;  /* a candidate direction whose share outside the base model's
                               span is below this is not separable (default 1e-6) */
-    double lookalike_ratio;/* two candidates whose union explains less than this factor
-                              more than the better one are look-alikes (default 1.02) */
+    double lookalike_ratio;/* two candidates are look-alikes when their union explains less
+                              than this factor more than the better one (default 1.02) and
+                              the better one adds nothing significant (at alpha) to the other */
     double orientation_weight_mm_per_rad; /* as in the fit (1000) */
 } dhc_diagnose_options;
 
