@@ -15,16 +15,7 @@ static test_rng rng = {0x5151ULL};
 
 static dhc_model paper_model(void)
 {
-    dhc_arm arm;
-    test_arm_from_table(&arm, TEST_TABLE3, 3U, 0.0);
-    dhc_arm_choose_conventions(&arm, 1e-3);
-    const double lo[3] = {-170.0, -10.0, -150.0};
-    const double hi[3] = {170.0, 170.0, 150.0};
-    for (size_t i = 0U; i < 3U; ++i) {
-        arm.joint[i].min_rad = lo[i] * TEST_DEG;
-        arm.joint[i].max_rad = hi[i] * TEST_DEG;
-    }
-    return test_model_of(&arm);
+    return test_paper3_model();
 }
 
 static dhc_sample template_sample(const dhc_model *m)

@@ -70,6 +70,22 @@ static inline dhc_model test_model_of(const dhc_arm *arm)
     return m;
 }
 
+/* The built arm of Table 3 with the joint ranges the acceptance data use: the base turns
+ * +-170 deg, the shoulder keeps the arm above the base plane, the elbow +-150 deg. */
+static inline dhc_model test_paper3_model(void)
+{
+    dhc_arm arm;
+    test_arm_from_table(&arm, TEST_TABLE3, 3U, 0.0);
+    dhc_arm_choose_conventions(&arm, 1e-3);
+    const double lo[3] = {-170.0, -10.0, -150.0};
+    const double hi[3] = {170.0, 170.0, 150.0};
+    for (size_t i = 0U; i < 3U; ++i) {
+        arm.joint[i].min_rad = lo[i] * TEST_DEG;
+        arm.joint[i].max_rad = hi[i] * TEST_DEG;
+    }
+    return test_model_of(&arm);
+}
+
 /* Random joint angles uniform over each joint's range. */
 static inline void test_random_q(test_rng *r, const dhc_arm *arm, double *q)
 {
