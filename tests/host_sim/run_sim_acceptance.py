@@ -47,7 +47,9 @@ CASES = [
     ('joint_harmonic_1.json', ('joint_harmonic', 1), []),
     ('joint_scale_1.json', ('joint_scale', 1), []),
     ('measurer_scale.json', ('measurer_scale', None), ['--wires']),
+    ('measurer_offset.json', ('measurer_offset', None), ['--wires']),
     ('joint_backlash_2_loaded.json', None, []),
+    ('measurer_anchors.json', None, ['--wires']),
 ]
 
 
