@@ -4,6 +4,10 @@
 #include <math.h>
 
 #define DHS_TWO_PI 6.28318530717958647692
+/* Counts are saturated here: 2^62, exact in double and in int64. */
+#define DHS_COUNTS_LIMIT 4611686018427387904.0
+/* Pending slip travel above this (1000 km) gets one aggregated draw. */
+#define DHS_SLIP_BULK_MM 1e9
 
 void dhs_wires_init(dhs_wires *w, const dhs_measurer_params *m, const double tool_world_mm[3],
                     uint64_t run_seed)
@@ -46,6 +50,13 @@ void dhs_wires_move(dhs_wires *w, const double p_mm[3])
             /* One draw per whole millimetre of travel: the random walk sampled coarsely,
              * the same statistics whether the travel comes in 10 kHz steps or in one jump. */
             w->pending_mm[k] += fabs(d);
+            if (w->pending_mm[k] > DHS_SLIP_BULK_MM) {
+                /* Beyond any real wire (a scenario with absurd geometry): the sum of the
+                 * whole millimetres' draws in one, sd * sqrt(mm), not a loop of 1e6+. */
+                const double whole = floor(w->pending_mm[k]);
+                w->pending_mm[k] -= whole;
+                w->wheel_mm[k] += w->slip_sd * sqrt(whole) * dhs_rng_gauss(&w->slip);
+            }
             while (w->pending_mm[k] >= 1.0) {
                 w->pending_mm[k] -= 1.0;
                 w->wheel_mm[k] += w->slip_sd * dhs_rng_gauss(&w->slip);
@@ -60,7 +71,16 @@ int64_t dhs_wires_counts(const dhs_wires *w, size_t k, dhs_rng *rng)
     if (rng != NULL && w->noise_mm > 0.0) {
         travel += w->noise_mm * dhs_rng_gauss(rng);
     }
-    return (int64_t)floor(travel * w->counts_per_mm + 0.5);
+    const double c = floor(travel * w->counts_per_mm + 0.5);
+    /* Saturated: a count beyond +-2^62 (or none, NaN) comes only from absurd geometry, and
+     * converting it to int64 would be undefined behaviour. */
+    if (isnan(c)) {
+        return 0;
+    }
+    if (c <= -DHS_COUNTS_LIMIT) {
+        return -(int64_t)DHS_COUNTS_LIMIT;
+    }
+    return c < DHS_COUNTS_LIMIT ? (int64_t)c : (int64_t)DHS_COUNTS_LIMIT;
 }
 
 uint32_t dhs_wires_register(const dhs_wires *w, int64_t counts)

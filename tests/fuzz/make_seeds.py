@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Writes the seed corpora of tests/fuzz/corpus/ (checked in; rerun after changing a
-target's input layout). Text targets (csv, model) get the example files plus small
+target's input layout). Text targets (csv, model, scenario) get the example files plus small
 hand-made files for each accepted feature and a few rejected ones; binary targets (trilat,
 lsq, predict) get inputs encoded the way their fz_reader decodes them (fuzz_common.h):
 plausible geometry, the edge cases their headers name, and non-finite values.
@@ -284,15 +284,74 @@ def model_seeds():
     put('model', 'wrong-type.json', '{"joints": [{"alpha_deg": "90", "a_mm": 0, "d_mm": 0}]}')
 
 
+# ---------------------------------------------------------------- scenario
+# fuzz_scenario.c puts paper-3dof-model.json (host_sim/scenarios) and
+# paper-6dof-nominal.json (examples/models) next to the input: seeds name them.
+def scenario_seeds():
+    src = os.path.join(ROOT, 'host_sim', 'scenarios')
+    for f in sorted(os.listdir(src)):
+        if f.endswith('.json') and 'model' not in f:
+            shutil.copy(os.path.join(src, f), os.path.join(CORPUS, 'scenario', f))
+    link3 = ('[{"link": {"mass_kg": 5, "com_mm": [0, -216, 0]}}, '
+             '{"link": {"mass_kg": 4, "com_mm": [-200, 0, 0]}}, '
+             '{"link": {"mass_kg": 2, "com_mm": [-170, 0, 0]}}]')
+    put('scenario', 'minimal.json',
+        '{"seed": 3, "model": "paper-3dof-model.json", "joints": %s}\n' % link3)
+    put('scenario', 'compliant-everything.json', '''{"seed": 9007199254740992,
+ "model": "paper-3dof-model.json",
+ "truth": {"joints": [{"theta_offset_deg": 1, "d_mm": 2, "a_mm": -3, "alpha_deg": 0.5},
+                      {"beta_deg": 0.2}, {"a_mm": 1}],
+           "base": {"xyz_mm": [1, 2, 3], "rpy_deg": [0.1, 0.2, 0.3]}, "tool_mm": [1, 0, 0],
+           "random_sd": {"theta_offset_deg": 0.1, "d_mm": 0.1, "a_mm": 0.1,
+                         "alpha_deg": 0.1, "beta_deg": 0.1}},
+ "physics": {"step_us": 50, "gravity_mps2": 9.81},
+ "joint_defaults": {"gear": {"ratio": 50, "backlash_deg": 0.1, "stiffness_nm_per_rad": 20000,
+                             "transmission_error": [{"order": 2, "sin_mrad": 0.3}]},
+                    "tacho": {"ripple": 0.1, "noise_v": 0.01},
+                    "controller": {"gear_ratio": 50.5, "encoder_lines": 512}},
+ "joints": %s,
+ "payload": {"mass_kg": 1, "com_mm": [10, 0, 0], "inertia_kgm2": [0.01, 0.01, 0.01]},
+ "drive": {"dac_range_v": 5, "adc_range_v": 5},
+ "measurer": {"anchor_errors_mm": [[1, 0, 0], [0, 1, 0], [0, 0, 1]],
+              "frame_error": {"xyz_mm": [1, 1, 1], "rpy_deg": [0.1, 0, 0]},
+              "wheel_radius_mm": 10, "wheel_radius_error": 0.001, "lines": 1000,
+              "counter_bits": 8, "zero_length_mm": [100, 100, 100],
+              "zero_length_error_mm": [0.1, 0, 0], "slip_sd_mm_per_sqrt_mm": 0.01,
+              "noise_mm": 0.01},
+ "noise": {"xyz_mm": 0.05},
+ "poses": {"min_axis_distance_mm": 100, "min_anchor_plane_mm": 100}}
+''' % link3)
+    put('scenario', 'model-6dof-wrong-joint-count.json',
+        '{"seed": 1, "model": "paper-6dof-nominal.json", "joints": %s}\n' % link3)
+    put('scenario', 'no-model-file.json',
+        '{"seed": 1, "model": "missing.json", "joints": %s}\n' % link3)
+    put('scenario', 'missing-seed.json',
+        '{"model": "paper-3dof-model.json", "joints": %s}\n' % link3)
+    put('scenario', 'nan.json',
+        '{"seed": 1, "model": "paper-3dof-model.json", "joints": %s,'
+        ' "noise": {"xyz_mm": NaN}}\n' % link3)
+    put('scenario', 'negative-stiffness.json',
+        '{"seed": 1, "model": "paper-3dof-model.json", "joints": %s,'
+        ' "joint_defaults": {"gear": {"stiffness_nm_per_rad": -5}}}\n' % link3)
+    put('scenario', 'unknown-key.json',
+        '{"seed": 1, "model": "paper-3dof-model.json", "joints": %s, "bogus": 1}\n' % link3)
+    put('scenario', 'repeated-key.json',
+        '{"seed": 1, "seed": 2, "model": "paper-3dof-model.json", "joints": %s}\n' % link3)
+    put('scenario', 'syntax-error.json', '{"seed": 1, "model": "paper-3dof-model.json", "jo')
+    put('scenario', 'fractional-seed.json',
+        '{"seed": 1.5, "model": "paper-3dof-model.json", "joints": %s}\n' % link3)
+
+
 if __name__ == '__main__':
     if os.path.isdir(CORPUS):
         shutil.rmtree(CORPUS)
-    for t in ('csv', 'model', 'trilat', 'lsq', 'predict'):
+    for t in ('csv', 'model', 'trilat', 'lsq', 'predict', 'scenario'):
         os.makedirs(os.path.join(CORPUS, t))
     trilat_seeds()
     lsq_seeds()
     predict_seeds()
     csv_seeds()
     model_seeds()
+    scenario_seeds()
     for t in sorted(os.listdir(CORPUS)):
         print('%-8s %d seeds' % (t, len(os.listdir(os.path.join(CORPUS, t)))))

@@ -48,11 +48,12 @@ void dhs_wires_init(dhs_wires *w, const dhs_measurer_params *m, const double too
 /* True wire lengths from the true anchors to point p (world, mm). */
 void dhs_wires_lengths(const dhs_wires *w, const double p_mm[3], double len_mm[3]);
 
-/* The tool moved to p (world, mm): the wheels roll the change of each wire, with slip. */
+/* The tool moved to p (world, mm): the wheels roll the change of each wire, with slip.
+ * Travel pending above 1e9 mm (absurd geometry) gets its slip as one aggregated draw. */
 void dhs_wires_move(dhs_wires *w, const double p_mm[3]);
 
 /* Counts of wire k now (not wrapped), with one reading's noise drawn from rng (NULL: no
- * noise). */
+ * noise). Saturated at +-2^62 (0 for a NaN travel): only absurd geometry gets there. */
 int64_t dhs_wires_counts(const dhs_wires *w, size_t k, dhs_rng *rng);
 
 /* The hardware counter: counts modulo 2^counter_bits. */
