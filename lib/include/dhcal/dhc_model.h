@@ -58,11 +58,11 @@ typedef enum {
 
 typedef struct {
     double q_rad[DHC_MAX_JOINTS]; /* measured joint angles (encoder, never commanded) */
-    int8_t dir[DHC_MAX_JOINTS];   /* last approach direction, -1 or +1 (0: unknown) */
     double temp_c;                /* temperature; T0 when not measured */
     double p_mm[3];               /* measured tool point, world (POSITION, POSE) */
     dhc_mat3 rot;                 /* measured orientation (POSE) */
     double wire_mm[3];            /* measured wire lengths (WIRES) */
+    int8_t dir[DHC_MAX_JOINTS];   /* last approach direction, -1 or +1 (0: unknown) */
     uint8_t kind;                 /* dhc_meas_kind */
 } dhc_sample;
 

@@ -1,0 +1,133 @@
+/* fw_sim_port.c - fw_port over dhs_plant (fw_sim_port.h). */
+#include "fw_sim_port.h"
+
+#include <math.h>
+#include <string.h>
+
+static fw_port_status sim_wait_tick(void *ctx, uint64_t *t_us)
+{
+    fw_sim *s = ctx;
+    if (s->fail_tick != FW_PORT_OK) {
+        return s->fail_tick;
+    }
+    if (dhs_plant_advance(&s->plant, 1000U) != DHC_OK) {
+        return FW_PORT_ERR_IO;
+    }
+    *t_us = dhs_plant_time_ns(&s->plant) / 1000U;
+    return FW_PORT_OK;
+}
+
+static fw_port_status sim_read_encoders(void *ctx, uint16_t counts[DHC_MAX_JOINTS])
+{
+    fw_sim *s = ctx;
+    for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
+        const int32_t r = (int32_t)dhs_plant_encoder(&s->plant, j) + s->encoder_offset[j];
+        counts[j] = (uint16_t)((uint32_t)r & 0xFFFFU);
+    }
+    return FW_PORT_OK;
+}
+
+static fw_port_status sim_read_tachos(void *ctx, uint16_t codes[DHC_MAX_JOINTS])
+{
+    fw_sim *s = ctx;
+    for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
+        int32_t r = (int32_t)dhs_plant_tacho_adc(&s->plant, j) + s->tacho_offset[j];
+        r = r < 0 ? 0 : (r > 4095 ? 4095 : r);
+        codes[j] = (uint16_t)r;
+    }
+    return FW_PORT_OK;
+}
+
+static fw_port_status sim_write_dacs(void *ctx, const uint16_t codes[DHC_MAX_JOINTS])
+{
+    fw_sim *s = ctx;
+    for (size_t j = 0U; j < s->plant.n; ++j) {
+        double c = (double)codes[j] + s->dac_extra_v[j] / s->plant.sc.dac_range_v * 2048.0;
+        c = fmin(fmax(round(c), 0.0), 4095.0);
+        if (dhs_plant_set_dac(&s->plant, j, (uint16_t)c) != DHC_OK) {
+            return FW_PORT_ERR_IO;
+        }
+        if (!s->brakes_released) {
+            (void)dhs_plant_set_brake(&s->plant, j, 0);
+        }
+    }
+    s->brakes_released = 1;
+    return FW_PORT_OK;
+}
+
+static fw_port_status sim_read_wires(void *ctx, uint16_t counts[3])
+{
+    fw_sim *s = ctx;
+    for (size_t k = 0U; k < 3U; ++k) {
+        const int64_t r = (int64_t)dhs_plant_wire_counter(&s->plant, k) + s->wire_offset[k];
+        counts[k] = (uint16_t)((uint64_t)r & 0xFFFFU);
+    }
+    return FW_PORT_OK;
+}
+
+static fw_nv_status sim_nv_read(void *ctx, size_t offset, void *buf, size_t len)
+{
+    fw_sim *s = ctx;
+    if (offset > FW_SIM_NV_SIZE || len > FW_SIM_NV_SIZE - offset) {
+        return FW_NV_ERR_RANGE;
+    }
+    memcpy(buf, s->nv + offset, len);
+    return FW_NV_OK;
+}
+
+static fw_nv_status sim_nv_write(void *ctx, size_t offset, const void *buf, size_t len)
+{
+    fw_sim *s = ctx;
+    if (offset > FW_SIM_NV_SIZE || len > FW_SIM_NV_SIZE - offset) {
+        return FW_NV_ERR_RANGE;
+    }
+    if (s->nv_fail) {
+        return FW_NV_ERR_IO;
+    }
+    memcpy(s->nv + offset, buf, len);
+    return FW_NV_OK;
+}
+
+dhc_status fw_sim_init(fw_sim *sim, const dhs_scenario *sc, uint64_t run_seed,
+                       const double *q_start_rad, fw_port *port)
+{
+    memset(sim, 0, sizeof *sim);
+    memset(sim->nv, 0xFF, sizeof sim->nv);
+    const dhc_status st = dhs_plant_init(&sim->plant, sc, run_seed, q_start_rad);
+    if (st != DHC_OK) {
+        return st;
+    }
+    memset(port, 0, sizeof *port);
+    port->ctx = sim;
+    port->n_joints = sim->plant.n;
+    port->wait_tick = sim_wait_tick;
+    port->read_encoders = sim_read_encoders;
+    port->read_tachos = sim_read_tachos;
+    port->write_dacs = sim_write_dacs;
+    port->read_wires = sim_read_wires;
+    port->nv.ctx = sim;
+    port->nv.size = FW_SIM_NV_SIZE;
+    port->nv.read = sim_nv_read;
+    port->nv.write = sim_nv_write;
+    return DHC_OK;
+}
+
+void fw_sim_io_config(const dhs_scenario *sc, fw_io_config *io)
+{
+    memset(io, 0, sizeof *io);
+    const double two_pi = 6.283185307179586;
+    for (size_t j = 0U; j < sc->n_joints; ++j) {
+        const dhs_joint_params *jp = &sc->joint[j];
+        io->counts_per_rad[j] = (double)jp->nominal_encoder_lines * 4.0 * jp->nominal_gear_ratio /
+                                two_pi;
+        io->tacho_v_per_rad_s[j] = jp->tacho_v_s_per_rad * jp->nominal_gear_ratio;
+    }
+    io->adc_v_full_scale = sc->adc_range_v;
+    io->dac_v_full_scale = sc->dac_range_v;
+    const dhs_measurer_params *m = &sc->measurer;
+    io->wire_mm_per_count = m->lines > 0U ? two_pi * m->wheel_radius_mm / (4.0 * (double)m->lines)
+                                          : 1.0;
+    for (size_t k = 0U; k < 3U; ++k) {
+        io->wire_ref_mm[k] = m->zero_length_nominal_mm[k];
+    }
+}

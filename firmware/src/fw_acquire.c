@@ -1,0 +1,371 @@
+/* fw_acquire.c - pose plans, acquisition, calibration on the controller (fw_acquire.h). */
+#include "dhcal_fw/fw_acquire.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "dhcal/dhc_trilat.h"
+#include "dhcal_fw/fw_calstore.h"
+
+static uint32_t rng_next(uint32_t *s)
+{
+    uint32_t x = *s;
+    x ^= x << 13U;
+    x ^= x >> 17U;
+    x ^= x << 5U;
+    *s = x;
+    return x;
+}
+
+static double rng_unit(uint32_t *s)
+{
+    return (double)(rng_next(s) >> 8U) / 16777216.0;
+}
+
+static dhc_status predict_point(const dhc_model *m, const double *q, const int8_t *dir,
+                                double p[3])
+{
+    dhc_sample s;
+    memset(&s, 0, sizeof s);
+    s.kind = (uint8_t)DHC_MEAS_POSITION;
+    s.temp_c = m->thermal_ref_c;
+    for (size_t j = 0U; j < m->arm.n_joints; ++j) {
+        s.q_rad[j] = q[j];
+        s.dir[j] = (int8_t)(dir != NULL ? dir[j] : 1);
+    }
+    dhc_prediction pr;
+    const dhc_status st = dhc_model_predict(m, &s, &pr);
+    if (st == DHC_OK) {
+        memcpy(p, pr.p_mm, sizeof pr.p_mm);
+    }
+    return st;
+}
+
+size_t fw_plan_poses(const dhc_model *model, size_t n, uint32_t seed, int mixed_dirs,
+                     fw_pose *poses)
+{
+    uint32_t s = seed != 0U ? seed : 0x9E3779B9U;
+    const size_t nj = model->arm.n_joints;
+    size_t got = 0U;
+    dhc_frame inv;
+    dhc_frame_inverse(&model->measurer.frame, &inv);
+    for (size_t tries = 0U; got < n && tries < 200U * n; ++tries) {
+        fw_pose ps;
+        memset(&ps, 0, sizeof ps);
+        for (size_t j = 0U; j < nj; ++j) {
+            const dhc_joint *jt = &model->arm.joint[j];
+            const double margin = 0.1 * (jt->max_rad - jt->min_rad);
+            ps.q_rad[j] = jt->min_rad + margin + rng_unit(&s) * (jt->max_rad - jt->min_rad - 2.0 * margin);
+            const int plus = (rng_next(&s) & 0x100U) != 0U || !mixed_dirs;
+            ps.dir[j] = plus ? (int8_t)1 : (int8_t)-1;
+        }
+        double p[3];
+        if (predict_point(model, ps.q_rad, ps.dir, p) != DHC_OK) {
+            continue;
+        }
+        if (sqrt(p[0] * p[0] + p[1] * p[1]) < 250.0 || p[2] < 100.0) {
+            continue;
+        }
+        if (model->measurer.present) {
+            double loc[3];
+            dhc_frame_apply(&inv, p, loc);
+            if (loc[0] < 300.0) {
+                continue;
+            }
+        }
+        poses[got++] = ps;
+    }
+    return got;
+}
+
+static dhc_status wire_prediction(const dhc_model *m, const fw_pose *ps, double w[3])
+{
+    dhc_sample s;
+    memset(&s, 0, sizeof s);
+    s.kind = (uint8_t)DHC_MEAS_WIRES;
+    s.temp_c = m->thermal_ref_c;
+    memcpy(s.q_rad, ps->q_rad, sizeof s.q_rad);
+    memcpy(s.dir, ps->dir, sizeof s.dir);
+    dhc_prediction pr;
+    const dhc_status st = dhc_model_predict(m, &s, &pr);
+    if (st == DHC_OK) {
+        memcpy(w, pr.wire_mm, sizeof pr.wire_mm);
+    }
+    return st;
+}
+
+static dhc_model obs_model;
+static double obs_normal[DHC_MAX_PARAMS * DHC_MAX_PARAMS];
+static double obs_rows[3][DHC_MAX_PARAMS];
+
+dhc_status fw_plan_observability(const dhc_model *model, const dhc_param_set *set,
+                                 const fw_pose *poses, size_t n, double *o1, size_t *rank)
+{
+    const size_t p = set->count;
+    if (p == 0U || n == 0U || o1 == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    memset(obs_normal, 0, sizeof obs_normal);
+    double delta[DHC_MAX_PARAMS];
+    for (size_t i = 0U; i < n; ++i) {
+        for (size_t k = 0U; k < p; ++k) {
+            /* step: 1e-6 rad for angles, 1e-3 mm or 1e-6 for the rest */
+            const double h = dhc_params_is_angle(set, k) ? 1e-6 : 1e-4;
+            double wp[3];
+            double wm[3];
+            memset(delta, 0, sizeof delta);
+            delta[k] = h;
+            obs_model = *model;
+            dhc_status st = dhc_params_apply(set, &obs_model, delta, p);
+            if (st == DHC_OK) {
+                st = wire_prediction(&obs_model, &poses[i], wp);
+            }
+            delta[k] = -h;
+            obs_model = *model;
+            if (st == DHC_OK) {
+                st = dhc_params_apply(set, &obs_model, delta, p);
+            }
+            if (st == DHC_OK) {
+                st = wire_prediction(&obs_model, &poses[i], wm);
+            }
+            if (st != DHC_OK) {
+                return st;
+            }
+            for (size_t r = 0U; r < 3U; ++r) {
+                obs_rows[r][k] = (wp[r] - wm[r]) / (2.0 * h);
+            }
+        }
+        for (size_t r = 0U; r < 3U; ++r) {
+            for (size_t a = 0U; a < p; ++a) {
+                for (size_t b = 0U; b < p; ++b) {
+                    obs_normal[a * p + b] += obs_rows[r][a] * obs_rows[r][b];
+                }
+            }
+        }
+    }
+    /* unit column norms */
+    double d[DHC_MAX_PARAMS];
+    for (size_t a = 0U; a < p; ++a) {
+        d[a] = obs_normal[a * p + a] > 0.0 ? 1.0 / sqrt(obs_normal[a * p + a]) : 0.0;
+    }
+    for (size_t a = 0U; a < p; ++a) {
+        for (size_t b = 0U; b < p; ++b) {
+            obs_normal[a * p + b] *= d[a] * d[b];
+        }
+    }
+    /* pivoted Cholesky in place: log det over the pivots kept */
+    size_t perm[DHC_MAX_PARAMS];
+    for (size_t a = 0U; a < p; ++a) {
+        perm[a] = a;
+    }
+    double log_det = 0.0;
+    size_t kept = 0U;
+    for (size_t k = 0U; k < p; ++k) {
+        size_t best = k;
+        for (size_t a = k + 1U; a < p; ++a) {
+            if (obs_normal[perm[a] * p + perm[a]] > obs_normal[perm[best] * p + perm[best]]) {
+                best = a;
+            }
+        }
+        const size_t tmp = perm[k];
+        perm[k] = perm[best];
+        perm[best] = tmp;
+        const size_t pk = perm[k];
+        const double piv = obs_normal[pk * p + pk];
+        if (!(piv > 1e-10)) {
+            break;
+        }
+        log_det += log(piv);
+        ++kept;
+        for (size_t a = k + 1U; a < p; ++a) {
+            const size_t pa = perm[a];
+            const double f = obs_normal[pa * p + pk] / piv;
+            for (size_t b = k + 1U; b < p; ++b) {
+                const size_t pb = perm[b];
+                obs_normal[pa * p + pb] -= f * obs_normal[pk * p + pb];
+            }
+        }
+    }
+    if (rank != NULL) {
+        *rank = kept;
+    }
+    if (kept == 0U) {
+        *o1 = 0.0;
+        return DHC_OK;
+    }
+    /* prod sigma = sqrt(det N) */
+    *o1 = exp(0.5 * log_det / (double)kept) / sqrt(3.0 * (double)n);
+    return DHC_OK;
+}
+
+static void model_measurer(const dhc_model *m, dhc_measurer *out)
+{
+    out->a_mm = m->measurer.anchor_mm[0][2];
+    out->b_mm = m->measurer.anchor_mm[1][1];
+    out->c_mm = m->measurer.anchor_mm[1][2];
+    out->x_sign = 1.0;
+    out->frame = m->measurer.frame;
+}
+
+fw_fault fw_acquire_one(fw_ctrl *c, const dhc_model *model, uint32_t hold_ticks,
+                        dhc_sample *out)
+{
+    double w[3];
+    if (fw_ctrl_hold(c, hold_ticks, w) != FW_FAULT_NONE) {
+        return c->fault;
+    }
+    dhc_sample s;
+    memset(&s, 0, sizeof s);
+    s.kind = (uint8_t)DHC_MEAS_WIRES;
+    s.temp_c = model->thermal_ref_c;
+    for (size_t j = 0U; j < c->n; ++j) {
+        s.q_rad[j] = c->q_rad[j]; /* encoder, never the command */
+        s.dir[j] = c->dir[j];
+    }
+    memcpy(s.wire_mm, w, sizeof w);
+    if (model->measurer.present) {
+        dhc_measurer m;
+        model_measurer(model, &m);
+        double pt[3];
+        double pm[3];
+        const dhc_status st = dhc_trilat_world(&m, w, 1.0, pt);
+        if (st != DHC_OK || predict_point(model, s.q_rad, s.dir, pm) != DHC_OK) {
+            fw_ctrl_fault(c, FW_FAULT_WIRES_INCONSISTENT, 0U);
+            return c->fault;
+        }
+        const double dx = pt[0] - pm[0];
+        const double dy = pt[1] - pm[1];
+        const double dz = pt[2] - pm[2];
+        if (sqrt(dx * dx + dy * dy + dz * dz) > 50.0) {
+            fw_ctrl_fault(c, FW_FAULT_WIRES_INCONSISTENT, 0U);
+            return c->fault;
+        }
+    }
+    *out = s;
+    return FW_FAULT_NONE;
+}
+
+fw_fault fw_acquire(fw_ctrl *c, const dhc_model *model, const fw_pose *poses, size_t n,
+                    uint32_t hold_ticks, dhc_sample *samples, size_t *n_done)
+{
+    for (size_t i = 0U; i < n; ++i) {
+        if (fw_ctrl_move_to(c, poses[i].q_rad, poses[i].dir) != FW_FAULT_NONE) {
+            return c->fault;
+        }
+        if (fw_acquire_one(c, model, hold_ticks, &samples[*n_done]) != FW_FAULT_NONE) {
+            return c->fault;
+        }
+        ++*n_done;
+    }
+    return FW_FAULT_NONE;
+}
+
+/* ---------------------------------------------------------------- calibration */
+
+typedef struct {
+    const dhc_sample *s;
+    size_t n;
+} sample_buf;
+
+static dhc_status read_sample(void *ctx, size_t index, dhc_sample *out)
+{
+    const sample_buf *b = ctx;
+    if (index >= b->n) {
+        return DHC_ERR_ARGUMENT;
+    }
+    *out = b->s[index];
+    return DHC_OK;
+}
+
+static dhc_calib_workspace cal_ws;
+static dhc_diagnose_workspace diag_ws;
+static dhc_diagnosis diag;
+static dhc_candidate cands[DHC_MAX_CANDIDATES];
+static uint8_t cal_flags[FW_ACQ_MAX_SAMPLES];
+static dhc_model stored_model;
+static dhc_model geo_model;
+
+double fw_wire_rms(const dhc_model *model, const dhc_sample *samples, size_t n)
+{
+    double ss = 0.0;
+    size_t used = 0U;
+    for (size_t i = 0U; i < n; ++i) {
+        double r[DHC_MAX_ROWS_PER_SAMPLE];
+        size_t rows = 0U;
+        if (dhc_model_residual(model, &samples[i], 1000.0, r, &rows) != DHC_OK) {
+            continue;
+        }
+        for (size_t k = 0U; k < rows; ++k) {
+            ss += r[k] * r[k];
+        }
+        ++used;
+    }
+    return used > 0U ? sqrt(ss / (double)used) : -1.0;
+}
+
+fw_fault fw_autocal(dhc_model *model, const dhc_sample *samples, size_t n,
+                    const fw_nvstore *nv, dhc_model *geo_out, fw_autocal_result *res)
+{
+    memset(res, 0, sizeof *res);
+    res->stored_rms_mm = -1.0;
+    if (n == 0U || n > FW_ACQ_MAX_SAMPLES) {
+        return FW_FAULT_ARGUMENT;
+    }
+    sample_buf buf = {samples, n};
+    dhc_calib_options opt;
+    dhc_calib_default_options(&opt);
+    dhc_param_set set;
+    if (dhc_params_base_model(&set, model) != DHC_OK) {
+        return FW_FAULT_ARGUMENT;
+    }
+    memset(cal_flags, 0, sizeof cal_flags);
+    geo_model = *model;
+    if (dhc_calib_fit(&geo_model, &set, read_sample, &buf, n, cal_flags, &opt, &cal_ws,
+                      &res->geo) != DHC_OK) {
+        return FW_FAULT_ARGUMENT;
+    }
+    *model = geo_model;
+    if (geo_out != NULL) {
+        *geo_out = geo_model;
+    }
+    dhc_diagnose_options dopt;
+    dhc_diagnose_default_options(&dopt);
+    const size_t nc = dhc_diagnose_candidates(&geo_model, &set, 1, 0.0, cands, DHC_MAX_CANDIDATES);
+    if (dhc_diagnose(&geo_model, &set, res->geo.identifiable, res->geo.sigma * res->geo.sigma,
+                     cands, nc, read_sample, &buf, n, cal_flags, &dopt, &diag_ws,
+                     &diag) == DHC_OK &&
+        diag.count > 0U && diag.c[0].significant) {
+        res->found = 1;
+        res->effect = diag.c[0].effect;
+        res->effect_joint = diag.c[0].joint;
+        res->effect_log10_p = diag.c[0].log10_p;
+        dhc_param_set set2 = set;
+        dhc_model m2 = geo_model;
+        if (dhc_params_add_effect(&set2, &m2, res->effect, res->effect_joint) == DHC_OK) {
+            memset(cal_flags, 0, sizeof cal_flags);
+            if (dhc_calib_fit(&m2, &set2, read_sample, &buf, n, cal_flags, &opt, &cal_ws,
+                              &res->eff) == DHC_OK) {
+                *model = m2;
+            }
+        }
+    }
+    res->new_rms_mm = fw_wire_rms(model, samples, n);
+    if (nv == NULL) {
+        return FW_FAULT_NONE;
+    }
+    uint32_t seq = 0U;
+    const fw_cal_status ls = fw_cal_load(nv, &stored_model, &seq);
+    if (ls == FW_CAL_OK) {
+        res->stored_rms_mm = fw_wire_rms(&stored_model, samples, n);
+    } else if (ls == FW_CAL_ERR_IO) {
+        return FW_FAULT_STORAGE;
+    }
+    if (ls == FW_CAL_OK && !(res->new_rms_mm < res->stored_rms_mm)) {
+        return FW_FAULT_NONE; /* the stored one is at least as good: keep it */
+    }
+    if (fw_cal_save(nv, model, &res->seq) != FW_CAL_OK) {
+        return FW_FAULT_STORAGE;
+    }
+    res->saved = 1;
+    return FW_FAULT_NONE;
+}
