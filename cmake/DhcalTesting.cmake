@@ -3,8 +3,9 @@
 #   Linked with the lib, Unity and the full warning set (tests compare doubles through
 #   tolerances, so -Wfloat-equal and friends stay on); tests/support/ is on the include path.
 #   Bare metal (DHCAL_BARE_METAL): also links the startup/semihosting runtime and linker
-#   script of tests/target/ and adds the label `target`; CTest runs the ELF through
-#   CMAKE_CROSSCOMPILING_EMULATOR (cmake/qemu-mps2-an386.sh).
+#   script of tests/target/. Cross builds (bare metal, aarch64-linux) add the label `target`;
+#   CTest runs the executable through CMAKE_CROSSCOMPILING_EMULATOR (qemu-mps2-an386.sh,
+#   qemu-aarch64).
 # dhcal_add_unity_executable(<source.c>)
 #   The executable alone, for binaries that a wrapper test runs (tests/target/).
 
@@ -28,7 +29,9 @@ function(dhcal_add_unity_test src)
   dhcal_add_unity_executable(${src})
   get_filename_component(name ${src} NAME_WE)
   set(labels ${arg_LABELS})
-  if(DHCAL_BARE_METAL)
+  # Cross builds (bare metal, aarch64-linux) run their tests on the target through
+  # CMAKE_CROSSCOMPILING_EMULATOR: those are the `target` label.
+  if(DHCAL_BARE_METAL OR CMAKE_CROSSCOMPILING)
     list(APPEND labels target)
   endif()
   add_test(NAME ${name} COMMAND ${name})
