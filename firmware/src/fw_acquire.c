@@ -207,11 +207,71 @@ static void model_measurer(const dhc_model *m, dhc_measurer *out)
     out->frame = m->measurer.frame;
 }
 
+static uint32_t retakes;
+
+uint32_t fw_acquire_retakes(void)
+{
+    return retakes;
+}
+
+/* Holds for hold_ticks averaging the wire lengths; *still = 0 (and returns early) when a
+ * joint leaves FW_ACQ_HOLD_TOL x the settle tolerance around its reference. */
+static fw_fault hold_still(fw_ctrl *c, uint32_t hold_ticks, double w[3], int *still)
+{
+    double sum[3] = {0.0, 0.0, 0.0};
+    const double tol = FW_ACQ_HOLD_TOL * c->cfg.settle_pos_tol_rad;
+    *still = 1;
+    for (uint32_t k = 0U; k < hold_ticks; ++k) {
+        if (fw_ctrl_tick(c, NULL, NULL) != FW_FAULT_NONE) {
+            return c->fault;
+        }
+        for (size_t j = 0U; j < c->n; ++j) {
+            if (!(fabs(c->q_ref_rad[j] - c->q_rad[j]) <= tol)) {
+                *still = 0;
+                return FW_FAULT_NONE;
+            }
+        }
+        double r[3];
+        fw_ctrl_wire_mm(c, r);
+        for (size_t i = 0U; i < 3U; ++i) {
+            sum[i] += r[i];
+        }
+    }
+    if (hold_ticks == 0U) {
+        fw_ctrl_wire_mm(c, w); /* no hold: the reading of the last tick */
+        return FW_FAULT_NONE;
+    }
+    for (size_t i = 0U; i < 3U; ++i) {
+        w[i] = sum[i] / (double)hold_ticks;
+    }
+    return FW_FAULT_NONE;
+}
+
 fw_fault fw_acquire_one(fw_ctrl *c, const dhc_model *model, uint32_t hold_ticks,
                         dhc_sample *out)
 {
-    double w[3];
-    if (fw_ctrl_hold(c, hold_ticks, w) != FW_FAULT_NONE) {
+    double w[3] = {0.0, 0.0, 0.0};
+    int still = 0;
+    for (uint32_t attempt = 0U; attempt < FW_ACQ_HOLD_ATTEMPTS && !still; ++attempt) {
+        if (attempt > 0U) {
+            /* the arm moved during the hold (a push, a glitch that kicked the servo): the
+             * averaged lengths belong to no single pose. Approach the target again from
+             * the same side and hold again. */
+            ++retakes;
+            double target[DHC_MAX_JOINTS];
+            int8_t d[DHC_MAX_JOINTS];
+            memcpy(target, c->q_ref_rad, sizeof target);
+            memcpy(d, c->dir, sizeof d);
+            if (fw_ctrl_move_to(c, target, d) != FW_FAULT_NONE) {
+                return c->fault;
+            }
+        }
+        if (hold_still(c, hold_ticks, w, &still) != FW_FAULT_NONE) {
+            return c->fault;
+        }
+    }
+    if (!still) {
+        fw_ctrl_fault(c, FW_FAULT_SETTLE_TIMEOUT, 0U);
         return c->fault;
     }
     dhc_sample s;
@@ -245,16 +305,67 @@ fw_fault fw_acquire_one(fw_ctrl *c, const dhc_model *model, uint32_t hold_ticks,
     return FW_FAULT_NONE;
 }
 
+/* The wires' change from the reference pose to this one against the model's prediction of
+ * that change (fw_acquire.h): index of the first wire that disagrees, or 3. */
+static size_t pair_check(const double ref_w[3], const double ref_pred[3], const double w[3],
+                         const double pred[3])
+{
+    for (size_t k = 0U; k < 3U; ++k) {
+        const double dm = w[k] - ref_w[k];
+        const double dp = pred[k] - ref_pred[k];
+        if (!(fabs(dm - dp) <= FW_ACQ_PAIR_TOL_MM + FW_ACQ_PAIR_TOL_REL * fabs(dp))) {
+            return k;
+        }
+    }
+    return 3U;
+}
+
 fw_fault fw_acquire(fw_ctrl *c, const dhc_model *model, const fw_pose *poses, size_t n,
                     uint32_t hold_ticks, dhc_sample *samples, size_t *n_done)
 {
+    /* reference for the pair check: where the arm is now and what its wires read */
+    fw_pose ref;
+    memset(&ref, 0, sizeof ref);
+    double ref_w[3] = {0.0, 0.0, 0.0};
+    double ref_pred[3] = {0.0, 0.0, 0.0};
+    int have_ref = 0;
+    if (model->measurer.present && c->fault == FW_FAULT_NONE) {
+        for (size_t j = 0U; j < c->n; ++j) {
+            ref.q_rad[j] = c->q_rad[j];
+            ref.dir[j] = c->dir[j] < 0 ? (int8_t)-1 : (int8_t)1;
+        }
+        fw_ctrl_wire_mm(c, ref_w);
+        have_ref = wire_prediction(model, &ref, ref_pred) == DHC_OK;
+    }
     for (size_t i = 0U; i < n; ++i) {
         if (fw_ctrl_move_to(c, poses[i].q_rad, poses[i].dir) != FW_FAULT_NONE) {
             return c->fault;
         }
-        if (fw_acquire_one(c, model, hold_ticks, &samples[*n_done]) != FW_FAULT_NONE) {
+        dhc_sample s;
+        if (fw_acquire_one(c, model, hold_ticks, &s) != FW_FAULT_NONE) {
             return c->fault;
         }
+        if (model->measurer.present) {
+            fw_pose cur;
+            memset(&cur, 0, sizeof cur);
+            memcpy(cur.q_rad, s.q_rad, sizeof cur.q_rad);
+            memcpy(cur.dir, s.dir, sizeof cur.dir);
+            double pred[3];
+            if (wire_prediction(model, &cur, pred) != DHC_OK) {
+                fw_ctrl_fault(c, FW_FAULT_WIRES_INCONSISTENT, 0U);
+                return c->fault;
+            }
+            const size_t bad = have_ref ? pair_check(ref_w, ref_pred, s.wire_mm, pred) : 3U;
+            if (bad < 3U) {
+                fw_ctrl_fault(c, FW_FAULT_WIRES_INCONSISTENT, bad);
+                return c->fault;
+            }
+            ref = cur;
+            memcpy(ref_w, s.wire_mm, sizeof ref_w);
+            memcpy(ref_pred, pred, sizeof ref_pred);
+            have_ref = 1;
+        }
+        samples[*n_done] = s;
         ++*n_done;
     }
     return FW_FAULT_NONE;
@@ -285,22 +396,59 @@ static uint8_t cal_flags[FW_ACQ_MAX_SAMPLES];
 static dhc_model stored_model;
 static dhc_model geo_model;
 
-double fw_wire_rms(const dhc_model *model, const dhc_sample *samples, size_t n)
+static double err_new[FW_ACQ_MAX_SAMPLES];
+static double err_old[FW_ACQ_MAX_SAMPLES];
+
+/* RMS of the per-sample residual norms; err (may be NULL, n <= FW_ACQ_MAX_SAMPLES) receives
+ * the norms of the samples that have a residual, *used how many. */
+static double wire_errors(const dhc_model *model, const dhc_sample *samples, size_t n,
+                          double *err, size_t *used)
 {
     double ss = 0.0;
-    size_t used = 0U;
+    size_t u = 0U;
     for (size_t i = 0U; i < n; ++i) {
         double r[DHC_MAX_ROWS_PER_SAMPLE];
         size_t rows = 0U;
         if (dhc_model_residual(model, &samples[i], 1000.0, r, &rows) != DHC_OK) {
             continue;
         }
+        double e2 = 0.0;
         for (size_t k = 0U; k < rows; ++k) {
-            ss += r[k] * r[k];
+            e2 += r[k] * r[k];
         }
-        ++used;
+        ss += e2;
+        if (err != NULL) {
+            err[u] = sqrt(e2);
+        }
+        ++u;
     }
-    return used > 0U ? sqrt(ss / (double)used) : -1.0;
+    if (used != NULL) {
+        *used = u;
+    }
+    return u > 0U ? sqrt(ss / (double)u) : -1.0;
+}
+
+double fw_wire_rms(const dhc_model *model, const dhc_sample *samples, size_t n)
+{
+    return wire_errors(model, samples, n, NULL, NULL);
+}
+
+/* Median of v[0 .. n) (sorted in place; n <= FW_ACQ_MAX_SAMPLES, insertion sort). */
+static double median(double *v, size_t n)
+{
+    if (n == 0U) {
+        return -1.0;
+    }
+    for (size_t i = 1U; i < n; ++i) {
+        const double x = v[i];
+        size_t j = i;
+        while (j > 0U && v[j - 1U] > x) {
+            v[j] = v[j - 1U];
+            --j;
+        }
+        v[j] = x;
+    }
+    return (n % 2U) != 0U ? v[n / 2U] : 0.5 * (v[n / 2U - 1U] + v[n / 2U]);
 }
 
 fw_fault fw_autocal(dhc_model *model, const dhc_sample *samples, size_t n,
@@ -308,6 +456,7 @@ fw_fault fw_autocal(dhc_model *model, const dhc_sample *samples, size_t n,
 {
     memset(res, 0, sizeof *res);
     res->stored_rms_mm = -1.0;
+    res->stored_median_mm = -1.0;
     if (n == 0U || n > FW_ACQ_MAX_SAMPLES) {
         return FW_FAULT_ARGUMENT;
     }
@@ -325,6 +474,7 @@ fw_fault fw_autocal(dhc_model *model, const dhc_sample *samples, size_t n,
         return FW_FAULT_ARGUMENT;
     }
     *model = geo_model;
+    const dhc_calib_report *final_fit = &res->geo;
     if (geo_out != NULL) {
         *geo_out = geo_model;
     }
@@ -346,22 +496,42 @@ fw_fault fw_autocal(dhc_model *model, const dhc_sample *samples, size_t n,
             if (dhc_calib_fit(&m2, &set2, read_sample, &buf, n, cal_flags, &opt, &cal_ws,
                               &res->eff) == DHC_OK) {
                 *model = m2;
+                final_fit = &res->eff;
             }
         }
     }
-    res->new_rms_mm = fw_wire_rms(model, samples, n);
+    size_t used_new = 0U;
+    res->new_rms_mm = wire_errors(model, samples, n, err_new, &used_new);
+    res->new_median_mm = median(err_new, used_new);
+    /* Akaike's final prediction error: the in-sample RMS of a fit with p parameters on m
+     * equations underestimates its error on new data by about sqrt((m - p) / (m + p)). */
+    const double m_rows = (double)final_fit->rows;
+    const double p_fit = (double)final_fit->rank;
+    res->new_fpe_mm = m_rows > p_fit ? res->new_rms_mm * sqrt((m_rows + p_fit) / (m_rows - p_fit))
+                                     : HUGE_VAL;
     if (nv == NULL) {
         return FW_FAULT_NONE;
     }
     uint32_t seq = 0U;
     const fw_cal_status ls = fw_cal_load(nv, &stored_model, &seq);
     if (ls == FW_CAL_OK) {
-        res->stored_rms_mm = fw_wire_rms(&stored_model, samples, n);
+        size_t used_old = 0U;
+        res->stored_rms_mm = wire_errors(&stored_model, samples, n, err_old, &used_old);
+        res->stored_median_mm = median(err_old, used_old);
+        /* significantly better (see fw_acquire.h): log(stored / FPE) above z standard
+         * deviations of that log-ratio, sd(log s) ~ 1 / sqrt(2 dof) per RMS estimate */
+        const double dof_new = m_rows - p_fit;
+        const double dof_old = 3.0 * (double)used_old;
+        const int better = dof_new > 0.0 && dof_old > 0.0 && res->new_fpe_mm > 0.0 &&
+                           res->stored_rms_mm > 0.0 &&
+                           log(res->stored_rms_mm / res->new_fpe_mm) >
+                               FW_AUTOCAL_Z * sqrt(0.5 / dof_new + 0.5 / dof_old) &&
+                           res->new_median_mm <= res->stored_median_mm;
+        if (!better) {
+            return FW_FAULT_NONE; /* the stored one is not clearly worse: keep it */
+        }
     } else if (ls == FW_CAL_ERR_IO) {
         return FW_FAULT_STORAGE;
-    }
-    if (ls == FW_CAL_OK && !(res->new_rms_mm < res->stored_rms_mm)) {
-        return FW_FAULT_NONE; /* the stored one is at least as good: keep it */
     }
     if (fw_cal_save(nv, model, &res->seq) != FW_CAL_OK) {
         return FW_FAULT_STORAGE;

@@ -18,16 +18,43 @@
  * wire lengths (no measurement is needed: a plan is scored before it runs).
  *
  * Acquisition: move (fw_ctrl_move_to, with the plan's directions), hold, average the wire
- * lengths over the hold, check them by trilateration (DHC_ERR_INCONSISTENT, or a point
+ * lengths over the hold (the arm must stay within FW_ACQ_HOLD_TOL settle tolerances of its
+ * reference all through it, else it approaches the target again from the same side and
+ * holds again, up to FW_ACQ_HOLD_ATTEMPTS holds, then FW_FAULT_SETTLE_TIMEOUT: lengths
+ * averaged over a moving arm match no pose, e.g. after an encoder glitch below the jump
+ * bound kicked the servo), check them by trilateration (DHC_ERR_INCONSISTENT, or a point
  * more than 50 mm from where the model puts the tool: FW_FAULT_WIRES_INCONSISTENT), and keep
  * a DHC_MEAS_WIRES sample with the ENCODER angles, the approach directions and the raw
  * lengths. On a fault the samples already taken stay in the buffer (*n_done of them).
+ * fw_acquire also checks each pose against the one before (the first against where the arm
+ * stood when fw_acquire was called): the measured change of every wire must match the
+ * model's predicted change of that wire within FW_ACQ_PAIR_TOL_MM + FW_ACQ_PAIR_TOL_REL x
+ * |predicted change|, else FW_FAULT_WIRES_INCONSISTENT (fault_index: the wire) and the
+ * sample is not kept. A geometry error changes the predicted change by a small share of it,
+ * but a counter that stopped (a seized wheel, a dead input: the tool moved by a known amount
+ * and the counter did not) or lost counts shows the whole difference; such a counter is
+ * caught on the first move that should change its wire by more than 10 / 0.75 = 13.3 mm.
+ * The bounds leave room for a nominal model some mm off (the 50 mm check above allows far
+ * more): clean data from the nominal model use at most 27 % of them on the paper arm's
+ * test fixture (2.8 mm nominal wire RMS, tests/firmware/sim/test_faults.c) and 32 % in the
+ * demo's runs over every host_sim scenario. Slips smaller than that but sudden (within
+ * one tick) are the controller's to catch (fw_ctrl_config.wire_max_step_change).
  *
  * Calibration (fw_autocal): base model fit, score-test diagnosis of the missing effect,
  * refit with the most significant one, and storage with fw_calstore only when the new
- * model is better than the stored one: both are scored by the RMS wire residual over the
- * current samples (held out for the stored model, which was fitted on earlier data). All
- * scratch is static (no heap); not reentrant.
+ * model is clearly better than the stored one (or nothing valid is stored). Both are scored
+ * on the current samples: the stored model by its RMS wire residual (held out: it was
+ * fitted on earlier data), the new one by its final prediction error (Akaike's FPE), the
+ * in-sample RMS times sqrt((m + p) / (m - p)) for m equations and p identified parameters,
+ * the expected RMS on fresh data; the in-sample RMS alone would favour any new fit, most
+ * of all one from few samples that it over-fits. Both scores are estimates: the new model
+ * replaces the stored one only when
+ *   log(stored RMS / FPE) > FW_AUTOCAL_Z x sqrt(1 / (2 (m - p)) + 1 / (2 x 3 n)),
+ * (sd(log s) ~ 1 / sqrt(2 dof) for an RMS s from dof residuals; n samples), i.e. better at
+ * about 95 % one-sided confidence, AND its median per-sample error is not above the stored
+ * model's: samples of which fewer than half are corrupted (a slipped wheel the checks
+ * missed) fit a good stored model at the noise on most samples, so a model bent to the
+ * corrupted ones does not replace it. All scratch is static (no heap); not reentrant.
  */
 #ifndef FW_ACQUIRE_H
 #define FW_ACQUIRE_H
@@ -42,6 +69,14 @@
 #include "dhcal_fw/fw_controller.h"
 
 #define FW_ACQ_MAX_SAMPLES 128U
+/* pair check of fw_acquire: |measured - predicted wire change| bound, mm and share */
+#define FW_ACQ_PAIR_TOL_MM 10.0
+#define FW_ACQ_PAIR_TOL_REL 0.25
+/* hold of a sample: allowed excursion (x settle_pos_tol_rad) and holds tried */
+#define FW_ACQ_HOLD_TOL 2.0
+#define FW_ACQ_HOLD_ATTEMPTS 3U
+/* one-sided normal quantile of fw_autocal's "clearly better" test (95 %) */
+#define FW_AUTOCAL_Z 1.645
 
 typedef struct {
     double q_rad[DHC_MAX_JOINTS];
@@ -56,13 +91,17 @@ size_t fw_plan_poses(const dhc_model *model, size_t n, uint32_t seed, int mixed_
 dhc_status fw_plan_observability(const dhc_model *model, const dhc_param_set *set,
                                  const fw_pose *poses, size_t n, double *o1, size_t *rank);
 
-/* Runs the plan; samples[0 .. *n_done) are kept whatever happens. */
+/* Runs the plan; samples[0 .. *n_done) are kept whatever happens, and a sample that fails
+ * a check is never added. */
 fw_fault fw_acquire(fw_ctrl *c, const dhc_model *model, const fw_pose *poses, size_t n,
                     uint32_t hold_ticks, dhc_sample *samples, size_t *n_done);
 
 /* One sample at the current (settled) pose. */
 fw_fault fw_acquire_one(fw_ctrl *c, const dhc_model *model, uint32_t hold_ticks,
                         dhc_sample *out);
+
+/* Holds retaken since start (diagnostics: the arm moved during a sample's hold). */
+uint32_t fw_acquire_retakes(void);
 
 typedef struct {
     dhc_calib_report geo;    /* base model fit */
@@ -72,7 +111,11 @@ typedef struct {
     double effect_log10_p;
     dhc_calib_report eff;    /* refit with the effect (valid when found) */
     double new_rms_mm;       /* of the final model on the samples */
+    double new_fpe_mm;       /* its final prediction error (see above; HUGE_VAL when the
+                                fit has no spare equations) */
     double stored_rms_mm;    /* of the stored model on the samples (-1: none stored) */
+    double new_median_mm;    /* median per-sample wire residual norm, new model */
+    double stored_median_mm; /* the same for the stored model (-1: none stored) */
     int saved;               /* the new model was stored */
     uint32_t seq;
 } fw_autocal_result;

@@ -7,7 +7,11 @@
  * on the encoder angle error with tacho velocity feedback, write the DACs. Faults latch:
  * on any fault the DACs are written at mid-scale (0 V: drives to zero), the fault code and
  * the joint (or wire) it concerns are kept, and every later call returns the fault without
- * moving. Nothing the caller collected is touched.
+ * moving. Nothing the caller collected is touched. Checks per tick: encoder and wire counter
+ * steps above the plausible maximum (a glitch or lost counts: encoder_jump,
+ * wires_inconsistent), a wire step that changes more than wire_max_step_change from the
+ * tick before (a slipping wheel: wires_inconsistent), tacho against encoder velocity,
+ * drive saturation, port errors.
  *
  * Moves (fw_ctrl_move_to): per joint a minimum-jerk segment to target - dir * approach,
  * then one to the target (so the last motion of joint j has the sign dir[j], recorded for
@@ -59,6 +63,12 @@ typedef struct {
     uint32_t sat_fault_ticks;      /* drive saturated this many consecutive ticks: fault */
     int32_t encoder_max_step;      /* counts per tick */
     int32_t wire_max_step;
+    /* Largest plausible change of a wire counter's per-tick step from one tick to the next
+     * (counts; 0: no check). The tool moves smoothly: its acceleration along a wire changes
+     * the step by well under a count per tick, and reading noise of sigma s counts gives
+     * second differences of sigma sqrt(6) s. A larger change is a wheel that slipped (or
+     * jumped) within the tick: FW_FAULT_WIRES_INCONSISTENT, the wire in fault_index. */
+    int32_t wire_max_step_change;
     double tick_s;                 /* control period (0.001) */
 } fw_ctrl_config;
 
@@ -71,6 +81,8 @@ typedef struct {
     int64_t enc_home[DHC_MAX_JOINTS]; /* absolute count of the reading at init */
     fw_counter wire[3];
     int64_t wire_home[3];
+    int64_t wire_step[3];                /* last tick's counter step, counts */
+    int64_t wire_step_change_max;        /* largest |step change| seen (diagnostics) */
     fw_pid_state pid[DHC_MAX_JOINTS];
     double q_rad[DHC_MAX_JOINTS];        /* encoder angles, latest tick */
     double qd_enc_rad_s[DHC_MAX_JOINTS]; /* low-passed encoder differences */
