@@ -2,6 +2,7 @@
  * a structural-identifiability check and outlier rejection. */
 #include "dhcal/dhc_calib.h"
 
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -338,7 +339,11 @@ static dhc_status flag_out_of_range(const fit_context *fc, const dhc_arm *arm)
         for (size_t j = 0U; j < arm->n_joints; ++j) {
             const double q = fc->ws->sample.q_rad[j];
             const double m = fc->opt->joint_margin_rad;
-            if (q < arm->joint[j].min_rad - m || q > arm->joint[j].max_rad + m) {
+            /* A non-finite angle is not a pose at all: left to the sample check, which
+             * stops the fit with DHC_ERR_NONFINITE (as it always did for NaN; an infinite
+             * angle used to pass as an outlier). */
+            if (dhc_is_finite(q) &&
+                (q < arm->joint[j].min_rad - m || q > arm->joint[j].max_rad + m)) {
                 fc->flags[i] = (uint8_t)DHC_SAMPLE_OUTLIER;
                 break;
             }
@@ -356,6 +361,42 @@ static double scaled_step_norm(const dhc_lsq_factor *fac, const double *delta, s
     return sqrt(s);
 }
 
+/* Rank analysis of ws->ne that keeps the parameters the fit's first analysis (at the input
+ * values) found unidentifiable unidentifiable to the end. Which of (nearly) dependent
+ * columns the pivoting drops depends on the iterate: without this, a parameter could take
+ * steps while identifiable and end up reported unidentifiable, off its input value, with its
+ * partners compensating. The set is kept in rep->identifiable (fill_report overwrites it);
+ * excluded columns are hidden from the analysis by a zero diagonal, which is restored
+ * afterwards (the partner search reads the full matrix) together with their true column
+ * scale. ws->delta holds the diagonal meanwhile: it is free until the next step. */
+static dhc_status analyse_keeping_set(const fit_context *fc, dhc_calib_report *rep)
+{
+    dhc_calib_workspace *const ws = fc->ws;
+    dhc_normal_eq *const ne = &ws->ne;
+    const size_t n = ne->n;
+    const int first = rep->iterations == 0U;
+    for (size_t j = 0U; j < n; ++j) {
+        ws->delta[j] = ne->jtj[j * n + j];
+        if (!first && !rep->identifiable[j]) {
+            ne->jtj[j * n + j] = 0.0;
+        }
+    }
+    const dhc_status st = dhc_lsq_analyse(ne, fc->opt->rank_rel_tol, &ws->fac);
+    for (size_t j = 0U; j < n; ++j) {
+        ne->jtj[j * n + j] = ws->delta[j];
+        if (st != DHC_OK) {
+            continue;
+        }
+        if (!ws->fac.identifiable[j] && ws->delta[j] > DBL_MIN) {
+            ws->fac.scale[j] = 1.0 / sqrt(ws->delta[j]);
+        }
+        if (first) {
+            rep->identifiable[j] = ws->fac.identifiable[j];
+        }
+    }
+    return st;
+}
+
 /* Levenberg-Marquardt from ws->current until the SSR stops falling. */
 static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *rep,
                                       pass_totals *tot, int *converged)
@@ -366,7 +407,7 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
     *converged = 0;
     dhc_status st = data_pass(fc, &ws->current, 1, tot);
     if (st == DHC_OK) {
-        st = dhc_lsq_analyse(&ws->ne, fc->opt->rank_rel_tol, &ws->fac);
+        st = analyse_keeping_set(fc, rep);
     }
     for (size_t it = 0U; st == DHC_OK && it < fc->opt->max_iterations; ++it) {
         rep->iterations++;
@@ -395,7 +436,7 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
             lambda = fmax(lambda / 10.0, 1e-12);
             st = data_pass(fc, &ws->current, 1, tot);
             if (st == DHC_OK) {
-                st = dhc_lsq_analyse(&ws->ne, fc->opt->rank_rel_tol, &ws->fac);
+                st = analyse_keeping_set(fc, rep);
             }
             if (gain <= fc->opt->ssr_rel_tol * tot->ssr || step <= fc->opt->step_rel_tol) {
                 *converged = 1;

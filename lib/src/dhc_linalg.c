@@ -4,6 +4,10 @@
 #include <float.h>
 #include <math.h>
 
+/* Pivot candidates within this relative distance of the largest diagonal count as ties:
+ * far above the rounding of a Schur complement (~n DBL_EPSILON), far below real differences. */
+#define PIVOT_TIE_REL 1e-9
+
 #define DHC_PI 3.14159265358979323846
 
 /* Below this angle the Rodrigues coefficients switch to their Taylor series: the dropped
@@ -546,15 +550,26 @@ dhc_status dhc_chol_pivoted(dhc_mat *a, size_t *perm, size_t perm_len, double re
     }
     size_t k = 0U;
     for (; k < n; ++k) {
-        size_t p = k;
+        double best = DHC_MAT_AT(a, k, k);
         for (size_t i = k + 1U; i < n; ++i) {
-            if (DHC_MAT_AT(a, i, i) > DHC_MAT_AT(a, p, p)) {
-                p = i;
-            }
+            best = fmax(best, DHC_MAT_AT(a, i, i));
         }
         /* Also stops a zero matrix (tol = 0) at rank 0: 0 > 0 is false. */
-        if (!(DHC_MAT_AT(a, p, p) > tol)) {
+        if (!(best > tol)) {
             break;
+        }
+        /* Among diagonals equal to the largest up to rounding, the last in the original
+         * order. A column-scaled normal matrix has a unit diagonal, and exactly dependent
+         * columns have equal Schur complements: picking among them by rounding noise made
+         * the choice of the parameter a fit leaves unidentifiable arbitrary and unstable.
+         * The last, because a parameter set lists the base model first and then the effects
+         * a caller chose to add (tool, base frame ...): a tie goes to those. */
+        size_t p = n;
+        for (size_t i = k; i < n; ++i) {
+            if (DHC_MAT_AT(a, i, i) >= best - PIVOT_TIE_REL * best &&
+                (p == n || perm[i] > perm[p])) {
+                p = i;
+            }
         }
         if (p != k) {
             lower_sym_swap(a, k, p);

@@ -114,6 +114,24 @@ dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double
             }
         }
     }
+    /* Finite rows can still overflow the sums (entries above ~1e154), which would poison
+     * every later analysis. Every entry of J^T W J and J^T W r is at most the largest of the
+     * diagonal and the SSR (Cauchy-Schwarz), and each row adds at most w max(|J|, |r|)^2
+     * to any of them: a finite bound, with room for rounding, means finite sums. */
+    double bound = ne->ssr;
+    for (size_t i = 0U; i < n; ++i) {
+        bound = fmax(bound, ne->jtj[i * n + i]);
+    }
+    for (size_t e = 0U; e < k; ++e) {
+        double m = fabs(r[e]);
+        for (size_t i = 0U; i < n; ++i) {
+            m = fmax(m, fabs(DHC_MAT_AT(jac, e, i)));
+        }
+        bound += (w != NULL ? w[e] : 1.0) * m * m;
+    }
+    if (!dhc_is_finite(2.0 * bound)) {
+        return DHC_ERR_NONFINITE;
+    }
     for (size_t e = 0U; e < k; ++e) {
         const double we = w != NULL ? w[e] : 1.0;
         const double *const row = &DHC_MAT_AT(jac, e, 0U);
