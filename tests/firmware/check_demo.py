@@ -16,10 +16,13 @@ def main():
     ap.add_argument("--demo", required=True)
     ap.add_argument("--scenario", required=True)
     ap.add_argument("--effect", default="joint_compliance:2")
+    # The main job's two minutes hold for the release build; sanitized builds run the same
+    # numbers several times slower and pass a larger bound.
+    ap.add_argument("--max-seconds", type=float, default=120.0)
     a = ap.parse_args()
     t0 = time.monotonic()
     run = subprocess.run([a.demo, "--scenario", a.scenario, "--json"], capture_output=True,
-                         text=True, timeout=240, check=False)
+                         text=True, timeout=max(240.0, 2.0 * a.max_seconds), check=False)
     took = time.monotonic() - t0
     sys.stderr.write(run.stderr)
     if run.returncode != 0:
@@ -45,8 +48,8 @@ def main():
         failures.append("noise floor not positive")
     if not r["after_rms_mm"] < r["geometric_rms_mm"] < r["before_rms_mm"]:
         failures.append("the geometric fit is not between nominal and final")
-    if took > 120.0:
-        failures.append(f"took {took:.0f} s (> 120 s)")
+    if took > a.max_seconds:
+        failures.append(f"took {took:.0f} s (> {a.max_seconds:.0f} s)")
     if failures:
         print("FAIL:", "; ".join(failures))
         return 1
