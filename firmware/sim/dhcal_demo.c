@@ -378,6 +378,9 @@ int main(int argc, char **argv)
     int mixed_dirs = 0;
     size_t n_samples = 60U;
     size_t n_targets = 20U;
+    fw_autocal_config autocal;
+    fw_autocal_default_config(&autocal);
+    const char *effects = NULL;
     for (int i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--json") == 0) {
             json = 1;
@@ -391,12 +394,33 @@ int main(int argc, char **argv)
             n_samples = (size_t)strtoul(argv[++i], NULL, 10);
         } else if (strcmp(argv[i], "--targets") == 0 && i + 1 < argc) {
             n_targets = (size_t)strtoul(argv[++i], NULL, 10);
+        } else if (strcmp(argv[i], "--effects") == 0 && i + 1 < argc) {
+            effects = argv[++i];
+        } else if (strcmp(argv[i], "--no-diagnose") == 0) {
+            autocal.diagnose = 0;
         } else {
             fprintf(stderr,
                     "usage: dhcal-demo --scenario S.json [--json] [--out DIR] [--samples N] "
-                    "[--targets N]\n");
+                    "[--targets N] [--mixed-directions] [--effects LIST] [--no-diagnose]\n"
+                    "  --effects LIST   the controller's configured effects, fitted in every "
+                    "calibration\n                   (e.g. joint_compliance:2,measurer_scale)\n"
+                    "  --no-diagnose    fit only those; do not look for a missing one\n");
             return 2;
         }
+    }
+    /* The configured effects, comma separated, in DESIGN.md's names. */
+    for (const char *e = effects; e != NULL && *e != '\0';) {
+        const char *comma = strchr(e, ',');
+        const size_t len = comma != NULL ? (size_t)(comma - e) : strlen(e);
+        if (autocal.n_effects == FW_AUTOCAL_MAX_EFFECTS ||
+            dhc_effect_parse(e, len, 3U, &autocal.effect[autocal.n_effects],
+                             &autocal.effect_joint[autocal.n_effects]) != DHC_OK) {
+            fprintf(stderr, "dhcal-demo: --effects: '%.*s' is not an effect of a 3-joint arm "
+                            "(at most %u)\n", (int)len, e, FW_AUTOCAL_MAX_EFFECTS);
+            return 2;
+        }
+        ++autocal.n_effects;
+        e = comma != NULL ? comma + 1 : e + len;
     }
     if (scenario == NULL || n_samples < 10U || n_samples > FW_ACQ_MAX_SAMPLES ||
         n_targets == 0U || n_targets > MAX_TARGETS) {
@@ -470,18 +494,26 @@ int main(int argc, char **argv)
     /* (c)-(e) calibrate, diagnose, refit, store */
     static fw_autocal_result res;
     final_model = nominal;
-    const fw_fault fc = fw_autocal(&final_model, samples, n_done, &port.nv, &geometric, &res);
+    const fw_fault fc = fw_autocal_configured(&autocal, &final_model, samples, n_done, &port.nv,
+                                              &geometric, &res);
     if (fc != FW_FAULT_NONE) {
         fprintf(stderr, "dhcal-demo: calibration fault %s\n", fw_fault_name(fc));
         return 1;
     }
     char effect[64];
     effect_label(&res, effect, sizeof effect);
-    fprintf(log, "(c) geometric fit: wire residual RMS %.4f mm, max %.4f mm (%zu params, "
-                 "rank %zu)\n", res.geo.rms_mm, res.geo.max_mm, res.geo.n_params, res.geo.rank);
-    fprintf(log, "(d) diagnosis: %s (log10 p %.1f)\n", effect, res.effect_log10_p);
+    fprintf(log, "(c) geometric fit%s%s: wire residual RMS %.4f mm, max %.4f mm (%zu params, "
+                 "rank %zu)\n", effects != NULL ? " with the configured " : "",
+            effects != NULL ? effects : "", res.geo.rms_mm, res.geo.max_mm, res.geo.n_params,
+            res.geo.rank);
+    if (autocal.diagnose != 0) {
+        fprintf(log, "(d) diagnosis: %s (log10 p %.1f)\n", effect, res.effect_log10_p);
+    } else {
+        fprintf(log, "(d) diagnosis: off (--no-diagnose)\n");
+    }
     fprintf(log, "(e) with %s: wire residual RMS %.4f mm; stored: %s (seq %u)\n", effect,
-            res.eff.rms_mm, res.saved ? "yes" : "no", (unsigned)res.seq);
+            res.found ? res.eff.rms_mm : res.geo.rms_mm, res.saved ? "yes" : "no",
+            (unsigned)res.seq);
     where_it_fails(&geometric, n_done, log);
 
     /* geometric model on fresh targets */

@@ -451,8 +451,23 @@ static double median(double *v, size_t n)
     return (n % 2U) != 0U ? v[n / 2U] : 0.5 * (v[n / 2U - 1U] + v[n / 2U]);
 }
 
+void fw_autocal_default_config(fw_autocal_config *cfg)
+{
+    memset(cfg, 0, sizeof *cfg);
+    cfg->diagnose = 1;
+}
+
 fw_fault fw_autocal(dhc_model *model, const dhc_sample *samples, size_t n,
                     const fw_nvstore *nv, dhc_model *geo_out, fw_autocal_result *res)
+{
+    fw_autocal_config cfg;
+    fw_autocal_default_config(&cfg);
+    return fw_autocal_configured(&cfg, model, samples, n, nv, geo_out, res);
+}
+
+fw_fault fw_autocal_configured(const fw_autocal_config *cfg, dhc_model *model,
+                               const dhc_sample *samples, size_t n, const fw_nvstore *nv,
+                               dhc_model *geo_out, fw_autocal_result *res)
 {
     memset(res, 0, sizeof *res);
     res->stored_rms_mm = -1.0;
@@ -464,8 +479,15 @@ fw_fault fw_autocal(dhc_model *model, const dhc_sample *samples, size_t n,
     dhc_calib_options opt;
     dhc_calib_default_options(&opt);
     dhc_param_set set;
-    if (dhc_params_base_model(&set, model) != DHC_OK) {
+    if (dhc_params_base_model(&set, model) != DHC_OK ||
+        cfg->n_effects > FW_AUTOCAL_MAX_EFFECTS) {
         return FW_FAULT_ARGUMENT;
+    }
+    for (size_t e = 0U; e < cfg->n_effects; ++e) {
+        if (dhc_params_add_effect(&set, model, cfg->effect[e], cfg->effect_joint[e]) !=
+            DHC_OK) {
+            return FW_FAULT_ARGUMENT;
+        }
     }
     memset(cal_flags, 0, sizeof cal_flags);
     geo_model = *model;
@@ -480,8 +502,12 @@ fw_fault fw_autocal(dhc_model *model, const dhc_sample *samples, size_t n,
     }
     dhc_diagnose_options dopt;
     dhc_diagnose_default_options(&dopt);
-    const size_t nc = dhc_diagnose_candidates(&geo_model, &set, 1, 0.0, cands, DHC_MAX_CANDIDATES);
-    if (dhc_diagnose(&geo_model, &set, res->geo.identifiable, res->geo.sigma * res->geo.sigma,
+    const size_t nc = cfg->diagnose != 0
+                          ? dhc_diagnose_candidates(&geo_model, &set, 1, 0.0, cands,
+                                                    DHC_MAX_CANDIDATES)
+                          : 0U;
+    if (nc > 0U &&
+        dhc_diagnose(&geo_model, &set, res->geo.identifiable, res->geo.sigma * res->geo.sigma,
                      cands, nc, read_sample, &buf, n, cal_flags, &dopt, &diag_ws,
                      &diag) == DHC_OK &&
         diag.count > 0U && diag.c[0].significant) {

@@ -120,6 +120,27 @@ typedef struct {
     uint32_t seq;
 } fw_autocal_result;
 
+/* The firmware's calibration configuration: effects fitted in every calibration besides
+ * the joint offsets and link geometry (a machine known to have, say, compliant joints), and
+ * whether the diagnosis may add one more when the data name it significantly. */
+#define FW_AUTOCAL_MAX_EFFECTS 8U
+typedef struct {
+    size_t n_effects;
+    dhc_effect effect[FW_AUTOCAL_MAX_EFFECTS];
+    size_t effect_joint[FW_AUTOCAL_MAX_EFFECTS]; /* 0-based; ignored for measurer effects */
+    int diagnose;
+} fw_autocal_config;
+
+/* No configured effects; the diagnosis on. */
+void fw_autocal_default_config(fw_autocal_config *cfg);
+
+/* fw_autocal with a configuration: the "base" fit (res->geo, geo_out) is the geometry plus
+ * the configured effects. FW_FAULT_ARGUMENT when an effect cannot be added to the model
+ * (a joint out of range, a measurer effect without a measurer, too many). */
+fw_fault fw_autocal_configured(const fw_autocal_config *cfg, dhc_model *model,
+                               const dhc_sample *samples, size_t n, const fw_nvstore *nv,
+                               dhc_model *geo_out, fw_autocal_result *res);
+
 /* model: in the current (e.g. nominal) model, out the calibrated one. nv may be NULL (no
  * storage); geo_out (may be NULL) receives the geometry-only fit. Returns FW_FAULT_STORAGE when the store fails (the model is still returned). */
 fw_fault fw_autocal(dhc_model *model, const dhc_sample *samples, size_t n,
