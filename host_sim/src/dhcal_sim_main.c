@@ -14,6 +14,9 @@
 #include "dhcal_io.h"
 #include "dhcal_sim/dhs_dataset.h"
 #include "dhcal_sim/dhs_scenario_json.h"
+#if defined(DHCAL_SIM_BUS)
+#include "dhs_bus_linux.h"
+#endif
 
 #define EXIT_COMPUTE 1
 #define EXIT_USAGE 2
@@ -23,7 +26,9 @@
 static const char *const usage_text =
     "usage: dhcal-sim dataset --scenario S.json --poses N --out D.csv [options]\n"
     "       dhcal-sim dataset --scenario S.json --plan P.csv --out D.csv [options]\n"
-    "       dhcal-sim --help | dataset --help\n"
+    "       dhcal-sim bus --scenario S.json --can IFNAME [options]   (Linux)\n"
+    "       dhcal-sim bus --gpio-chip NAME --lines A,B [options]     (Linux, gpio-sim)\n"
+    "       dhcal-sim --help | dataset --help | bus --help\n"
     "exit codes: 0 success, 1 computation failed, 2 bad input or usage\n";
 
 static const char *const dataset_help =
@@ -479,6 +484,180 @@ static int run_dataset(const options *o)
     return 0;
 }
 
+#if defined(DHCAL_SIM_BUS)
+/* ---------------------------------------------------------------- bus mode */
+
+static const char *const bus_help =
+    "usage: dhcal-sim bus --scenario S.json --can IFNAME [--seed K] [--drop-frame ID@TICK]\n"
+    "                     [--stop-at TICK] [--idle-exit-ms MS] [--start-wait-ms MS]\n"
+    "       dhcal-sim bus --gpio-chip NAME --lines A,B [--gpio-steps N] [--gpio-burst N\n"
+    "                     --gpio-pause-ms MS] [--gpio-start-delay-ms MS] [--gpio-step-us US]\n"
+    "The simulated arm's drives and draw-wire measurer on a SocketCAN interface, in lockstep\n"
+    "with the controller (firmware/can/dhcal.dbc): each SYNC advances the plant one 1 ms\n"
+    "tick and is answered with the drives' and the measurer's feedback. The plant starts\n"
+    "at q = (0, 60, -60) deg with run seed K (default 7): dhcal-fw --port sim's run.\n"
+    "  --drop-frame ID@TICK  drop the answer frame ID (e.g. 0x181) to SYNC number TICK\n"
+    "                        (0: the first SYNC)\n"
+    "  --stop-at TICK        stop answering from SYNC number TICK on (a pulled cable)\n"
+    "  --idle-exit-ms MS     quit when the bus is quiet this long (default 1500)\n"
+    "  --start-wait-ms MS    give up when no SYNC comes within this (default 20000)\n"
+    "Or an encoder's A/B lines on a gpio-sim chip, through its sysfs 'pull' attributes:\n"
+    "both low, wait --gpio-start-delay-ms (1500), then N forward quadrature steps (16), one\n"
+    "edge each, --gpio-step-us apart (2000), pausing --gpio-pause-ms after step\n"
+    "--gpio-burst.\n"
+    "Prints one JSON object: what the nodes saw and sent, and the last drive commands.\n";
+
+static int bus_number(const char *name, const char *v, unsigned long long max,
+                      unsigned long long *out)
+{
+    if (!parse_ulong(v, max, out)) {
+        return usage_error("%s: '%s' is not a number in 0..%llu", name, v, max);
+    }
+    return 0;
+}
+
+static int run_bus(int argc, char **argv)
+{
+    const char *scenario = NULL;
+    dhs_bus_linux_options bo;
+    memset(&bo, 0, sizeof bo);
+    bo.run_seed = 7U;
+    bo.idle_exit_ms = 1500U;
+    bo.start_wait_ms = 20000U;
+    dhs_gpio_play_options go;
+    memset(&go, 0, sizeof go);
+    go.start_delay_ms = 1500U;
+    go.steps = 16U;
+    go.step_us = 2000U;
+    int have_lines = 0;
+    for (int k = 2; k < argc; ++k) {
+        const char *a = argv[k];
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            fputs(bus_help, stdout);
+            return 0;
+        }
+        if (k + 1 >= argc) {
+            return usage_error("%s needs a value", a);
+        }
+        const char *v = argv[++k];
+        unsigned long long n = 0U;
+        int rc = 0;
+        if (strcmp(a, "--scenario") == 0) {
+            scenario = v;
+        } else if (strcmp(a, "--can") == 0) {
+            bo.can = v;
+        } else if (strcmp(a, "--gpio-chip") == 0) {
+            go.chip = v;
+        } else if (strcmp(a, "--seed") == 0) {
+            rc = bus_number(a, v, 18446744073709551615ULL, &n);
+            bo.run_seed = n;
+        } else if (strcmp(a, "--drop-frame") == 0) {
+            char *end = NULL;
+            errno = 0;
+            const unsigned long id = strtoul(v, &end, 0);
+            if (errno != 0 || end == v || *end != '@' || id > 0x7FFUL ||
+                !parse_ulong(end + 1, 18446744073709551615ULL, &n)) {
+                return usage_error("--drop-frame: '%s' is not ID@TICK (e.g. 0x181@500)", v);
+            }
+            bo.drop = 1;
+            bo.drop_id = (uint32_t)id;
+            bo.drop_tick = n;
+        } else if (strcmp(a, "--stop-at") == 0) {
+            rc = bus_number(a, v, 18446744073709551615ULL, &n);
+            bo.stop = 1;
+            bo.stop_tick = n;
+        } else if (strcmp(a, "--idle-exit-ms") == 0) {
+            rc = bus_number(a, v, 3600000U, &n);
+            bo.idle_exit_ms = (uint32_t)n;
+        } else if (strcmp(a, "--start-wait-ms") == 0) {
+            rc = bus_number(a, v, 3600000U, &n);
+            bo.start_wait_ms = (uint32_t)n;
+        } else if (strcmp(a, "--lines") == 0) {
+            unsigned long long la = 0U;
+            unsigned long long lb = 0U;
+            const char *comma = strchr(v, ',');
+            char first[24];
+            if (comma == NULL || (size_t)(comma - v) >= sizeof first) {
+                return usage_error("--lines: '%s' is not two different offsets A,B", v);
+            }
+            memcpy(first, v, (size_t)(comma - v));
+            first[comma - v] = '\0';
+            if (!parse_ulong(first, 65535U, &la) || !parse_ulong(comma + 1, 65535U, &lb) ||
+                la == lb) {
+                return usage_error("--lines: '%s' is not two different offsets A,B", v);
+            }
+            go.line[0] = (unsigned)la;
+            go.line[1] = (unsigned)lb;
+            have_lines = 1;
+        } else if (strcmp(a, "--gpio-steps") == 0) {
+            rc = bus_number(a, v, 1000000U, &n);
+            go.steps = (uint32_t)n;
+        } else if (strcmp(a, "--gpio-burst") == 0) {
+            rc = bus_number(a, v, 1000000U, &n);
+            go.burst = (uint32_t)n;
+        } else if (strcmp(a, "--gpio-pause-ms") == 0) {
+            rc = bus_number(a, v, 3600000U, &n);
+            go.pause_ms = (uint32_t)n;
+        } else if (strcmp(a, "--gpio-start-delay-ms") == 0) {
+            rc = bus_number(a, v, 3600000U, &n);
+            go.start_delay_ms = (uint32_t)n;
+        } else if (strcmp(a, "--gpio-step-us") == 0) {
+            rc = bus_number(a, v, 10000000U, &n);
+            go.step_us = (uint32_t)n;
+        } else {
+            return usage_error("bus: unknown option '%s'", a);
+        }
+        if (rc != 0) {
+            return rc;
+        }
+    }
+    char why[320];
+    if (go.chip != NULL || have_lines) {
+        if (go.chip == NULL || !have_lines || bo.can != NULL) {
+            return usage_error("bus: --gpio-chip goes with --lines, and not with --can");
+        }
+        const int rc = dhs_gpio_play(&go, why, sizeof why);
+        if (rc != 0) {
+            fprintf(stderr, "dhcal-sim: %s\n", why);
+            return rc == 2 ? EXIT_USAGE : EXIT_COMPUTE;
+        }
+        printf("{\"mode\": \"gpio\", \"chip\": \"%s\", \"lines\": [%u, %u], \"steps\": %u}\n",
+               go.chip, go.line[0], go.line[1], go.steps);
+        return 0;
+    }
+    if (scenario == NULL || bo.can == NULL) {
+        return usage_error("bus: needs --scenario and --can (or --gpio-chip and --lines)");
+    }
+    static dhs_scenario_file sf;
+    dhcal_error err;
+    memset(&err, 0, sizeof err);
+    const int lrc = dhs_scenario_load(scenario, &sf, &err);
+    if (lrc != DHCAL_IO_OK) {
+        fprintf(stderr, "dhcal-sim: %s\n", err.msg);
+        return lrc == DHCAL_IO_BAD_INPUT ? EXIT_USAGE : EXIT_COMPUTE;
+    }
+    /* dhcal-fw's start pose (and dhcal-demo's): the plant must start where the
+     * controller homes its counters. */
+    const double q_start[3] = {0.0, 60.0 * SIM_PI / 180.0, -60.0 * SIM_PI / 180.0};
+    if (sf.sc.n_joints != 3U) {
+        fprintf(stderr, "dhcal-sim: bus: %s: a 3-joint arm is needed\n", scenario);
+        return EXIT_USAGE;
+    }
+    dhs_bus_linux_report rep;
+    const int rc = dhs_bus_linux_run(&sf.sc, q_start, &bo, &rep, why, sizeof why);
+    if (rc != 0) {
+        fprintf(stderr, "dhcal-sim: %s\n", why);
+    }
+    printf("{\"mode\": \"bus\", \"can\": \"%s\", \"syncs\": %llu, \"frames_sent\": %u, "
+           "\"dropped\": %u, \"overruns\": %u, \"commands_after_stop\": %u, "
+           "\"last_dac\": [%u, %u, %u], \"last_enable\": [%u, %u, %u], \"plant_failed\": %d}\n",
+           bo.can, (unsigned long long)rep.syncs, rep.frames_sent, rep.dropped, rep.overruns,
+           rep.commands_after_stop, rep.last_dac[0], rep.last_dac[1], rep.last_dac[2],
+           rep.last_enable[0], rep.last_enable[1], rep.last_enable[2], rep.plant_failed);
+    return rc == 2 ? EXIT_USAGE : rc;
+}
+#endif
+
 int main(int argc, char **argv)
 {
     if (argc < 2) {
@@ -489,8 +668,17 @@ int main(int argc, char **argv)
         fputs(usage_text, stdout);
         fputs("\n", stdout);
         fputs(dataset_help, stdout);
+#if defined(DHCAL_SIM_BUS)
+        fputs("\n", stdout);
+        fputs(bus_help, stdout);
+#endif
         return 0;
     }
+#if defined(DHCAL_SIM_BUS)
+    if (strcmp(argv[1], "bus") == 0) {
+        return run_bus(argc, argv);
+    }
+#endif
     if (strcmp(argv[1], "dataset") != 0) {
         return usage_error("unknown command '%s'", argv[1]);
     }

@@ -1,0 +1,576 @@
+/* dhcal-fw - the controller's main job on an embedded Linux controller: the calibration run
+ * (plan, acquire, calibrate with fw_autocal, store) over the Linux port (drives and measurer
+ * on SocketCAN through fw_can_link, storage in a file), or, with --port sim, over the
+ * simulation port: the same run, deterministic, so both can be compared number by number.
+ * --gpio-watch checks the GPIO quadrature input of an encoder instead (libgpiod).
+ *
+ * Exit codes: 0 the run completed, 1 it ended in a fault or failed (the JSON says which),
+ * 2 bad usage or configuration, or a missing interface, GPIO chip or line. */
+#ifndef _POSIX_C_SOURCE
+#define _POSIX_C_SOURCE 200809L
+#endif
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "dhcal/dhc_params.h"
+#include "dhcal_fw/fw_acquire.h"
+#include "dhcal_fw/fw_can.h"
+#include "dhcal_fw/fw_can_link.h"
+#include "dhcal_fw/fw_controller.h"
+#include "dhcal_io.h"
+#include "dhcal_model_map.h"
+#include "dhcal_sim/dhs_scenario_json.h"
+#include "fw_linux_can.h"
+#include "fw_linux_gpio.h"
+#include "fw_linux_nv.h"
+#include "fw_sim_port.h"
+
+#define EXIT_FAULT 1
+#define EXIT_USAGE 2
+#define FW_PI 3.14159265358979323846
+#define NV_SIZE 8192U
+#define MAX_CONFIG_BYTES 65536U
+
+static const char *const help_text =
+    "usage: dhcal-fw [--config FILE] [options]\n"
+    "The controller's calibration run: plan the poses, move the arm through them and read\n"
+    "the draw-wire measurer, calibrate (geometry, diagnosis, the named effect) and store the\n"
+    "result; prints one JSON object. Options (each also a 'key = value' line of --config,\n"
+    "without the dashes; the command line wins):\n"
+    "  --config FILE         key = value lines, '#' comments\n"
+    "  --port linux|sim      linux (default): drives and measurer over SocketCAN;\n"
+    "                        sim: the simulated arm in-process (the reference run)\n"
+    "  --scenario FILE       the machine: its nominal model and the nominal drive and\n"
+    "                        measurer data (gear ratios, encoder lines, converter ranges,\n"
+    "                        wheel); the sim port also builds the simulated arm from it\n"
+    "  --can IFNAME          CAN interface (default vcan0)\n"
+    "  --reply-timeout-us N  all feedback of a tick within this after SYNC (default 20000;\n"
+    "                        longer than the 800 us of a real drive: a shared, emulated CPU)\n"
+    "  --start-timeout-ms N  wait this long for the drives to answer the first SYNC\n"
+    "                        (default 5000)\n"
+    "  --nv FILE             calibration store file (linux default dhcal-fw.nv; sim: RAM\n"
+    "                        unless given)\n"
+    "  --samples N           poses in the plan (10..128, default 30)\n"
+    "  --plan-seed N         seed of the pose plan (default 4242)\n"
+    "  --run-seed N          sim port: the plant's run seed (default 7, as dhcal-sim bus)\n"
+    "  --hold-ticks N        ticks averaged per sample (default 200)\n"
+    "  --params-out FILE     the calibrated parameters, one 'name value' line each\n"
+    "  --gpio-chip NAME      GPIO chip of an encoder's A/B lines (e.g. gpiochip0)\n"
+    "  --enc-lines A,B       their line offsets\n"
+    "  --gpio-watch N        instead of the run: decode N quadrature steps from the GPIO\n"
+    "                        lines (or stop at the first missed edge) and report\n"
+    "  --gpio-timeout-ms N   --gpio-watch gives up after this long without edges (3000)\n"
+    "  --help                this text\n"
+    "Exit codes: 0 completed, 1 fault or failure (see the JSON), 2 usage, configuration,\n"
+    "or a missing interface, GPIO chip or line.\n";
+
+typedef struct {
+    const char *port;
+    const char *scenario;
+    const char *can;
+    const char *nv;
+    const char *params_out;
+    const char *gpio_chip;
+    unsigned long long reply_timeout_us;
+    unsigned long long start_timeout_ms;
+    unsigned long long samples;
+    unsigned long long plan_seed;
+    unsigned long long run_seed;
+    unsigned long long hold_ticks;
+    unsigned long long gpio_watch;
+    unsigned long long gpio_timeout_ms;
+    unsigned long long gpio_stall_ms;
+    unsigned enc_line[2];
+    int have_lines;
+} options;
+
+/* Config file values live here: options point into it. */
+static char config_text[MAX_CONFIG_BYTES + 1U];
+
+static int usage(const char *fmt, const char *arg)
+{
+    fputs("dhcal-fw: ", stderr);
+    fprintf(stderr, fmt, arg);
+    fputs("\n(dhcal-fw --help for the options)\n", stderr);
+    return EXIT_USAGE;
+}
+
+static int parse_u(const char *s, unsigned long long max, unsigned long long *out)
+{
+    if (s == NULL || *s < '0' || *s > '9') {
+        return -1;
+    }
+    errno = 0;
+    char *end = NULL;
+    const unsigned long long v = strtoull(s, &end, 10);
+    if (errno != 0 || *end != '\0' || v > max) {
+        return -1;
+    }
+    *out = v;
+    return 0;
+}
+
+/* One option by its name (without dashes). Returns 0, or EXIT_USAGE after a message. */
+static int set_option(options *o, const char *key, const char *val)
+{
+    struct {
+        const char *name;
+        unsigned long long *dst;
+        unsigned long long max;
+    } nums[] = {
+        {"reply-timeout-us", &o->reply_timeout_us, 10000000ULL},
+        {"start-timeout-ms", &o->start_timeout_ms, 600000ULL},
+        {"samples", &o->samples, FW_ACQ_MAX_SAMPLES},
+        {"plan-seed", &o->plan_seed, 0xFFFFFFFFULL},
+        {"run-seed", &o->run_seed, 0xFFFFFFFFULL},
+        {"hold-ticks", &o->hold_ticks, 100000ULL},
+        {"gpio-watch", &o->gpio_watch, 1000000ULL},
+        {"gpio-timeout-ms", &o->gpio_timeout_ms, 600000ULL},
+        {"gpio-stall-ms", &o->gpio_stall_ms, 600000ULL},
+    };
+    for (size_t i = 0U; i < sizeof nums / sizeof nums[0]; ++i) {
+        if (strcmp(key, nums[i].name) == 0) {
+            if (parse_u(val, nums[i].max, nums[i].dst) != 0) {
+                fprintf(stderr, "dhcal-fw: %s: '%s' is not a number in 0..%llu\n", key,
+                        val != NULL ? val : "", nums[i].max);
+                return EXIT_USAGE;
+            }
+            return 0;
+        }
+    }
+    struct {
+        const char *name;
+        const char **dst;
+    } strs[] = {{"port", &o->port},           {"scenario", &o->scenario},
+                {"can", &o->can},             {"nv", &o->nv},
+                {"params-out", &o->params_out}, {"gpio-chip", &o->gpio_chip}};
+    for (size_t i = 0U; i < sizeof strs / sizeof strs[0]; ++i) {
+        if (strcmp(key, strs[i].name) == 0) {
+            if (val == NULL || val[0] == '\0') {
+                return usage("%s needs a value", key);
+            }
+            *strs[i].dst = val;
+            return 0;
+        }
+    }
+    if (strcmp(key, "enc-lines") == 0) {
+        unsigned long long a = 0U;
+        unsigned long long b = 0U;
+        const char *comma = val != NULL ? strchr(val, ',') : NULL;
+        char first[24];
+        if (comma == NULL || (size_t)(comma - val) >= sizeof first) {
+            return usage("enc-lines: '%s' is not two different line offsets A,B",
+                         val != NULL ? val : "");
+        }
+        memcpy(first, val, (size_t)(comma - val));
+        first[comma - val] = '\0';
+        if (parse_u(first, 65535U, &a) != 0 || parse_u(comma + 1, 65535U, &b) != 0 || a == b) {
+            return usage("enc-lines: '%s' is not two different line offsets A,B", val);
+        }
+        o->enc_line[0] = (unsigned)a;
+        o->enc_line[1] = (unsigned)b;
+        o->have_lines = 1;
+        return 0;
+    }
+    return usage("unknown option '%s'", key);
+}
+
+static char *trim(char *s)
+{
+    while (*s == ' ' || *s == '\t') {
+        ++s;
+    }
+    size_t n = strlen(s);
+    while (n > 0U && (s[n - 1U] == ' ' || s[n - 1U] == '\t' || s[n - 1U] == '\r')) {
+        s[--n] = '\0';
+    }
+    return s;
+}
+
+static int load_config(options *o, const char *path)
+{
+    FILE *f = fopen(path, "r");
+    if (f == NULL) {
+        fprintf(stderr, "dhcal-fw: config %s: %s\n", path, strerror(errno));
+        return EXIT_USAGE;
+    }
+    const size_t n = fread(config_text, 1U, MAX_CONFIG_BYTES + 1U, f);
+    const int bad = ferror(f);
+    (void)fclose(f);
+    if (bad || n > MAX_CONFIG_BYTES) {
+        fprintf(stderr, "dhcal-fw: config %s: unreadable or larger than %u bytes\n", path,
+                MAX_CONFIG_BYTES);
+        return EXIT_USAGE;
+    }
+    config_text[n] = '\0';
+    size_t line_no = 0U;
+    for (char *line = config_text; line != NULL && *line != '\0';) {
+        char *next = strchr(line, '\n');
+        if (next != NULL) {
+            *next++ = '\0';
+        }
+        ++line_no;
+        char *hash = strchr(line, '#');
+        if (hash != NULL) {
+            *hash = '\0';
+        }
+        char *s = trim(line);
+        if (*s != '\0') {
+            char *eq = strchr(s, '=');
+            if (eq == NULL) {
+                fprintf(stderr, "dhcal-fw: config %s:%zu: expected 'key = value'\n", path,
+                        line_no);
+                return EXIT_USAGE;
+            }
+            *eq = '\0';
+            const int rc = set_option(o, trim(s), trim(eq + 1));
+            if (rc != 0) {
+                fprintf(stderr, "  (in %s:%zu)\n", path, line_no);
+                return rc;
+            }
+        }
+        line = next;
+    }
+    return 0;
+}
+
+static int parse_args(int argc, char **argv, options *o)
+{
+    memset(o, 0, sizeof *o);
+    o->port = "linux";
+    o->can = "vcan0";
+    o->reply_timeout_us = 20000U;
+    o->start_timeout_ms = 5000U;
+    o->samples = 30U;
+    o->plan_seed = 4242U;
+    o->run_seed = 7U;
+    o->hold_ticks = 200U;
+    o->gpio_timeout_ms = 3000U;
+    /* The config file first, whatever its place: the command line overrides it. */
+    for (int i = 1; i < argc; ++i) {
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+            fputs(help_text, stdout);
+            return -1;
+        }
+        if (strcmp(argv[i], "--config") == 0) {
+            if (i + 1 >= argc) {
+                return usage("%s needs a value", "--config");
+            }
+            const int rc = load_config(o, argv[i + 1]);
+            if (rc != 0) {
+                return rc;
+            }
+        }
+    }
+    for (int i = 1; i < argc; ++i) {
+        if (strncmp(argv[i], "--", 2U) != 0) {
+            return usage("unexpected argument '%s'", argv[i]);
+        }
+        if (i + 1 >= argc) {
+            return usage("%s needs a value", argv[i]);
+        }
+        if (strcmp(argv[i], "--config") != 0) {
+            const int rc = set_option(o, argv[i] + 2, argv[i + 1]);
+            if (rc != 0) {
+                return rc;
+            }
+        }
+        ++i;
+    }
+    if (strcmp(o->port, "linux") != 0 && strcmp(o->port, "sim") != 0) {
+        return usage("--port: '%s' is neither linux nor sim", o->port);
+    }
+    if (o->gpio_watch == 0U && o->scenario == NULL) {
+        return usage("%s", "--scenario is required (the machine's nominal data)");
+    }
+    if (o->gpio_watch == 0U && o->samples < 10U) {
+        return usage("%s", "--samples: 10..128");
+    }
+    if ((o->gpio_chip != NULL) != (o->have_lines != 0)) {
+        return usage("%s", "--gpio-chip and --enc-lines go together");
+    }
+    if (o->gpio_watch > 0U && o->gpio_chip == NULL) {
+        return usage("%s", "--gpio-watch needs --gpio-chip and --enc-lines");
+    }
+    if (o->reply_timeout_us == 0U) {
+        return usage("%s", "--reply-timeout-us must be > 0");
+    }
+    if (o->nv == NULL && strcmp(o->port, "linux") == 0) {
+        o->nv = "dhcal-fw.nv";
+    }
+    return 0;
+}
+
+static double elapsed_s(const struct timespec *t0)
+{
+    struct timespec t1;
+    (void)clock_gettime(CLOCK_MONOTONIC, &t1);
+    return (double)(t1.tv_sec - t0->tv_sec) + (double)(t1.tv_nsec - t0->tv_nsec) * 1e-9;
+}
+
+/* ---------------------------------------------------------------- GPIO encoder check */
+
+static int run_gpio_watch(const options *o)
+{
+    static fw_linux_gpio_enc enc;
+    char why[256];
+    const fw_linux_gpio_status st = fw_linux_gpio_open(&enc, o->gpio_chip, o->enc_line[0],
+                                                       o->enc_line[1], why, sizeof why);
+    if (st != FW_LINUX_GPIO_OK) {
+        fprintf(stderr, "dhcal-fw: %s\n", why);
+        return st == FW_LINUX_GPIO_ERR ? EXIT_FAULT : EXIT_USAGE;
+    }
+    /* Tell a waiting test that the lines are requested: edges from now on are seen. */
+    fprintf(stderr, "dhcal-fw: watching %s lines %u,%u\n", o->gpio_chip, o->enc_line[0],
+            o->enc_line[1]);
+    fw_linux_gpio_result r;
+    fw_linux_gpio_watch(&enc, (int64_t)o->gpio_watch, (uint32_t)o->gpio_timeout_ms,
+                        (uint32_t)o->gpio_stall_ms, &r);
+    fw_linux_gpio_close(&enc);
+    printf("{\"mode\": \"gpio-watch\", \"chip\": \"%s\", \"lines\": [%u, %u], \"edges\": %llu, "
+           "\"counts\": %lld, \"fault\": \"%s\", \"detail\": \"%s\"}\n",
+           o->gpio_chip, o->enc_line[0], o->enc_line[1], (unsigned long long)r.edges,
+           (long long)r.counts, r.fault ? fw_fault_name(FW_FAULT_ENCODER_JUMP) : "none",
+           r.detail);
+    return r.fault ? EXIT_FAULT : 0;
+}
+
+/* ---------------------------------------------------------------- the calibration run */
+
+static dhs_scenario_file sf;
+static fw_sim sim;
+static fw_linux_can can_bus;
+static fw_can_link link_;
+static fw_linux_nv nv_file;
+static fw_port port;
+static fw_io_config io;
+static fw_ctrl ctrl;
+static fw_pose plan[FW_ACQ_MAX_SAMPLES];
+static dhc_sample samples[FW_ACQ_MAX_SAMPLES];
+static dhc_model nominal;
+static dhc_model final_model;
+static dhc_model geometric;
+static fw_autocal_result res;
+
+static int open_linux_port(const options *o)
+{
+    char why[256];
+    /* Feedback only: the kernel drops our own SYNC and commands and anything else. */
+    uint32_t rx[FW_CAN_MAX_DRIVES + 1U];
+    size_t n_rx = 0U;
+    for (size_t j = 0U; j < sf.sc.n_joints && j < FW_CAN_MAX_DRIVES; ++j) {
+        rx[n_rx++] = FW_CAN_ID_DRIVE_FB_BASE + (uint32_t)j;
+    }
+    rx[n_rx++] = FW_CAN_ID_WIRES;
+    fw_can_transport tr;
+    const fw_linux_can_status cs = fw_linux_can_open(&can_bus, o->can, rx, n_rx, &tr, why,
+                                                     sizeof why);
+    if (cs != FW_LINUX_CAN_OK) {
+        fprintf(stderr, "dhcal-fw: %s%s\n", why,
+                cs == FW_LINUX_CAN_NO_PF_CAN ? " (this kernel has no SocketCAN)" : "");
+        return EXIT_USAGE;
+    }
+    fw_can_link_config lc;
+    fw_can_link_default_config(&lc, sf.sc.n_joints);
+    lc.reply_timeout_us = (uint32_t)o->reply_timeout_us;
+    if (fw_can_link_init(&link_, &tr, &lc, &port) != FW_PORT_OK) {
+        fprintf(stderr, "dhcal-fw: the CAN link rejected %zu joints\n", sf.sc.n_joints);
+        return EXIT_USAGE;
+    }
+    return 0;
+}
+
+static int open_nv(const options *o)
+{
+    if (o->nv == NULL) {
+        return 0; /* the sim port's RAM store */
+    }
+    char why[300];
+    if (fw_linux_nv_open(&nv_file, o->nv, NV_SIZE, &port.nv, why, sizeof why) != 0) {
+        fprintf(stderr, "dhcal-fw: %s\n", why);
+        return EXIT_USAGE;
+    }
+    return 0;
+}
+
+static void print_counters(void)
+{
+    const fw_can_link_counters *k = &link_.counters;
+    printf(", \"bus\": {\"ticks\": %llu, \"complete\": %llu, \"timeouts\": %u, \"lost\": %u, "
+           "\"late\": %u, \"duplicate\": %u, \"malformed\": %u, \"overruns\": %u, "
+           "\"io_errors\": %u, \"rx_frames\": %llu, \"tx_frames\": %llu}",
+           (unsigned long long)k->ticks, (unsigned long long)k->complete, k->timeouts, k->lost,
+           k->late, k->duplicate, k->malformed, k->overruns, k->io_errors,
+           (unsigned long long)can_bus.rx_frames, (unsigned long long)can_bus.tx_frames);
+}
+
+/* The JSON result. fault: the controller's (FW_FAULT_NONE when the run completed). */
+static void print_result(const options *o, fw_fault fault, size_t n_done, int calibrated,
+                         const struct timespec *t0)
+{
+    const int is_linux = strcmp(o->port, "linux") == 0;
+    printf("{\"mode\": \"calibrate\", \"port\": \"%s\", \"fault\": \"%s\", \"fault_index\": %zu, "
+           "\"ticks\": %llu, \"samples\": %zu",
+           o->port, fw_fault_name(fault), fault != FW_FAULT_NONE ? ctrl.fault_index : 0U,
+           (unsigned long long)ctrl.ticks, n_done);
+    if (fault != FW_FAULT_NONE) {
+        /* What the controller last commanded: 0 V once the fault latched. */
+        printf(", \"drive_v_after_fault\": [%.6f, %.6f, %.6f]", ctrl.u_v[0], ctrl.u_v[1],
+               ctrl.u_v[2]);
+    }
+    if (calibrated) {
+        char effect[64];
+        if (!res.found) {
+            snprintf(effect, sizeof effect, "none");
+        } else if (dhc_effect_is_per_joint(res.effect)) {
+            snprintf(effect, sizeof effect, "%s:%zu", dhc_effect_name(res.effect),
+                     res.effect_joint + 1U);
+        } else {
+            snprintf(effect, sizeof effect, "%s", dhc_effect_name(res.effect));
+        }
+        printf(", \"effect\": \"%s\", \"geometric_rms_mm\": %.9f, \"wire_rms_mm\": %.9f, "
+               "\"saved\": %d, \"seq\": %u, \"params\": {",
+               effect, res.geo.rms_mm, res.new_rms_mm, res.saved, (unsigned)res.seq);
+        dhc_param_set set;
+        (void)dhc_params_base_model(&set, &final_model);
+        if (res.found) {
+            (void)dhc_params_add_effect(&set, &final_model, res.effect, res.effect_joint);
+        }
+        FILE *pf = o->params_out != NULL ? fopen(o->params_out, "w") : NULL;
+        for (size_t k = 0U; k < set.count; ++k) {
+            char name[64];
+            (void)dhc_params_name(&set, k, name, sizeof name);
+            const double v = dhc_params_value(&set, &final_model, k);
+            printf("%s\"%s\": %.17g", k > 0U ? ", " : "", name, v);
+            if (pf != NULL) {
+                fprintf(pf, "%s %.17g\n", name, v);
+            }
+        }
+        if (pf != NULL) {
+            (void)fclose(pf);
+        }
+        printf("}");
+    }
+    if (is_linux) {
+        print_counters();
+    }
+    printf(", \"elapsed_s\": %.3f}\n", elapsed_s(t0));
+    fflush(stdout);
+}
+
+static int run_calibration(const options *o)
+{
+    struct timespec t0;
+    (void)clock_gettime(CLOCK_MONOTONIC, &t0);
+    dhcal_error err;
+    memset(&err, 0, sizeof err);
+    if (dhs_scenario_load(o->scenario, &sf, &err) != DHCAL_IO_OK ||
+        dhcal_model_to_lib(&sf.model, sf.model_path, &nominal, &err) != DHCAL_IO_OK) {
+        fprintf(stderr, "dhcal-fw: %s\n", err.msg);
+        return EXIT_USAGE;
+    }
+    if (sf.sc.n_joints != 3U || !nominal.measurer.present) {
+        fprintf(stderr, "dhcal-fw: %s: the machine must be a 3-joint arm with a measurer\n",
+                o->scenario);
+        return EXIT_USAGE;
+    }
+    /* The start pose and the counters' homing are the sim run's (dhcal-demo's). */
+    const double q_start[3] = {0.0, 60.0 * FW_PI / 180.0, -60.0 * FW_PI / 180.0};
+    fw_sim_io_config(&sf.sc, &io);
+    int rc = 0;
+    if (o->gpio_chip != NULL) {
+        /* Encoder lines configured: a missing chip or line is a configuration error now,
+         * not a fault in the middle of the run. */
+        static fw_linux_gpio_enc enc;
+        char why[256];
+        const fw_linux_gpio_status gs = fw_linux_gpio_open(&enc, o->gpio_chip, o->enc_line[0],
+                                                           o->enc_line[1], why, sizeof why);
+        if (gs != FW_LINUX_GPIO_OK) {
+            fprintf(stderr, "dhcal-fw: %s\n", why);
+            return EXIT_USAGE;
+        }
+        fw_linux_gpio_close(&enc);
+    }
+    if (strcmp(o->port, "sim") == 0) {
+        if (fw_sim_init(&sim, &sf.sc, o->run_seed, q_start, &port) != DHC_OK) {
+            fprintf(stderr, "dhcal-fw: the scenario was rejected by the plant\n");
+            return EXIT_USAGE;
+        }
+    } else if ((rc = open_linux_port(o)) != 0) {
+        return rc;
+    }
+    if ((rc = open_nv(o)) != 0) {
+        fw_linux_can_close(&can_bus);
+        return rc;
+    }
+    fw_ctrl_config cfg;
+    fw_ctrl_default_config(&cfg, 3U);
+    for (size_t j = 0U; j < 3U; ++j) {
+        cfg.q_min_rad[j] = nominal.arm.joint[j].min_rad;
+        cfg.q_max_rad[j] = nominal.arm.joint[j].max_rad;
+    }
+    dhc_sample s0;
+    memset(&s0, 0, sizeof s0);
+    s0.kind = (uint8_t)DHC_MEAS_WIRES;
+    memcpy(s0.q_rad, q_start, sizeof q_start);
+    s0.dir[0] = s0.dir[1] = s0.dir[2] = 1;
+    s0.temp_c = nominal.thermal_ref_c;
+    dhc_prediction pr;
+    if (dhc_model_predict(&nominal, &s0, &pr) != DHC_OK) {
+        fprintf(stderr, "dhcal-fw: the nominal model cannot predict the start pose\n");
+        return EXIT_FAULT;
+    }
+    fw_fault fault = FW_FAULT_NONE;
+    if (strcmp(o->port, "linux") == 0) {
+        /* The drives may come up after us: repeat SYNC 0 until they answer. */
+        const uint64_t tries = o->start_timeout_ms * 1000U / o->reply_timeout_us + 1U;
+        fw_port_status ps = FW_PORT_ERR_TIMEOUT;
+        for (uint64_t k = 0U; k < tries && ps == FW_PORT_ERR_TIMEOUT; ++k) {
+            ps = fw_can_link_start(&link_);
+        }
+        if (ps != FW_PORT_OK) {
+            fault = ps == FW_PORT_ERR_TIMEOUT ? FW_FAULT_PORT_TIMEOUT : FW_FAULT_PORT_IO;
+            fprintf(stderr, "dhcal-fw: no answer from the drives on %s\n", o->can);
+        }
+    }
+    if (fault == FW_FAULT_NONE) {
+        fault = fw_ctrl_init(&ctrl, &port, &io, &cfg, q_start, pr.wire_mm);
+    }
+    size_t n_done = 0U;
+    if (fault == FW_FAULT_NONE) {
+        const size_t n_plan = fw_plan_poses(&nominal, (size_t)o->samples,
+                                            (uint32_t)o->plan_seed, 0, plan);
+        fault = fw_acquire(&ctrl, &nominal, plan, n_plan, (uint32_t)o->hold_ticks, samples,
+                           &n_done);
+    }
+    int calibrated = 0;
+    if (fault == FW_FAULT_NONE) {
+        final_model = nominal;
+        fault = fw_autocal(&final_model, samples, n_done, &port.nv, &geometric, &res);
+        calibrated = fault == FW_FAULT_NONE || fault == FW_FAULT_STORAGE;
+    }
+    if (fault != FW_FAULT_NONE) {
+        fprintf(stderr, "dhcal-fw: fault %s (index %zu) after %zu samples\n",
+                fw_fault_name(fault), ctrl.fault_index, n_done);
+    }
+    print_result(o, fault, n_done, calibrated, &t0);
+    fw_linux_nv_close(&nv_file);
+    fw_linux_can_close(&can_bus);
+    return fault == FW_FAULT_NONE ? 0 : EXIT_FAULT;
+}
+
+int main(int argc, char **argv)
+{
+    options o;
+    const int rc = parse_args(argc, argv, &o);
+    if (rc != 0) {
+        return rc < 0 ? 0 : rc;
+    }
+    nv_file.fd = -1;
+    can_bus.fd = -1;
+    return o.gpio_watch > 0U ? run_gpio_watch(&o) : run_calibration(&o);
+}
