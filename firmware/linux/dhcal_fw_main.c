@@ -20,6 +20,7 @@
 #include "dhcal_fw/fw_acquire.h"
 #include "dhcal_fw/fw_can.h"
 #include "dhcal_fw/fw_can_link.h"
+#include "dhcal_fw/fw_can_offset.h"
 #include "dhcal_fw/fw_controller.h"
 #include "dhcal_io.h"
 #include "dhcal_model_map.h"
@@ -48,6 +49,8 @@ static const char *const help_text =
     "                        measurer data (gear ratios, encoder lines, converter ranges,\n"
     "                        wheel); the sim port also builds the simulated arm from it\n"
     "  --can IFNAME          CAN interface (default vcan0)\n"
+    "  --can-id-offset N     the DBC's identifiers moved by N on the bus, for a bus shared\n"
+    "                        with other devices or arms (0..1535, default 0)\n"
     "  --reply-timeout-us N  all feedback of a tick within this after SYNC (default 20000;\n"
     "                        longer than the 800 us of a real drive: a shared, emulated CPU)\n"
     "  --start-timeout-ms N  wait this long for the drives to answer the first SYNC\n"
@@ -76,6 +79,7 @@ typedef struct {
     const char *params_out;
     const char *gpio_chip;
     unsigned long long reply_timeout_us;
+    unsigned long long can_id_offset;
     unsigned long long start_timeout_ms;
     unsigned long long samples;
     unsigned long long plan_seed;
@@ -123,6 +127,7 @@ static int set_option(options *o, const char *key, const char *val)
         unsigned long long max;
     } nums[] = {
         {"reply-timeout-us", &o->reply_timeout_us, 10000000ULL},
+        {"can-id-offset", &o->can_id_offset, FW_CAN_OFFSET_MAX},
         {"start-timeout-ms", &o->start_timeout_ms, 600000ULL},
         {"samples", &o->samples, FW_ACQ_MAX_SAMPLES},
         {"plan-seed", &o->plan_seed, 0xFFFFFFFFULL},
@@ -345,6 +350,7 @@ static dhs_scenario_file sf;
 static fw_sim sim;
 static fw_linux_can can_bus;
 static fw_can_link link_;
+static fw_can_offset id_offset_wrap;
 static fw_linux_nv nv_file;
 static fw_port port;
 static fw_io_config io;
@@ -360,18 +366,26 @@ static int open_linux_port(const options *o)
 {
     char why[256];
     /* Feedback only: the kernel drops our own SYNC and commands and anything else. */
+    const uint32_t offset = (uint32_t)o->can_id_offset;
     uint32_t rx[FW_CAN_MAX_DRIVES + 1U];
     size_t n_rx = 0U;
     for (size_t j = 0U; j < sf.sc.n_joints && j < FW_CAN_MAX_DRIVES; ++j) {
-        rx[n_rx++] = FW_CAN_ID_DRIVE_FB_BASE + (uint32_t)j;
+        rx[n_rx++] = fw_can_offset_bus_id(offset, FW_CAN_ID_DRIVE_FB_BASE + (uint32_t)j);
     }
-    rx[n_rx++] = FW_CAN_ID_WIRES;
+    rx[n_rx++] = fw_can_offset_bus_id(offset, FW_CAN_ID_WIRES);
     fw_can_transport tr;
     const fw_linux_can_status cs = fw_linux_can_open(&can_bus, o->can, rx, n_rx, &tr, why,
                                                      sizeof why);
     if (cs != FW_LINUX_CAN_OK) {
         fprintf(stderr, "dhcal-fw: %s%s\n", why,
                 cs == FW_LINUX_CAN_NO_PF_CAN ? " (this kernel has no SocketCAN)" : "");
+        return EXIT_USAGE;
+    }
+    /* The link and the codec keep the DBC's identifiers; the offset lives on the bus. */
+    fw_can_transport on_bus = tr;
+    if (fw_can_offset_init(&id_offset_wrap, &on_bus, offset, &tr) != 0) {
+        fprintf(stderr, "dhcal-fw: --can-id-offset %u leaves the 11-bit identifiers\n",
+                (unsigned)offset);
         return EXIT_USAGE;
     }
     fw_can_link_config lc;

@@ -15,6 +15,7 @@
 #include "dhcal_sim/dhs_dataset.h"
 #include "dhcal_sim/dhs_scenario_json.h"
 #if defined(DHCAL_SIM_BUS)
+#include "dhcal_fw/fw_can_offset.h"
 #include "dhs_bus_linux.h"
 #endif
 
@@ -488,14 +489,17 @@ static int run_dataset(const options *o)
 /* ---------------------------------------------------------------- bus mode */
 
 static const char *const bus_help =
-    "usage: dhcal-sim bus --scenario S.json --can IFNAME [--seed K] [--drop-frame ID@TICK]\n"
-    "                     [--stop-at TICK] [--idle-exit-ms MS] [--start-wait-ms MS]\n"
+    "usage: dhcal-sim bus --scenario S.json --can IFNAME [--can-id-offset N] [--seed K]\n"
+    "                     [--drop-frame ID@TICK] [--stop-at TICK] [--idle-exit-ms MS]\n"
+    "                     [--start-wait-ms MS]\n"
     "       dhcal-sim bus --gpio-chip NAME --lines A,B [--gpio-steps N] [--gpio-burst N\n"
     "                     --gpio-pause-ms MS] [--gpio-start-delay-ms MS] [--gpio-step-us US]\n"
     "The simulated arm's drives and draw-wire measurer on a SocketCAN interface, in lockstep\n"
     "with the controller (firmware/can/dhcal.dbc): each SYNC advances the plant one 1 ms\n"
     "tick and is answered with the drives' and the measurer's feedback. The plant starts\n"
     "at q = (0, 60, -60) deg with run seed K (default 7): dhcal-fw --port sim's run.\n"
+    "  --can-id-offset N     the DBC's identifiers moved by N on the bus (0..1535; the\n"
+    "                        controller's dhcal-fw --can-id-offset must match)\n"
     "  --drop-frame ID@TICK  drop the answer frame ID (e.g. 0x181) to SYNC number TICK\n"
     "                        (0: the first SYNC)\n"
     "  --stop-at TICK        stop answering from SYNC number TICK on (a pulled cable)\n"
@@ -546,6 +550,9 @@ static int run_bus(int argc, char **argv)
             scenario = v;
         } else if (strcmp(a, "--can") == 0) {
             bo.can = v;
+        } else if (strcmp(a, "--can-id-offset") == 0) {
+            rc = bus_number(a, v, FW_CAN_OFFSET_MAX, &n);
+            bo.id_offset = (uint32_t)n;
         } else if (strcmp(a, "--gpio-chip") == 0) {
             go.chip = v;
         } else if (strcmp(a, "--seed") == 0) {

@@ -14,6 +14,7 @@
 #include <time.h>
 
 #include "dhcal_fw/fw_can.h"
+#include "dhcal_fw/fw_can_offset.h"
 #include "dhcal_sim/dhs_bus.h"
 #include "dhcal_sim/dhs_plant.h"
 #include "fw_linux_can.h"
@@ -64,18 +65,28 @@ int dhs_bus_linux_run(const dhs_scenario *sc, const double *q_start_rad,
     /* The controller's frames only: SYNC and the drives' commands. */
     uint32_t rx[1U + FW_CAN_MAX_DRIVES];
     size_t n_rx = 0U;
-    rx[n_rx++] = FW_CAN_ID_SYNC;
+    rx[n_rx++] = fw_can_offset_bus_id(o->id_offset, FW_CAN_ID_SYNC);
     for (size_t j = 0U; j < bus.n; ++j) {
-        rx[n_rx++] = FW_CAN_ID_DRIVE_CMD_BASE + (uint32_t)j;
+        rx[n_rx++] = fw_can_offset_bus_id(o->id_offset, FW_CAN_ID_DRIVE_CMD_BASE + (uint32_t)j);
     }
-    fw_can_transport t;
-    const fw_linux_can_status cs = fw_linux_can_open(&sock, o->can, rx, n_rx, &t, why, why_cap);
+    fw_can_transport on_bus;
+    const fw_linux_can_status cs =
+        fw_linux_can_open(&sock, o->can, rx, n_rx, &on_bus, why, why_cap);
     if (cs != FW_LINUX_CAN_OK) {
         if (cs == FW_LINUX_CAN_NO_PF_CAN) {
             const size_t used = strlen(why);
             (void)snprintf(why + used, why_cap - used, " (this kernel has no SocketCAN)");
         }
         return cs == FW_LINUX_CAN_ERR ? 1 : 2;
+    }
+    /* dhs_bus speaks the DBC's identifiers; the offset lives on the bus. */
+    fw_can_offset id_offset_wrap;
+    fw_can_transport t;
+    if (fw_can_offset_init(&id_offset_wrap, &on_bus, o->id_offset, &t) != 0) {
+        (void)snprintf(why, why_cap, "CAN id offset %u leaves the 11-bit identifiers",
+                       (unsigned)o->id_offset);
+        fw_linux_can_close(&sock);
+        return 2;
     }
     emit_ctx ec = {&t, 0};
     int rc = 0;

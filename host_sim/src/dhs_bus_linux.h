@@ -11,8 +11,9 @@
 
 typedef struct {
     const char *can;          /* interface */
+    uint32_t id_offset;       /* the DBC's identifiers moved by this on the bus */
     uint64_t run_seed;        /* the plant's (7: dhcal-fw --port sim's default) */
-    uint32_t drop_id;         /* fault: drop the answer frame drop_id ... */
+    uint32_t drop_id;         /* fault: drop the answer frame drop_id (the DBC's id) ... */
     uint64_t drop_tick;       /* ... to the drop_tick-th SYNC (0: the first) */
     int drop;                 /* the drop is armed */
     uint64_t stop_tick;       /* fault: go silent from this SYNC on (the cable pulled) */
