@@ -10,6 +10,7 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "dhcal/dhc_model.h"
 #include "dhcal_sim/dhs_plant.h"
 #include "dhcal_sim/dhs_scenario.h"
 
@@ -41,15 +42,35 @@ static inline void sim_fixture_nominal(dhc_arm *arm)
 }
 
 /* The paper's measurer: anchors (0,0,1200), (0,+-600,300) mm, frame at (1300,0,0) facing -x. */
-static inline void sim_fixture_measurer(dhs_scenario *sc)
+static inline void sim_fixture_measurer_geometry(double anchors[3][3], dhc_frame *frame)
 {
-    const double anchors[3][3] = {
-        {0.0, 0.0, 1200.0}, {0.0, 600.0, 300.0}, {0.0, -600.0, 300.0}};
+    const double a[3][3] = {{0.0, 0.0, 1200.0}, {0.0, 600.0, 300.0}, {0.0, -600.0, 300.0}};
     const double xyz[3] = {1300.0, 0.0, 0.0};
     const double rpy[3] = {0.0, 0.0, SIM_PI};
+    memcpy(anchors, a, sizeof a);
+    dhc_frame_from_xyz_rpy(xyz, rpy, frame);
+}
+
+static inline void sim_fixture_measurer(dhs_scenario *sc)
+{
+    double anchors[3][3];
     dhc_frame f;
-    dhc_frame_from_xyz_rpy(xyz, rpy, &f);
-    dhs_scenario_set_measurer(sc, anchors, &f);
+    sim_fixture_measurer_geometry(anchors, &f);
+    dhs_scenario_set_measurer(sc, (const double(*)[3])anchors, &f);
+}
+
+/* What the controller believes: the nominal arm (sim_fixture_nominal) with the paper's
+ * measurer where sim_fixture_measurer puts it, no effects. */
+static inline dhc_status sim_fixture_nominal_model(dhc_model *model)
+{
+    const dhc_status st = dhc_model_init(model, 3U);
+    if (st != DHC_OK) {
+        return st;
+    }
+    sim_fixture_nominal(&model->arm);
+    model->measurer.present = 1;
+    sim_fixture_measurer_geometry(model->measurer.anchor_mm, &model->measurer.frame);
+    return DHC_OK;
 }
 
 /* Links as in the scenario files of host_sim/scenarios: column, upper arm with the elbow

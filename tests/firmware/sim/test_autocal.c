@@ -33,14 +33,7 @@ static const double q_start[3] = {0.0, 60.0 * SIM_DEG, -60.0 * SIM_DEG};
 
 static void build_nominal(void)
 {
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_model_init(&nominal, 3U));
-    sim_fixture_nominal(&nominal.arm);
-    const double anchors[3][3] = {{0.0, 0.0, 1200.0}, {0.0, 600.0, 300.0}, {0.0, -600.0, 300.0}};
-    const double xyz[3] = {1300.0, 0.0, 0.0};
-    const double rpy[3] = {0.0, 0.0, SIM_PI};
-    nominal.measurer.present = 1;
-    memcpy(nominal.measurer.anchor_mm, anchors, sizeof anchors);
-    dhc_frame_from_xyz_rpy(xyz, rpy, &nominal.measurer.frame);
+    TEST_ASSERT_EQUAL(DHC_OK, sim_fixture_nominal_model(&nominal));
 }
 
 /* Samples of the rigid fixture arm, its joint 2 made compliant when joint2_stiffness > 0

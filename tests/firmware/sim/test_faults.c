@@ -73,14 +73,7 @@ static size_t n_faults_injected;
 
 static void build_model(void)
 {
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_model_init(&model, 3U));
-    sim_fixture_nominal(&model.arm);
-    const double anchors[3][3] = {{0.0, 0.0, 1200.0}, {0.0, 600.0, 300.0}, {0.0, -600.0, 300.0}};
-    const double xyz[3] = {1300.0, 0.0, 0.0};
-    const double rpy[3] = {0.0, 0.0, SIM_PI};
-    model.measurer.present = 1;
-    memcpy(model.measurer.anchor_mm, anchors, sizeof anchors);
-    dhc_frame_from_xyz_rpy(xyz, rpy, &model.measurer.frame);
+    TEST_ASSERT_EQUAL(DHC_OK, sim_fixture_nominal_model(&model));
 }
 
 /* Power on: plant at q_start with the brakes on, store erased, controller homed. io_in:

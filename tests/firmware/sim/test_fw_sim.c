@@ -29,18 +29,11 @@ void setUp(void)
     fw_sim_io_config(&sc, &io);
     fw_ctrl_config cfg;
     fw_ctrl_default_config(&cfg, 3U);
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_model_init(&model, 3U));
-    sim_fixture_nominal(&model.arm);
+    TEST_ASSERT_EQUAL(DHC_OK, sim_fixture_nominal_model(&model));
     for (size_t j = 0U; j < 3U; ++j) {
         cfg.q_min_rad[j] = model.arm.joint[j].min_rad;
         cfg.q_max_rad[j] = model.arm.joint[j].max_rad;
     }
-    const double anchors[3][3] = {{0.0, 0.0, 1200.0}, {0.0, 600.0, 300.0}, {0.0, -600.0, 300.0}};
-    const double xyz[3] = {1300.0, 0.0, 0.0};
-    const double rpy[3] = {0.0, 0.0, SIM_PI};
-    model.measurer.present = 1;
-    memcpy(model.measurer.anchor_mm, anchors, sizeof anchors);
-    dhc_frame_from_xyz_rpy(xyz, rpy, &model.measurer.frame);
     dhs_plant_truth t;
     dhs_plant_get_truth(&sim.plant, &t);
     TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_ctrl_init(&ctrl, &port, &io, &cfg, q_start, t.wire_mm));
