@@ -9,7 +9,11 @@
  * the covariance of the identified parameters from the wire Jacobian J of the samples (s:
  * the fit's residual standard deviation per wire) and J_p the tool point's sensitivity to
  * them at the target, combined (root sum of squares) with the servo's encoder resolution
- * at the tool (one count per joint). */
+ * at the tool (one count per joint). With the calibration's noise model on (the default:
+ * encoder quantisation and the measured wire noise, fw_autocal_config), the fit is
+ * generalized least squares: J^T J becomes J^T W J, each sample's rows whitened like the
+ * fit's (dhc_sample_whiten), and s is the fit's unit-free sigma, so C is again the
+ * covariance of the parameters the fit identified. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -218,17 +222,34 @@ static int invert(size_t p, const uint8_t *use)
 }
 
 static double noise_floor(const dhc_model *m, const dhc_param_set *set, const uint8_t *use,
-                          double sigma, size_t n, const phase_result *r)
+                          double sigma, size_t n, const phase_result *r,
+                          const fw_autocal_result *res)
 {
     const size_t p = set->count;
+    static double rows_buf[3U * DHC_MAX_PARAMS];
     for (size_t i = 0U; i < n; ++i) {
+        dhc_mat rows;
+        if (dhc_mat_init(&rows, 3U, p, rows_buf, sizeof rows_buf / sizeof rows_buf[0]) != DHC_OK) {
+            return (double)NAN;
+        }
         for (size_t k = 0U; k < p; ++k) {
             double d[3] = {0.0, 0.0, 0.0};
             if (use[k] && sens(m, set, &samples[i], 1, k, d) != 0) {
                 return (double)NAN;
             }
             for (size_t row = 0U; row < 3U; ++row) {
-                jw[3U * i + row][k] = d[row];
+                DHC_MAT_AT(&rows, row, k) = d[row];
+            }
+        }
+        /* the fit's weighting (nothing when its noise model was off) */
+        double dummy_r[DHC_MAX_ROWS_PER_SAMPLE] = {0.0};
+        if (dhc_sample_whiten(m, &samples[i], res->joint_noise_rad, res->meas_noise_mm, 1000.0,
+                              dummy_r, &rows) != DHC_OK) {
+            return (double)NAN;
+        }
+        for (size_t row = 0U; row < 3U; ++row) {
+            for (size_t k = 0U; k < p; ++k) {
+                jw[3U * i + row][k] = DHC_MAT_AT(&rows, row, k);
             }
         }
     }
@@ -381,6 +402,7 @@ int main(int argc, char **argv)
     fw_autocal_config autocal;
     fw_autocal_default_config(&autocal);
     const char *effects = NULL;
+    int weighted = 1;
     for (int i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--json") == 0) {
             json = 1;
@@ -398,13 +420,18 @@ int main(int argc, char **argv)
             effects = argv[++i];
         } else if (strcmp(argv[i], "--no-diagnose") == 0) {
             autocal.diagnose = 0;
+        } else if (strcmp(argv[i], "--unweighted") == 0) {
+            weighted = 0;
         } else {
             fprintf(stderr,
                     "usage: dhcal-demo --scenario S.json [--json] [--out DIR] [--samples N] "
                     "[--targets N] [--mixed-directions] [--effects LIST] [--no-diagnose]\n"
+                    "       [--unweighted]\n"
                     "  --effects LIST   the controller's configured effects, fitted in every "
                     "calibration\n                   (e.g. joint_compliance:2,measurer_scale)\n"
-                    "  --no-diagnose    fit only those; do not look for a missing one\n");
+                    "  --no-diagnose    fit only those; do not look for a missing one\n"
+                    "  --unweighted     no noise model (encoder quantisation, wire noise): "
+                    "plain least squares\n");
             return 2;
         }
     }
@@ -442,6 +469,9 @@ int main(int argc, char **argv)
         return 1;
     }
     fw_sim_io_config(&sf.sc, &io);
+    /* the calibration's noise model: encoder quantisation from the io configuration, the
+     * wires' noise measured over the holds (fw_acquire_wire_noise_mm) */
+    autocal.io = weighted ? &io : NULL;
     fw_ctrl_config cfg;
     fw_ctrl_default_config(&cfg, 3U);
     for (size_t j = 0U; j < 3U; ++j) {
@@ -502,10 +532,20 @@ int main(int argc, char **argv)
     }
     char effect[64];
     effect_label(&res, effect, sizeof effect);
+    if (res.meas_noise_mm > 0.0) {
+        fprintf(log, "    noise model: joint angles %.3g %.3g %.3g urad (1 count / sqrt 12 with the "
+                     "holds' dither), wires %.4f mm (measured over the holds)\n",
+                res.joint_noise_rad[0] * 1e6, res.joint_noise_rad[1] * 1e6,
+                res.joint_noise_rad[2] * 1e6, res.meas_noise_mm);
+    }
     fprintf(log, "(c) geometric fit%s%s: wire residual RMS %.4f mm, max %.4f mm (%zu params, "
                  "rank %zu)\n", effects != NULL ? " with the configured " : "",
             effects != NULL ? effects : "", res.geo.rms_mm, res.geo.max_mm, res.geo.n_params,
             res.geo.rank);
+    if (res.meas_noise_mm > 0.0) {
+        fprintf(log, "    whitened residual sd %.3f (1: as the noise model predicts)\n",
+                res.geo.sigma);
+    }
     if (autocal.diagnose != 0) {
         fprintf(log, "(d) diagnosis: %s (log10 p %.1f)\n", effect, res.effect_log10_p);
     } else {
@@ -536,7 +576,7 @@ int main(int argc, char **argv)
     }
     const dhc_calib_report *fr = res.found ? &res.eff : &res.geo;
     const double floor_mm = noise_floor(&final_model, &fset, fr->identifiable, fr->sigma, n_done,
-                                        &ph[2]);
+                                        &ph[2], &res);
 
     fprintf(log, "\n%-28s %10s %10s\n", "model (fresh targets)", "RMS mm", "max mm");
     char label[96];

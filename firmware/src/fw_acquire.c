@@ -208,17 +208,38 @@ static void model_measurer(const dhc_model *m, dhc_measurer *out)
 }
 
 static uint32_t retakes;
+/* sum over holds and wires of the squared standard error of the mean, and their count */
+static double wire_sem_ss;
+static uint32_t wire_sem_count;
+/* per joint: sum over holds of (last reading - mean reading over the hold)^2, and holds */
+static double angle_dither_ss[DHC_MAX_JOINTS];
+static uint32_t angle_dither_count;
 
 uint32_t fw_acquire_retakes(void)
 {
     return retakes;
 }
 
+double fw_acquire_wire_noise_mm(void)
+{
+    return wire_sem_count > 0U ? sqrt(wire_sem_ss / (double)wire_sem_count) : 0.0;
+}
+
+double fw_acquire_angle_dither_rad(size_t joint)
+{
+    return joint < DHC_MAX_JOINTS && angle_dither_count > 0U
+               ? sqrt(angle_dither_ss[joint] / (double)angle_dither_count)
+               : 0.0;
+}
+
 /* Holds for hold_ticks averaging the wire lengths; *still = 0 (and returns early) when a
  * joint leaves FW_ACQ_HOLD_TOL x the settle tolerance around its reference. */
 static fw_fault hold_still(fw_ctrl *c, uint32_t hold_ticks, double w[3], int *still)
 {
+    double qsum[DHC_MAX_JOINTS] = {0.0};
     double sum[3] = {0.0, 0.0, 0.0};
+    double sum2[3] = {0.0, 0.0, 0.0};
+    double first[3] = {0.0, 0.0, 0.0}; /* spread about the first reading: no cancellation */
     const double tol = FW_ACQ_HOLD_TOL * c->cfg.settle_pos_tol_rad;
     *still = 1;
     for (uint32_t k = 0U; k < hold_ticks; ++k) {
@@ -231,18 +252,36 @@ static fw_fault hold_still(fw_ctrl *c, uint32_t hold_ticks, double w[3], int *st
                 return FW_FAULT_NONE;
             }
         }
+        for (size_t j = 0U; j < c->n; ++j) {
+            qsum[j] += c->q_rad[j];
+        }
         double r[3];
         fw_ctrl_wire_mm(c, r);
         for (size_t i = 0U; i < 3U; ++i) {
+            first[i] = k == 0U ? r[i] : first[i];
             sum[i] += r[i];
+            sum2[i] += (r[i] - first[i]) * (r[i] - first[i]);
         }
     }
     if (hold_ticks == 0U) {
         fw_ctrl_wire_mm(c, w); /* no hold: the reading of the last tick */
         return FW_FAULT_NONE;
     }
+    const double nt = (double)hold_ticks;
+    for (size_t j = 0U; j < c->n; ++j) {
+        const double d = c->q_rad[j] - qsum[j] / nt;
+        angle_dither_ss[j] += d * d;
+    }
+    ++angle_dither_count;
     for (size_t i = 0U; i < 3U; ++i) {
-        w[i] = sum[i] / (double)hold_ticks;
+        w[i] = sum[i] / nt;
+        if (hold_ticks > 1U) {
+            /* sample variance of the readings, then that of their mean */
+            const double dm = w[i] - first[i];
+            const double var = fmax(sum2[i] - nt * dm * dm, 0.0) / (nt - 1.0);
+            wire_sem_ss += var / nt;
+            ++wire_sem_count;
+        }
     }
     return FW_FAULT_NONE;
 }
@@ -455,6 +494,8 @@ void fw_autocal_default_config(fw_autocal_config *cfg)
 {
     memset(cfg, 0, sizeof *cfg);
     cfg->diagnose = 1;
+    cfg->io = NULL;
+    cfg->wire_noise_mm = 0.0;
 }
 
 fw_fault fw_autocal(dhc_model *model, const dhc_sample *samples, size_t n,
@@ -478,6 +519,27 @@ fw_fault fw_autocal_configured(const fw_autocal_config *cfg, dhc_model *model,
     sample_buf buf = {samples, n};
     dhc_calib_options opt;
     dhc_calib_default_options(&opt);
+    dhc_diagnose_options dopt;
+    dhc_diagnose_default_options(&dopt);
+    if (cfg->io != NULL) {
+        /* one encoder count, uniform (variance count^2 / 12), plus the hold's dither: the
+         * sample keeps the last reading, the wires saw the mean pose of the hold */
+        for (size_t j = 0U; j < model->arm.n_joints && j < DHC_MAX_JOINTS; ++j) {
+            const double cpr = cfg->io->counts_per_rad[j];
+            const double dither = fw_acquire_angle_dither_rad(j);
+            opt.joint_noise_rad[j] =
+                cpr > 0.0 ? sqrt(1.0 / (12.0 * cpr * cpr) + dither * dither) : 0.0;
+        }
+        opt.meas_noise_mm = cfg->wire_noise_mm > 0.0 ? cfg->wire_noise_mm
+                                                     : fw_acquire_wire_noise_mm();
+        if (!(opt.meas_noise_mm > 0.0)) {
+            opt.meas_noise_mm = cfg->io->wire_mm_per_count / sqrt(12.0);
+        }
+        memcpy(dopt.joint_noise_rad, opt.joint_noise_rad, sizeof opt.joint_noise_rad);
+        dopt.meas_noise_mm = opt.meas_noise_mm;
+        memcpy(res->joint_noise_rad, opt.joint_noise_rad, sizeof opt.joint_noise_rad);
+        res->meas_noise_mm = opt.meas_noise_mm;
+    }
     dhc_param_set set;
     if (dhc_params_base_model(&set, model) != DHC_OK ||
         cfg->n_effects > FW_AUTOCAL_MAX_EFFECTS) {
@@ -500,8 +562,6 @@ fw_fault fw_autocal_configured(const fw_autocal_config *cfg, dhc_model *model,
     if (geo_out != NULL) {
         *geo_out = geo_model;
     }
-    dhc_diagnose_options dopt;
-    dhc_diagnose_default_options(&dopt);
     const size_t nc = cfg->diagnose != 0
                           ? dhc_diagnose_candidates(&geo_model, &set, 1, 0.0, cands,
                                                     DHC_MAX_CANDIDATES)

@@ -20,6 +20,11 @@
 #define MEDIAN_REL_PRECISION 1e-2
 #define STRUCTURAL_EXTRA_POSES 8U
 
+static double sq(double x)
+{
+    return x * x;
+}
+
 void dhc_calib_default_options(dhc_calib_options *opt)
 {
     DHC_ASSERT(opt != NULL);
@@ -33,6 +38,127 @@ void dhc_calib_default_options(dhc_calib_options *opt)
     opt->joint_margin_rad = 0.1;
     opt->max_outlier_rounds = 3U;
     opt->structural_seed = 12345U;
+    for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
+        opt->joint_noise_rad[j] = 0.0;
+    }
+    opt->meas_noise_mm = 0.0;
+}
+
+dhc_status dhc_noise_model_check(const double *joint_noise_rad, double meas_noise_mm,
+                                 size_t n_joints, int *on)
+{
+    if (on == NULL || joint_noise_rad == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    *on = 0;
+    int joints_on = 0;
+    /* !(x >= 0) also refuses NaN; an infinite sd would whiten everything to 0 */
+    int ok = meas_noise_mm >= 0.0 && dhc_is_finite(meas_noise_mm);
+    for (size_t j = 0U; j < n_joints && j < DHC_MAX_JOINTS; ++j) {
+        ok = ok && joint_noise_rad[j] >= 0.0 && dhc_is_finite(joint_noise_rad[j]);
+        joints_on = joints_on || joint_noise_rad[j] > 0.0;
+    }
+    if (!ok || (joints_on && !(meas_noise_mm > 0.0))) {
+        return DHC_ERR_ARGUMENT;
+    }
+    *on = joints_on || meas_noise_mm > 0.0;
+    return DHC_OK;
+}
+
+/* x = L^-1 x for the lower triangle of l (rows x rows, row stride DHC_MAX_ROWS_PER_SAMPLE);
+ * x's entries are stride apart (a residual: 1; a Jacobian column: its column count). */
+static void lower_solve(const double *l, size_t rows, double *x, size_t stride)
+{
+    for (size_t i = 0U; i < rows; ++i) {
+        double v = x[i * stride];
+        for (size_t m = 0U; m < i; ++m) {
+            v -= l[i * DHC_MAX_ROWS_PER_SAMPLE + m] * x[m * stride];
+        }
+        x[i * stride] = v / l[i * DHC_MAX_ROWS_PER_SAMPLE + i];
+    }
+}
+
+dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_sample *s,
+                             const double *joint_noise_rad, double meas_noise_mm,
+                             double weight_mm_per_rad, double *r, dhc_mat *jac)
+{
+    if (model == NULL || s == NULL || r == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    const size_t n = model->arm.n_joints;
+    if (n == 0U || n > DHC_MAX_JOINTS) {
+        return DHC_ERR_CAPACITY;
+    }
+    int on = 0;
+    dhc_status st = dhc_noise_model_check(joint_noise_rad, meas_noise_mm, n, &on);
+    if (st != DHC_OK || !on) {
+        return st;
+    }
+    const size_t rows = dhc_sample_rows(s);
+    if (jac != NULL && (jac->data == NULL || jac->rows != rows)) {
+        return DHC_ERR_DIMENSION;
+    }
+    /* d(prediction)/d(q_eff_i) is the joint-offset column of joint i: the same screw */
+    dhc_param_set thetas;
+    thetas.count = n;
+    for (size_t j = 0U; j < n; ++j) {
+        thetas.id[j].kind = (uint8_t)DHC_P_THETA;
+        thetas.id[j].joint = (uint8_t)j;
+        thetas.id[j].aux = 0U;
+    }
+    double jq_buf[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_JOINTS];
+    dhc_mat jq;
+    st = dhc_mat_init(&jq, rows, n, jq_buf, sizeof jq_buf / sizeof jq_buf[0]);
+    if (st == DHC_OK) {
+        st = dhc_model_jacobian(model, &thetas, s, weight_mm_per_rad, &jq, NULL);
+    }
+    if (st != DHC_OK) {
+        return st;
+    }
+    /* Covariance of the sample's rows: the measurement's own noise plus each joint's angle
+     * noise through its column, times dq_eff/dq of the joint's scale and harmonic. */
+    double c[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_ROWS_PER_SAMPLE];
+    for (size_t a = 0U; a < rows; ++a) {
+        for (size_t b = 0U; b < rows; ++b) {
+            c[a * DHC_MAX_ROWS_PER_SAMPLE + b] = a == b ? meas_noise_mm * meas_noise_mm : 0.0;
+        }
+    }
+    for (size_t j = 0U; j < n; ++j) {
+        const dhc_joint_effects *fx = &model->effect[j];
+        const double q = s->q_rad[j];
+        const double sd = joint_noise_rad[j] * (1.0 + fx->scale + fx->harmonic_sin_rad * cos(q) -
+                                                fx->harmonic_cos_rad * sin(q));
+        for (size_t a = 0U; a < rows; ++a) {
+            for (size_t b = 0U; b <= a; ++b) {
+                c[a * DHC_MAX_ROWS_PER_SAMPLE + b] +=
+                    sd * sd * DHC_MAT_AT(&jq, a, j) * DHC_MAT_AT(&jq, b, j);
+            }
+        }
+    }
+    /* Cholesky in place (lower triangle): every eigenvalue is at least meas_noise_mm^2 > 0,
+     * so only an overflowing covariance can fail. */
+    for (size_t k = 0U; k < rows; ++k) {
+        double d = c[k * DHC_MAX_ROWS_PER_SAMPLE + k];
+        for (size_t m = 0U; m < k; ++m) {
+            d -= sq(c[k * DHC_MAX_ROWS_PER_SAMPLE + m]);
+        }
+        if (!(d > 0.0) || !dhc_is_finite(d)) {
+            return DHC_ERR_NONFINITE;
+        }
+        c[k * DHC_MAX_ROWS_PER_SAMPLE + k] = sqrt(d);
+        for (size_t i = k + 1U; i < rows; ++i) {
+            double v = c[i * DHC_MAX_ROWS_PER_SAMPLE + k];
+            for (size_t m = 0U; m < k; ++m) {
+                v -= c[i * DHC_MAX_ROWS_PER_SAMPLE + m] * c[k * DHC_MAX_ROWS_PER_SAMPLE + m];
+            }
+            c[i * DHC_MAX_ROWS_PER_SAMPLE + k] = v / c[k * DHC_MAX_ROWS_PER_SAMPLE + k];
+        }
+    }
+    lower_solve(c, rows, r, 1U);
+    for (size_t col = 0U; jac != NULL && col < jac->cols; ++col) {
+        lower_solve(c, rows, jac->data + col, jac->cols);
+    }
+    return DHC_OK;
 }
 
 /* Everything one pass over the samples needs; kept together to keep signatures short. */
@@ -44,6 +170,7 @@ typedef struct {
     uint8_t *flags;
     const dhc_calib_options *opt;
     dhc_calib_workspace *ws;
+    int whiten; /* the noise model is on */
 } fit_context;
 
 typedef struct {
@@ -63,11 +190,6 @@ typedef struct {
     size_t rows;
     data_traits traits;
 } pass_totals;
-
-static double sq(double x)
-{
-    return x * x;
-}
 
 static void note_traits(data_traits *t, const dhc_sample *s, size_t n_joints, int first)
 {
@@ -107,30 +229,39 @@ static dhc_status data_pass(const fit_context *fc, const dhc_model *model, int a
         const dhc_sample *const s = &ws->sample;
         const size_t rows = dhc_sample_rows(s);
         double r[DHC_MAX_ROWS_PER_SAMPLE];
+        double rw[DHC_MAX_ROWS_PER_SAMPLE]; /* whitened (a copy of r with the model off) */
         size_t got_rows;
         st = dhc_model_residual(model, s, w, r, &got_rows);
+        if (st == DHC_OK) {
+            memcpy(rw, r, sizeof r);
+        }
+        dhc_mat jac;
         if (st == DHC_OK && accumulate) {
-            dhc_mat jac;
             st = dhc_mat_init(&jac, rows, p, ws->jac_buf,
                               sizeof ws->jac_buf / sizeof ws->jac_buf[0]);
             if (st == DHC_OK) {
                 st = dhc_model_jacobian(model, fc->set, s, w, &jac, NULL);
             }
-            if (st == DHC_OK) {
-                st = dhc_normal_eq_add(&ws->ne, &jac, r, NULL, rows);
-            }
+        }
+        if (st == DHC_OK && fc->whiten) {
+            st = dhc_sample_whiten(model, s, fc->opt->joint_noise_rad, fc->opt->meas_noise_mm, w,
+                                   rw, accumulate ? &jac : NULL);
+        }
+        if (st == DHC_OK && accumulate) {
+            st = dhc_normal_eq_add(&ws->ne, &jac, rw, NULL, rows);
         }
         if (st != DHC_OK) {
             return st;
         }
         note_traits(&tot->traits, s, model->arm.n_joints, tot->samples == 0U);
+        /* the error totals stay physical (mm, rad); the SSR is what the fit minimises */
         const double e2 = sq(r[0]) + sq(r[1]) + sq(r[2]);
         tot->pos_ss += e2;
         tot->max_pos = fmax(tot->max_pos, sqrt(e2));
-        tot->ssr += e2;
+        tot->ssr += fc->whiten ? sq(rw[0]) + sq(rw[1]) + sq(rw[2]) : e2;
         if (rows == 6U) {
             const double o2 = sq(r[3]) + sq(r[4]) + sq(r[5]);
-            tot->ssr += o2;
+            tot->ssr += fc->whiten ? sq(rw[3]) + sq(rw[4]) + sq(rw[5]) : o2;
             tot->rot_ss += o2 / (w * w);
             tot->pose_samples++;
         }
@@ -228,6 +359,13 @@ static dhc_status sample_error2(const fit_context *fc, const dhc_model *model, s
     double r[DHC_MAX_ROWS_PER_SAMPLE];
     st = dhc_model_residual(model, &fc->ws->sample, fc->opt->orientation_weight_mm_per_rad, r,
                             rows);
+    if (st == DHC_OK && fc->whiten) {
+        /* screened in units of each sample's own noise: a sample at a pose where the joint
+         * noise maps large is not an outlier for being larger */
+        st = dhc_sample_whiten(model, &fc->ws->sample, fc->opt->joint_noise_rad,
+                               fc->opt->meas_noise_mm, fc->opt->orientation_weight_mm_per_rad, r,
+                               NULL);
+    }
     if (st != DHC_OK) {
         return st;
     }
@@ -498,10 +636,15 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
         model->arm.n_joints > DHC_MAX_JOINTS) {
         return DHC_ERR_CAPACITY;
     }
+    int whiten = 0;
+    if (dhc_noise_model_check(opt->joint_noise_rad, opt->meas_noise_mm, model->arm.n_joints,
+                              &whiten) != DHC_OK) {
+        return DHC_ERR_ARGUMENT;
+    }
     /* memset, not a compound literal: the report is ~5 KiB and M4 stacks are small. */
     memset(rep, 0, sizeof *rep);
     rep->n_params = set->count;
-    const fit_context fc = {set, read, ctx, n, flags, opt, ws};
+    const fit_context fc = {set, read, ctx, n, flags, opt, ws, whiten};
     ws->current = *model;
 
     dhc_status st = flag_out_of_range(&fc, &model->arm);

@@ -21,6 +21,10 @@ void dhc_diagnose_default_options(dhc_diagnose_options *opt)
     opt->separable_tol = 1e-6;
     opt->lookalike_ratio = 1.02;
     opt->orientation_weight_mm_per_rad = 1000.0;
+    for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
+        opt->joint_noise_rad[j] = 0.0;
+    }
+    opt->meas_noise_mm = 0.0;
 }
 
 /* ln Gamma(dof / 2), exact sums: chi-square only needs integer and half-integer arguments,
@@ -303,6 +307,11 @@ static dhc_status accumulate(const dhc_model *model, dhc_sample_reader read, voi
                                     &jac, NULL);
         }
         if (st == DHC_OK) {
+            /* off: returns at once, r and jac untouched */
+            st = dhc_sample_whiten(model, &ws->sample, opt->joint_noise_rad, opt->meas_noise_mm,
+                                   opt->orientation_weight_mm_per_rad, r, &jac);
+        }
+        if (st == DHC_OK) {
             st = dhc_normal_eq_add(&ws->ne, &jac, r, NULL, k);
         }
         for (size_t m = 0U; st == DHC_OK && m < k; ++m) {
@@ -456,6 +465,11 @@ dhc_status dhc_diagnose(const dhc_model *model, const dhc_param_set *base,
     }
     if (n_candidates > DHC_MAX_CANDIDATES) {
         return DHC_ERR_CAPACITY;
+    }
+    int on = 0; /* checked once here; accumulate whitens each sample when it is on */
+    if (dhc_noise_model_check(opt->joint_noise_rad, opt->meas_noise_mm, model->arm.n_joints,
+                              &on) != DHC_OK) {
+        return DHC_ERR_ARGUMENT;
     }
     memset(out, 0, sizeof *out);
     out->sigma2 = sigma2;

@@ -103,6 +103,22 @@ fw_fault fw_acquire_one(fw_ctrl *c, const dhc_model *model, uint32_t hold_ticks,
 /* Holds retaken since start (diagnostics: the arm moved during a sample's hold). */
 uint32_t fw_acquire_retakes(void);
 
+/* The wire lengths' own noise, measured: each completed hold of fw_acquire_one gives, per
+ * wire, the standard error of its mean (sample sd of the readings over the hold /
+ * sqrt(readings)); this is the root mean square of those over every hold and wire since
+ * start, in mm (0 before any hold of 2 or more ticks). Assumes readings independent from
+ * tick to tick (the counter's noise and quantisation; a slow drift over a hold would be
+ * underestimated). */
+double fw_acquire_wire_noise_mm(void);
+
+/* The hold's dither of joint `joint`'s encoder angle, measured: root mean square over every
+ * completed hold since start of (last reading - mean reading over the hold), rad (0 before
+ * any hold). A sample keeps the last reading (what positioning later servos to) while the
+ * averaged wires saw the hold's mean pose: a servo holding a continuous reference dithers
+ * between two counts in about half the holds (0.4 count RMS on the paper arm), joint-angle
+ * noise on top of the count's quantisation. */
+double fw_acquire_angle_dither_rad(size_t joint);
+
 typedef struct {
     dhc_calib_report geo;    /* base model fit */
     int found;               /* the diagnosis named a significant effect */
@@ -116,6 +132,8 @@ typedef struct {
     double stored_rms_mm;    /* of the stored model on the samples (-1: none stored) */
     double new_median_mm;    /* median per-sample wire residual norm, new model */
     double stored_median_mm; /* the same for the stored model (-1: none stored) */
+    double joint_noise_rad[DHC_MAX_JOINTS]; /* the noise model the fits used (all 0: off) */
+    double meas_noise_mm;
     int saved;               /* the new model was stored */
     uint32_t seq;
 } fw_autocal_result;
@@ -129,9 +147,22 @@ typedef struct {
     dhc_effect effect[FW_AUTOCAL_MAX_EFFECTS];
     size_t effect_joint[FW_AUTOCAL_MAX_EFFECTS]; /* 0-based; ignored for measurer effects */
     int diagnose;
+    /* Noise model of the fits and the diagnosis (errors in variables, dhc_calib.h). The
+     * samples carry encoder angles, quantised to one count: uniform, sd = 1 / (counts_per_rad
+     * sqrt(12)) per joint, at the tool several times the averaged wires' noise and larger
+     * where the arm is stretched; unweighted, the score test then flags joint-angle-like
+     * candidates (joint 1's harmonic) on clean data.
+     * io: the encoders' counts_per_rad give each joint's sd, sqrt(count^2 / 12 + dither^2)
+     * with the measured fw_acquire_angle_dither_rad; NULL: the noise model is off
+     * (unweighted least squares, as before).
+     * wire_noise_mm: sd of one averaged wire length; 0: fw_acquire_wire_noise_mm() (measured
+     * over the holds), or, when no hold showed any spread (an exact counter reading the same
+     * count throughout), one wire count's quantisation, wire_mm_per_count / sqrt(12). */
+    const fw_io_config *io;
+    double wire_noise_mm;
 } fw_autocal_config;
 
-/* No configured effects; the diagnosis on. */
+/* No configured effects; the diagnosis on; no noise model. */
 void fw_autocal_default_config(fw_autocal_config *cfg);
 
 /* fw_autocal with a configuration: the "base" fit (res->geo, geo_out) is the geometry plus

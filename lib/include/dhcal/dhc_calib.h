@@ -44,10 +44,24 @@ typedef struct {
     double step_rel_tol;         /* ... or the scaled step is below this (1e-12) */
     double orientation_weight_mm_per_rad; /* rad residuals count as this many mm (1000) */
     double outlier_threshold;    /* |error| / robust sigma above this is an outlier (6); 0 off */
-    double outlier_floor_mm;     /* robust sigma is at least this (1e-6 mm: noise-free data) */
+    double outlier_floor_mm;     /* robust sigma is at least this (1e-6 mm: noise-free data);
+                                    with the noise model on, errors and this floor are in
+                                    whitened (unit-free) units */
     double joint_margin_rad;     /* a joint angle beyond its range by more is an outlier (0.1) */
     size_t max_outlier_rounds;   /* refits after removing outliers (3) */
     uint32_t structural_seed;    /* seed of the random poses used for the structural rank */
+    /* Noise model (errors in variables; all 0 by default = off, unweighted least squares).
+     * The joint angles of a sample are measured too (an encoder's quantisation is uniform,
+     * sd = 1 count / sqrt(12)); mapped to the prediction through the pose-dependent
+     * Jacobian their noise is heteroscedastic and correlated between the rows of a sample.
+     * When on, each sample's residual and Jacobian rows are whitened by L^-1, with
+     *   L L^T = meas_noise_mm^2 I + J_q diag(joint_noise_rad^2) J_q^T,
+     * J_q = d(prediction)/d(measured joint angles) at the sample (dhc_sample_whiten): the fit
+     * is generalized least squares and the report's sigma is unit-free (see below). */
+    double joint_noise_rad[DHC_MAX_JOINTS]; /* sd of each measured joint angle, rad */
+    double meas_noise_mm;        /* sd of each measured row, mm (orientation rows: in their
+                                    mm-equivalents, i.e. meas_noise_mm / weight rad); must be
+                                    > 0 when a joint noise is set */
 } dhc_calib_options;
 
 typedef struct {
@@ -63,7 +77,12 @@ typedef struct {
                                samples the error is the vector of 3 wire residuals */
     double max_mm;          /* largest such error over used samples */
     double rms_rad;         /* same for orientation (0 without pose samples) */
-    double sigma;           /* residual standard deviation per row, sqrt(SSR / (rows - rank)) */
+    double sigma;           /* residual standard deviation per row, sqrt(SSR / (rows - rank));
+                               with the noise model on, SSR is the whitened sum of squares
+                               and sigma is unit-free: the ratio of the actual scatter to
+                               the noise model's (about 1 when the model is right; std_err
+                               are still in parameter units, from sigma^2 (J^T W J)^-1).
+                               rms_mm, max_mm and rms_rad stay physical (unweighted). */
     double condition;       /* condition estimate of the scaled identifiable block */
     double value[DHC_MAX_PARAMS];    /* parameter values after the fit (dhc_params_value) */
     double std_err[DHC_MAX_PARAMS];  /* standard errors (0 for unidentifiable) */
@@ -86,6 +105,27 @@ typedef struct {
 
 void dhc_calib_default_options(dhc_calib_options *opt);
 
+/* Checks a noise model (joint_noise_rad[0..n_joints), meas_noise_mm): *on = 1 when it is on
+ * (any value > 0), 0 when all are 0. DHC_ERR_ARGUMENT (*on = 0) for NULL, a negative or
+ * non-finite value, or joint noise without a positive meas_noise_mm. */
+dhc_status dhc_noise_model_check(const double *joint_noise_rad, double meas_noise_mm,
+                                 size_t n_joints, int *on);
+
+/* Whitens one sample under the noise model (see dhc_calib_options): r (dhc_sample_rows(s)
+ * entries, as dhc_model_residual with the same weight) and, when jac is not NULL, its rows
+ * (rows x any columns) are replaced by L^-1 r and L^-1 jac. J_q is the model Jacobian's
+ * joint-offset columns (d prediction / d q_eff) times dq_eff/dq = 1 + s_i + A_i cos q_i -
+ * B_i sin q_i (joint scale and harmonic: the chain rule of dhc_model.h); compliance's
+ * dependence on q (c dtau/dq, ~1e-3 of the diagonal for mm-level compliance) is left out,
+ * a per-mil change of the covariance, like the Jacobian's second-order terms.
+ * DHC_ERR_ARGUMENT for a negative or non-finite noise value, or joint noise without a
+ * positive meas_noise_mm (a pose sample's 6 x 6 covariance from 3 joints is singular);
+ * errors of dhc_model_jacobian; DHC_ERR_DIMENSION for a jac of the wrong row count. With the
+ * noise model off, nothing is changed. O(rows^2 (n_joints + cols)). */
+dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_sample *s,
+                             const double *joint_noise_rad, double meas_noise_mm,
+                             double weight_mm_per_rad, double *r, dhc_mat *jac);
+
 /* Fits the parameters of set to the samples. flags (n bytes) marks samples the caller
  * excludes; the fit adds DHC_SAMPLE_OUTLIER marks and refits without them.
  * Returns DHC_OK (converged), DHC_ERR_NOT_CONVERGED (model holds the best iterate, report
@@ -93,7 +133,11 @@ void dhc_calib_default_options(dhc_calib_options *opt);
  * identify from data like these: the model is unchanged, the report says rank and
  * structural_rank). The structural rank comes from random poses over the joint ranges with
  * the data's measurement kind, temperature span and approach directions.
- * DHC_ERR_NO_DATA, DHC_ERR_CAPACITY, DHC_ERR_NONFINITE or the reader's status.
+ * DHC_ERR_NO_DATA, DHC_ERR_CAPACITY, DHC_ERR_NONFINITE or the reader's status;
+ * DHC_ERR_ARGUMENT for an invalid noise model (dhc_noise_model_check).
+ * With the noise model on, the SSR minimised and the outlier screening use whitened
+ * residuals (a sample's whitened squared error ~ sigma^2 chi^2(rows)); the structural rank
+ * does not depend on it.
  * Cost per iteration: 2 passes over the data, O(n P^2) + O(P^3). */
 dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_reader read,
                          void *ctx, size_t n, uint8_t *flags, const dhc_calib_options *opt,

@@ -70,6 +70,13 @@ typedef struct {
                               than this factor more than the better one (default 1.02) and
                               the better one adds nothing significant (at alpha) to the other */
     double orientation_weight_mm_per_rad; /* as in the fit (1000) */
+    /* Noise model, as dhc_calib_options (all 0 = off): use the fit's. When on, residuals
+     * and Jacobian rows (candidates' too) are whitened sample by sample (dhc_sample_whiten),
+     * so the score test's i.i.d. assumption holds for joint-angle noise too; sigma2 is then
+     * the fit's unit-free sigma^2, ssr and explained_ss are whitened sums of squares and
+     * explained their ratio. */
+    double joint_noise_rad[DHC_MAX_JOINTS];
+    double meas_noise_mm;
 } dhc_diagnose_options;
 
 /* Scratch of dhc_diagnose (about 10 * DHC_MAX_PARAMS^2 bytes; keep it static). Every array
@@ -106,7 +113,8 @@ size_t dhc_diagnose_candidates(const dhc_model *model, const dhc_param_set *base
  * parameter set and its identifiable flags (dhc_calib_report), sigma2 its noise variance per
  * row and flags its sample flags (only DHC_SAMPLE_USED rows count).
  * DHC_ERR_CAPACITY when base alone leaves no room for a candidate's columns;
- * DHC_ERR_ARGUMENT for sigma2 <= 0 or a candidate the model cannot take; errors of the
+ * DHC_ERR_ARGUMENT for sigma2 <= 0, an invalid noise model (dhc_noise_model_check) or a
+ * candidate the model cannot take; errors of the
  * reader and of dhc_model_jacobian. O(passes * n * P^2 + candidates * P^2 k). */
 dhc_status dhc_diagnose(const dhc_model *model, const dhc_param_set *base,
                         const uint8_t *identifiable, double sigma2,
