@@ -58,18 +58,7 @@ static phase_result ph[3];
 
 static void predict_point(const dhc_model *m, const double *q, double p[3])
 {
-    dhc_sample s;
-    memset(&s, 0, sizeof s);
-    s.kind = (uint8_t)DHC_MEAS_POSITION;
-    s.temp_c = m->thermal_ref_c;
-    for (size_t j = 0U; j < m->arm.n_joints; ++j) {
-        s.q_rad[j] = q[j];
-        s.dir[j] = 1;
-    }
-    dhc_prediction pr;
-    if (dhc_model_predict(m, &s, &pr) == DHC_OK) {
-        memcpy(p, pr.p_mm, sizeof pr.p_mm);
-    } else {
+    if (dhc_model_tool_point(m, q, NULL, p) != DHC_OK) {
         p[0] = p[1] = p[2] = (double)NAN;
     }
 }

@@ -22,25 +22,6 @@ static double rng_unit(uint32_t *s)
     return (double)(rng_next(s) >> 8U) / 16777216.0;
 }
 
-static dhc_status predict_point(const dhc_model *m, const double *q, const int8_t *dir,
-                                double p[3])
-{
-    dhc_sample s;
-    memset(&s, 0, sizeof s);
-    s.kind = (uint8_t)DHC_MEAS_POSITION;
-    s.temp_c = m->thermal_ref_c;
-    for (size_t j = 0U; j < m->arm.n_joints; ++j) {
-        s.q_rad[j] = q[j];
-        s.dir[j] = (int8_t)(dir != NULL ? dir[j] : 1);
-    }
-    dhc_prediction pr;
-    const dhc_status st = dhc_model_predict(m, &s, &pr);
-    if (st == DHC_OK) {
-        memcpy(p, pr.p_mm, sizeof pr.p_mm);
-    }
-    return st;
-}
-
 size_t fw_plan_poses(const dhc_model *model, size_t n, uint32_t seed, int mixed_dirs,
                      fw_pose *poses)
 {
@@ -60,7 +41,7 @@ size_t fw_plan_poses(const dhc_model *model, size_t n, uint32_t seed, int mixed_
             ps.dir[j] = plus ? (int8_t)1 : (int8_t)-1;
         }
         double p[3];
-        if (predict_point(model, ps.q_rad, ps.dir, p) != DHC_OK) {
+        if (dhc_model_tool_point(model, ps.q_rad, ps.dir, p) != DHC_OK) {
             continue;
         }
         if (sqrt(p[0] * p[0] + p[1] * p[1]) < 250.0 || p[2] < 100.0) {
@@ -328,7 +309,7 @@ fw_fault fw_acquire_one(fw_ctrl *c, const dhc_model *model, uint32_t hold_ticks,
         double pt[3];
         double pm[3];
         const dhc_status st = dhc_trilat_world(&m, w, 1.0, pt);
-        if (st != DHC_OK || predict_point(model, s.q_rad, s.dir, pm) != DHC_OK) {
+        if (st != DHC_OK || dhc_model_tool_point(model, s.q_rad, s.dir, pm) != DHC_OK) {
             fw_ctrl_fault(c, FW_FAULT_WIRES_INCONSISTENT, 0U);
             return c->fault;
         }

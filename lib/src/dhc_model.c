@@ -188,6 +188,28 @@ dhc_status dhc_model_predict(const dhc_model *model, const dhc_sample *s, dhc_pr
     return dhc_model_evaluate(model, s, 0, &ev, out);
 }
 
+dhc_status dhc_model_tool_point(const dhc_model *model, const double *q_rad, const int8_t *dir,
+                                double p_mm[3])
+{
+    if (model == NULL || q_rad == NULL || p_mm == NULL || model->arm.n_joints > DHC_MAX_JOINTS) {
+        return DHC_ERR_ARGUMENT;
+    }
+    dhc_sample s;
+    memset(&s, 0, sizeof s);
+    s.kind = (uint8_t)DHC_MEAS_POSITION;
+    s.temp_c = model->thermal_ref_c;
+    for (size_t j = 0U; j < model->arm.n_joints; ++j) {
+        s.q_rad[j] = q_rad[j];
+        s.dir[j] = (int8_t)(dir != NULL ? dir[j] : 1);
+    }
+    dhc_prediction pr;
+    const dhc_status st = dhc_model_predict(model, &s, &pr);
+    if (st == DHC_OK) {
+        memcpy(p_mm, pr.p_mm, sizeof pr.p_mm);
+    }
+    return st;
+}
+
 dhc_status dhc_model_residual(const dhc_model *model, const dhc_sample *s,
                               double weight_mm_per_rad, double r[DHC_MAX_ROWS_PER_SAMPLE],
                               size_t *rows)

@@ -92,6 +92,40 @@ static void test_joint_effects_shift_the_effective_angles(void)
     }
 }
 
+/* What a controller plans with: plain forward kinematics at the effective angles of the
+ * given approach directions (NULL: all +1), at the thermal reference temperature. */
+static void test_tool_point_is_forward_kinematics_at_the_effective_angles(void)
+{
+    dhc_model m = paper_model();
+    m.effect[0].scale = 1e-3;
+    m.effect[2].backlash_rad = 0.004;
+    m.thermal_per_k = 1e-5; /* no expansion at the reference temperature */
+    const double q[DHC_MAX_JOINTS] = {0.7, 0.3, -0.9};
+    const double q_up[DHC_MAX_JOINTS] = {0.7 * 1.001, 0.3, -0.9 + 0.002};
+    const double q_down[DHC_MAX_JOINTS] = {0.7 * 1.001, 0.3, -0.9 - 0.002};
+    dhc_frame up;
+    dhc_frame down;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_forward(&m.arm, q_up, DHC_MAX_JOINTS, &up));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_forward(&m.arm, q_down, DHC_MAX_JOINTS, &down));
+    double p[3];
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_model_tool_point(&m, q, NULL, p));
+    for (size_t r = 0U; r < 3U; ++r) {
+        TEST_ASSERT_DOUBLE_WITHIN(1e-9, up.pos[r], p[r]);
+    }
+    const int8_t dir[DHC_MAX_JOINTS] = {1, 1, -1};
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_model_tool_point(&m, q, dir, p));
+    for (size_t r = 0U; r < 3U; ++r) {
+        TEST_ASSERT_DOUBLE_WITHIN(1e-9, down.pos[r], p[r]);
+    }
+    const double kept[3] = {1.0, 2.0, 3.0};
+    memcpy(p, kept, sizeof kept);
+    const double bad[DHC_MAX_JOINTS] = {0.7, (double)NAN, -0.9};
+    TEST_ASSERT_NOT_EQUAL(DHC_OK, dhc_model_tool_point(&m, bad, NULL, p));
+    TEST_ASSERT_EQUAL_MEMORY(kept, p, sizeof kept);
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_model_tool_point(NULL, q, NULL, p));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_model_tool_point(&m, q, NULL, NULL));
+}
+
 static void test_thermal_expansion_scales_the_arm_about_its_base(void)
 {
     dhc_model m = paper_model();
@@ -354,6 +388,7 @@ int main(void)
     UNITY_BEGIN();
     RUN_TEST(test_gravity_moments_of_the_paper_arm_match_the_closed_form);
     RUN_TEST(test_joint_effects_shift_the_effective_angles);
+    RUN_TEST(test_tool_point_is_forward_kinematics_at_the_effective_angles);
     RUN_TEST(test_thermal_expansion_scales_the_arm_about_its_base);
     RUN_TEST(test_wire_lengths_are_scaled_distances_plus_offsets);
     RUN_TEST(test_model_jacobian_matches_central_differences_for_every_effect);

@@ -117,6 +117,12 @@ void dhc_measurer_anchor_world(const dhc_measurer_model *m, size_t k, double out
  * result is not finite. O(N^2) for compliance, O(N) otherwise. */
 dhc_status dhc_model_predict(const dhc_model *model, const dhc_sample *s, dhc_prediction *out);
 
+/* The tool point (world, mm) the model puts at joint angles q_rad (n_joints entries), each
+ * joint approached from dir (NULL: all from +1), at the thermal reference temperature: what
+ * a controller commands and plans with. Errors as dhc_model_predict; p_mm untouched then. */
+dhc_status dhc_model_tool_point(const dhc_model *model, const double *q_rad, const int8_t *dir,
+                                double p_mm[3]);
+
 /* Residual r = measured - predicted, rows as dhc_sample_rows; orientation rows are
  * weighted into mm-equivalents with weight_mm_per_rad. Errors of dhc_model_predict, and
  * DHC_ERR_NONFINITE when a residual is not finite (a non-finite or overflowing weight, a
