@@ -523,10 +523,7 @@ static int run_calibration(const options *o)
     }
     fw_ctrl_config cfg;
     fw_ctrl_default_config(&cfg, 3U);
-    for (size_t j = 0U; j < 3U; ++j) {
-        cfg.q_min_rad[j] = nominal.arm.joint[j].min_rad;
-        cfg.q_max_rad[j] = nominal.arm.joint[j].max_rad;
-    }
+    fw_ctrl_config_limits(&cfg, &nominal.arm);
     dhc_sample s0;
     memset(&s0, 0, sizeof s0);
     s0.kind = (uint8_t)DHC_MEAS_WIRES;

@@ -463,10 +463,7 @@ int main(int argc, char **argv)
     autocal.io = weighted ? &io : NULL;
     fw_ctrl_config cfg;
     fw_ctrl_default_config(&cfg, 3U);
-    for (size_t j = 0U; j < 3U; ++j) {
-        cfg.q_min_rad[j] = nominal.arm.joint[j].min_rad;
-        cfg.q_max_rad[j] = nominal.arm.joint[j].max_rad;
-    }
+    fw_ctrl_config_limits(&cfg, &nominal.arm);
     /* wire counters: homed near the lengths the nominal model expects at the start pose */
     dhc_sample s0;
     memset(&s0, 0, sizeof s0);

@@ -13,6 +13,14 @@ const char *fw_fault_name(fw_fault f)
     return (unsigned)f < (unsigned)FW_FAULT_COUNT ? names[f] : "unknown";
 }
 
+void fw_ctrl_config_limits(fw_ctrl_config *cfg, const dhc_arm *arm)
+{
+    for (size_t j = 0U; j < arm->n_joints && j < DHC_MAX_JOINTS; ++j) {
+        cfg->q_min_rad[j] = arm->joint[j].min_rad;
+        cfg->q_max_rad[j] = arm->joint[j].max_rad;
+    }
+}
+
 void fw_ctrl_default_config(fw_ctrl_config *cfg, size_t n_joints)
 {
     memset(cfg, 0, sizeof *cfg);

@@ -202,11 +202,35 @@ static void test_port_timeout_and_io_error(void)
     TEST_ASSERT_EQUAL_STRING("port_io", fw_fault_name(ctrl.fault));
 }
 
+static void test_joint_ranges_come_from_the_model_arm(void)
+{
+    dhc_arm arm;
+    memset(&arm, 0, sizeof arm);
+    arm.n_joints = 2U;
+    arm.joint[0].min_rad = -1.5;
+    arm.joint[0].max_rad = 2.5;
+    arm.joint[1].min_rad = -0.25;
+    arm.joint[1].max_rad = 0.75;
+    fw_ctrl_config c;
+    fw_ctrl_default_config(&c, 3U);
+    const double third_min = c.q_min_rad[2];
+    const double third_max = c.q_max_rad[2];
+    fw_ctrl_config_limits(&c, &arm);
+    TEST_ASSERT_EQUAL_DOUBLE(-1.5, c.q_min_rad[0]);
+    TEST_ASSERT_EQUAL_DOUBLE(2.5, c.q_max_rad[0]);
+    TEST_ASSERT_EQUAL_DOUBLE(-0.25, c.q_min_rad[1]);
+    TEST_ASSERT_EQUAL_DOUBLE(0.75, c.q_max_rad[1]);
+    /* a joint the arm does not have keeps the default */
+    TEST_ASSERT_EQUAL_DOUBLE(third_min, c.q_min_rad[2]);
+    TEST_ASSERT_EQUAL_DOUBLE(third_max, c.q_max_rad[2]);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_move_settles_at_the_target_from_the_chosen_side);
     RUN_TEST(test_target_outside_the_range_is_refused);
+    RUN_TEST(test_joint_ranges_come_from_the_model_arm);
     RUN_TEST(test_encoder_jump);
     RUN_TEST(test_tacho_mismatch);
     RUN_TEST(test_drive_saturation);

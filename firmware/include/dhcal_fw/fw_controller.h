@@ -25,6 +25,7 @@
 #include <stdint.h>
 
 #include "dhcal/dhc_config.h"
+#include "dhcal/dhc_kinematics.h"
 #include "dhcal_fw/fw_counter.h"
 #include "dhcal_fw/fw_port.h"
 #include "dhcal_fw/fw_servo.h"
@@ -100,6 +101,10 @@ typedef struct {
 
 /* Gains and limits for the paper's drive (PHYSICS.md: 100:1 gear, ~10 Hz position loop). */
 void fw_ctrl_default_config(fw_ctrl_config *cfg, size_t n_joints);
+
+/* The joint ranges of the model's arm (each joint's min_rad..max_rad): the controller then
+ * refuses the targets the model says the arm cannot reach. */
+void fw_ctrl_config_limits(fw_ctrl_config *cfg, const dhc_arm *arm);
 
 /* Homes the counters: the joints are at q_home_rad (n entries) and the wires, if
  * wire_expected_mm is not NULL, about those lengths (within half a counter wrap); the

@@ -50,10 +50,7 @@ static void acquire(double joint2_stiffness)
     fw_sim_io_config(&sc, &io);
     fw_ctrl_config cfg;
     fw_ctrl_default_config(&cfg, 3U);
-    for (size_t j = 0U; j < 3U; ++j) {
-        cfg.q_min_rad[j] = nominal.arm.joint[j].min_rad;
-        cfg.q_max_rad[j] = nominal.arm.joint[j].max_rad;
-    }
+    fw_ctrl_config_limits(&cfg, &nominal.arm);
     dhs_plant_truth t;
     dhs_plant_get_truth(&sim.plant, &t);
     TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_ctrl_init(&ctrl, &port, &io, &cfg, q_start, t.wire_mm));

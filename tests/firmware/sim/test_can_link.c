@@ -206,10 +206,7 @@ static void setup_world(int variant)
     fw_ctrl_default_config(&cfg, 3U);
     dhc_arm nominal;
     sim_fixture_nominal(&nominal);
-    for (size_t j = 0U; j < 3U; ++j) {
-        cfg.q_min_rad[j] = nominal.joint[j].min_rad;
-        cfg.q_max_rad[j] = nominal.joint[j].max_rad;
-    }
+    fw_ctrl_config_limits(&cfg, &nominal);
 
     TEST_ASSERT_EQUAL(DHC_OK, fw_sim_init(&sim, &sc, RUN_SEED, q_start, &sim_port));
     dhs_plant_truth t;

@@ -87,10 +87,7 @@ static void boot(const fw_io_config *io_in)
         io = *io_in;
     }
     fw_ctrl_default_config(&cfg, 3U);
-    for (size_t j = 0U; j < 3U; ++j) {
-        cfg.q_min_rad[j] = model.arm.joint[j].min_rad;
-        cfg.q_max_rad[j] = model.arm.joint[j].max_rad;
-    }
+    fw_ctrl_config_limits(&cfg, &model.arm);
     dhs_plant_truth t;
     dhs_plant_get_truth(&sim.plant, &t);
     TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_ctrl_init(&ctrl, &port, &io, &cfg, q_start, t.wire_mm));

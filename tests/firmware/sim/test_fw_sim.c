@@ -30,10 +30,7 @@ void setUp(void)
     fw_ctrl_config cfg;
     fw_ctrl_default_config(&cfg, 3U);
     TEST_ASSERT_EQUAL(DHC_OK, sim_fixture_nominal_model(&model));
-    for (size_t j = 0U; j < 3U; ++j) {
-        cfg.q_min_rad[j] = model.arm.joint[j].min_rad;
-        cfg.q_max_rad[j] = model.arm.joint[j].max_rad;
-    }
+    fw_ctrl_config_limits(&cfg, &model.arm);
     dhs_plant_truth t;
     dhs_plant_get_truth(&sim.plant, &t);
     TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_ctrl_init(&ctrl, &port, &io, &cfg, q_start, t.wire_mm));
