@@ -585,9 +585,17 @@ int main(int argc, char **argv)
         printf("{\"before_rms_mm\": %.6f, \"geometric_rms_mm\": %.6f, \"after_rms_mm\": %.6f, "
                "\"effect\": \"%s\", \"noise_floor_mm\": %.6f, \"before_max_mm\": %.6f, "
                "\"geometric_max_mm\": %.6f, \"after_max_mm\": %.6f, \"samples\": %zu, "
-               "\"observability_o1\": %.6g}\n",
+               "\"observability_o1\": %.6g, ",
                ph[0].rms_mm, ph[1].rms_mm, ph[2].rms_mm, effect, floor_mm, ph[0].max_mm,
                ph[1].max_mm, ph[2].max_mm, n_done, o1);
+        /* the noise model the controller measured and fitted with: what `dhcal --noise`
+         * takes at the desk (largest joint sd, in degrees) */
+        double joint_sd_deg = 0.0;
+        for (size_t j = 0U; j < 3U; ++j) {
+            joint_sd_deg = fmax(joint_sd_deg, res.joint_noise_rad[j] * 180.0 / PI);
+        }
+        printf("\"noise_model\": {\"joint_deg\": %.6g, \"meas_mm\": %.6g}}\n", joint_sd_deg,
+               res.meas_noise_mm);
     }
     return 0;
 }

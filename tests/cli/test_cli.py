@@ -150,6 +150,25 @@ class Cli(unittest.TestCase):
                       'joint_scale:9']):
             self.assertEqual(self.run_dhcal(*args).returncode, 2, args)
 
+    def test_bad_noise_models_exit_2_and_leave_out_untouched(self):
+        for bad in ('0.001', 'x,0.01', '0.001,0', '0.001,-1', '-0.001,0.01', '2,0.01',
+                    'nan,0.01', '0.001,inf', '0.001,0.01,3', '0.001,1e3'):
+            r = self.fit(None, None, '--noise', bad)
+            self.assert_bad_input(r, '--noise', bad)
+            self.assert_out_untouched(None)
+
+    def test_a_noise_model_weights_the_fit_and_reports_itself(self):
+        r = self.fit(None, None, '--effects', 'joint_compliance:2', '--noise', '0.001,0.05',
+                     '--json')
+        self.assertEqual(r.returncode, 0, r.stderr)
+        d = json.loads(r.stdout)
+        self.assertEqual(d['noise_model']['joint_deg'], 0.001)
+        self.assertEqual(d['noise_model']['meas_mm'], 0.05)
+        self.assertNotIn('sigma_mm', d)
+        # the fixture's noise is 0.05 mm per coordinate: the whitened sd is near 1
+        self.assertGreater(d['noise_model']['whitened_sd'], 0.5)
+        self.assertLess(d['noise_model']['whitened_sd'], 2.0)
+
     def test_help_on_every_command(self):
         for cmd in ('compare', 'fit', 'diagnose', 'plot'):
             r = self.run_dhcal(cmd, '--help')

@@ -3,6 +3,7 @@
 
 #include "dhcal/dhc_jacobian.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -56,11 +57,48 @@ int dhcal_parse_effects(const char *list, const dhc_model *model, dhc_param_set 
     return DHCAL_IO_OK;
 }
 
-int dhcal_run_fit(const dhc_model *nominal, const char *effects, dhcal_samples *s,
-                  const dhcal_samples *held, dhcal_fit *out, dhcal_error *err)
+int dhcal_parse_noise(const char *text, dhcal_noise *out, dhcal_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (text == NULL) {
+        return DHCAL_IO_OK;
+    }
+    char *end = NULL;
+    errno = 0;
+    const double joint_deg = strtod(text, &end);
+    const int joint_ok = end != text && *end == ',' && errno == 0 && isfinite(joint_deg) &&
+                         joint_deg >= 0.0 && joint_deg <= 1.0;
+    const char *second = joint_ok ? end + 1 : NULL;
+    double meas_mm = 0.0;
+    int meas_ok = 0;
+    if (second != NULL) {
+        errno = 0;
+        meas_mm = strtod(second, &end);
+        meas_ok = end != second && *end == '\0' && errno == 0 && isfinite(meas_mm) &&
+                  meas_mm > 0.0 && meas_mm <= 100.0;
+    }
+    if (!joint_ok || !meas_ok) {
+        snprintf(err->msg, sizeof err->msg,
+                 "--noise: '%.100s' is not JOINT_DEG,MEAS_MM with 0 <= JOINT_DEG <= 1 (each "
+                 "joint angle's sd) and 0 < MEAS_MM <= 100 (each measured row's sd)",
+                 text);
+        return DHCAL_IO_BAD_INPUT;
+    }
+    out->on = 1;
+    out->joint_rad = joint_deg * PI / 180.0;
+    out->meas_mm = meas_mm;
+    return DHCAL_IO_OK;
+}
+
+int dhcal_run_fit(const dhc_model *nominal, const char *effects, const dhcal_noise *noise,
+                  dhcal_samples *s, const dhcal_samples *held, dhcal_fit *out,
+                  dhcal_error *err)
 {
     memset(out, 0, sizeof *out);
     out->model = *nominal;
+    if (noise != NULL) {
+        out->noise = *noise;
+    }
     if (dhc_params_base_model(&out->set, &out->model) != DHC_OK) {
         snprintf(err->msg, sizeof err->msg, "too many joints for the parameter limit");
         return DHCAL_IO_BAD_INPUT;
@@ -71,6 +109,12 @@ int dhcal_run_fit(const dhc_model *nominal, const char *effects, dhcal_samples *
     }
     dhc_calib_options opt;
     dhc_calib_default_options(&opt);
+    if (out->noise.on) {
+        for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
+            opt.joint_noise_rad[j] = out->noise.joint_rad;
+        }
+        opt.meas_noise_mm = out->noise.meas_mm;
+    }
     out->status = dhc_calib_fit(&out->model, &out->set, dhcal_samples_read, s, s->n, s->flags,
                                 &opt, &calib_ws, &out->rep);
     if (out->status == DHC_ERR_UNDERDETERMINED) {
@@ -115,6 +159,12 @@ int dhcal_run_diagnose(const dhcal_fit *fit, const dhcal_samples *s, dhc_diagnos
                                               cands, DHC_MAX_CANDIDATES);
     dhc_diagnose_options opt;
     dhc_diagnose_default_options(&opt);
+    if (fit->noise.on) {
+        for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
+            opt.joint_noise_rad[j] = fit->noise.joint_rad;
+        }
+        opt.meas_noise_mm = fit->noise.meas_mm;
+    }
     const double sigma2 = fit->rep.sigma * fit->rep.sigma;
     if (!(sigma2 > 0.0)) {
         snprintf(err->msg, sizeof err->msg,

@@ -7,8 +7,21 @@
 #include "dhcal_data.h"
 #include "dhcal_io.h"
 
+/* The samples' noise model (--noise): off, or each joint angle's and each measured row's
+ * standard deviation; on, every sample is weighted by its covariance (dhc_calib_options). */
+typedef struct {
+    int on;
+    double joint_rad;
+    double meas_mm;
+} dhcal_noise;
+
+/* Parses "JOINT_DEG,MEAS_MM" (e.g. "0.0009,0.004"): joint angle sd in degrees (0..1), the
+ * measurement's sd in mm (greater than 0, up to 100). DHCAL_IO_BAD_INPUT with the reason. */
+int dhcal_parse_noise(const char *text, dhcal_noise *out, dhcal_error *err);
+
 typedef struct {
     dhc_model model;      /* calibrated (nominal when the fit failed) */
+    dhcal_noise noise;    /* what the fit weighted with (the diagnosis uses the same) */
     dhc_param_set set;    /* base model + effects */
     dhc_calib_report rep;
     dhc_status status;
@@ -26,8 +39,9 @@ int dhcal_parse_effects(const char *list, const dhc_model *model, dhc_param_set 
  * DHCAL_IO_OK when the library returned DHC_OK or DHC_ERR_NOT_CONVERGED (see out->status),
  * DHCAL_IO_FAILED with a plain-words message otherwise (under-determined data included),
  * DHCAL_IO_BAD_INPUT for a bad effects list. */
-int dhcal_run_fit(const dhc_model *nominal, const char *effects, dhcal_samples *s,
-                  const dhcal_samples *held, dhcal_fit *out, dhcal_error *err);
+int dhcal_run_fit(const dhc_model *nominal, const char *effects, const dhcal_noise *noise,
+                  dhcal_samples *s, const dhcal_samples *held, dhcal_fit *out,
+                  dhcal_error *err);
 
 /* Ranks every candidate effect the fit's model can take against its residuals. */
 int dhcal_run_diagnose(const dhcal_fit *fit, const dhcal_samples *s, dhc_diagnosis *out,

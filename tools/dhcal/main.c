@@ -18,6 +18,7 @@
 
 #define EXIT_COMPUTE 1
 #define EXIT_USAGE 2
+#define PI 3.14159265358979323846
 
 typedef struct {
     const char *command;
@@ -26,6 +27,7 @@ typedef struct {
     const char *heldout;
     const char *out;
     const char *effects;
+    const char *noise;
     int json;
 } options;
 
@@ -39,6 +41,10 @@ static const char *const common_help =
     "                     joint_harmonic:i, joint_backlash:i, joint_compliance:i,\n"
     "                     measurer_scale, measurer_offset, measurer_anchors, thermal_scale\n"
     "  --heldout H.csv    rows not used in the fit; their RMS error is reported\n"
+    "  --noise J,M        the samples' noise: each joint angle's sd J (deg) and each\n"
+    "                     measured coordinate's sd M (mm); every row is then weighted by\n"
+    "                     its covariance (errors in variables): use it when the angles are\n"
+    "                     as noisy as the measurement, e.g. encoder quantisation\n"
     "  --json             one JSON object on stdout instead of text\n";
 
 static const char *const usage_text =
@@ -124,6 +130,8 @@ static int parse_args(int argc, char **argv, options *o)
             slot = &o->out;
         } else if (strcmp(a, "--effects") == 0) {
             slot = &o->effects;
+        } else if (strcmp(a, "--noise") == 0) {
+            slot = &o->noise;
         } else {
             char msg[300];
             snprintf(msg, sizeof msg, "unknown option '%.200s'", a);
@@ -167,6 +175,7 @@ static int parse_args(int argc, char **argv, options *o)
 typedef struct {
     dhcal_model file_model;
     dhc_model model;
+    dhcal_noise noise;
     dhcal_dataset data;
     dhcal_samples samples;
     dhcal_dataset held_data;
@@ -179,7 +188,10 @@ static int load_session(const options *o, session *s)
     dhcal_error err;
     memset(&err, 0, sizeof err);
     memset(s, 0, sizeof *s);
-    int rc = dhcal_model_load(o->model, &s->file_model, &err);
+    int rc = dhcal_parse_noise(o->noise, &s->noise, &err);
+    if (rc == DHCAL_IO_OK) {
+        rc = dhcal_model_load(o->model, &s->file_model, &err);
+    }
     if (rc == DHCAL_IO_OK) {
         rc = dhcal_model_to_lib(&s->file_model, o->model, &s->model, &err);
     }
@@ -279,7 +291,15 @@ static void json_fit(cJSON *obj, const dhcal_fit *f, const session *s, const dou
     }
     cJSON_AddNumberToObject(obj, "iterations", (double)f->rep.iterations);
     cJSON_AddBoolToObject(obj, "converged", f->rep.converged);
-    cJSON_AddNumberToObject(obj, "sigma_mm", f->rep.sigma);
+    if (f->noise.on) {
+        /* weighted rows: the residual's sd is in units of the noise model (1: it fits) */
+        cJSON *nm = cJSON_AddObjectToObject(obj, "noise_model");
+        cJSON_AddNumberToObject(nm, "joint_deg", f->noise.joint_rad * 180.0 / PI);
+        cJSON_AddNumberToObject(nm, "meas_mm", f->noise.meas_mm);
+        cJSON_AddNumberToObject(nm, "whitened_sd", f->rep.sigma);
+    } else {
+        cJSON_AddNumberToObject(obj, "sigma_mm", f->rep.sigma);
+    }
     cJSON *params = cJSON_AddArrayToObject(obj, "parameters");
     cJSON *unid = cJSON_AddArrayToObject(obj, "unidentifiable");
     char name[48];
@@ -379,8 +399,8 @@ static int do_fit(const options *o, session *s, dhcal_fit *fit, double **row_err
 {
     dhcal_error err;
     memset(&err, 0, sizeof err);
-    const int rc = dhcal_run_fit(&s->model, o->effects, &s->samples, s->have_held ? &s->held : NULL,
-                                 fit, &err);
+    const int rc = dhcal_run_fit(&s->model, o->effects, &s->noise, &s->samples,
+                                 s->have_held ? &s->held : NULL, fit, &err);
     if (rc != DHCAL_IO_OK) {
         fprintf(stderr, "dhcal: %s\n", err.msg);
         return rc == DHCAL_IO_BAD_INPUT ? EXIT_USAGE : EXIT_COMPUTE;
@@ -451,9 +471,16 @@ static void candidate_params(const dhcal_fit *fit, const dhc_candidate_result *c
 static void text_diagnosis(const dhcal_fit *fit, const dhc_diagnosis *d)
 {
     char label[64];
-    printf("\ndiagnosis: %zu candidate effects scored against the remaining residual "
-           "(noise estimate %.4f mm per coordinate)\n",
-           d->count, sqrt(d->sigma2));
+    if (fit->noise.on) {
+        printf("\ndiagnosis: %zu candidate effects scored against the remaining residual "
+               "(rows weighted by the noise model: joint angles %.2g deg, measurements %.2g "
+               "mm; whitened residual sd %.3f, 1 when the model fits to that noise)\n",
+               d->count, fit->noise.joint_rad * 180.0 / PI, fit->noise.meas_mm, sqrt(d->sigma2));
+    } else {
+        printf("\ndiagnosis: %zu candidate effects scored against the remaining residual "
+               "(noise estimate %.4f mm per coordinate)\n",
+               d->count, sqrt(d->sigma2));
+    }
     const dhc_candidate_result *top = d->count > 0U ? &d->c[0] : NULL;
     if (top == NULL || !top->significant) {
         printf("no missing effect found: nothing explains a significant share of the residual; "
@@ -595,7 +622,10 @@ static int cmd_plot(const options *o, session *s)
         for (size_t i = 0U; i < n; ++i) {
             s->samples.flags[i] = (uint8_t)DHC_SAMPLE_USED;
         }
-        rc = dhcal_run_fit(&s->model, list, &s->samples, NULL, &after, &err) == DHCAL_IO_OK ? 0 : EXIT_COMPUTE;
+        rc = dhcal_run_fit(&s->model, list, &s->noise, &s->samples, NULL, &after, &err) ==
+                     DHCAL_IO_OK
+                 ? 0
+                 : EXIT_COMPUTE;
     } else if (rc == 0) {
         after = before;
     }
