@@ -8,6 +8,7 @@
 #     whose probe fails names its packages and fails, installed or not: a compiler without
 #     its target's C library is caught here, not in CMake's compiler check.
 #   prereq_packages NEED...   the packages the needs list, one a line
+#   prereq_scipy_python       the python3 that imports numpy and scipy (need bench)
 #
 # The needs are the names in scripts/packages: demo host static valgrind linux-port asan
 # fuzz cortex-m4 aarch64-linux bench.
@@ -236,9 +237,22 @@ probe_aarch64_linux() {
     prereq_fail "the aarch64 program did not run under qemu-aarch64: $(tail -3 log)"
 }
 
+# The interpreter that imports numpy and scipy: python3 on PATH, else Debian's own (a
+# python3 of pyenv or a venv earlier on PATH does not see Debian's python3-scipy).
+prereq_scipy_python() {
+  local py
+  for py in python3 /usr/bin/python3; do
+    if "$py" -c 'import numpy, scipy' >/dev/null 2>&1; then
+      command -v "$py"
+      return 0
+    fi
+  done
+  return 1
+}
+
 probe_bench() {
   probe_demo || return 1
-  python3 -c 'import numpy, scipy' >log 2>&1 || prereq_fail "python3 cannot import numpy and scipy"
+  prereq_scipy_python >/dev/null || prereq_fail "no python3 here imports numpy and scipy"
 }
 
 prereq_probe() {
