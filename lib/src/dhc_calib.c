@@ -32,6 +32,8 @@ void dhc_calib_default_options(dhc_calib_options *opt)
     opt->rank_rel_tol = 1e-10;
     opt->ssr_rel_tol = 1e-10;
     opt->step_rel_tol = 1e-12;
+    opt->noise_rel_tol = 1e-2;
+    opt->max_identifiability_checks = 3U;
     opt->orientation_weight_mm_per_rad = 1000.0;
     opt->outlier_threshold = 6.0;
     opt->outlier_floor_mm = 1e-6;
@@ -506,7 +508,8 @@ static double scaled_step_norm(const dhc_lsq_factor *fac, const double *delta, s
  * partners compensating. The set is kept in rep->identifiable (fill_report overwrites it);
  * excluded columns are hidden from the analysis by a zero diagonal, which is restored
  * afterwards (the partner search reads the full matrix) together with their true column
- * scale. ws->delta holds the diagonal meanwhile: it is free until the next step. */
+ * scale. ws->scratch holds the diagonal meanwhile (ws->delta, the step just taken, is read
+ * after this by the convergence test). */
 static dhc_status analyse_keeping_set(const fit_context *fc, dhc_calib_report *rep)
 {
     dhc_calib_workspace *const ws = fc->ws;
@@ -514,25 +517,71 @@ static dhc_status analyse_keeping_set(const fit_context *fc, dhc_calib_report *r
     const size_t n = ne->n;
     const int first = rep->iterations == 0U;
     for (size_t j = 0U; j < n; ++j) {
-        ws->delta[j] = ne->jtj[j * n + j];
+        ws->scratch[j] = ne->jtj[j * n + j];
         if (!first && !rep->identifiable[j]) {
             ne->jtj[j * n + j] = 0.0;
         }
     }
     const dhc_status st = dhc_lsq_analyse(ne, fc->opt->rank_rel_tol, &ws->fac);
     for (size_t j = 0U; j < n; ++j) {
-        ne->jtj[j * n + j] = ws->delta[j];
+        ne->jtj[j * n + j] = ws->scratch[j];
         if (st != DHC_OK) {
             continue;
         }
-        if (!ws->fac.identifiable[j] && ws->delta[j] > DBL_MIN) {
-            ws->fac.scale[j] = 1.0 / sqrt(ws->delta[j]);
+        if (!ws->fac.identifiable[j] && ws->scratch[j] > DBL_MIN) {
+            ws->fac.scale[j] = 1.0 / sqrt(ws->scratch[j]);
         }
         if (first) {
             rep->identifiable[j] = ws->fac.identifiable[j];
         }
     }
     return st;
+}
+
+/* sigma^2, the residual variance per degree of freedom of the analysis in ws->fac (0 when
+ * there are no degrees of freedom: nothing to compare with). */
+static double residual_variance(const fit_context *fc, const pass_totals *tot)
+{
+    const double dof = (double)tot->rows - (double)fc->ws->fac.rank;
+    return dof > 0.0 ? tot->ssr / dof : 0.0;
+}
+
+/* Convergence relative to the noise the fit estimates, before a step: a full Gauss-Newton
+ * step from here promises an SSR decrease below (noise_rel_tol sigma)^2, i.e. what is left
+ * is under noise_rel_tol standard errors (Mahalanobis). ws->ne and ws->fac: the current
+ * estimate's accumulation and analysis. */
+static int nothing_left_to_gain(const fit_context *fc, const pass_totals *tot)
+{
+    const double tol = fc->opt->noise_rel_tol;
+    const double sigma2 = residual_variance(fc, tot);
+    double decrement;
+    return tol > 0.0 && sigma2 > 0.0 &&
+           dhc_lsq_decrement(&fc->ws->ne, &fc->ws->fac, &decrement) == DHC_OK &&
+           decrement <= tol * tol * sigma2;
+}
+
+/* ... and after an accepted step: it moved no parameter by more than noise_rel_tol of its
+ * standard error and lowered the SSR by under 2 noise_rel_tol sigma^2. Where the data
+ * barely determine a combination of parameters, the SSR is flat and curved along it: the
+ * Gauss-Newton model overshoots, and LM creeps along the valley with steps that change
+ * nothing a statistician could see (the SSR's own sd is sigma^2 sqrt(2 dof)). ws->fac is the
+ * analysis at the new estimate; scratch holds n_params doubles. */
+static int step_below_noise(const fit_context *fc, const pass_totals *tot, double gain,
+                            double *scratch)
+{
+    const double tol = fc->opt->noise_rel_tol;
+    const double sigma2 = residual_variance(fc, tot);
+    const size_t p = fc->set->count;
+    if (!(tol > 0.0) || !(sigma2 > 0.0) || gain > 2.0 * tol * sigma2 ||
+        dhc_lsq_std_errors(&fc->ws->fac, sigma2, scratch, p) != DHC_OK) {
+        return 0;
+    }
+    for (size_t k = 0U; k < p; ++k) {
+        if (fabs(fc->ws->delta[k]) > tol * scratch[k]) { /* unidentifiable: both 0 */
+            return 0;
+        }
+    }
+    return 1;
 }
 
 /* Levenberg-Marquardt from ws->current until the SSR stops falling. */
@@ -550,7 +599,7 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
     for (size_t it = 0U; st == DHC_OK && it < fc->opt->max_iterations; ++it) {
         rep->iterations++;
         /* A perfect fit leaves nothing to improve; relative tests would divide by ~0. */
-        if (tot->ssr <= 1e-30 * (double)tot->rows) {
+        if (tot->ssr <= 1e-30 * (double)tot->rows || nothing_left_to_gain(fc, tot)) {
             *converged = 1;
             break;
         }
@@ -576,7 +625,8 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
             if (st == DHC_OK) {
                 st = analyse_keeping_set(fc, rep);
             }
-            if (gain <= fc->opt->ssr_rel_tol * tot->ssr || step <= fc->opt->step_rel_tol) {
+            if (gain <= fc->opt->ssr_rel_tol * tot->ssr || step <= fc->opt->step_rel_tol ||
+                step_below_noise(fc, tot, gain, ws->scratch)) {
                 *converged = 1;
                 break;
             }
@@ -591,6 +641,46 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
         }
     }
     return st;
+}
+
+/* Judges identifiability again at the converged estimate (ws->ne is its accumulation):
+ * parameters kept out because the input values could not identify them, and that these
+ * values do identify, join the fitted set. *freed counts them; with none, ws->fac is the
+ * analysis of the kept set again. */
+static dhc_status free_identifiable(const fit_context *fc, dhc_calib_report *rep, size_t *freed)
+{
+    dhc_calib_workspace *const ws = fc->ws;
+    *freed = 0U;
+    dhc_status st = dhc_lsq_analyse(&ws->ne, fc->opt->rank_rel_tol, &ws->fac);
+    if (st != DHC_OK) {
+        return st;
+    }
+    for (size_t k = 0U; k < fc->set->count; ++k) {
+        if (ws->fac.identifiable[k] && !rep->identifiable[k]) {
+            rep->identifiable[k] = 1U;
+            ++*freed;
+        }
+    }
+    return *freed == 0U ? analyse_keeping_set(fc, rep) : DHC_OK;
+}
+
+/* Levenberg-Marquardt, then identifiability judged at the estimate; again while that frees
+ * parameters (at most max_identifiability_checks times). */
+static dhc_status fit_to_convergence(const fit_context *fc, dhc_calib_report *rep,
+                                     pass_totals *tot, int *converged)
+{
+    for (size_t check = 0U;; ++check) {
+        dhc_status st = levenberg_marquardt(fc, rep, tot, converged);
+        if (st != DHC_OK || !*converged || check >= fc->opt->max_identifiability_checks) {
+            return st;
+        }
+        size_t freed;
+        st = free_identifiable(fc, rep, &freed);
+        if (st != DHC_OK || freed == 0U) {
+            return st;
+        }
+        rep->freed += freed;
+    }
 }
 
 static void fill_report(const fit_context *fc, const pass_totals *tot, dhc_calib_report *rep)
@@ -666,11 +756,11 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
 
     int converged = 0;
     for (size_t round = 0U; round <= opt->max_outlier_rounds; ++round) {
-        st = levenberg_marquardt(&fc, rep, &tot, &converged);
+        st = fit_to_convergence(&fc, rep, &tot, &converged);
         if (st != DHC_OK) {
             return st;
         }
-        if (ws->fac.rank < rep->structural_rank || tot.rows < rep->structural_rank) {
+        if (tot.rows < rep->structural_rank || tot.rows <= ws->fac.rank) {
             fill_report(&fc, &tot, rep);
             return DHC_ERR_UNDERDETERMINED;
         }
@@ -683,6 +773,21 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
         }
         if (flagged == 0U) {
             break;
+        }
+    }
+    if (rep->freed > 0U) {
+        /* What rich data identify changed with the estimate as well (the same point moved
+         * off the same axis): the report's structural rank is the estimate's. The structural
+         * poses borrow ws->ne, so the data are accumulated and analysed again after them. */
+        st = structural_rank(&fc, &ws->current, &tot.traits, rep);
+        if (st == DHC_OK) {
+            st = data_pass(&fc, &ws->current, 1, &tot);
+        }
+        if (st == DHC_OK) {
+            st = analyse_keeping_set(&fc, rep);
+        }
+        if (st != DHC_OK) {
+            return st;
         }
     }
     fill_report(&fc, &tot, rep);

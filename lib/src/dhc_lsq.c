@@ -280,6 +280,31 @@ dhc_status dhc_lsq_step(const dhc_normal_eq *ne, dhc_lsq_factor *fac, double lam
     return DHC_OK;
 }
 
+dhc_status dhc_lsq_decrement(const dhc_normal_eq *ne, const dhc_lsq_factor *fac,
+                             double *decrement)
+{
+    if (!ne_valid(ne) || !fac_valid(fac) || decrement == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    const size_t n = ne->n;
+    if (fac->n != n) {
+        return DHC_ERR_DIMENSION;
+    }
+    /* |L^-1 S g1|^2 with L L^T = S N11 S (pivoted order) */
+    double y[DHC_MAX_PARAMS];
+    for (size_t i = 0U; i < fac->rank; ++i) {
+        y[i] = ne->jtr[fac->perm[i]] * fac->scale[fac->perm[i]];
+    }
+    const tri_view l = analysed_factor(fac);
+    tri_forward(&l, fac->rank, y);
+    double sum = 0.0;
+    for (size_t i = 0U; i < fac->rank; ++i) {
+        sum += y[i] * y[i];
+    }
+    *decrement = sum;
+    return DHC_OK;
+}
+
 dhc_status dhc_lsq_std_errors(const dhc_lsq_factor *fac, double sigma2, double *std, size_t len)
 {
     if (!fac_valid(fac) || std == NULL) {

@@ -294,6 +294,76 @@ static void test_step_is_the_least_squares_solution(void)
     }
 }
 
+/* SSR of res - J x over the stored problem, summed directly. */
+static double direct_ssr(size_t m, size_t p, const double *x)
+{
+    double ssr = 0.0;
+    for (size_t e = 0U; e < m; ++e) {
+        double r = res[e];
+        for (size_t j = 0U; j < p; ++j) {
+            r -= jac_buf[e * p + j] * x[j];
+        }
+        ssr += r * r;
+    }
+    return ssr;
+}
+
+/* The Newton decrement is what the least-squares solution takes off the SSR, measured by
+ * summing the residuals before and after it (elimination reference); a duplicated column
+ * adds nothing to it. */
+static void test_decrement_is_the_ssr_the_solution_removes(void)
+{
+    const size_t m = 50U;
+    const size_t p = 6U;
+    const double x_true[6] = {0.5, -2.0, 1.25, 3.0, -0.75, 0.1};
+    const size_t cols[6] = {0U, 1U, 2U, 3U, 4U, 5U};
+    random_jacobian(m, p, -1.0, 1.0);
+    make_residuals(m, p, x_true, 0.3);
+    accumulate_all(&ne, m, p, NULL);
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_lsq_analyse(&ne, 1e-10, &fac));
+    double dec = -1.0;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_lsq_decrement(&ne, &fac, &dec));
+    double ref[6];
+    reference_solution(m, p, cols, p, NULL, ref);
+    const double zero[6] = {0.0};
+    const double drop = direct_ssr(m, p, zero) - direct_ssr(m, p, ref);
+    assert_close(drop, dec, 1e-10, 1e-12);
+    TEST_ASSERT_TRUE(dec > 1.0); /* the signal, far above the noise */
+
+    /* column 5 a copy of column 1: rank 5, the same projection, the same decrement */
+    for (size_t e = 0U; e < m; ++e) {
+        jac_buf[e * p + 5U] = jac_buf[e * p + 1U];
+    }
+    accumulate_all(&ne, m, p, NULL);
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_lsq_analyse(&ne, 1e-10, &fac));
+    TEST_ASSERT_EQUAL_size_t(5U, fac.rank);
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_lsq_decrement(&ne, &fac, &dec));
+    double ref5[5];
+    reference_solution(m, p, cols, 5U, NULL, ref5);
+    double x6[6] = {0.0};
+    memcpy(x6, ref5, sizeof ref5);
+    assert_close(direct_ssr(m, p, zero) - direct_ssr(m, p, x6), dec, 1e-10, 1e-12);
+
+    /* at the solution nothing is left: the residuals are orthogonal to the columns */
+    for (size_t e = 0U; e < m; ++e) {
+        double r = res[e];
+        for (size_t j = 0U; j < 5U; ++j) {
+            r -= jac_buf[e * p + j] * ref5[j];
+        }
+        res[e] = r;
+    }
+    accumulate_all(&ne, m, p, NULL);
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_lsq_analyse(&ne, 1e-10, &fac));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_lsq_decrement(&ne, &fac, &dec));
+    TEST_ASSERT_TRUE(dec < 1e-20);
+
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_lsq_decrement(&ne, &fac, NULL));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_lsq_decrement(NULL, &fac, &dec));
+    fac2 = fac;
+    fac2.n = p - 1U;
+    TEST_ASSERT_EQUAL(DHC_ERR_DIMENSION, dhc_lsq_decrement(&ne, &fac2, &dec));
+}
+
 static void test_weighted_step_is_the_weighted_solution(void)
 {
     const size_t m = 30U;
@@ -866,6 +936,7 @@ int main(void)
     RUN_TEST(test_add_accumulates_weighted_sums);
     RUN_TEST(test_add_rejects_bad_input_leaving_accumulator_unchanged);
     RUN_TEST(test_step_is_the_least_squares_solution);
+    RUN_TEST(test_decrement_is_the_ssr_the_solution_removes);
     RUN_TEST(test_weighted_step_is_the_weighted_solution);
     RUN_TEST(test_streaming_result_is_independent_of_chunking);
     RUN_TEST(test_duplicate_and_zero_columns_are_unidentifiable);

@@ -777,6 +777,14 @@ static void test_too_few_poses_underdetermine_and_leave_the_model_alone(void)
     }
 }
 
+/* A fit that succeeds leaves in the model exactly what it reports. */
+static void assert_model_holds_report(const dhc_model *m)
+{
+    for (size_t k = 0U; k < set.count; ++k) {
+        TEST_ASSERT_EQUAL_DOUBLE(rep.value[k], dhc_params_value(&set, m, k));
+    }
+}
+
 static void test_identical_poses_identify_no_more_than_one_pose_does(void)
 {
     test_rng g = {0x1D1D1D1DULL};
@@ -811,9 +819,17 @@ static void test_identical_poses_identify_no_more_than_one_pose_does(void)
         TEST_ASSERT_EQUAL(copies * rows, rep.rows);
         TEST_ASSERT_TRUE(rep.rank <= rows);
         TEST_ASSERT_TRUE(rep.rank >= 1U);
-        TEST_ASSERT_EQUAL(DHC_ERR_UNDERDETERMINED, st);
-        TEST_ASSERT_EQUAL_MEMORY(&nominal, &model, sizeof model);
-        /* The one pose is fitted exactly all the same (in the report, not the model). */
+        TEST_ASSERT_TRUE(rep.rank < rep.structural_rank);
+        if (rep.rows < rep.structural_rank) {
+            /* fewer equations than the model's parameters: refused, nothing leaks out */
+            TEST_ASSERT_EQUAL(DHC_ERR_UNDERDETERMINED, st);
+            TEST_ASSERT_EQUAL_MEMORY(&nominal, &model, sizeof model);
+        } else {
+            /* enough equations, one pose's worth of rank: fitted, what is not identified
+             * kept at its input (asserted above) and reported as such */
+            TEST_ASSERT_EQUAL(DHC_OK, st);
+        }
+        /* The one pose is fitted exactly either way (in the report). */
         TEST_ASSERT_TRUE(rep.rms_mm <= 1e-9 * L);
     }
 }
@@ -859,7 +875,8 @@ static void test_a_joint_never_moved_confounds_its_offset_and_effects(void)
         const dhc_status st = fit(&model, L);
         assert_report_sane(st);
         assert_unidentifiable_untouched(&nominal);
-        TEST_ASSERT_EQUAL(DHC_ERR_UNDERDETERMINED, st);
+        /* the data identify fewer than the model could: fitted and reported, not refused */
+        TEST_ASSERT_EQUAL(DHC_OK, st);
         TEST_ASSERT_EQUAL(set.count, rep.structural_rank); /* a moving joint: all of them */
         const size_t lost = 3U + (j == 0U ? 0U : 4U);
         TEST_ASSERT_EQUAL(set.count - lost, rep.rank);
@@ -892,7 +909,7 @@ static void test_a_joint_never_moved_confounds_its_offset_and_effects(void)
         /* The report holds the fit of the rest: exact, the other joints at their truth. */
         TEST_ASSERT_TRUE(rep.rms_mm <= 1e-9 * L);
         assert_identifiable_match(&truth, L);
-        TEST_ASSERT_EQUAL_MEMORY(&nominal, &model, sizeof model);
+        assert_model_holds_report(&model);
     }
 }
 
@@ -1095,7 +1112,8 @@ static void test_duplicated_columns_name_each_other(void)
         dhc_status st = fit(&model, L);
         assert_report_sane(st);
         assert_unidentifiable_untouched(&nominal);
-        TEST_ASSERT_EQUAL(DHC_ERR_UNDERDETERMINED, st);
+        /* the data identify one fewer than the model could: fitted and reported */
+        TEST_ASSERT_EQUAL(DHC_OK, st);
         TEST_ASSERT_EQUAL(set.count, rep.structural_rank);
         TEST_ASSERT_EQUAL(set.count - 1U, rep.rank);
         const size_t th = index_of(DHC_P_THETA, j);
@@ -1103,7 +1121,7 @@ static void test_duplicated_columns_name_each_other(void)
         TEST_ASSERT_TRUE(rep.identifiable[th] != rep.identifiable[bl]);
         TEST_ASSERT_TRUE(rep.identifiable[th] ? rep.confounded[bl][th] : rep.confounded[th][bl]);
         TEST_ASSERT_EQUAL(1U, partner_count(rep.identifiable[th] ? bl : th));
-        TEST_ASSERT_EQUAL_MEMORY(&nominal, &model, sizeof model);
+        assert_model_holds_report(&model);
 
         /* Base frame: 6 + 4 parameters for 8 degrees of freedom. Errors away from joint 1. */
         int skip0[DHC_MAX_JOINTS] = {0};

@@ -347,6 +347,15 @@ static void text_fit(const dhcal_fit *f, const session *s, const options *o, con
         printf("; held-out RMS %.4f mm", f->heldout_rms_mm);
     }
     printf("\n%zu parameters, %zu identified from the data\n", rep->n_params, rep->rank);
+    if (rep->rank < rep->structural_rank) {
+        printf("the data identify %zu of the %zu parameters that poses spread over the joint "
+               "ranges would: the others are kept at their input values (below)\n",
+               rep->rank, rep->structural_rank);
+    }
+    if (rep->freed > 0U) {
+        printf("%zu parameter%s that the input values could not identify, the estimate can: "
+               "fitted\n", rep->freed, rep->freed == 1U ? "" : "s");
+    }
     for (size_t i = 0U; i < f->model.arm.n_joints; ++i) {
         if (f->model.arm.joint[i].convention == DHC_CONV_HAYATI) {
             printf("joint %zu: axes %zu and %zu are nominally parallel: Hayati's beta%zu is fitted "
@@ -375,7 +384,11 @@ static void text_fit(const dhcal_fit *f, const session *s, const options *o, con
             continue;
         }
         (void)dhc_params_name(&f->set, k, name, sizeof name);
-        printf("not identifiable: %s (kept at nominal)", name);
+        printf("%s: %s (kept at nominal)",
+               rep->rank < rep->structural_rank && rep->structurally_identifiable[k]
+                   ? "not identified from these data"
+                   : "not identifiable",
+               name);
         size_t partners = 0U;
         for (size_t m = 0U; m < f->set.count; ++m) {
             if (rep->confounded[k][m]) {

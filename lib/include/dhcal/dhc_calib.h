@@ -42,6 +42,14 @@ typedef struct {
     double rank_rel_tol;         /* pivot tolerance on the scaled normal matrix (1e-10) */
     double ssr_rel_tol;          /* stop when SSR falls by less than this share (1e-10) */
     double step_rel_tol;         /* ... or the scaled step is below this (1e-12) */
+    double noise_rel_tol;        /* ... or the fit is this close to its minimum relative to
+                                    the noise it estimates (1e-2): what a Gauss-Newton step
+                                    still promises is below (tol sigma)^2, or an accepted
+                                    step moved no parameter by more than tol of its standard
+                                    error and lowered the SSR by under 2 tol sigma^2. The
+                                    test real data meet; 0 turns it off */
+    size_t max_identifiability_checks; /* re-analyses at the converged estimate that may
+                                    free parameters found unidentifiable at the start (3) */
     double orientation_weight_mm_per_rad; /* rad residuals count as this many mm (1000) */
     double outlier_threshold;    /* |error| / robust sigma above this is an outlier (6); 0 off */
     double outlier_floor_mm;     /* robust sigma is at least this (1e-6 mm: noise-free data);
@@ -71,7 +79,12 @@ typedef struct {
     size_t rows;            /* equations in the final fit */
     size_t n_params;
     size_t rank;            /* parameters identified from the data */
-    size_t structural_rank; /* parameters the model could identify from rich data */
+    size_t structural_rank; /* parameters the model could identify from rich data; more
+                               than rank: some parameter is identifiable in principle but
+                               not from these data (structurally_identifiable and not
+                               identifiable), kept at its input value */
+    size_t freed;           /* parameters unidentifiable at the input values that the
+                               analysis at the estimate found identifiable and fitted */
     size_t outliers;        /* samples flagged DHC_SAMPLE_OUTLIER */
     double rms_mm;          /* sqrt(mean |position error|^2) over used samples; for wire
                                samples the error is the vector of 3 wire residuals */
@@ -100,6 +113,7 @@ typedef struct {
     dhc_model trial;
     dhc_sample sample;
     double delta[DHC_MAX_PARAMS];
+    double scratch[DHC_MAX_PARAMS];
     double jac_buf[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS];
 } dhc_calib_workspace;
 
@@ -128,10 +142,20 @@ dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_sample *s,
 
 /* Fits the parameters of set to the samples. flags (n bytes) marks samples the caller
  * excludes; the fit adds DHC_SAMPLE_OUTLIER marks and refits without them.
+ * Identifiability is judged on the data at the input values (the set is kept fixed through
+ * the iterations: which of two nearly dependent columns pivoting drops would otherwise
+ * change with the iterate) and judged again at the converged estimate: parameters that
+ * became identifiable there (a tool point that the fit moved off an axis it sat on
+ * nominally) are freed and the fit goes on, up to max_identifiability_checks times.
+ * Convergence: relative to the noise the fit estimates (noise_rel_tol), or the SSR or the
+ * scaled step stop changing (noise-free data), or no damped step lowers the SSR.
  * Returns DHC_OK (converged), DHC_ERR_NOT_CONVERGED (model holds the best iterate, report
- * filled), DHC_ERR_UNDERDETERMINED (fewer independent equations than the model can
- * identify from data like these: the model is unchanged, the report says rank and
- * structural_rank). The structural rank comes from random poses over the joint ranges with
+ * filled), DHC_ERR_UNDERDETERMINED (fewer equations than the parameters the model can
+ * identify from data like these, or no more equations than the data identify, so nothing
+ * is left to check the fit against: the model is unchanged, the report says rank and
+ * structural_rank). Data that identify fewer parameters than rich data would are fitted,
+ * not refused: the report's rank, structural_rank and flags name what is left at its input.
+ * The structural rank comes from random poses over the joint ranges with
  * the data's measurement kind, temperature span and approach directions.
  * DHC_ERR_NO_DATA, DHC_ERR_CAPACITY, DHC_ERR_NONFINITE or the reader's status;
  * DHC_ERR_ARGUMENT for an invalid noise model (dhc_noise_model_check).

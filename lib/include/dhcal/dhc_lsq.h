@@ -80,6 +80,15 @@ dhc_status dhc_lsq_analyse(const dhc_normal_eq *ne, double rel_tol, dhc_lsq_fact
 dhc_status dhc_lsq_step(const dhc_normal_eq *ne, dhc_lsq_factor *fac, double lambda,
                         double *delta, size_t len);
 
+/* The decrease of the SSR that a full Gauss-Newton step on the identifiable parameters
+ * predicts: g1^T N11^-1 g1 (g = J^T W r), the Newton decrement squared. Equal to the step's
+ * squared length in the metric of N11, so decrement <= t sigma^2 means the step that is
+ * left is at most sqrt(t) standard errors long (Mahalanobis): a convergence test relative
+ * to the noise, in the units of the SSR. ne must be the accumulator fac was analysed from.
+ * DHC_ERR_ARGUMENT (NULL, fac not analysed), DHC_ERR_DIMENSION (fac->n != ne->n). O(r^2). */
+dhc_status dhc_lsq_decrement(const dhc_normal_eq *ne, const dhc_lsq_factor *fac,
+                             double *decrement);
+
 /* Covariance of the identifiable parameters at noise variance sigma2 (per unit weight):
  * std[k] = sqrt(sigma2 * (N11^-1)_kk) for identifiable k, 0 otherwise; std has len >= n
  * entries, the first n written. DHC_ERR_ARGUMENT (NULL, sigma2 < 0, fac not analysed),
