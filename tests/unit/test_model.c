@@ -65,6 +65,42 @@ static void test_gravity_moments_of_the_paper_arm_match_the_closed_form(void)
     }
 }
 
+/* A weight on the axis has no moment about it, exactly: the UR arms' wrist frames (a = 0)
+ * put o_{i+1} on z_i, where the products would leave rounding that the scaled rank test
+ * took for a compliance parameter (c_44 of a UR10 fitted as 6 deg/mm, std 4e9). Published
+ * UR10 (CB3) DH table; the cross-products are checked against a dot-product closed form. */
+static void test_a_weight_on_the_axis_has_no_moment_about_it(void)
+{
+    static const test_dh_row ur10[6] = {{90.0, 0.0, 127.3},     {0.0, -612.0, 0.0},
+                                        {0.0, -572.3, 0.0},     {90.0, 0.0, 163.941},
+                                        {-90.0, 0.0, 115.7},    {0.0, 0.0, 92.2}};
+    dhc_arm arm;
+    test_arm_from_table(&arm, ur10, 6U, 0.0);
+    const dhc_model m = test_model_of(&arm);
+    for (size_t trial = 0U; trial < 50U; ++trial) {
+        double q[DHC_MAX_JOINTS] = {0.0};
+        test_random_q(&rng, &m.arm, q);
+        double tau[DHC_MAX_JOINTS][DHC_MAX_JOINTS];
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_model_gravity_moments(&m, 1.0, q, tau));
+        for (size_t i = 3U; i < 6U; ++i) {
+            TEST_ASSERT_EQUAL_DOUBLE(0.0, tau[i][i]); /* o_{i+1} on z_i */
+        }
+        for (size_t j = 0U; j < 6U; ++j) {
+            TEST_ASSERT_EQUAL_DOUBLE(0.0, tau[0][j]); /* axis 1 parallel to gravity */
+        }
+        /* joint 2 carries the upper arm: -(horizontal reach of o_3 from axis 2) along y */
+        dhc_frame f[DHC_MAX_JOINTS + 1U];
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_forward_frames(&m.arm, q, DHC_MAX_JOINTS, f,
+                                                     DHC_MAX_JOINTS + 1U, NULL));
+        double z[3];
+        dhc_rot_column(&f[1].rot, 2U, z);
+        const double lx = f[2].pos[0] - f[1].pos[0];
+        const double ly = f[2].pos[1] - f[1].pos[1];
+        /* (lever x g) . z with g = (0, 0, -1): -ly z_x + lx z_y */
+        TEST_ASSERT_DOUBLE_WITHIN(1e-9, -ly * z[0] + lx * z[1], tau[1][1]);
+    }
+}
+
 static void test_joint_effects_shift_the_effective_angles(void)
 {
     dhc_model m = paper_model();
@@ -387,6 +423,7 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_gravity_moments_of_the_paper_arm_match_the_closed_form);
+    RUN_TEST(test_a_weight_on_the_axis_has_no_moment_about_it);
     RUN_TEST(test_joint_effects_shift_the_effective_angles);
     RUN_TEST(test_tool_point_is_forward_kinematics_at_the_effective_angles);
     RUN_TEST(test_thermal_expansion_scales_the_arm_about_its_base);
