@@ -128,8 +128,14 @@ dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_sample *s,
     for (size_t j = 0U; j < n; ++j) {
         const dhc_joint_effects *fx = &model->effect[j];
         const double q = s->q_rad[j];
-        const double sd = joint_noise_rad[j] * (1.0 + fx->scale + fx->harmonic_sin_rad * cos(q) -
-                                                fx->harmonic_cos_rad * sin(q));
+        double slope = 1.0 + fx->scale + fx->harmonic_sin_rad * cos(q) -
+                       fx->harmonic_cos_rad * sin(q);
+        for (size_t k = 0U; k + 1U < DHC_HARMONIC_MAX_ORDER; ++k) {
+            const double order = (double)(k + 2U);
+            slope += order * (fx->harmonic_hi_sin_rad[k] * cos(order * q) -
+                              fx->harmonic_hi_cos_rad[k] * sin(order * q));
+        }
+        const double sd = joint_noise_rad[j] * slope;
         for (size_t a = 0U; a < rows; ++a) {
             for (size_t b = 0U; b <= a; ++b) {
                 c[a * DHC_MAX_ROWS_PER_SAMPLE + b] +=

@@ -205,8 +205,8 @@ static double joint_effect_factor(const dhc_param_id *id, const dhc_sample *s,
     const double q = s->q_rad[id->joint];
     switch ((dhc_param_kind)id->kind) {
     case DHC_P_JOINT_SCALE: return q;
-    case DHC_P_HARMONIC_SIN: return sin(q);
-    case DHC_P_HARMONIC_COS: return cos(q);
+    case DHC_P_HARMONIC_SIN: return sin((double)(id->aux + 1U) * q);
+    case DHC_P_HARMONIC_COS: return cos((double)(id->aux + 1U) * q);
     case DHC_P_BACKLASH: return 0.5 * (double)s->dir[id->joint];
     case DHC_P_COMPLIANCE: return tau_row[id->aux];
     default: return 0.0;
@@ -262,13 +262,22 @@ dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set,
     }
     const dhc_arm *const arm = &model->arm;
     const double dtemp = s->temp_c - model->thermal_ref_c;
+    const double dt = s->t_s - model->drift_ref_s;
+    /* the session's drift scales every move of the arm's point about the base origin; a
+     * move of the base origin itself moves the measured point one to one */
+    const double drift = dhc_model_drift_factor(model, s->t_s);
+    const double *const p_arm = pr->p_arm_mm;
     const int with_orientation = s->kind == (uint8_t)DHC_MEAS_POSE;
     for (size_t k = 0U; k < set->count; ++k) {
         const dhc_param_id *id = &set->id[k];
         double dp[3] = {0.0, 0.0, 0.0};
         double dw[3] = {0.0, 0.0, 0.0};
+        double dp_scale = drift;
         if (is_geometric(id->kind)) {
-            geometric_column(arm, ev.frames, pr->q_eff_rad, pr->p_mm, id, dp, dw);
+            geometric_column(arm, ev.frames, pr->q_eff_rad, p_arm, id, dp, dw);
+            if (id->kind >= (uint8_t)DHC_P_BASE_X && id->kind <= (uint8_t)DHC_P_BASE_Z) {
+                dp_scale = 1.0;
+            }
             /* lengths are stored unscaled; the chain used them times the thermal factor */
             if (id->kind == (uint8_t)DHC_P_D || id->kind == (uint8_t)DHC_P_A ||
                 id->kind >= (uint8_t)DHC_P_TOOL_X) {
@@ -277,14 +286,22 @@ dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set,
         } else if (id->kind <= (uint8_t)DHC_P_COMPLIANCE) {
             const dhc_param_id joint_theta = {(uint8_t)DHC_P_THETA, id->joint, 0U};
             const double factor = joint_effect_factor(id, s, ev.tau[id->joint]);
-            geometric_column(arm, ev.frames, pr->q_eff_rad, pr->p_mm, &joint_theta, dp, dw);
+            geometric_column(arm, ev.frames, pr->q_eff_rad, p_arm, &joint_theta, dp, dw);
             dhc_vec3_scale(dp, factor, dp);
             dhc_vec3_scale(dw, factor, dw);
         } else if (id->kind == (uint8_t)DHC_P_THERMAL) {
             /* scaling every length scales the tool point about the base origin */
-            dhc_vec3_sub(pr->p_mm, arm->base.pos, dp);
+            dhc_vec3_sub(p_arm, arm->base.pos, dp);
             dhc_vec3_scale(dp, dtemp / ev.length_scale, dp);
+        } else if (id->kind == (uint8_t)DHC_P_DRIFT_SCALE) {
+            dhc_vec3_sub(p_arm, arm->base.pos, dp);
+            dhc_vec3_scale(dp, dt, dp);
+            dp_scale = 1.0;
+        } else if (id->kind == (uint8_t)DHC_P_DRIFT_OFFSET) {
+            dp[id->aux % 3U] = dt;
+            dp_scale = 1.0;
         }
+        dhc_vec3_scale(dp, dp_scale, dp);
         if (s->kind == (uint8_t)DHC_MEAS_WIRES) {
             double col[3];
             wire_rows(model, id, pr->p_mm, dp, col);

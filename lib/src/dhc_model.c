@@ -36,7 +36,7 @@ dhc_status dhc_sample_check(const dhc_model *model, const dhc_sample *s)
         (s->kind == (uint8_t)DHC_MEAS_WIRES && !model->measurer.present)) {
         return DHC_ERR_ARGUMENT;
     }
-    if (!dhc_is_finite(s->temp_c)) {
+    if (!dhc_is_finite(s->temp_c) || !dhc_is_finite(s->t_s)) {
         return DHC_ERR_NONFINITE;
     }
     for (size_t i = 0U; i < model->arm.n_joints; ++i) {
@@ -112,6 +112,21 @@ dhc_status dhc_model_gravity_moments(const dhc_model *model, double length_scale
     return st;
 }
 
+double dhc_model_drift_factor(const dhc_model *model, double t_s)
+{
+    return 1.0 + model->drift_scale_per_s * (t_s - model->drift_ref_s);
+}
+
+void dhc_model_drift(const dhc_model *model, double t_s, const double p_arm[3], double p[3])
+{
+    const double dt = t_s - model->drift_ref_s;
+    const double f = dhc_model_drift_factor(model, t_s);
+    const double *const b = model->arm.base.pos;
+    for (size_t r = 0U; r < 3U; ++r) {
+        p[r] = b[r] + f * (p_arm[r] - b[r]) + model->drift_mm_per_s[r] * dt;
+    }
+}
+
 static int has_compliance(const dhc_model *model)
 {
     for (size_t i = 0U; i < model->arm.n_joints; ++i) {
@@ -159,6 +174,14 @@ dhc_status dhc_model_evaluate(const dhc_model *model, const dhc_sample *s, int n
         const double q = s->q_rad[i];
         double dq = fx->scale * q + fx->harmonic_sin_rad * sin(q) +
                     fx->harmonic_cos_rad * cos(q) + 0.5 * fx->backlash_rad * (double)s->dir[i];
+        for (size_t k = 0U; k + 1U < DHC_HARMONIC_MAX_ORDER; ++k) {
+            const double a = fx->harmonic_hi_sin_rad[k];
+            const double b = fx->harmonic_hi_cos_rad[k];
+            if (fabs(a) > 0.0 || fabs(b) > 0.0) {
+                const double kq = (double)(k + 2U) * q;
+                dq += a * sin(kq) + b * cos(kq);
+            }
+        }
         for (size_t j = i; compliant && j < n; ++j) {
             dq += fx->compliance[j] * ev->tau[i][j];
         }
@@ -170,6 +193,8 @@ dhc_status dhc_model_evaluate(const dhc_model *model, const dhc_sample *s, int n
         return st;
     }
     out->rot = ev->frames[n].rot;
+    dhc_vec3_copy(out->p_mm, out->p_arm_mm);
+    dhc_model_drift(model, s->t_s, out->p_arm_mm, out->p_mm);
     dhc_vec3_set(out->wire_mm, 0.0, 0.0, 0.0);
     if (s->kind == (uint8_t)DHC_MEAS_WIRES) {
         const dhc_measurer_model *m = &model->measurer;
@@ -205,6 +230,7 @@ dhc_status dhc_model_tool_point(const dhc_model *model, const double *q_rad, con
     memset(&s, 0, sizeof s);
     s.kind = (uint8_t)DHC_MEAS_POSITION;
     s.temp_c = model->thermal_ref_c;
+    s.t_s = model->drift_ref_s; /* a controller plans without the session's drift */
     for (size_t j = 0U; j < model->arm.n_joints; ++j) {
         s.q_rad[j] = q_rad[j];
         s.dir[j] = (int8_t)(dir != NULL ? dir[j] : 1);

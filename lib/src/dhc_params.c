@@ -3,7 +3,15 @@
 
 #include <string.h>
 
-typedef enum { SCOPE_NONE, SCOPE_JOINT, SCOPE_JOINT_PAIR, SCOPE_WIRE, SCOPE_ANCHOR } scope;
+typedef enum {
+    SCOPE_NONE,
+    SCOPE_JOINT,
+    SCOPE_JOINT_ORDER, /* joint, aux = harmonic order - 1 */
+    SCOPE_JOINT_PAIR,
+    SCOPE_WIRE,
+    SCOPE_ANCHOR,
+    SCOPE_AXIS
+} scope;
 
 static scope kind_scope(unsigned kind)
 {
@@ -14,9 +22,10 @@ static scope kind_scope(unsigned kind)
     case DHC_P_ALPHA:
     case DHC_P_BETA:
     case DHC_P_JOINT_SCALE:
-    case DHC_P_HARMONIC_SIN:
-    case DHC_P_HARMONIC_COS:
     case DHC_P_BACKLASH: return SCOPE_JOINT;
+    case DHC_P_HARMONIC_SIN:
+    case DHC_P_HARMONIC_COS: return SCOPE_JOINT_ORDER;
+    case DHC_P_DRIFT_OFFSET: return SCOPE_AXIS;
     case DHC_P_COMPLIANCE: return SCOPE_JOINT_PAIR;
     case DHC_P_MEAS_OFFSET: return SCOPE_WIRE;
     case DHC_P_MEAS_ANCHOR: return SCOPE_ANCHOR;
@@ -41,6 +50,8 @@ static int indices_fit(const dhc_model *model, unsigned kind, size_t joint, size
     const size_t n = model->arm.n_joints;
     switch (kind_scope(kind)) {
     case SCOPE_JOINT: return joint < n && aux == 0U;
+    case SCOPE_JOINT_ORDER: return joint < n && aux < DHC_HARMONIC_MAX_ORDER;
+    case SCOPE_AXIS: return joint == 0U && aux < 3U;
     case SCOPE_JOINT_PAIR: return joint < n && aux >= joint && aux < n;
     case SCOPE_WIRE: return joint == 0U && aux < 3U;
     case SCOPE_ANCHOR: return joint == 0U && aux < 9U;
@@ -105,6 +116,14 @@ static dhc_status add_run(dhc_param_set *set, const dhc_model *model, dhc_param_
     return DHC_OK;
 }
 
+/* A_ik and B_ik of one harmonic order (aux = order - 1). */
+static dhc_status add_harmonic(dhc_param_set *set, const dhc_model *model, size_t joint,
+                               size_t order)
+{
+    dhc_status st = dhc_params_add(set, model, DHC_P_HARMONIC_SIN, joint, order - 1U);
+    return st == DHC_OK ? dhc_params_add(set, model, DHC_P_HARMONIC_COS, joint, order - 1U) : st;
+}
+
 static dhc_status add_kinds(dhc_param_set *set, const dhc_model *model, dhc_param_kind first,
                             dhc_param_kind last, size_t joint)
 {
@@ -133,9 +152,15 @@ dhc_status dhc_params_add_effect(dhc_param_set *set, const dhc_model *model, dhc
     case DHC_EFFECT_BASE_FRAME: st = add_kinds(set, model, DHC_P_BASE_X, DHC_P_BASE_RZ, 0U); break;
     case DHC_EFFECT_TOOL_OFFSET: st = add_kinds(set, model, DHC_P_TOOL_X, DHC_P_TOOL_Z, 0U); break;
     case DHC_EFFECT_JOINT_SCALE: st = dhc_params_add(set, model, DHC_P_JOINT_SCALE, j, 0U); break;
-    case DHC_EFFECT_JOINT_HARMONIC:
-        st = add_kinds(set, model, DHC_P_HARMONIC_SIN, DHC_P_HARMONIC_COS, j);
+    case DHC_EFFECT_JOINT_HARMONIC: st = add_harmonic(set, model, j, 1U); break;
+    case DHC_EFFECT_JOINT_HARMONIC2:
+    case DHC_EFFECT_JOINT_HARMONIC3:
+    case DHC_EFFECT_JOINT_HARMONIC4:
+        st = add_harmonic(set, model, j,
+                          2U + (size_t)((unsigned)effect - (unsigned)DHC_EFFECT_JOINT_HARMONIC2));
         break;
+    case DHC_EFFECT_DRIFT_SCALE: st = dhc_params_add(set, model, DHC_P_DRIFT_SCALE, 0U, 0U); break;
+    case DHC_EFFECT_DRIFT_OFFSET: st = add_run(set, model, DHC_P_DRIFT_OFFSET, 0U, 0U, 3U); break;
     case DHC_EFFECT_JOINT_BACKLASH: st = dhc_params_add(set, model, DHC_P_BACKLASH, j, 0U); break;
     case DHC_EFFECT_JOINT_COMPLIANCE:
         st = add_run(set, model, DHC_P_COMPLIANCE, j, j, model->arm.n_joints);
@@ -156,7 +181,8 @@ dhc_status dhc_params_add_effect(dhc_param_set *set, const dhc_model *model, dhc
 static const char *const effect_names[DHC_EFFECT_COUNT] = {
     "base_frame",       "tool_offset",     "joint_scale",     "joint_harmonic",
     "joint_backlash",   "joint_compliance", "measurer_scale", "measurer_offset",
-    "measurer_anchors", "thermal_scale"};
+    "measurer_anchors", "thermal_scale",   "joint_harmonic2", "joint_harmonic3",
+    "joint_harmonic4",  "drift_scale",     "drift_offset"};
 
 const char *dhc_effect_name(dhc_effect effect)
 {
@@ -166,7 +192,9 @@ const char *dhc_effect_name(dhc_effect effect)
 int dhc_effect_is_per_joint(dhc_effect effect)
 {
     return effect == DHC_EFFECT_JOINT_SCALE || effect == DHC_EFFECT_JOINT_HARMONIC ||
-           effect == DHC_EFFECT_JOINT_BACKLASH || effect == DHC_EFFECT_JOINT_COMPLIANCE;
+           effect == DHC_EFFECT_JOINT_BACKLASH || effect == DHC_EFFECT_JOINT_COMPLIANCE ||
+           effect == DHC_EFFECT_JOINT_HARMONIC2 || effect == DHC_EFFECT_JOINT_HARMONIC3 ||
+           effect == DHC_EFFECT_JOINT_HARMONIC4;
 }
 
 dhc_status dhc_effect_parse(const char *text, size_t len, size_t n_joints, dhc_effect *effect,
@@ -228,13 +256,17 @@ dhc_effect dhc_params_effect_of(const dhc_param_id *id)
     case DHC_P_TOOL_Z: return DHC_EFFECT_TOOL_OFFSET;
     case DHC_P_JOINT_SCALE: return DHC_EFFECT_JOINT_SCALE;
     case DHC_P_HARMONIC_SIN:
-    case DHC_P_HARMONIC_COS: return DHC_EFFECT_JOINT_HARMONIC;
+    case DHC_P_HARMONIC_COS:
+        return id->aux == 0U ? DHC_EFFECT_JOINT_HARMONIC
+                             : (dhc_effect)((unsigned)DHC_EFFECT_JOINT_HARMONIC2 + id->aux - 1U);
     case DHC_P_BACKLASH: return DHC_EFFECT_JOINT_BACKLASH;
     case DHC_P_COMPLIANCE: return DHC_EFFECT_JOINT_COMPLIANCE;
     case DHC_P_MEAS_SCALE: return DHC_EFFECT_MEASURER_SCALE;
     case DHC_P_MEAS_OFFSET: return DHC_EFFECT_MEASURER_OFFSET;
     case DHC_P_MEAS_ANCHOR: return DHC_EFFECT_MEASURER_ANCHORS;
     case DHC_P_THERMAL: return DHC_EFFECT_THERMAL_SCALE;
+    case DHC_P_DRIFT_SCALE: return DHC_EFFECT_DRIFT_SCALE;
+    case DHC_P_DRIFT_OFFSET: return DHC_EFFECT_DRIFT_OFFSET;
     default: return DHC_EFFECT_COUNT;
     }
 }
@@ -259,14 +291,18 @@ static double *param_slot(dhc_model *model, const dhc_param_id *id)
     case DHC_P_TOOL_Y: return &model->arm.tool_mm[1];
     case DHC_P_TOOL_Z: return &model->arm.tool_mm[2];
     case DHC_P_JOINT_SCALE: return &fx->scale;
-    case DHC_P_HARMONIC_SIN: return &fx->harmonic_sin_rad;
-    case DHC_P_HARMONIC_COS: return &fx->harmonic_cos_rad;
+    case DHC_P_HARMONIC_SIN:
+        return id->aux == 0U ? &fx->harmonic_sin_rad : &fx->harmonic_hi_sin_rad[id->aux - 1U];
+    case DHC_P_HARMONIC_COS:
+        return id->aux == 0U ? &fx->harmonic_cos_rad : &fx->harmonic_hi_cos_rad[id->aux - 1U];
     case DHC_P_BACKLASH: return &fx->backlash_rad;
     case DHC_P_COMPLIANCE: return &fx->compliance[id->aux];
     case DHC_P_MEAS_SCALE: return &m->scale;
     case DHC_P_MEAS_OFFSET: return &m->offset_mm[id->aux];
     case DHC_P_MEAS_ANCHOR: return &m->anchor_mm[id->aux / 3U][id->aux % 3U];
     case DHC_P_THERMAL: return &model->thermal_per_k;
+    case DHC_P_DRIFT_SCALE: return &model->drift_scale_per_s;
+    case DHC_P_DRIFT_OFFSET: return &model->drift_mm_per_s[id->aux];
     case DHC_P_BASE_RX:
     case DHC_P_BASE_RY:
     case DHC_P_BASE_RZ:
@@ -359,7 +395,7 @@ size_t dhc_params_name(const dhc_param_set *set, size_t k, char *buf, size_t cap
         "base_x",       "base_y",       "base_z",      "base_rx",        "base_ry",
         "base_rz",      "tool_x",       "tool_y",      "tool_z",         "scale",
         "harmonic_sin", "harmonic_cos", "backlash",    "compliance",     "measurer_scale",
-        "measurer_offset", "anchor",    "thermal_scale"};
+        "measurer_offset", "anchor",    "thermal_scale", "drift_scale",  "drift_offset"};
     static const char axes[3] = {'x', 'y', 'z'};
     if (set == NULL || buf == NULL || cap == 0U || k >= set->count ||
         set->id[k].kind >= (uint8_t)DHC_P_KIND_COUNT) {
@@ -369,9 +405,23 @@ size_t dhc_params_name(const dhc_param_set *set, size_t k, char *buf, size_t cap
         return 0U;
     }
     const dhc_param_id id = set->id[k];
-    size_t pos = put_str(buf, cap, 0U, names[id.kind]);
+    size_t pos = 0U;
+    if (kind_scope(id.kind) == SCOPE_JOINT_ORDER && id.aux > 0U) {
+        /* order k >= 2: "harmonic3_sin2" */
+        pos = put_str(buf, cap, pos, "harmonic");
+        pos = put_uint(buf, cap, pos, (unsigned)id.aux + 1U);
+        pos = put_str(buf, cap, pos, id.kind == (uint8_t)DHC_P_HARMONIC_SIN ? "_sin" : "_cos");
+    } else {
+        pos = put_str(buf, cap, pos, names[id.kind]);
+    }
     switch (kind_scope(id.kind)) {
-    case SCOPE_JOINT: pos = put_uint(buf, cap, pos, (unsigned)id.joint + 1U); break;
+    case SCOPE_JOINT:
+    case SCOPE_JOINT_ORDER: pos = put_uint(buf, cap, pos, (unsigned)id.joint + 1U); break;
+    case SCOPE_AXIS: {
+        const char axis[3] = {'_', axes[id.aux % 3U], '\0'};
+        pos = put_str(buf, cap, pos, axis);
+        break;
+    }
     case SCOPE_JOINT_PAIR:
         pos = put_uint(buf, cap, pos, (unsigned)id.joint + 1U);
         pos = put_str(buf, cap, pos, "_");

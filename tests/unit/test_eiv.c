@@ -54,6 +54,10 @@ static dhc_model true_model(void)
 /* ------------------------------------------------------------ (a) off = before */
 
 /* Base-model fit and diagnosis of 60 position samples with 0.05 mm noise (seed 101). */
+/* The golden capture predates the higher harmonics and drift: its best candidate is the
+ * best of the first catalogue. */
+static int first_catalogue_only;
+
 static void fit_and_diagnose(const dhc_calib_options *opt, const dhc_diagnose_options *dopt,
                              dhc_model *fitted, dhc_calib_report *r)
 {
@@ -61,7 +65,16 @@ static void fit_and_diagnose(const dhc_calib_options *opt, const dhc_diagnose_op
     TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, fitted));
     TEST_ASSERT_EQUAL(DHC_OK, dhc_calib_fit(fitted, &set, test_read_sample, &data, data.n,
                                             data.flags, opt, &cws, r));
-    const size_t nc = dhc_diagnose_candidates(fitted, &set, 0, 0.0, cands, DHC_MAX_CANDIDATES);
+    size_t nc = dhc_diagnose_candidates(fitted, &set, 0, 0.0, cands, DHC_MAX_CANDIDATES);
+    if (first_catalogue_only) {
+        size_t kept = 0U;
+        for (size_t c = 0U; c < nc; ++c) {
+            if ((unsigned)cands[c].effect < (unsigned)DHC_EFFECT_JOINT_HARMONIC2) {
+                cands[kept++] = cands[c];
+            }
+        }
+        nc = kept;
+    }
     TEST_ASSERT_EQUAL(DHC_OK, dhc_diagnose(fitted, &set, r->identifiable, r->sigma * r->sigma,
                                            cands, nc, test_read_sample, &data, data.n,
                                            data.flags, dopt, &dws, &diag));
@@ -139,6 +152,7 @@ static void test_noise_model_off_is_bit_identical_to_before(void)
      * at a hundredth of a standard error from where this one stopped (the same parameters
      * to 1e-2 std, checked below); switched off, the library is bit-identical. */
     opt.noise_rel_tol = 0.0;
+    first_catalogue_only = 1;
     dhc_model fitted;
     fit_and_diagnose(&opt, &dopt, &fitted, &rep);
     TEST_ASSERT_EQUAL_size_t(12U, set.count);
@@ -178,6 +192,7 @@ static void test_noise_model_off_is_bit_identical_to_before(void)
             TEST_ASSERT_DOUBLE_WITHIN(1e-2 * rep.std_err[k] + 1e-15, g, rep_off.value[k]);
         }
     }
+    first_catalogue_only = 0;
 }
 
 /* ------------------------------------------------------------ (b) dense GLS */

@@ -199,10 +199,14 @@ static void test_wire_lengths_are_scaled_distances_plus_offsets(void)
     }
 }
 
-static void every_effect(dhc_param_set *set, const dhc_model *m)
+/* The base model and every effect of one part of the catalogue (all of it does not fit in
+ * DHC_MAX_PARAMS): part 0 the first catalogue, part 1 the higher harmonics and drift. */
+static void every_effect(dhc_param_set *set, const dhc_model *m, unsigned part)
 {
     TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(set, m));
-    for (unsigned e = 0U; e < (unsigned)DHC_EFFECT_COUNT; ++e) {
+    const unsigned first = part == 0U ? 0U : (unsigned)DHC_EFFECT_JOINT_HARMONIC2;
+    const unsigned end = part == 0U ? (unsigned)DHC_EFFECT_JOINT_HARMONIC2 : DHC_EFFECT_COUNT;
+    for (unsigned e = first; e < end; ++e) {
         if (dhc_effect_is_per_joint((dhc_effect)e)) {
             for (size_t j = 0U; j < m->arm.n_joints; ++j) {
                 TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(set, m, (dhc_effect)e, j));
@@ -217,11 +221,12 @@ static void every_effect(dhc_param_set *set, const dhc_model *m)
  * compared with the analytic column. skip_geometric: compliance makes the columns of
  * geometry and thermal scale first-order only (the gravity moments move with them; see
  * dhc_jacobian.h), so those are checked on a model without compliance. */
-static size_t check_columns(const dhc_model *m, const dhc_sample *s, int skip_geometric)
+static size_t check_columns(const dhc_model *m, const dhc_sample *s, int skip_geometric,
+                            unsigned part)
 {
     static dhc_param_set set;
     static double buf[6 * DHC_MAX_PARAMS];
-    every_effect(&set, m);
+    every_effect(&set, m, part);
     const size_t rows = dhc_sample_rows(s);
     dhc_mat jac;
     TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&jac, rows, set.count, buf, 6U * DHC_MAX_PARAMS));
@@ -236,7 +241,9 @@ static size_t check_columns(const dhc_model *m, const dhc_sample *s, int skip_ge
         }
         char name[32];
         (void)dhc_params_name(&set, k, name, sizeof name);
-        const double h = set.id[k].kind == (uint8_t)DHC_P_COMPLIANCE ? 1e-9
+        const double h = set.id[k].kind == (uint8_t)DHC_P_COMPLIANCE ||
+                                 set.id[k].kind == (uint8_t)DHC_P_DRIFT_SCALE
+                             ? 1e-9
                          : set.id[k].kind == (uint8_t)DHC_P_THERMAL   ? 1e-7
                          : set.id[k].kind == (uint8_t)DHC_P_JOINT_SCALE ||
                                  set.id[k].kind == (uint8_t)DHC_P_MEAS_SCALE
@@ -300,6 +307,15 @@ static dhc_model model_with_effects(int with_compliance)
     m.measurer.offset_mm[0] = 1.0;
     m.measurer.anchor_mm[1][2] += 2.0;
     m.thermal_per_k = 2e-5;
+    for (size_t i = 0U; i < 3U; ++i) {
+        for (size_t k = 0U; k + 1U < DHC_HARMONIC_MAX_ORDER; ++k) {
+            m.effect[i].harmonic_hi_sin_rad[k] = 1e-4 * (double)(k + 1U);
+            m.effect[i].harmonic_hi_cos_rad[k] = -2e-4 / (double)(k + 1U);
+        }
+    }
+    m.drift_scale_per_s = 3e-7;
+    dhc_vec3_set(m.drift_mm_per_s, 1e-4, -2e-4, 5e-5);
+    m.drift_ref_s = 100.0;
     return m;
 }
 
@@ -315,10 +331,12 @@ static void test_model_jacobian_matches_central_differences_for_every_effect(voi
             dhc_sample s = sample_at(&m, q, kinds[trial % 3U]);
             s.dir[1] = -1;
             s.temp_c = 27.5;
-            checked += check_columns(&m, &s, with_compliance);
+            s.t_s = 350.0 + 10.0 * (double)trial;
+            checked += check_columns(&m, &s, with_compliance, 0U);
+            checked += check_columns(&m, &s, with_compliance, 1U);
         }
     }
-    TEST_ASSERT_GREATER_THAN(500U, checked);
+    TEST_ASSERT_GREATER_THAN(800U, checked);
 }
 
 static void test_effect_names_parse_and_print(void)
@@ -338,6 +356,31 @@ static void test_effect_names_parse_and_print(void)
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_effect_parse("base_frame:1", 12U, 3U, &e, &j));
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_effect_parse("gremlins", 8U, 3U, &e, &j));
     TEST_ASSERT_EQUAL_STRING("thermal_scale", dhc_effect_name(DHC_EFFECT_THERMAL_SCALE));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_effect_parse("joint_harmonic3:2", 17U, 3U, &e, &j));
+    TEST_ASSERT_EQUAL(DHC_EFFECT_JOINT_HARMONIC3, e);
+    TEST_ASSERT_EQUAL(1U, j);
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_effect_parse("drift_offset", 12U, 3U, &e, &j));
+    TEST_ASSERT_EQUAL(DHC_EFFECT_DRIFT_OFFSET, e);
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_effect_parse("drift_scale:1", 13U, 3U, &e, &j));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_effect_parse("joint_harmonic5:1", 17U, 3U, &e, &j));
+    {
+        static dhc_param_set hs;
+        dhc_params_clear(&hs);
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(&hs, &m, DHC_EFFECT_JOINT_HARMONIC3, 1U));
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(&hs, &m, DHC_EFFECT_DRIFT_OFFSET, 0U));
+        TEST_ASSERT_EQUAL(5U, hs.count);
+        char hn[32];
+        (void)dhc_params_name(&hs, 0U, hn, sizeof hn);
+        TEST_ASSERT_EQUAL_STRING("harmonic3_sin2", hn);
+        (void)dhc_params_name(&hs, 1U, hn, sizeof hn);
+        TEST_ASSERT_EQUAL_STRING("harmonic3_cos2", hn);
+        (void)dhc_params_name(&hs, 4U, hn, sizeof hn);
+        TEST_ASSERT_EQUAL_STRING("drift_offset_z", hn);
+        TEST_ASSERT_EQUAL(DHC_EFFECT_JOINT_HARMONIC3, dhc_params_effect_of(&hs.id[0]));
+        TEST_ASSERT_EQUAL(DHC_EFFECT_DRIFT_OFFSET, dhc_params_effect_of(&hs.id[2]));
+        TEST_ASSERT_TRUE(dhc_params_is_angle(&hs, 0U));
+        TEST_ASSERT_FALSE(dhc_params_is_angle(&hs, 2U));
+    }
 
     static dhc_param_set set;
     dhc_params_clear(&set);

@@ -196,6 +196,10 @@ static void ref_predict(const dhc_model *m, const dhc_sample *s, double out[3], 
         const double q = s->q_rad[i];
         double dq = fx->scale * q + fx->harmonic_sin_rad * sin(q) + fx->harmonic_cos_rad * cos(q) +
                     0.5 * fx->backlash_rad * (double)s->dir[i];
+        for (size_t k = 2U; k <= DHC_HARMONIC_MAX_ORDER; ++k) {
+            dq += fx->harmonic_hi_sin_rad[k - 2U] * sin((double)k * q) +
+                  fx->harmonic_hi_cos_rad[k - 2U] * cos((double)k * q);
+        }
         for (size_t j = i; j < n; ++j) {
             /* tau_ij = z_i . ((o_{j+1} - o_i) x g), frames of the measured angles */
             const double l[3] = {f[j + 1U].p[0] - f[i].p[0], f[j + 1U].p[1] - f[i].p[1],
@@ -215,6 +219,13 @@ static void ref_predict(const dhc_model *m, const dhc_sample *s, double out[3], 
         t.p[k] = ls * m->arm.tool_mm[k];
     }
     ref_mul(&f[n], &t, tool);
+    /* the session's drift: p = b + (1 + k (t - t0)) (p_arm - b) + v (t - t0) */
+    const double dt = s->t_s - m->drift_ref_s;
+    for (size_t k = 0U; k < 3U; ++k) {
+        const double b = m->arm.base.pos[k];
+        tool->p[k] = b + (1.0 + m->drift_scale_per_s * dt) * (tool->p[k] - b) +
+                     m->drift_mm_per_s[k] * dt;
+    }
     if (s->kind != (uint8_t)DHC_MEAS_WIRES) {
         memcpy(out, tool->p, sizeof tool->p);
         return;
@@ -267,8 +278,14 @@ static void ref_perturb(dhc_model *m, const dhc_param_id *id, double h)
     case DHC_P_TOOL_Y:
     case DHC_P_TOOL_Z: m->arm.tool_mm[id->kind - (uint8_t)DHC_P_TOOL_X] += h; break;
     case DHC_P_JOINT_SCALE: fx->scale += h; break;
-    case DHC_P_HARMONIC_SIN: fx->harmonic_sin_rad += h; break;
-    case DHC_P_HARMONIC_COS: fx->harmonic_cos_rad += h; break;
+    case DHC_P_HARMONIC_SIN:
+        *(id->aux == 0U ? &fx->harmonic_sin_rad : &fx->harmonic_hi_sin_rad[id->aux - 1U]) += h;
+        break;
+    case DHC_P_HARMONIC_COS:
+        *(id->aux == 0U ? &fx->harmonic_cos_rad : &fx->harmonic_hi_cos_rad[id->aux - 1U]) += h;
+        break;
+    case DHC_P_DRIFT_SCALE: m->drift_scale_per_s += h; break;
+    case DHC_P_DRIFT_OFFSET: m->drift_mm_per_s[id->aux] += h; break;
     case DHC_P_BACKLASH: fx->backlash_rad += h; break;
     case DHC_P_COMPLIANCE: fx->compliance[id->aux] += h; break;
     case DHC_P_MEAS_SCALE: m->measurer.scale += h; break;
@@ -319,6 +336,10 @@ static void random_effects(test_rng *g, dhc_model *m, double L, int with_complia
         m->effect[i].harmonic_sin_rad = test_range(g, -1e-3, 1e-3);
         m->effect[i].harmonic_cos_rad = test_range(g, -1e-3, 1e-3);
         m->effect[i].backlash_rad = test_range(g, 0.0, 2e-3);
+        for (size_t k = 0U; k + 1U < DHC_HARMONIC_MAX_ORDER; ++k) {
+            m->effect[i].harmonic_hi_sin_rad[k] = test_range(g, -1e-3, 1e-3);
+            m->effect[i].harmonic_hi_cos_rad[k] = test_range(g, -1e-3, 1e-3);
+        }
         for (size_t j = i; with_compliance && j < n; ++j) {
             m->effect[i].compliance[j] = test_range(g, -1e-4, 1e-4) / L;
         }
@@ -337,6 +358,11 @@ static void random_effects(test_rng *g, dhc_model *m, double L, int with_complia
     dhc_frame_from_xyz_rpy(xyz, rpy, &m->measurer.frame);
     m->measurer.scale = test_range(g, -1e-3, 1e-3);
     m->thermal_per_k = test_range(g, -3e-5, 3e-5);
+    m->drift_ref_s = test_range(g, 0.0, 1e3);
+    m->drift_scale_per_s = test_range(g, -1e-7, 1e-7);
+    for (size_t k = 0U; k < 3U; ++k) {
+        m->drift_mm_per_s[k] = L * test_range(g, -1e-6, 1e-6);
+    }
 }
 
 /* Every parameter kind: theta, d, a, alpha, beta on every joint (whatever its convention),
@@ -351,17 +377,21 @@ static void all_kinds(dhc_param_set *s, const dhc_model *m, size_t first)
             TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add(s, m, (dhc_param_kind)k, i, 0U));
         }
     }
-    const dhc_effect global[6] = {DHC_EFFECT_BASE_FRAME,         DHC_EFFECT_TOOL_OFFSET,
-                                  DHC_EFFECT_MEASURER_SCALE,     DHC_EFFECT_MEASURER_OFFSET,
-                                  DHC_EFFECT_MEASURER_ANCHORS,   DHC_EFFECT_THERMAL_SCALE};
-    for (size_t e = 0U; e < 6U; ++e) {
+    const dhc_effect global[8] = {DHC_EFFECT_BASE_FRAME,       DHC_EFFECT_TOOL_OFFSET,
+                                  DHC_EFFECT_MEASURER_SCALE,   DHC_EFFECT_MEASURER_OFFSET,
+                                  DHC_EFFECT_MEASURER_ANCHORS, DHC_EFFECT_THERMAL_SCALE,
+                                  DHC_EFFECT_DRIFT_SCALE,      DHC_EFFECT_DRIFT_OFFSET};
+    for (size_t e = 0U; e < 8U; ++e) {
         TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(s, m, global[e], 0U));
     }
-    const dhc_effect per_joint[4] = {DHC_EFFECT_JOINT_COMPLIANCE, DHC_EFFECT_JOINT_SCALE,
-                                     DHC_EFFECT_JOINT_HARMONIC, DHC_EFFECT_JOINT_BACKLASH};
+    /* the joint `first` gets every order of harmonic first, then the rest as they fit */
+    const dhc_effect per_joint[7] = {DHC_EFFECT_JOINT_HARMONIC2, DHC_EFFECT_JOINT_HARMONIC4,
+                                     DHC_EFFECT_JOINT_COMPLIANCE, DHC_EFFECT_JOINT_SCALE,
+                                     DHC_EFFECT_JOINT_HARMONIC,   DHC_EFFECT_JOINT_BACKLASH,
+                                     DHC_EFFECT_JOINT_HARMONIC3};
     for (size_t t = 0U; t < n; ++t) {
         const size_t i = (first + t) % n;
-        for (size_t e = 0U; e < 4U; ++e) {
+        for (size_t e = 0U; e < 7U; ++e) {
             const dhc_status st = dhc_params_add_effect(s, m, per_joint[e], i);
             TEST_ASSERT_TRUE(st == DHC_OK || st == DHC_ERR_CAPACITY);
         }
@@ -385,6 +415,8 @@ static double fd_step(const dhc_param_set *s, size_t k, double L)
     case DHC_P_COMPLIANCE: return 1e-6 / L;
     case DHC_P_THERMAL: return 1e-7;
     case DHC_P_MEAS_SCALE: return 1e-7;
+    case DHC_P_DRIFT_SCALE: return 1e-10;
+    case DHC_P_DRIFT_OFFSET: return 1e-7 * L;
     default: return 1e-6; /* angles, joint scale */
     }
 }
@@ -497,6 +529,7 @@ static void test_model_jacobian_matches_independent_differences_on_random_arms(v
                 s.dir[i] = (int8_t)((int)(test_uniform(&g) * 3.0) - 1);
             }
             s.temp_c = m.thermal_ref_c + test_range(&g, -10.0, 10.0);
+            s.t_s = m.drift_ref_s + test_range(&g, -500.0, 500.0);
             s.kind = (uint8_t)kinds[(c + pose) % 3U];
             check_jacobian(&m, &s, L, compliant);
         }

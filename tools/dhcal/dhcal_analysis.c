@@ -28,12 +28,12 @@ int dhcal_parse_effects(const char *list, const dhc_model *model, dhc_param_set 
         dhc_effect effect;
         size_t joint;
         if (dhc_effect_parse(p, len, model->arm.n_joints, &effect, &joint) != DHC_OK) {
+            char known[512];
+            (void)dhcal_effect_catalogue(known, sizeof known);
             snprintf(err->msg, sizeof err->msg,
-                     "--effects: '%.*s' is not an effect of this model (names: base_frame, "
-                     "tool_offset, joint_scale:i, joint_harmonic:i, joint_backlash:i, "
-                     "joint_compliance:i with 1 <= i <= %zu, measurer_scale, "
-                     "measurer_offset, measurer_anchors, thermal_scale)",
-                     (int)(len > 60U ? 60U : len), p, model->arm.n_joints);
+                     "--effects: '%.*s' is not an effect of this model (names: %s; "
+                     "1 <= i <= %zu)",
+                     (int)(len > 60U ? 60U : len), p, known, model->arm.n_joints);
             return DHCAL_IO_BAD_INPUT;
         }
         const dhc_status st = dhc_params_add_effect(set, model, effect, joint);
@@ -90,6 +90,34 @@ int dhcal_parse_noise(const char *text, dhcal_noise *out, dhcal_error *err)
     return DHCAL_IO_OK;
 }
 
+/* t0 of the session's drift: the mean time of the rows fitted (DESIGN.md 3b), unless the
+ * model already carries a drift with its own t0. */
+static void set_drift_reference(dhc_model *model, const dhcal_samples *s)
+{
+    const double *v = model->drift_mm_per_s;
+    if (fabs(model->drift_scale_per_s) > 0.0 || fabs(v[0]) > 0.0 || fabs(v[1]) > 0.0 ||
+        fabs(v[2]) > 0.0) {
+        return;
+    }
+    double sum = 0.0;
+    size_t n = 0U;
+    for (size_t i = 0U; i < s->n; ++i) {
+        if (s->flags[i] == (uint8_t)DHC_SAMPLE_USED) {
+            sum += s->samples[i].t_s;
+            ++n;
+        }
+    }
+    model->drift_ref_s = n > 0U ? sum / (double)n : 0.0;
+}
+
+dhc_model dhcal_model_without_drift(const dhc_model *model)
+{
+    dhc_model m = *model;
+    m.drift_scale_per_s = 0.0;
+    dhc_vec3_set(m.drift_mm_per_s, 0.0, 0.0, 0.0);
+    return m;
+}
+
 int dhcal_run_fit(const dhc_model *nominal, const char *effects, const dhcal_noise *noise,
                   dhcal_samples *s, const dhcal_samples *held, dhcal_fit *out,
                   dhcal_error *err)
@@ -107,6 +135,7 @@ int dhcal_run_fit(const dhc_model *nominal, const char *effects, const dhcal_noi
     if (rc != DHCAL_IO_OK) {
         return rc;
     }
+    set_drift_reference(&out->model, s);
     dhc_calib_options opt;
     dhc_calib_default_options(&opt);
     if (out->noise.on) {
@@ -131,7 +160,10 @@ int dhcal_run_fit(const dhc_model *nominal, const char *effects, const dhcal_noi
     }
     if (held != NULL) {
         double *e = calloc(held->n > 0U ? held->n : 1U, sizeof *e);
-        rc = e != NULL ? dhcal_samples_errors(&out->model, held, NULL, e, &out->heldout_rms_mm,
+        /* held-out rows come from another session: the calibration session's drift is not
+         * theirs */
+        const dhc_model steady = dhcal_model_without_drift(&out->model);
+        rc = e != NULL ? dhcal_samples_errors(&steady, held, NULL, e, &out->heldout_rms_mm,
                                               &out->heldout_max_mm)
                        : DHCAL_IO_FAILED;
         free(e);
@@ -285,6 +317,11 @@ const char *dhcal_effect_signature(dhc_effect effect)
     case DHC_EFFECT_MEASURER_OFFSET: return "a constant error on each wire (wire zero reference)";
     case DHC_EFFECT_MEASURER_ANCHORS: return "errors pointing at the measurer's anchors (measurer built off its drawing)";
     case DHC_EFFECT_THERMAL_SCALE: return "lengths growing with temperature (thermal expansion)";
+    case DHC_EFFECT_JOINT_HARMONIC2: return "a joint error repeating twice per turn (encoder ellipticity, gear harmonic)";
+    case DHC_EFFECT_JOINT_HARMONIC3: return "a joint error repeating three times per turn (gear harmonic)";
+    case DHC_EFFECT_JOINT_HARMONIC4: return "a joint error repeating four times per turn (gear harmonic)";
+    case DHC_EFFECT_DRIFT_SCALE: return "errors growing over the session in proportion to the distance from the base (warming arm)";
+    case DHC_EFFECT_DRIFT_OFFSET: return "a constant error growing over the session (measurer or base moving)";
     case DHC_EFFECT_COUNT:
     default: return "an unknown pattern";
     }

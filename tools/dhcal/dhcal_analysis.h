@@ -30,6 +30,10 @@ typedef struct {
     double heldout_max_mm;
 } dhcal_fit;
 
+/* The model without the calibration session's drift (drift_scale, drift_offset): what
+ * another session's measurements (held-out rows, a controller) see. */
+dhc_model dhcal_model_without_drift(const dhc_model *model);
+
 /* Adds the effects of a comma-separated list ("joint_compliance:2,base_frame") to set.
  * DHCAL_IO_BAD_INPUT naming the offending item. NULL or "" adds nothing. */
 int dhcal_parse_effects(const char *list, const dhc_model *model, dhc_param_set *set,

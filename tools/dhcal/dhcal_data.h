@@ -21,7 +21,7 @@ typedef struct {
 /* Builds samples. Raw wire lengths L1..L3 are used as they are (residuals in wire-length
  * space, where noise is independent and equal) whenever the model has a measurer;
  * otherwise the tool point x,y,z (with qw..qz: a pose). Directions default to 0
- * (unknown), temperature to the model's thermal reference.
+ * (unknown), temperature to the model's thermal reference, time to the 0-based row number.
  * DHCAL_IO_BAD_INPUT (message names file and line) for wire-only data and a model without
  * a measurer. */
 int dhcal_samples_build(const dhc_model *model, const dhcal_dataset *data, const char *path,

@@ -17,6 +17,7 @@
 #include <string.h>
 
 #include "dhcal/dhc_linalg.h"
+#include "dhcal/dhc_params.h"
 #include "dhcal_file.h"
 
 #define IO_PI 3.14159265358979323846
@@ -29,6 +30,7 @@
 #define LEN_MAX_MM 1e5
 #define CSV_Q_MAX_DEG 720.0
 #define TEMP_MIN_C (-60.0)
+#define TIME_MAX_S 1e9
 #define TEMP_MAX_C 150.0
 #define UNIT_NORM_TOL 1e-3
 /* Anchors closer than this are one point; sin(angle) below ANCHOR_SIN_TOL is a line. */
@@ -224,7 +226,16 @@ static size_t split_fields(char *line, size_t len, span **spans, size_t *cap)
 
 /* ------------------------------------------------------------------ CSV: columns */
 
-typedef enum { COL_Q, COL_XYZ, COL_WIRE, COL_QUAT, COL_DIR, COL_TEMP, COL_KIND_COUNT } col_kind;
+typedef enum {
+    COL_Q,
+    COL_XYZ,
+    COL_WIRE,
+    COL_QUAT,
+    COL_DIR,
+    COL_TEMP,
+    COL_TIME,
+    COL_KIND_COUNT
+} col_kind;
 
 typedef struct {
     col_kind kind;
@@ -254,6 +265,8 @@ static const char *col_name(csv_col c, char buf[16])
     case COL_DIR:
         (void)snprintf(buf, 16U, "dir%zu", c.idx + 1U);
         return buf;
+    case COL_TIME:
+        return "t_s";
     case COL_TEMP:
     case COL_KIND_COUNT:
     default:
@@ -310,6 +323,10 @@ static int classify(const char *name, size_t n_joints, csv_col *col, size_t *bey
     }
     if (strcmp(name, "temp_c") == 0) {
         *col = (csv_col){COL_TEMP, 0U};
+        return 1;
+    }
+    if (strcmp(name, "t_s") == 0) {
+        *col = (csv_col){COL_TIME, 0U};
         return 1;
     }
     col_kind kind = COL_Q;
@@ -395,7 +412,7 @@ static int parse_header(csv_ctx *c, dhcal_dataset *data)
         if (cls == 0) {
             return set_error(c->rd.err, DHCAL_IO_BAD_INPUT,
                              "%s:%zu: unknown column '%s' (known: q1..q%zu, x,y,z, L1,L2,L3, "
-                             "qw,qx,qy,qz, dir1..dir%zu, temp_c)",
+                             "qw,qx,qy,qz, dir1..dir%zu, temp_c, t_s)",
                              path, line, show(f.s, f.n, sb), c->n_joints, c->n_joints);
         }
         size_t *const slot = &seen[col.kind][col.idx];
@@ -433,6 +450,7 @@ static int parse_header(csv_ctx *c, dhcal_dataset *data)
                          "%s:%zu: no position columns: need x,y,z or L1,L2,L3", path, line);
     }
     data->has_temp = seen[COL_TEMP][0] != 0U;
+    data->has_time = seen[COL_TIME][0] != 0U;
     c->has_quat = data->has_quat;
     return DHCAL_IO_OK;
 }
@@ -567,6 +585,12 @@ static int parse_row(csv_ctx *c, dhcal_row *row)
                                  c->rd.line_no, col_name(col, nb), show(f.s, f.n, sb));
             }
             row->dir[col.idx] = v > 0.0 ? 1 : -1;
+            break;
+        case COL_TIME:
+            if (v < -TIME_MAX_S || v > TIME_MAX_S) {
+                return out_of_range(c, col, f, "[-1e9, 1e9] s");
+            }
+            row->t_s = v;
             break;
         case COL_TEMP:
         case COL_KIND_COUNT:
@@ -1038,29 +1062,24 @@ static int load_measurer(const jctx *c, const cJSON *m, dhcal_model *model)
     return load_frame(c, m, "measurer", "frame", &model->measurer_frame);
 }
 
-/* Effect names of DESIGN.md section 3: those that take ":i" and those that do not. */
-static const char *const JOINT_EFFECTS[] = {"joint_scale", "joint_harmonic", "joint_backlash",
-                                            "joint_compliance"};
-static const char *const PLAIN_EFFECTS[] = {"base_frame",     "tool_offset",
-                                            "measurer_scale", "measurer_offset",
-                                            "measurer_anchors", "thermal_scale"};
-
+/* The effect catalogue is the library's (dhc_params): one list of names for every program. */
 static int effect_name_ok(const char *name, size_t n_joints)
 {
-    size_t idx = 0U;
-    const char *const colon = strchr(name, ':');
-    if (colon == NULL) {
-        return find_name(name, PLAIN_EFFECTS, sizeof PLAIN_EFFECTS / sizeof PLAIN_EFFECTS[0],
-                         &idx);
+    dhc_effect effect;
+    size_t joint;
+    return dhc_effect_parse(name, strlen(name), n_joints, &effect, &joint) == DHC_OK;
+}
+
+size_t dhcal_effect_catalogue(char *buf, size_t cap)
+{
+    size_t pos = 0U;
+    for (unsigned e = 0U; e < (unsigned)DHC_EFFECT_COUNT; ++e) {
+        const int n = snprintf(buf + (pos < cap ? pos : cap), pos < cap ? cap - pos : 0U,
+                               "%s%s%s", e == 0U ? "" : ", ", dhc_effect_name((dhc_effect)e),
+                               dhc_effect_is_per_joint((dhc_effect)e) ? ":i" : "");
+        pos += n > 0 ? (size_t)n : 0U;
     }
-    const size_t base_len = (size_t)(colon - name);
-    int found = 0;
-    for (size_t i = 0U; i < sizeof JOINT_EFFECTS / sizeof JOINT_EFFECTS[0]; ++i) {
-        found |= strlen(JOINT_EFFECTS[i]) == base_len &&
-                 strncmp(name, JOINT_EFFECTS[i], base_len) == 0;
-    }
-    const size_t joint = parse_index(colon + 1);
-    return found && joint >= 1U && joint <= n_joints;
+    return pos;
 }
 
 static int load_effects(const jctx *c, const cJSON *fx, dhcal_model *model)
@@ -1078,11 +1097,9 @@ static int load_effects(const jctx *c, const cJSON *fx, dhcal_model *model)
         }
         if (strlen(e->string) >= sizeof model->effects[0].name ||
             !effect_name_ok(e->string, c->n_joints)) {
-            return jfail(c, kp,
-                         "unknown effect (known: base_frame, tool_offset, measurer_scale, "
-                         "measurer_offset, measurer_anchors, thermal_scale, and "
-                         "joint_scale, joint_harmonic, joint_backlash, joint_compliance "
-                         "with :i, 1 <= i <= %zu)",
+            char known[512];
+            (void)dhcal_effect_catalogue(known, sizeof known);
+            return jfail(c, kp, "unknown effect (known: %s; 1 <= i <= %zu)", known,
                          c->n_joints);
         }
         if (model->n_effects == DHCAL_MAX_EFFECTS) {

@@ -88,18 +88,20 @@ typedef struct {
     double quat[4];               /* has_quat: w, x, y, z (normalised on load) */
     int dir[DHC_MAX_JOINTS];      /* has_dir: -1 or +1 */
     double temp_c;                /* has_temp */
+    double t_s;                   /* has_time: time of the measurement, s (drift) */
 } dhcal_row;
 
 typedef struct {
     size_t n_rows;
     size_t n_joints;
-    int has_xyz, has_wires, has_quat, has_dir, has_temp;
+    int has_xyz, has_wires, has_quat, has_dir, has_temp, has_time;
     dhcal_row *rows; /* heap, n_rows entries */
 } dhcal_dataset;
 
 /* Loads a measurement CSV for an arm with n_joints joints: '#' comment lines, then a
  * header naming columns in any order: q1..qN (deg, required), and x,y,z and/or L1,L2,L3
- * (at least one complete group), optional qw,qx,qy,qz, dir1..dirN, temp_c. Rejects: an
+ * (at least one complete group), optional qw,qx,qy,qz, dir1..dirN, temp_c, t_s (seconds,
+ * any origin, within +-1e9). Rejects: an
  * empty file, a header without rows, unknown / repeated / partial-group / missing columns,
  * a q column beyond n_joints, short or long rows, fields that are not numbers (strtod must
  * consume the whole trimmed field), NaN/Inf, joint angles beyond [-720, 720] deg, lengths
@@ -117,5 +119,10 @@ typedef struct {
 int dhcal_csv_load(const char *path, size_t n_joints, dhcal_dataset *data, dhcal_error *err);
 /* Frees the rows and empties *data; NULL and already-empty datasets are fine. */
 void dhcal_dataset_free(dhcal_dataset *data);
+
+/* The effect names a model file and --effects accept, from the library's catalogue
+ * ("base_frame, tool_offset, joint_scale:i, ..."), into buf (snprintf rules); returns the
+ * full length. */
+size_t dhcal_effect_catalogue(char *buf, size_t cap);
 
 #endif /* DHCAL_IO_H */

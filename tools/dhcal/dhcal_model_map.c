@@ -56,6 +56,31 @@ int dhcal_model_to_lib(const dhcal_model *file, const char *path, dhc_model *out
             fx->harmonic_sin_rad = v[0] * DEG;
             fx->harmonic_cos_rad = v[1] * DEG;
             break;
+        case DHC_EFFECT_JOINT_HARMONIC2:
+        case DHC_EFFECT_JOINT_HARMONIC3:
+        case DHC_EFFECT_JOINT_HARMONIC4: {
+            if (k != 2U) {
+                return bad(err, path, ev->name, "expected [A_deg, B_deg]", k);
+            }
+            const size_t order = (size_t)((unsigned)effect - (unsigned)DHC_EFFECT_JOINT_HARMONIC2);
+            fx->harmonic_hi_sin_rad[order] = v[0] * DEG;
+            fx->harmonic_hi_cos_rad[order] = v[1] * DEG;
+            break;
+        }
+        case DHC_EFFECT_DRIFT_SCALE:
+            if (k != 2U) {
+                return bad(err, path, ev->name, "expected [k_per_s, t0_s]", k);
+            }
+            out->drift_scale_per_s = v[0];
+            out->drift_ref_s = v[1];
+            break;
+        case DHC_EFFECT_DRIFT_OFFSET:
+            if (k != 4U) {
+                return bad(err, path, ev->name, "expected [vx_mm_per_s, vy, vz, t0_s]", k);
+            }
+            memcpy(out->drift_mm_per_s, v, 3U * sizeof v[0]);
+            out->drift_ref_s = v[3];
+            break;
         case DHC_EFFECT_JOINT_BACKLASH:
             if (k != 1U) {
                 return bad(err, path, ev->name, "expected [b_deg]", k);
@@ -142,6 +167,16 @@ void dhcal_model_from_lib(const dhc_model *m, const dhcal_model *template_model,
             const double v[2] = {fx->harmonic_sin_rad / DEG, fx->harmonic_cos_rad / DEG};
             put_effect(out, DHC_EFFECT_JOINT_HARMONIC, j, v, 2U);
         }
+        for (size_t order = 0U; order + 1U < DHC_HARMONIC_MAX_ORDER; ++order) {
+            if (fabs(fx->harmonic_hi_sin_rad[order]) > 0.0 ||
+                fabs(fx->harmonic_hi_cos_rad[order]) > 0.0) {
+                const double v[2] = {fx->harmonic_hi_sin_rad[order] / DEG,
+                                     fx->harmonic_hi_cos_rad[order] / DEG};
+                put_effect(out,
+                           (dhc_effect)((unsigned)DHC_EFFECT_JOINT_HARMONIC2 + (unsigned)order),
+                           j, v, 2U);
+            }
+        }
         if (fabs(fx->backlash_rad) > 0.0) {
             const double v = fx->backlash_rad / DEG;
             put_effect(out, DHC_EFFECT_JOINT_BACKLASH, j, &v, 1U);
@@ -166,5 +201,14 @@ void dhcal_model_from_lib(const dhc_model *m, const dhcal_model *template_model,
     if (fabs(m->thermal_per_k) > 0.0) {
         const double v[2] = {m->thermal_per_k, m->thermal_ref_c};
         put_effect(out, DHC_EFFECT_THERMAL_SCALE, 0U, v, 2U);
+    }
+    if (fabs(m->drift_scale_per_s) > 0.0) {
+        const double v[2] = {m->drift_scale_per_s, m->drift_ref_s};
+        put_effect(out, DHC_EFFECT_DRIFT_SCALE, 0U, v, 2U);
+    }
+    const double *dv = m->drift_mm_per_s;
+    if (fabs(dv[0]) > 0.0 || fabs(dv[1]) > 0.0 || fabs(dv[2]) > 0.0) {
+        const double v[4] = {dv[0], dv[1], dv[2], m->drift_ref_s};
+        put_effect(out, DHC_EFFECT_DRIFT_OFFSET, 0U, v, 4U);
     }
 }

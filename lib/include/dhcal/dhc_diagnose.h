@@ -28,7 +28,7 @@
 #include "dhc_status.h"
 
 #ifndef DHC_MAX_CANDIDATES
-#define DHC_MAX_CANDIDATES 48U
+#define DHC_MAX_CANDIDATES 64U
 #endif
 
 /* Most parameters one candidate effect brings (measurer anchors: 9). */

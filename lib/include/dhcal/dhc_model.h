@@ -5,12 +5,17 @@
  *   q_eff_i = q_i + dq_i,
  *   dq_i    = s_i q_i                         joint_scale      (gear ratio / resolution)
  *           + A_i sin q_i + B_i cos q_i       joint_harmonic   (eccentricity)
+ *           + A_ik sin k q_i + B_ik cos k q_i joint_harmonicK, k = 2..4 (encoder
+ *                                             ellipticity, gear harmonics)
  *           + (b_i / 2) dir_i                 joint_backlash
  *           + sum_{j>=i} c_ij tau_ij(q)       joint_compliance (stiffness under gravity)
  * where tau_ij = z_{i-1} . ((o_j - o_{i-1}) x g) is the gravity moment about axis i of a unit
  * weight at the origin of frame j (mm, g a unit vector), evaluated on the arm at the measured q.
  * All link lengths (a, d, tool) scale by 1 + k (T - T0) (thermal_scale).
- * The tool point p = FK(q_eff). A wire-length sample sees
+ * The arm's tool point p_arm = FK(q_eff). Over a session the measured point drifts with the
+ * sample's time t (drift_scale, drift_offset):
+ *   p = b + (1 + k_d (t - t0)) (p_arm - b) + v (t - t0),   b the base origin.
+ * A wire-length sample sees
  *   L_k = (1 + s_m) |p - P_k| + o_k,   P_k = T_meas * anchor_k.
  * Units: mm, rad; c_ij in rad per mm of gravity moment arm.
  */
@@ -25,10 +30,15 @@
 #include "dhc_linalg.h"
 #include "dhc_status.h"
 
+/* Highest order of a joint harmonic (joint_harmonic2 .. joint_harmonic4). */
+#define DHC_HARMONIC_MAX_ORDER 4U
+
 typedef struct {
     double scale;               /* s_i */
     double harmonic_sin_rad;    /* A_i */
     double harmonic_cos_rad;    /* B_i */
+    double harmonic_hi_sin_rad[DHC_HARMONIC_MAX_ORDER - 1U]; /* A_ik, k = 2.. (index k-2) */
+    double harmonic_hi_cos_rad[DHC_HARMONIC_MAX_ORDER - 1U]; /* B_ik */
     double backlash_rad;        /* b_i: full play; each direction sees half */
     double compliance[DHC_MAX_JOINTS]; /* c_ij for j = index >= i, rad/mm */
 } dhc_joint_effects;
@@ -48,6 +58,9 @@ typedef struct {
     dhc_measurer_model measurer;
     double thermal_per_k;     /* k */
     double thermal_ref_c;     /* T0 */
+    double drift_scale_per_s; /* k_d */
+    double drift_mm_per_s[3]; /* v, world frame */
+    double drift_ref_s;       /* t0 */
 } dhc_model;
 
 typedef enum {
@@ -59,6 +72,7 @@ typedef enum {
 typedef struct {
     double q_rad[DHC_MAX_JOINTS]; /* measured joint angles (encoder, never commanded) */
     double temp_c;                /* temperature; T0 when not measured */
+    double t_s;                   /* time of the measurement, s (drift); any origin */
     double p_mm[3];               /* measured tool point, world (POSITION, POSE) */
     dhc_mat3 rot;                 /* measured orientation (POSE) */
     double wire_mm[3];            /* measured wire lengths (WIRES) */
@@ -69,6 +83,7 @@ typedef struct {
 /* What the model predicts for a sample. */
 typedef struct {
     double q_eff_rad[DHC_MAX_JOINTS];
+    double p_arm_mm[3]; /* the arm's tool point, before the session's drift */
     double p_mm[3];
     dhc_mat3 rot;
     double wire_mm[3]; /* WIRES samples only */
@@ -88,6 +103,12 @@ dhc_status dhc_sample_check(const dhc_model *model, const dhc_sample *s);
 
 /* Factor 1 + k (T - T0) by which thermal expansion scales every link length. */
 double dhc_model_length_scale(const dhc_model *model, double temp_c);
+
+/* Factor 1 + k_d (t - t0) by which the session's drift scales the arm about its base, and
+ * the measured point p that drift makes of the arm's point p_arm at time t_s (p may alias
+ * p_arm). */
+double dhc_model_drift_factor(const dhc_model *model, double t_s);
+void dhc_model_drift(const dhc_model *model, double t_s, const double p_arm[3], double p[3]);
 
 /* Gravity moments tau_ij (row i, column j, j >= i; others 0) at joint angles q, with link
  * lengths scaled by length_scale. */

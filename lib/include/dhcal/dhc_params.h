@@ -33,14 +33,16 @@ typedef enum {
     DHC_P_TOOL_Y,
     DHC_P_TOOL_Z,
     DHC_P_JOINT_SCALE,   /* s_i (joint) */
-    DHC_P_HARMONIC_SIN,  /* A_i, rad (joint) */
-    DHC_P_HARMONIC_COS,  /* B_i, rad (joint) */
+    DHC_P_HARMONIC_SIN,  /* A_ik, rad (joint i, aux k - 1: order k = 1..4) */
+    DHC_P_HARMONIC_COS,  /* B_ik, rad (joint i, aux k - 1) */
     DHC_P_BACKLASH,      /* b_i, rad (joint) */
     DHC_P_COMPLIANCE,    /* c_ij, rad/mm (joint i, aux j >= i) */
     DHC_P_MEAS_SCALE,    /* s_m */
     DHC_P_MEAS_OFFSET,   /* o_k, mm (aux k = 0..2) */
     DHC_P_MEAS_ANCHOR,   /* anchor coordinate, mm (aux = 3 k + axis) */
     DHC_P_THERMAL,       /* k, 1/K */
+    DHC_P_DRIFT_SCALE,   /* k_d, 1/s */
+    DHC_P_DRIFT_OFFSET,  /* v, mm/s (aux = world axis 0..2) */
     DHC_P_KIND_COUNT
 } dhc_param_kind;
 
@@ -56,6 +58,11 @@ typedef enum {
     DHC_EFFECT_MEASURER_OFFSET,
     DHC_EFFECT_MEASURER_ANCHORS,
     DHC_EFFECT_THERMAL_SCALE,
+    DHC_EFFECT_JOINT_HARMONIC2, /* orders 2..4 of joint_harmonic, in order */
+    DHC_EFFECT_JOINT_HARMONIC3,
+    DHC_EFFECT_JOINT_HARMONIC4,
+    DHC_EFFECT_DRIFT_SCALE,
+    DHC_EFFECT_DRIFT_OFFSET,
     DHC_EFFECT_COUNT
 } dhc_effect;
 
@@ -109,8 +116,9 @@ dhc_status dhc_params_apply(const dhc_param_set *set, dhc_model *model, const do
                             size_t len);
 
 /* A stable name for reports, e.g. "theta3", "beta2", "base_rx", "tool_z", "scale2",
- * "harmonic_sin2", "backlash1", "compliance2_3", "measurer_scale", "measurer_offset1",
- * "anchor2_y", "thermal_scale" (joints and wires 1-based). Writes at most cap bytes
+ * "harmonic_sin2", "harmonic3_cos2" (order 3), "backlash1", "compliance2_3",
+ * "measurer_scale", "measurer_offset1", "anchor2_y", "thermal_scale", "drift_scale",
+ * "drift_offset_x" (joints and wires 1-based). Writes at most cap bytes
  * including the terminator; returns the length of the full name. */
 size_t dhc_params_name(const dhc_param_set *set, size_t k, char *buf, size_t cap);
 
