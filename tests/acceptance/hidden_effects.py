@@ -18,6 +18,12 @@ Hidden effects (q in rad; the library's definitions, DESIGN.md section 3):
   joint_compliance:i  q_eff_i = q_i + sum_{j>=i} c_ij tau_ij(q),
                       tau_ij = z_{i-1} . ((o_j - o_{i-1}) x g)  [mm, unit weight],
                       frames of the TRUE arm at the MEASURED angles q
+  joint_harmonic2:i   q_eff_i = q_i + A sin 2q_i + B cos 2q_i  (two per turn)
+  drift_offset        the measured point moves by v (t - t0) over the session: t from the
+                      CSV column t_s (~30 s a pose, jittered), t0 the training rows' mean
+  drift_scale         the measured point's offset from the base grows by k (t - t0):
+                      no t_s column, t = the 0-based row number
+                      (held-out rows are another session: no drift there)
   measurer_scale      CSV has raw wire lengths L_k = (1 + s) |p - P_k| + noise
   clean               no effect
 
@@ -96,7 +102,11 @@ EFFECT_SIZE = {
     "joint_compliance:2": {"c22": 1.2e-6, "c23": 1.8e-6},
     "joint_compliance:3": {"c33": 1.0e-5},
     "measurer_scale": 1e-3,     # 1
+    "joint_harmonic2": 1e-3,    # rad, A and B each
+    "drift_offset": 3e-4,       # mm/s per axis: ~0.5 mm over a 30-minute session
+    "drift_scale": 2.5e-5,      # per row: ~0.5 mm at 700 mm from the base over 60 rows
 }
+SECONDS_PER_POSE = 30.0
 # Joints where each effect is observable. joint_compliance:1 is excluded: axis 1 is
 # vertical, so tau_1j = z_0 . (r x g) = 0 for every pose (gravity has no moment about it).
 CASES = (
@@ -104,6 +114,7 @@ CASES = (
     + ["joint_harmonic:%d" % i for i in (1, 2, 3)]
     + ["joint_backlash:%d" % i for i in (1, 2, 3)]
     + ["joint_compliance:%d" % i for i in (2, 3)]
+    + ["joint_harmonic2:1", "drift_offset", "drift_scale"]
     + ["measurer_scale", "clean"]
 )
 
@@ -327,7 +338,36 @@ def draw_effect(case, rng):
                                  for k, v in sorted(sizes.items())}}
     if name == "measurer_scale":
         return {"s": _magnitude(rng, EFFECT_SIZE[name])}
+    if name == "joint_harmonic2":
+        return {"A_rad": _magnitude(rng, EFFECT_SIZE[name]),
+                "B_rad": _magnitude(rng, EFFECT_SIZE[name])}
+    if name == "drift_offset":
+        return {"v_mm_per_s": [_magnitude(rng, EFFECT_SIZE[name]) for _ in range(3)]}
+    if name == "drift_scale":
+        return {"k_per_row": _magnitude(rng, EFFECT_SIZE[name])}
     raise AssertionError(case)
+
+
+def pose_times(case, rng, n):
+    """Measurement times of n poses (s): ~SECONDS_PER_POSE apart, jittered; the drift
+    cases' clock. drift_scale's CSV has no t_s: its clock is the row number."""
+    if parse_case(case)[0] == "drift_scale":
+        return [float(k) for k in range(n)]
+    t, out = 0.0, []
+    for _ in range(n):
+        t += SECONDS_PER_POSE * rng.uniform(0.8, 1.2)
+        out.append(round(t, 3))
+    return out
+
+
+def drifted(case, effect, p, t, t0):
+    """The measured point after the session's drift (DESIGN.md 3b), base at the origin."""
+    name, _ = parse_case(case)
+    if name == "drift_offset":
+        return [p[k] + effect["v_mm_per_s"][k] * (t - t0) for k in range(3)]
+    if name == "drift_scale":
+        return [(1.0 + effect["k_per_row"] * (t - t0)) * p[k] for k in range(3)]
+    return list(p)
 
 
 def effective_angles(case, effect, arm, q_rad, dirs):
@@ -341,6 +381,9 @@ def effective_angles(case, effect, arm, q_rad, dirs):
         q_eff[i] += effect["s"] * q_rad[i]
     elif name == "joint_harmonic":
         q_eff[i] += effect["A_rad"] * math.sin(q_rad[i]) + effect["B_rad"] * math.cos(q_rad[i])
+    elif name == "joint_harmonic2":
+        q_eff[i] += (effect["A_rad"] * math.sin(2.0 * q_rad[i])
+                     + effect["B_rad"] * math.cos(2.0 * q_rad[i]))
     elif name == "joint_backlash":
         q_eff[i] += 0.5 * effect["b_rad"] * dirs[i]
     elif name == "joint_compliance":
@@ -368,15 +411,19 @@ def sample_poses(rng, n, arm):
     return poses
 
 
-def simulate(case, effect, arm, poses, rng_noise=None):
+def simulate(case, effect, arm, poses, rng_noise=None, times=None):
     """Rows of measurements: list of dicts with q (deg), dir, p_true (no noise), p_ref
-    (without the effect), and meas (x,y,z or L1..L3, with noise when rng_noise is given)."""
+    (without the effect), and meas (x,y,z or L1..L3, with noise when rng_noise is given).
+    times: the drift cases' clock per pose (None: a session without drift)."""
     name, _ = parse_case(case)
     rows = []
-    for q_deg, dirs in poses:
+    t0 = sum(times) / len(times) if times else 0.0
+    for k, (q_deg, dirs) in enumerate(poses):
         q = [math.radians(v) for v in q_deg]
         p_ref = tool_point(arm, q)
         p = tool_point(arm, effective_angles(case, effect, arm, q, dirs))
+        if times:
+            p = drifted(case, effect, p, times[k], t0)
         if name == "measurer_scale":
             exact = wire_lengths(p, effect["s"])
             ref = wire_lengths(p)
@@ -387,7 +434,8 @@ def simulate(case, effect, arm, poses, rng_noise=None):
             p_apparent = p
         meas = [v + (rng_noise.gauss(0.0, NOISE_MM) if rng_noise else 0.0) for v in exact]
         rows.append({"q_deg": q_deg, "dir": dirs, "p": p, "p_ref": p_ref,
-                     "p_apparent": p_apparent, "exact": exact, "ref": ref, "meas": meas})
+                     "p_apparent": p_apparent, "exact": exact, "ref": ref, "meas": meas,
+                     "t_s": times[k] if times else None})
     return rows
 
 
@@ -433,8 +481,11 @@ class Scenario(object):
         self.train_poses = sample_poses(_rng(case, seed, "train-poses"), N_TRAIN, self.arm)
         self.heldout_poses = sample_poses(_rng(case, seed, "heldout-poses"), N_HELDOUT,
                                           self.arm)
+        drift = self.name in ("drift_offset", "drift_scale")
+        self.train_times = (pose_times(case, _rng(case, seed, "train-times"), N_TRAIN)
+                            if drift else None)
         self.train = simulate(case, self.effect, self.arm, self.train_poses,
-                              _rng(case, seed, "train-noise"))
+                              _rng(case, seed, "train-noise"), self.train_times)
         self.heldout = simulate(case, self.effect, self.arm, self.heldout_poses,
                                 _rng(case, seed, "heldout-noise"))
 
@@ -465,6 +516,9 @@ class Scenario(object):
     def write_csv(self, path, rows, label):
         cols = ["q1", "q2", "q3", "dir1", "dir2", "dir3"]
         cols += ["L1", "L2", "L3"] if self.wire_data else ["x", "y", "z"]
+        with_time = self.name == "drift_offset" and label == "train"
+        if with_time:
+            cols.append("t_s")
         with open(path, "w", newline="") as f:
             f.write("# dhcal acceptance case=%s seed=%d set=%s noise_mm=%g\n"
                     % (self.case, self.seed, label, NOISE_MM))
@@ -473,7 +527,8 @@ class Scenario(object):
             for r in rows:
                 w.writerow(["%.*f" % (Q_DECIMALS, v) for v in r["q_deg"]]
                            + ["%d" % d for d in r["dir"]]
-                           + ["%.6f" % v for v in r["meas"]])
+                           + ["%.6f" % v for v in r["meas"]]
+                           + (["%.3f" % r["t_s"]] if with_time else []))
 
     def write(self, out_dir):
         os.makedirs(out_dir, exist_ok=True)

@@ -237,9 +237,27 @@ class Effects(unittest.TestCase):
 
 class Scenarios(unittest.TestCase):
     def test_case_list(self):
-        self.assertEqual(len(he.CASES), 13)
-        self.assertEqual(len(set(he.CASES)), 13)
+        self.assertEqual(len(he.CASES), 16)
+        self.assertEqual(len(set(he.CASES)), 16)
         self.assertNotIn("joint_compliance:1", he.CASES)
+
+    def test_drift_grows_over_the_session_and_only_there(self):
+        for case, column in (("drift_offset", True), ("drift_scale", False)):
+            sc = he.Scenario(case, 3)
+            dev = [he.norm(he.sub(r["p"], r["p_ref"])) for r in sc.train]
+            # linear in t about the session's mean time: largest at the ends, ~0 mid-way
+            self.assertGreater(max(dev[:5] + dev[-5:]), 0.3, case)
+            self.assertLess(min(dev), 0.05, case)
+            for r in sc.heldout:  # another session
+                self.assertEqual(r["p"], r["p_ref"])
+            with tempfile.TemporaryDirectory() as d:
+                sc.write(d)
+                with open(os.path.join(d, "train.csv")) as f:
+                    header = [l for l in f if not l.startswith("#")][0].strip().split(",")
+            self.assertEqual("t_s" in header, column, case)
+        t = he.pose_times("drift_offset", he._rng("drift_offset", 3, "x"), 60)
+        self.assertTrue(all(b > a for a, b in zip(t, t[1:])))
+        self.assertAlmostEqual(t[-1] / 60.0, he.SECONDS_PER_POSE, delta=3.0)
 
     def test_true_geometry(self):
         arm = he.Scenario("clean", 4).arm
