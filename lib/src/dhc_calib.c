@@ -80,9 +80,26 @@ static void lower_solve(const double *l, size_t rows, double *x, size_t stride)
     }
 }
 
+/* dhc_sample_whiten with the covariance of the sample at `model`, whose residual there is
+ * r_model (for the orientation rows' slope; may alias r, read first), applied to r and jac
+ * (which may belong to another estimate: a trial step judged with its start's weights). */
+static dhc_status whiten_at(const dhc_model *model, const dhc_sample *s,
+                            const double *joint_noise_rad, double meas_noise_mm,
+                            double weight_mm_per_rad, const double *r_model, double *r,
+                            dhc_mat *jac);
+
 dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_sample *s,
                              const double *joint_noise_rad, double meas_noise_mm,
                              double weight_mm_per_rad, double *r, dhc_mat *jac)
+{
+    /* r_model may alias r: it is read before r is whitened */
+    return whiten_at(model, s, joint_noise_rad, meas_noise_mm, weight_mm_per_rad, r, r, jac);
+}
+
+static dhc_status whiten_at(const dhc_model *model, const dhc_sample *s,
+                            const double *joint_noise_rad, double meas_noise_mm,
+                            double weight_mm_per_rad, const double *r_model, double *r,
+                            dhc_mat *jac)
 {
     if (model == NULL || s == NULL || r == NULL) {
         return DHC_ERR_ARGUMENT;
@@ -117,6 +134,8 @@ dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_sample *s,
     if (st != DHC_OK) {
         return st;
     }
+    /* the joint noise moves the residual, whose orientation rows turn by J_r^-1(w) */
+    dhc_model_residual_slope(s, r_model, weight_mm_per_rad, &jq);
     /* Covariance of the sample's rows: the measurement's own noise plus each joint's angle
      * noise through its column, times dq_eff/dq of the joint's scale and harmonic. */
     double c[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_ROWS_PER_SAMPLE];
@@ -210,8 +229,24 @@ static void note_traits(data_traits *t, const dhc_sample *s, size_t n_joints, in
 }
 
 /* One pass: SSR and error totals of `model`; with accumulate, also the normal equations. */
+static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *model,
+                                     const dhc_model *weights, int accumulate,
+                                     pass_totals *tot);
+
+/* One pass with each sample whitened at the model itself. */
 static dhc_status data_pass(const fit_context *fc, const dhc_model *model, int accumulate,
                             pass_totals *tot)
+{
+    return data_pass_weighted(fc, model, model, accumulate, tot);
+}
+
+/* One pass whose samples are whitened with the covariance at `weights` (with the noise
+ * model on): a trial step is judged with the weights of the estimate it starts from, so LM
+ * minimises the objective whose gradient it steps along and stops where that gradient
+ * vanishes (the weighted fit's fixed point). */
+static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *model,
+                                     const dhc_model *weights, int accumulate,
+                                     pass_totals *tot)
 {
     dhc_calib_workspace *const ws = fc->ws;
     const size_t p = fc->set->count;
@@ -251,9 +286,22 @@ static dhc_status data_pass(const fit_context *fc, const dhc_model *model, int a
                 st = dhc_model_jacobian(model, fc->set, s, w, &jac, NULL);
             }
         }
+        if (st == DHC_OK && accumulate) {
+            dhc_model_residual_slope(s, r, w, &jac);
+        }
         if (st == DHC_OK && fc->whiten) {
-            st = dhc_sample_whiten(model, s, fc->opt->joint_noise_rad, fc->opt->meas_noise_mm, w,
-                                   rw, accumulate ? &jac : NULL);
+            /* the covariance at `weights`: its own residual gives the orientation slope (in
+             * the workspace: this is the library's deepest call chain) */
+            double *const r_weights = ws->weights_residual;
+            size_t weights_rows = rows;
+            memcpy(r_weights, r, sizeof ws->weights_residual);
+            if (weights != model && s->kind == (uint8_t)DHC_MEAS_POSE) {
+                st = dhc_model_residual(weights, s, w, r_weights, &weights_rows);
+            }
+            if (st == DHC_OK) {
+                st = whiten_at(weights, s, fc->opt->joint_noise_rad, fc->opt->meas_noise_mm, w,
+                               r_weights, rw, accumulate ? &jac : NULL);
+            }
         }
         if (st == DHC_OK && accumulate) {
             st = dhc_normal_eq_add(&ws->ne, &jac, rw, NULL, rows);
@@ -566,37 +614,58 @@ static int nothing_left_to_gain(const fit_context *fc, const pass_totals *tot)
            decrement <= tol * tol * sigma2;
 }
 
-/* ... and after an accepted step: it moved no parameter by more than noise_rel_tol of its
- * standard error and lowered the SSR by under 2 noise_rel_tol sigma^2. Where the data
- * barely determine a combination of parameters, the SSR is flat and curved along it: the
- * Gauss-Newton model overshoots, and LM creeps along the valley with steps that change
- * nothing a statistician could see (the SSR's own sd is sigma^2 sqrt(2 dof)). ws->fac is the
- * analysis at the new estimate; scratch holds n_params doubles. */
-static int step_below_noise(const fit_context *fc, const pass_totals *tot, double gain,
-                            double *scratch)
+/* ... and after accepted steps whose gains shrink geometrically (ratio q = gain / previous
+ * gain < 1): what the steps still to come can take off the SSR, q gain / (1 - q), is below
+ * noise_rel_tol sigma^2. Where the data barely determine a combination of parameters the
+ * SSR is flat and curved along it: the Gauss-Newton model misjudges it and LM creeps along
+ * the valley, each step taking a little; the steps' own sizes say nothing about how far the
+ * minimum is, the sum of what is left to gain does. */
+static int little_left_to_gain(const fit_context *fc, const pass_totals *tot, double gain,
+                               double previous_gain)
 {
     const double tol = fc->opt->noise_rel_tol;
     const double sigma2 = residual_variance(fc, tot);
-    const size_t p = fc->set->count;
-    if (!(tol > 0.0) || !(sigma2 > 0.0) || gain > 2.0 * tol * sigma2 ||
-        dhc_lsq_std_errors(&fc->ws->fac, sigma2, scratch, p) != DHC_OK) {
+    if (!(tol > 0.0) || !(sigma2 > 0.0) || !(previous_gain > 0.0) || !(gain < previous_gain)) {
         return 0;
     }
-    for (size_t k = 0U; k < p; ++k) {
-        if (fabs(fc->ws->delta[k]) > tol * scratch[k]) { /* unidentifiable: both 0 */
-            return 0;
-        }
-    }
-    return 1;
+    const double q = gain / previous_gain;
+    return q * gain / (1.0 - q) <= tol * sigma2;
 }
 
-/* Levenberg-Marquardt from ws->current until the SSR stops falling. */
+/* The SSR decrease the linear model predicts for the step delta: 2 delta^T g - delta^T N
+ * delta (g = J^T W r, N = J^T W J of the accumulation at the current estimate). */
+static double predicted_decrease(const dhc_normal_eq *ne, const double *delta)
+{
+    const size_t n = ne->n;
+    double lin = 0.0;
+    double quad = 0.0;
+    for (size_t i = 0U; i < n; ++i) {
+        if (!(fabs(delta[i]) > 0.0)) {
+            continue;
+        }
+        lin += delta[i] * ne->jtr[i];
+        double row = 0.0;
+        for (size_t j = 0U; j < n; ++j) {
+            row += ne->jtj[i * n + j] * delta[j];
+        }
+        quad += delta[i] * row;
+    }
+    return 2.0 * lin - quad;
+}
+
+/* Levenberg-Marquardt from ws->current until the SSR stops falling. The damping follows
+ * the gain ratio rho (actual over predicted decrease; Nielsen's update, as in Madsen,
+ * Nielsen and Tingleff's notes): a good model shrinks lambda, a poor one grows it
+ * gradually, a rejected step doubles the growth. A fixed x10 / /10 schedule oscillates in
+ * the curved valleys of real arms' barely determined parameters and creeps along them. */
 static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *rep,
                                       pass_totals *tot, int *converged)
 {
     dhc_calib_workspace *const ws = fc->ws;
     const size_t p = fc->set->count;
     double lambda = LAMBDA_START;
+    double nu = 2.0;
+    double previous_gain = 0.0;
     *converged = 0;
     dhc_status st = data_pass(fc, &ws->current, 1, tot);
     if (st == DHC_OK) {
@@ -617,7 +686,7 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
         st = dhc_params_apply(fc->set, &ws->trial, ws->delta, p);
         pass_totals trial_tot;
         if (st == DHC_OK) {
-            st = data_pass(fc, &ws->trial, 0, &trial_tot);
+            st = data_pass_weighted(fc, &ws->trial, &ws->current, 0, &trial_tot);
         }
         if (st != DHC_OK) {
             break;
@@ -625,19 +694,32 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
         if (trial_tot.ssr < tot->ssr) {
             const double gain = tot->ssr - trial_tot.ssr;
             const double step = scaled_step_norm(&ws->fac, ws->delta, p);
+            const double predicted = predicted_decrease(&ws->ne, ws->delta);
+            const double rho = predicted > 0.0 ? gain / predicted : 0.0;
+            const double t = 2.0 * rho - 1.0;
             ws->current = ws->trial;
-            lambda = fmax(lambda / 10.0, 1e-12);
+            lambda = fmax(lambda * fmax(0.1, 1.0 - t * t * t), 1e-12);
+            nu = 2.0;
             st = data_pass(fc, &ws->current, 1, tot);
             if (st == DHC_OK) {
                 st = analyse_keeping_set(fc, rep);
             }
-            if (gain <= fc->opt->ssr_rel_tol * tot->ssr || step <= fc->opt->step_rel_tol ||
-                step_below_noise(fc, tot, gain, ws->scratch)) {
+            /* "the SSR stopped falling" judged by what an undamped step would still take,
+             * not by the damped step just taken (damping makes that small long before) */
+            double decrement = HUGE_VAL;
+            if (st == DHC_OK &&
+                dhc_lsq_decrement(&ws->ne, &ws->fac, &decrement) != DHC_OK) {
+                decrement = HUGE_VAL;
+            }
+            if (decrement <= fc->opt->ssr_rel_tol * tot->ssr || step <= fc->opt->step_rel_tol ||
+                little_left_to_gain(fc, tot, gain, previous_gain)) {
                 *converged = 1;
                 break;
             }
+            previous_gain = gain;
         } else {
-            lambda *= 10.0;
+            lambda *= nu;
+            nu *= 2.0;
             if (lambda > LAMBDA_MAX) {
                 /* No step in any direction lowers the SSR: we are at its minimum to
                  * working precision. */

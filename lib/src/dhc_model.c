@@ -285,3 +285,38 @@ dhc_status dhc_model_residual(const dhc_model *model, const dhc_sample *s,
     *rows = n;
     return DHC_OK;
 }
+
+void dhc_model_residual_slope(const dhc_sample *s, const double *r, double weight_mm_per_rad,
+                              dhc_mat *jac)
+{
+    if (s == NULL || r == NULL || jac == NULL || jac->data == NULL ||
+        s->kind != (uint8_t)DHC_MEAS_POSE || jac->rows != 6U || !(weight_mm_per_rad > 0.0)) {
+        return;
+    }
+    double w[3];
+    for (size_t k = 0U; k < 3U; ++k) {
+        w[k] = r[3U + k] / weight_mm_per_rad;
+    }
+    const double t = dhc_vec3_norm(w);
+    if (!(t > 1e-8) || !(t < 3.14159)) {
+        return; /* J_r^-1 = I to 1e-8; at pi the log's axis flips and no slope helps */
+    }
+    const double c2 = 1.0 / (t * t) - (1.0 + cos(t)) / (2.0 * t * sin(t));
+    /* M = I + [w]/2 + c2 [w]^2, [w]^2 = w w^T - t^2 I */
+    double m[3][3];
+    const double skew[3][3] = {{0.0, -w[2], w[1]}, {w[2], 0.0, -w[0]}, {-w[1], w[0], 0.0}};
+    for (size_t a = 0U; a < 3U; ++a) {
+        for (size_t b = 0U; b < 3U; ++b) {
+            m[a][b] = (a == b ? 1.0 - c2 * t * t : 0.0) + 0.5 * skew[a][b] + c2 * w[a] * w[b];
+        }
+    }
+    for (size_t col = 0U; col < jac->cols; ++col) {
+        double v[3];
+        for (size_t a = 0U; a < 3U; ++a) {
+            v[a] = DHC_MAT_AT(jac, 3U + a, col);
+        }
+        for (size_t a = 0U; a < 3U; ++a) {
+            DHC_MAT_AT(jac, 3U + a, col) = m[a][0] * v[0] + m[a][1] * v[1] + m[a][2] * v[2];
+        }
+    }
+}

@@ -89,9 +89,11 @@ static void check_samples(const dhcal_dataset *d, const char *path)
     double *const e = calloc(s.n, sizeof *e);
     double *const resid = calloc(3U * s.n, sizeof *resid);
     FZ_CHECK(e != NULL && resid != NULL);
-    double rms = -1.0;
-    double mx = -1.0;
-    FZ_CHECK(dhcal_samples_errors(&model, &s, resid, e, &rms, &mx) == DHCAL_IO_OK);
+    dhcal_error_stats es = {-1.0, -1.0, -1.0, 0U};
+    FZ_CHECK(dhcal_samples_errors(&model, &s, resid, e, &es) == DHCAL_IO_OK);
+    const double rms = es.rms_mm;
+    const double mx = es.max_mm;
+    FZ_CHECK(es.mean_mm <= rms * (1.0 + 1e-12) + 1e-300);
     for (size_t i = 0U; i < s.n; ++i) {
         FZ_CHECK(dhc_is_finite(e[i]) && e[i] >= 0.0);
     }

@@ -121,20 +121,24 @@ static const uint64_t GOLDEN_SCALARS[4] = {
     0x3f85faaf06fb469dULL,
 };
 
-static void assert_same(uint64_t golden, double got)
+/* The capture is the minimum the unweighted fit found then; the Levenberg-Marquardt path to
+ * it has changed since (Nielsen's damping, stopping on the Newton decrement), so the same
+ * minimum is reached to within where each path stopped, not bit for bit: within tol
+ * relative, or for a parameter within 1e-4 of its standard error. */
+static double golden(uint64_t bits_of)
 {
-#if defined(__x86_64__)
-    TEST_ASSERT_EQUAL_HEX64(golden, bits(got));
-#else
-    /* another libm rounds sin/cos/sqrt differently in the last bit: the capture is bit-exact
-     * on the machine it came from only */
     double g;
-    memcpy(&g, &golden, sizeof g);
-    TEST_ASSERT_DOUBLE_WITHIN(1e-9 * (fabs(g) + 1e-12), g, got);
-#endif
+    memcpy(&g, &bits_of, sizeof g);
+    return g;
 }
 
-static void test_noise_model_off_is_bit_identical_to_before(void)
+static void assert_same(uint64_t golden_bits, double got, double tol)
+{
+    const double g = golden(golden_bits);
+    TEST_ASSERT_DOUBLE_WITHIN(tol * (fabs(g) + 1e-12), g, got);
+}
+
+static void test_noise_model_off_is_the_unweighted_fit_of_before(void)
 {
     simulate_positions(101ULL);
     dhc_calib_options opt;
@@ -149,21 +153,22 @@ static void test_noise_model_off_is_bit_identical_to_before(void)
         TEST_ASSERT_EQUAL_DOUBLE(0.0, dopt.joint_noise_rad[j]);
     }
     /* The capture predates the convergence tests relative to the noise: those stop a fit
-     * at a hundredth of a standard error from where this one stopped (the same parameters
-     * to 1e-2 std, checked below); switched off, the library is bit-identical. */
+     * within a hundredth of a standard error of the minimum (checked below); switched off,
+     * the fit runs to the minimum of the capture. */
     opt.noise_rel_tol = 0.0;
     first_catalogue_only = 1;
     dhc_model fitted;
     fit_and_diagnose(&opt, &dopt, &fitted, &rep);
     TEST_ASSERT_EQUAL_size_t(12U, set.count);
     for (size_t k = 0U; k < set.count; ++k) {
-        assert_same(GOLDEN_VALUE[k], rep.value[k]);
-        assert_same(GOLDEN_STD[k], rep.std_err[k]);
+        TEST_ASSERT_DOUBLE_WITHIN(1e-4 * golden(GOLDEN_STD[k]) + 1e-300, golden(GOLDEN_VALUE[k]),
+                                  rep.value[k]);
+        assert_same(GOLDEN_STD[k], rep.std_err[k], 1e-6);
     }
-    assert_same(GOLDEN_SCALARS[0], rep.sigma);
-    assert_same(GOLDEN_SCALARS[1], rep.rms_mm);
-    assert_same(GOLDEN_SCALARS[2], diag.c[0].log10_p);
-    assert_same(GOLDEN_SCALARS[3], diag.c[0].explained_ss);
+    assert_same(GOLDEN_SCALARS[0], rep.sigma, 1e-9);
+    assert_same(GOLDEN_SCALARS[1], rep.rms_mm, 1e-9);
+    assert_same(GOLDEN_SCALARS[2], diag.c[0].log10_p, 1e-6);
+    assert_same(GOLDEN_SCALARS[3], diag.c[0].explained_ss, 1e-6);
 
     /* A noise model of exactly 1 mm per row whitens by L = 1: every division by 1 and
      * subtraction of 0 x r is exact, so not one bit may change. */
@@ -186,10 +191,8 @@ static void test_noise_model_off_is_bit_identical_to_before(void)
         dhc_model early;
         fit_and_diagnose(&dflt, &dopt, &early, &rep_off);
         for (size_t k = 0U; k < set.count; ++k) {
-            double g;
-            const uint64_t golden = GOLDEN_VALUE[k];
-            memcpy(&g, &golden, sizeof g);
-            TEST_ASSERT_DOUBLE_WITHIN(1e-2 * rep.std_err[k] + 1e-15, g, rep_off.value[k]);
+            TEST_ASSERT_DOUBLE_WITHIN(1e-2 * rep.std_err[k] + 1e-15, golden(GOLDEN_VALUE[k]),
+                                      rep_off.value[k]);
         }
     }
     first_catalogue_only = 0;
@@ -591,7 +594,7 @@ static void test_false_alarms_are_rare_with_the_noise_model(void)
 int main(void)
 {
     UNITY_BEGIN();
-    RUN_TEST(test_noise_model_off_is_bit_identical_to_before);
+    RUN_TEST(test_noise_model_off_is_the_unweighted_fit_of_before);
     RUN_TEST(test_whitened_fit_equals_dense_gls);
     RUN_TEST(test_bad_noise_models_are_refused);
     RUN_TEST(test_false_alarms_are_rare_with_the_noise_model);

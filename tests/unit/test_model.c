@@ -339,6 +339,69 @@ static void test_model_jacobian_matches_central_differences_for_every_effect(voi
     TEST_ASSERT_GREATER_THAN(800U, checked);
 }
 
+/* The slope of a pose residual: central differences of dhc_model_residual itself (not of the
+ * prediction) against the model Jacobian times J_r^-1(w), at orientation errors from a
+ * milliradian to 2.5 rad; without the correction the rows are off by up to ~|w|/2. */
+static void test_pose_residual_slope_matches_differences_of_the_residual(void)
+{
+    const dhc_model m = model_with_effects(0);
+    static dhc_param_set set;
+    every_effect(&set, &m, 0U);
+    static double buf[6 * DHC_MAX_PARAMS];
+    const double sizes[4] = {1e-3, 0.3, 1.2, 2.5};
+    double worst_plain = 0.0;
+    for (size_t trial = 0U; trial < 8U; ++trial) {
+        double q[DHC_MAX_JOINTS] = {0.0};
+        test_random_q(&rng, &m.arm, q);
+        dhc_sample s = sample_at(&m, q, DHC_MEAS_POSE);
+        dhc_prediction pr;
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_model_predict(&m, &s, &pr));
+        dhc_vec3_copy(pr.p_mm, s.p_mm);
+        double axis[3] = {test_uniform(&rng) - 0.5, test_uniform(&rng) - 0.5, 0.4};
+        dhc_vec3_scale(axis, sizes[trial % 4U] / dhc_vec3_norm(axis), axis);
+        dhc_mat3 turn;
+        dhc_rot_exp(axis, &turn);
+        dhc_rot_mul(&turn, &pr.rot, &s.rot);
+        const double weight = 250.0;
+        double r0[6];
+        size_t rows;
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_model_residual(&m, &s, weight, r0, &rows));
+        dhc_mat jac;
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&jac, 6U, set.count, buf, 6U * DHC_MAX_PARAMS));
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_model_jacobian(&m, &set, &s, weight, &jac, NULL));
+        static double plain[6 * DHC_MAX_PARAMS];
+        memcpy(plain, buf, sizeof plain);
+        dhc_model_residual_slope(&s, r0, weight, &jac);
+        for (size_t k = 0U; k < set.count; ++k) {
+            if (set.id[k].kind == (uint8_t)DHC_P_MEAS_ANCHOR ||
+                set.id[k].kind == (uint8_t)DHC_P_MEAS_SCALE ||
+                set.id[k].kind == (uint8_t)DHC_P_MEAS_OFFSET) {
+                continue; /* wires only */
+            }
+            static double delta[DHC_MAX_PARAMS];
+            const double h = dhc_params_is_angle(&set, k) ? 1e-6 : 1e-5;
+            double rp[6];
+            double rm[6];
+            for (int sign = -1; sign <= 1; sign += 2) {
+                dhc_model moved = m;
+                for (size_t c = 0U; c < set.count; ++c) {
+                    delta[c] = c == k ? (double)sign * h : 0.0;
+                }
+                TEST_ASSERT_EQUAL(DHC_OK, dhc_params_apply(&set, &moved, delta, set.count));
+                TEST_ASSERT_EQUAL(DHC_OK,
+                                  dhc_model_residual(&moved, &s, weight, sign > 0 ? rp : rm, &rows));
+            }
+            for (size_t r = 3U; r < 6U; ++r) {
+                const double fd = -(rp[r] - rm[r]) / (2.0 * h); /* residual falls as pred rises */
+                const double tol = 1e-5 * (fabs(fd) + weight);
+                TEST_ASSERT_DOUBLE_WITHIN(tol, fd, DHC_MAT_AT(&jac, r, k));
+                worst_plain = fmax(worst_plain, fabs(fd - plain[r * set.count + k]) / (fabs(fd) + weight));
+            }
+        }
+    }
+    TEST_ASSERT_TRUE(worst_plain > 0.1); /* the correction matters at large errors */
+}
+
 static void test_effect_names_parse_and_print(void)
 {
     const dhc_model m = paper_model();
@@ -472,6 +535,7 @@ int main(void)
     RUN_TEST(test_thermal_expansion_scales_the_arm_about_its_base);
     RUN_TEST(test_wire_lengths_are_scaled_distances_plus_offsets);
     RUN_TEST(test_model_jacobian_matches_central_differences_for_every_effect);
+    RUN_TEST(test_pose_residual_slope_matches_differences_of_the_residual);
     RUN_TEST(test_effect_names_parse_and_print);
     RUN_TEST(test_bad_samples_are_refused);
     RUN_TEST(test_non_finite_slopes_and_residuals_are_reported);

@@ -118,32 +118,79 @@ dhc_model dhcal_model_without_drift(const dhc_model *model)
     return m;
 }
 
-int dhcal_run_fit(const dhc_model *nominal, const char *effects, const dhcal_noise *noise,
-                  dhcal_samples *s, const dhcal_samples *held, dhcal_fit *out,
-                  dhcal_error *err)
+int dhcal_parse_geometry(const char *text, dhcal_geometry *out, dhcal_error *err)
 {
+    static const char *const names[3] = {"offsets", "lengths", "full"};
+    if (text == NULL) {
+        *out = DHCAL_GEOMETRY_FULL;
+        return DHCAL_IO_OK;
+    }
+    for (size_t k = 0U; k < 3U; ++k) {
+        if (strcmp(text, names[k]) == 0) {
+            *out = (dhcal_geometry)k;
+            return DHCAL_IO_OK;
+        }
+    }
+    snprintf(err->msg, sizeof err->msg,
+             "--geometry: '%.60s' is not a level (offsets, lengths or full)", text);
+    return DHCAL_IO_BAD_INPUT;
+}
+
+const char *dhcal_geometry_name(dhcal_geometry g)
+{
+    return g == DHCAL_GEOMETRY_OFFSETS ? "offsets" : g == DHCAL_GEOMETRY_LENGTHS ? "lengths" : "full";
+}
+
+int dhcal_geometry_set(const dhc_model *model, dhcal_geometry g, dhc_param_set *set)
+{
+    if (dhc_params_base_model(set, model) != DHC_OK) {
+        return DHCAL_IO_FAILED;
+    }
+    if (g == DHCAL_GEOMETRY_FULL) {
+        return DHCAL_IO_OK;
+    }
+    /* offsets: theta only; lengths: theta, a and d (beta where Hayati replaces d) */
+    size_t kept = 0U;
+    for (size_t k = 0U; k < set->count; ++k) {
+        const uint8_t kind = set->id[k].kind;
+        const int keep = kind == (uint8_t)DHC_P_THETA ||
+                         (g == DHCAL_GEOMETRY_LENGTHS &&
+                          (kind == (uint8_t)DHC_P_A || kind == (uint8_t)DHC_P_D ||
+                           kind == (uint8_t)DHC_P_BETA));
+        if (keep) {
+            set->id[kept++] = set->id[k];
+        }
+    }
+    set->count = kept;
+    return DHCAL_IO_OK;
+}
+
+void dhcal_calib_options_for(const dhcal_noise *noise, dhc_calib_options *opt)
+{
+    dhc_calib_default_options(opt);
+    if (noise != NULL && noise->on) {
+        for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
+            opt->joint_noise_rad[j] = noise->joint_rad;
+        }
+        opt->meas_noise_mm = noise->meas_mm;
+    }
+}
+
+int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhcal_noise *noise,
+                   dhcal_samples *s, const dhcal_samples *held, dhcal_fit *out,
+                   dhcal_error *err)
+{
+    const dhcal_geometry geometry = out->geometry;
     memset(out, 0, sizeof *out);
-    out->model = *nominal;
+    out->geometry = geometry;
+    out->model = *start;
+    out->set = *set;
     if (noise != NULL) {
         out->noise = *noise;
     }
-    if (dhc_params_base_model(&out->set, &out->model) != DHC_OK) {
-        snprintf(err->msg, sizeof err->msg, "too many joints for the parameter limit");
-        return DHCAL_IO_BAD_INPUT;
-    }
-    int rc = dhcal_parse_effects(effects, &out->model, &out->set, err);
-    if (rc != DHCAL_IO_OK) {
-        return rc;
-    }
     set_drift_reference(&out->model, s);
     dhc_calib_options opt;
-    dhc_calib_default_options(&opt);
-    if (out->noise.on) {
-        for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
-            opt.joint_noise_rad[j] = out->noise.joint_rad;
-        }
-        opt.meas_noise_mm = out->noise.meas_mm;
-    }
+    dhcal_calib_options_for(&out->noise, &opt);
     out->status = dhc_calib_fit(&out->model, &out->set, dhcal_samples_read, s, s->n, s->flags,
                                 &opt, &calib_ws, &out->rep);
     if (out->status == DHC_ERR_UNDERDETERMINED) {
@@ -158,22 +205,42 @@ int dhcal_run_fit(const dhc_model *nominal, const char *effects, const dhcal_noi
         snprintf(err->msg, sizeof err->msg, "fit failed: %s", dhc_status_str(out->status));
         return DHCAL_IO_FAILED;
     }
-    if (held != NULL) {
-        double *e = calloc(held->n > 0U ? held->n : 1U, sizeof *e);
+    double *e = calloc(s->n > 0U ? s->n : 1U, sizeof *e);
+    int rc = e != NULL ? dhcal_samples_errors(&out->model, s, NULL, e, &out->train)
+                       : DHCAL_IO_FAILED;
+    free(e);
+    if (rc == DHCAL_IO_OK && held != NULL) {
+        e = calloc(held->n > 0U ? held->n : 1U, sizeof *e);
         /* held-out rows come from another session: the calibration session's drift is not
          * theirs */
         const dhc_model steady = dhcal_model_without_drift(&out->model);
-        rc = e != NULL ? dhcal_samples_errors(&steady, held, NULL, e, &out->heldout_rms_mm,
-                                              &out->heldout_max_mm)
+        rc = e != NULL ? dhcal_samples_errors(&steady, held, NULL, e, &out->heldout)
                        : DHCAL_IO_FAILED;
         free(e);
-        if (rc != DHCAL_IO_OK) {
-            snprintf(err->msg, sizeof err->msg, "%s: evaluation failed", held->path);
-            return DHCAL_IO_FAILED;
-        }
-        out->have_heldout = 1;
+        out->have_heldout = rc == DHCAL_IO_OK;
+    }
+    if (rc != DHCAL_IO_OK) {
+        snprintf(err->msg, sizeof err->msg, "evaluation of the fitted model failed");
+        return DHCAL_IO_FAILED;
     }
     return DHCAL_IO_OK;
+}
+
+int dhcal_run_fit(const dhc_model *nominal, const char *effects, dhcal_geometry geometry,
+                  const dhcal_noise *noise, dhcal_samples *s, const dhcal_samples *held,
+                  dhcal_fit *out, dhcal_error *err)
+{
+    static dhc_param_set set;
+    if (dhcal_geometry_set(nominal, geometry, &set) != DHCAL_IO_OK) {
+        snprintf(err->msg, sizeof err->msg, "too many joints for the parameter limit");
+        return DHCAL_IO_BAD_INPUT;
+    }
+    const int rc = dhcal_parse_effects(effects, nominal, &set, err);
+    if (rc != DHCAL_IO_OK) {
+        return rc;
+    }
+    out->geometry = geometry;
+    return dhcal_fit_from(nominal, &set, noise, s, held, out, err);
 }
 
 int dhcal_run_diagnose(const dhcal_fit *fit, const dhcal_samples *s, dhc_diagnosis *out,

@@ -19,15 +19,26 @@ typedef struct {
  * measurement's sd in mm (greater than 0, up to 100). DHCAL_IO_BAD_INPUT with the reason. */
 int dhcal_parse_noise(const char *text, dhcal_noise *out, dhcal_error *err);
 
+/* How much geometry a fit adjusts (--geometry): joint offsets; offsets plus a and d (beta
+ * where Hayati's convention replaces d); every geometric parameter (the default). */
+typedef enum { DHCAL_GEOMETRY_OFFSETS, DHCAL_GEOMETRY_LENGTHS, DHCAL_GEOMETRY_FULL } dhcal_geometry;
+
+/* "offsets" | "lengths" | "full"; NULL is full. DHCAL_IO_BAD_INPUT with the reason. */
+int dhcal_parse_geometry(const char *text, dhcal_geometry *out, dhcal_error *err);
+const char *dhcal_geometry_name(dhcal_geometry g);
+/* The base parameter set of a geometry level (a subset of dhc_params_base_model). */
+int dhcal_geometry_set(const dhc_model *model, dhcal_geometry g, dhc_param_set *set);
+
 typedef struct {
     dhc_model model;      /* calibrated (nominal when the fit failed) */
+    dhcal_geometry geometry;
     dhcal_noise noise;    /* what the fit weighted with (the diagnosis uses the same) */
     dhc_param_set set;    /* base model + effects */
     dhc_calib_report rep;
     dhc_status status;
+    dhcal_error_stats train;   /* over the rows fitted (filled by the caller's evaluation) */
     int have_heldout;
-    double heldout_rms_mm;
-    double heldout_max_mm;
+    dhcal_error_stats heldout; /* the model without the session's drift */
 } dhcal_fit;
 
 /* The model without the calibration session's drift (drift_scale, drift_offset): what
@@ -39,13 +50,24 @@ dhc_model dhcal_model_without_drift(const dhc_model *model);
 int dhcal_parse_effects(const char *list, const dhc_model *model, dhc_param_set *set,
                         dhcal_error *err);
 
-/* Fits nominal + effects to s (flags updated with outliers); evaluates held (may be NULL).
- * DHCAL_IO_OK when the library returned DHC_OK or DHC_ERR_NOT_CONVERGED (see out->status),
- * DHCAL_IO_FAILED with a plain-words message otherwise (under-determined data included),
+/* The library's fit options with the noise model (NULL or off: unweighted). */
+void dhcal_calib_options_for(const dhcal_noise *noise, dhc_calib_options *opt);
+
+/* Fits the parameters of set, starting from start (a previous solution: the fit can only
+ * lower its SSR), to s (flags updated with outliers); evaluates the fitted rows into
+ * out->train and held (may be NULL) into out->heldout. out->geometry is kept as the caller
+ * set it. DHCAL_IO_OK when the library returned DHC_OK or DHC_ERR_NOT_CONVERGED (see
+ * out->status), DHCAL_IO_FAILED with a plain-words message otherwise (under-determined
+ * data included). */
+int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhcal_noise *noise,
+                   dhcal_samples *s, const dhcal_samples *held, dhcal_fit *out,
+                   dhcal_error *err);
+
+/* Fits the geometry level plus effects to s from nominal (dhcal_fit_from);
  * DHCAL_IO_BAD_INPUT for a bad effects list. */
-int dhcal_run_fit(const dhc_model *nominal, const char *effects, const dhcal_noise *noise,
-                  dhcal_samples *s, const dhcal_samples *held, dhcal_fit *out,
-                  dhcal_error *err);
+int dhcal_run_fit(const dhc_model *nominal, const char *effects, dhcal_geometry geometry,
+                  const dhcal_noise *noise, dhcal_samples *s, const dhcal_samples *held,
+                  dhcal_fit *out, dhcal_error *err);
 
 /* Ranks every candidate effect the fit's model can take against its residuals. */
 int dhcal_run_diagnose(const dhcal_fit *fit, const dhcal_samples *s, dhc_diagnosis *out,

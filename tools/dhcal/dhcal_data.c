@@ -80,9 +80,10 @@ dhc_status dhcal_samples_read(void *ctx, size_t index, dhc_sample *out)
 }
 
 int dhcal_samples_errors(const dhc_model *model, const dhcal_samples *s, double *resid,
-                         double *err_mm, double *rms_mm, double *max_mm)
+                         double *err_mm, dhcal_error_stats *stats)
 {
     double ss = 0.0;
+    double sum = 0.0;
     double mx = 0.0;
     size_t used = 0U;
     for (size_t i = 0U; i < s->n; ++i) {
@@ -97,11 +98,14 @@ int dhcal_samples_errors(const dhc_model *model, const dhcal_samples *s, double 
         err_mm[i] = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
         if (s->flags[i] == (uint8_t)DHC_SAMPLE_USED) {
             ss += err_mm[i] * err_mm[i];
+            sum += err_mm[i];
             mx = fmax(mx, err_mm[i]);
             used++;
         }
     }
-    *rms_mm = used > 0U ? sqrt(ss / (double)used) : 0.0;
-    *max_mm = mx;
+    stats->rms_mm = used > 0U ? sqrt(ss / (double)used) : 0.0;
+    stats->mean_mm = used > 0U ? sum / (double)used : 0.0;
+    stats->max_mm = mx;
+    stats->used = used;
     return DHCAL_IO_OK;
 }

@@ -31,10 +31,18 @@ void dhcal_samples_free(dhcal_samples *s);
 /* dhc_sample_reader over dhcal_samples. */
 dhc_status dhcal_samples_read(void *ctx, size_t index, dhc_sample *out);
 
+/* RMS, mean and largest error norm over the samples counted (flag DHC_SAMPLE_USED). */
+typedef struct {
+    double rms_mm;
+    double mean_mm;
+    double max_mm;
+    size_t used;
+} dhcal_error_stats;
+
 /* Residual of every sample (3 values per row: position or wire lengths, mm) into resid
- * (may be NULL), its norm into err_mm (n entries), and the RMS and maximum of the norm
- * over samples whose flag is DHC_SAMPLE_USED. */
+ * (may be NULL), its norm into err_mm (n entries), and their statistics over samples whose
+ * flag is DHC_SAMPLE_USED into *stats. */
 int dhcal_samples_errors(const dhc_model *model, const dhcal_samples *s, double *resid,
-                         double *err_mm, double *rms_mm, double *max_mm);
+                         double *err_mm, dhcal_error_stats *stats);
 
 #endif /* DHCAL_DATA_H */

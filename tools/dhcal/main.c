@@ -28,6 +28,7 @@ typedef struct {
     const char *out;
     const char *effects;
     const char *noise;
+    const char *geometry;
     int json;
 } options;
 
@@ -48,6 +49,8 @@ static const char *const common_help =
     "                     measured coordinate's sd M (mm); every row is then weighted by\n"
     "                     its covariance (errors in variables): use it when the angles are\n"
     "                     as noisy as the measurement, e.g. encoder quantisation\n"
+    "  --geometry LEVEL   how much geometry to fit: offsets (joint offsets), lengths\n"
+    "                     (offsets, a and d), full (every parameter, the default)\n"
     "  --json             one JSON object on stdout instead of text\n";
 
 static const char *const usage_text =
@@ -135,6 +138,8 @@ static int parse_args(int argc, char **argv, options *o)
             slot = &o->effects;
         } else if (strcmp(a, "--noise") == 0) {
             slot = &o->noise;
+        } else if (strcmp(a, "--geometry") == 0) {
+            slot = &o->geometry;
         } else {
             char msg[300];
             snprintf(msg, sizeof msg, "unknown option '%.200s'", a);
@@ -179,6 +184,7 @@ typedef struct {
     dhcal_model file_model;
     dhc_model model;
     dhcal_noise noise;
+    dhcal_geometry geometry;
     dhcal_dataset data;
     dhcal_samples samples;
     dhcal_dataset held_data;
@@ -192,6 +198,9 @@ static int load_session(const options *o, session *s)
     memset(&err, 0, sizeof err);
     memset(s, 0, sizeof *s);
     int rc = dhcal_parse_noise(o->noise, &s->noise, &err);
+    if (rc == DHCAL_IO_OK) {
+        rc = dhcal_parse_geometry(o->geometry, &s->geometry, &err);
+    }
     if (rc == DHCAL_IO_OK) {
         rc = dhcal_model_load(o->model, &s->file_model, &err);
     }
@@ -250,18 +259,18 @@ static int cmd_compare(const options *o, session *s)
 {
     const size_t n = s->samples.n;
     double *err_mm = calloc(n > 0U ? n : 1U, sizeof *err_mm);
-    double rms = 0.0;
-    double mx = 0.0;
+    dhcal_error_stats es = {0.0, 0.0, 0.0, 0U};
     if (err_mm == NULL ||
-        dhcal_samples_errors(&s->model, &s->samples, NULL, err_mm, &rms, &mx) != DHCAL_IO_OK) {
+        dhcal_samples_errors(&s->model, &s->samples, NULL, err_mm, &es) != DHCAL_IO_OK) {
         free(err_mm);
         fprintf(stderr, "dhcal: compare failed\n");
         return EXIT_COMPUTE;
     }
     if (o->json) {
         cJSON *obj = cJSON_CreateObject();
-        cJSON_AddNumberToObject(obj, "rms_mm", rms);
-        cJSON_AddNumberToObject(obj, "max_mm", mx);
+        cJSON_AddNumberToObject(obj, "rms_mm", es.rms_mm);
+        cJSON_AddNumberToObject(obj, "mean_mm", es.mean_mm);
+        cJSON_AddNumberToObject(obj, "max_mm", es.max_mm);
         cJSON *rows = cJSON_AddArrayToObject(obj, "rows");
         for (size_t i = 0U; i < n; ++i) {
             cJSON *r = cJSON_CreateObject();
@@ -278,7 +287,7 @@ static int cmd_compare(const options *o, session *s)
     for (size_t i = 0U; i < n; ++i) {
         printf("%6zu %8zu %12.4f\n", i + 1U, s->data.rows[i].line, err_mm[i]);
     }
-    printf("RMS %.4f mm, max %.4f mm\n", rms, mx);
+    printf("RMS %.4f mm, mean %.4f mm, max %.4f mm\n", es.rms_mm, es.mean_mm, es.max_mm);
     free(err_mm);
     return 0;
 }
@@ -288,9 +297,11 @@ static int cmd_compare(const options *o, session *s)
 static void json_fit(cJSON *obj, const dhcal_fit *f, const session *s, const double *row_err)
 {
     cJSON_AddNumberToObject(obj, "rms_mm", f->rep.rms_mm);
+    cJSON_AddNumberToObject(obj, "mean_mm", f->train.mean_mm);
     cJSON_AddNumberToObject(obj, "max_mm", f->rep.max_mm);
     if (f->have_heldout) {
-        cJSON_AddNumberToObject(obj, "heldout_rms_mm", f->heldout_rms_mm);
+        cJSON_AddNumberToObject(obj, "heldout_rms_mm", f->heldout.rms_mm);
+        cJSON_AddNumberToObject(obj, "heldout_mean_mm", f->heldout.mean_mm);
     }
     cJSON_AddNumberToObject(obj, "iterations", (double)f->rep.iterations);
     cJSON_AddBoolToObject(obj, "converged", f->rep.converged);
@@ -347,7 +358,7 @@ static void text_fit(const dhcal_fit *f, const session *s, const options *o, con
     printf("%s after %zu iterations: RMS %.4f mm, max %.4f mm%s", rep->converged ? "converged" : "NOT converged",
            rep->iterations, rep->rms_mm, rep->max_mm, s->samples.wires ? " (wire lengths)" : "");
     if (f->have_heldout) {
-        printf("; held-out RMS %.4f mm", f->heldout_rms_mm);
+        printf("; held-out RMS %.4f mm, mean %.4f mm", f->heldout.rms_mm, f->heldout.mean_mm);
     }
     printf("\n%zu parameters, %zu identified from the data\n", rep->n_params, rep->rank);
     if (rep->rank < rep->structural_rank) {
@@ -415,17 +426,16 @@ static int do_fit(const options *o, session *s, dhcal_fit *fit, double **row_err
 {
     dhcal_error err;
     memset(&err, 0, sizeof err);
-    const int rc = dhcal_run_fit(&s->model, o->effects, &s->noise, &s->samples,
+    const int rc = dhcal_run_fit(&s->model, o->effects, s->geometry, &s->noise, &s->samples,
                                  s->have_held ? &s->held : NULL, fit, &err);
     if (rc != DHCAL_IO_OK) {
         fprintf(stderr, "dhcal: %s\n", err.msg);
         return rc == DHCAL_IO_BAD_INPUT ? EXIT_USAGE : EXIT_COMPUTE;
     }
     *row_err = calloc(s->samples.n > 0U ? s->samples.n : 1U, sizeof **row_err);
-    double rms;
-    double mx;
+    dhcal_error_stats unused;
     if (*row_err == NULL ||
-        dhcal_samples_errors(&fit->model, &s->samples, NULL, *row_err, &rms, &mx) != DHCAL_IO_OK) {
+        dhcal_samples_errors(&fit->model, &s->samples, NULL, *row_err, &unused) != DHCAL_IO_OK) {
         fprintf(stderr, "dhcal: evaluation failed\n");
         return EXIT_COMPUTE;
     }
@@ -621,12 +631,11 @@ static int cmd_plot(const options *o, session *s)
     rc = q_deg && res_before && res_after && err_before && err_after && joint_err && moment && dir
              ? 0
              : EXIT_COMPUTE;
-    double rms_b = 0.0;
-    double rms_a = 0.0;
-    double mx;
+    dhcal_error_stats es_b = {0.0, 0.0, 0.0, 0U};
+    dhcal_error_stats es_a = {0.0, 0.0, 0.0, 0U};
     char label[64] = "";
     if (rc == 0) {
-        rc = dhcal_samples_errors(&before.model, &s->samples, res_before, err_before, &rms_b, &mx);
+        rc = dhcal_samples_errors(&before.model, &s->samples, res_before, err_before, &es_b);
     }
 
     /* "after": the effect the diagnosis names, added to whatever --effects gave */
@@ -638,7 +647,8 @@ static int cmd_plot(const options *o, session *s)
         for (size_t i = 0U; i < n; ++i) {
             s->samples.flags[i] = (uint8_t)DHC_SAMPLE_USED;
         }
-        rc = dhcal_run_fit(&s->model, list, &s->noise, &s->samples, NULL, &after, &err) ==
+        rc = dhcal_run_fit(&s->model, list, s->geometry, &s->noise, &s->samples, NULL, &after,
+                           &err) ==
                      DHCAL_IO_OK
                  ? 0
                  : EXIT_COMPUTE;
@@ -646,7 +656,7 @@ static int cmd_plot(const options *o, session *s)
         after = before;
     }
     if (rc == 0) {
-        rc = dhcal_samples_errors(&after.model, &s->samples, res_after, err_after, &rms_a, &mx);
+        rc = dhcal_samples_errors(&after.model, &s->samples, res_after, err_after, &es_a);
     }
     /* Joint view: the final model's residual plus the dq of its own effects, so the effect
      * the diagnosis named appears with its full shape (component plus residual). */
@@ -672,7 +682,7 @@ static int cmd_plot(const options *o, session *s)
     }
     if (rc == 0) {
         const dhcal_plot_data d = {s->file_model.name, n, nj, q_deg, res_before, res_after,
-                                   err_before, err_after, rms_b, rms_a,
+                                   err_before, err_after, es_b.rms_mm, es_a.rms_mm,
                                    s->samples.wires, label, cands, nc, joint_err, moment, dir};
         rc = dhcal_plot_write(o->out, &d, &err) == DHCAL_IO_OK ? 0 : EXIT_COMPUTE;
         if (rc != 0) {
@@ -680,11 +690,11 @@ static int cmd_plot(const options *o, session *s)
         } else if (!o->json) {
             printf("wrote %s/residuals.svg, %s/joints.svg, %s/errors.svg, %s/candidates.svg\n",
                    o->out, o->out, o->out, o->out);
-            printf("RMS before %.4f mm, after %s %.4f mm\n", rms_b, label[0] != '\0' ? label : "(no effect named)", rms_a);
+            printf("RMS before %.4f mm, after %s %.4f mm\n", es_b.rms_mm, label[0] != '\0' ? label : "(no effect named)", es_a.rms_mm);
         } else {
             cJSON *obj = cJSON_CreateObject();
-            cJSON_AddNumberToObject(obj, "rms_before_mm", rms_b);
-            cJSON_AddNumberToObject(obj, "rms_after_mm", rms_a);
+            cJSON_AddNumberToObject(obj, "es_b.rms_mmefore_mm", es_b.rms_mm);
+            cJSON_AddNumberToObject(obj, "es_a.rms_mmfter_mm", es_a.rms_mm);
             cJSON_AddStringToObject(obj, "effect", label);
             cJSON *files = cJSON_AddArrayToObject(obj, "files");
             const char *names[4] = {"residuals.svg", "joints.svg", "errors.svg", "candidates.svg"};

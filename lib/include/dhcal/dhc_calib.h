@@ -114,6 +114,7 @@ typedef struct {
     dhc_sample sample;
     double delta[DHC_MAX_PARAMS];
     double scratch[DHC_MAX_PARAMS];
+    double weights_residual[DHC_MAX_ROWS_PER_SAMPLE];
     double jac_buf[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS];
 } dhc_calib_workspace;
 

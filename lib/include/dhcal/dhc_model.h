@@ -152,4 +152,15 @@ dhc_status dhc_model_residual(const dhc_model *model, const dhc_sample *s,
                               double weight_mm_per_rad, double r[DHC_MAX_ROWS_PER_SAMPLE],
                               size_t *rows);
 
+/* The slope of a pose sample's residual: dhc_model_jacobian gives how the prediction moves
+ * (orientation rows: world rotation increments omega, times the weight), but the
+ * orientation residual w = log(R_meas R_pred^T) moves by J_r^-1(w) omega, J_r the right
+ * Jacobian of SO(3) (J_r^-1(w) = I + [w]/2 + (1/t^2 - (1 + cos t)/(2 t sin t)) [w]^2,
+ * t = |w|): the identity for small errors, and 2x or more off at orientation errors of a
+ * radian or more, where Gauss-Newton on the plain rows stalls. Multiplies rows 3..5 of jac
+ * (any column count) by J_r^-1(w), w = r[3..5] / weight_mm_per_rad; other samples, and
+ * errors of 1e-8 rad or less, are left unchanged. r as dhc_model_residual gives it. */
+void dhc_model_residual_slope(const dhc_sample *s, const double *r, double weight_mm_per_rad,
+                              dhc_mat *jac);
+
 #endif /* DHC_MODEL_H */
