@@ -13,6 +13,10 @@
 #define CHI2_MEDIAN_3DOF 2.365973884375338
 #define CHI2_MEDIAN_6DOF 5.348120627447122
 #define LAMBDA_START 1e-3
+/* freeing a parameter at the estimate asks this much more of its pivot than the fit does */
+#define FREE_TOL_FACTOR 1e4
+/* link parameters held back for want of support, at most, in one fit */
+#define MAX_HOLDS 8U
 #define LAMBDA_MAX 1e12
 #define MEDIAN_BISECTIONS 64U
 /* The robust sigma needs the median only to a per cent (sigma to half that) against a
@@ -34,6 +38,8 @@ void dhc_calib_default_options(dhc_calib_options *opt)
     opt->step_rel_tol = 1e-12;
     opt->noise_rel_tol = 1e-2;
     opt->max_identifiability_checks = 3U;
+    opt->max_std_angle_rad = 0.0;
+    opt->max_std_length_mm = 0.0;
     opt->orientation_weight_mm_per_rad = 1000.0;
     opt->outlier_threshold = 6.0;
     opt->outlier_floor_mm = 1e-6;
@@ -197,7 +203,8 @@ typedef struct {
     uint8_t *flags;
     const dhc_calib_options *opt;
     dhc_calib_workspace *ws;
-    int whiten; /* the noise model is on */
+    int whiten;              /* the noise model is on */
+    const dhc_model *input;  /* the caller's model: where held parameters stay */
 } fit_context;
 
 typedef struct {
@@ -739,12 +746,15 @@ static dhc_status free_identifiable(const fit_context *fc, dhc_calib_report *rep
 {
     dhc_calib_workspace *const ws = fc->ws;
     *freed = 0U;
-    dhc_status st = dhc_lsq_analyse(&ws->ne, fc->opt->rank_rel_tol, &ws->fac);
+    /* Freed only with a clear margin: an exact dependence (d1 and the base along axis 1)
+     * leaves a rounding-level pivot that the plain tolerance can take at another estimate. */
+    dhc_status st = dhc_lsq_analyse(&ws->ne, fmin(fc->opt->rank_rel_tol * FREE_TOL_FACTOR, 0.5),
+                                    &ws->fac);
     if (st != DHC_OK) {
         return st;
     }
     for (size_t k = 0U; k < fc->set->count; ++k) {
-        if (ws->fac.identifiable[k] && !rep->identifiable[k]) {
+        if (ws->fac.identifiable[k] && !rep->identifiable[k] && !rep->unsupported[k]) {
             rep->identifiable[k] = 1U;
             ++*freed;
         }
@@ -754,20 +764,96 @@ static dhc_status free_identifiable(const fit_context *fc, dhc_calib_report *rep
 
 /* Levenberg-Marquardt, then identifiability judged at the estimate; again while that frees
  * parameters (at most max_identifiability_checks times). */
+/* The standard error beyond which the data do not pin a link parameter inside its
+ * physical range (options max_std_*; 0: no bound for that kind). */
+static double support_bound(const fit_context *fc, uint8_t kind)
+{
+    switch ((dhc_param_kind)kind) {
+    case DHC_P_THETA:
+    case DHC_P_ALPHA:
+    case DHC_P_BETA: return fc->opt->max_std_angle_rad;
+    case DHC_P_D:
+    case DHC_P_A: return fc->opt->max_std_length_mm;
+    default: return 0.0;
+    }
+}
+
+/* At a converged estimate: the link parameter whose standard error exceeds its bound by the
+ * largest factor goes back to its input value and out of the fitted set (*held = 1). A
+ * combination of parameters the data barely see wanders along its valley, far outside the
+ * physical range, at no cost in the SSR: holding one of the group pins the rest. */
+static dhc_status hold_unsupported(const fit_context *fc, const pass_totals *tot,
+                                   dhc_calib_report *rep, int *held)
+{
+    dhc_calib_workspace *const ws = fc->ws;
+    const size_t p = fc->set->count;
+    *held = 0;
+    if (!(fc->opt->max_std_angle_rad > 0.0) && !(fc->opt->max_std_length_mm > 0.0)) {
+        return DHC_OK;
+    }
+    const double sigma2 = residual_variance(fc, tot);
+    if (!(sigma2 > 0.0) || dhc_lsq_std_errors(&ws->fac, sigma2, ws->scratch, p) != DHC_OK) {
+        return DHC_OK;
+    }
+    size_t worst = p;
+    double worst_ratio = 1.0;
+    for (size_t k = 0U; k < p; ++k) {
+        const double bound = support_bound(fc, fc->set->id[k].kind);
+        if (rep->identifiable[k] && bound > 0.0 && ws->scratch[k] / bound > worst_ratio) {
+            worst_ratio = ws->scratch[k] / bound;
+            worst = k;
+        }
+    }
+    if (worst == p) {
+        return DHC_OK;
+    }
+    for (size_t k = 0U; k < p; ++k) {
+        ws->delta[k] = k == worst ? dhc_params_value(fc->set, fc->input, k) -
+                                        dhc_params_value(fc->set, &ws->current, k)
+                                  : 0.0;
+    }
+    dhc_status st = dhc_params_apply(fc->set, &ws->current, ws->delta, p);
+    if (st == DHC_OK) {
+        rep->identifiable[worst] = 0U;
+        rep->unsupported[worst] = 1U;
+        *held = 1;
+    }
+    return st;
+}
+
 static dhc_status fit_to_convergence(const fit_context *fc, dhc_calib_report *rep,
                                      pass_totals *tot, int *converged)
 {
-    for (size_t check = 0U;; ++check) {
+    size_t checks = 0U;
+    size_t holds = 0U;
+    for (;;) {
         dhc_status st = levenberg_marquardt(fc, rep, tot, converged);
-        if (st != DHC_OK || !*converged || check >= fc->opt->max_identifiability_checks) {
+        if (st != DHC_OK || !*converged) {
             return st;
         }
-        size_t freed;
-        st = free_identifiable(fc, rep, &freed);
-        if (st != DHC_OK || freed == 0U) {
-            return st;
+        size_t freed = 0U;
+        if (checks < fc->opt->max_identifiability_checks) {
+            st = free_identifiable(fc, rep, &freed);
+            if (st != DHC_OK) {
+                return st;
+            }
+            checks += freed > 0U ? 1U : 0U;
+            rep->freed += freed;
         }
-        rep->freed += freed;
+        if (freed > 0U) {
+            continue;
+        }
+        int held = 0;
+        if (holds < MAX_HOLDS) {
+            st = hold_unsupported(fc, tot, rep, &held);
+            if (st != DHC_OK) {
+                return st;
+            }
+        }
+        if (!held) {
+            return DHC_OK;
+        }
+        holds++;
     }
 }
 
@@ -822,7 +908,7 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
     /* memset, not a compound literal: the report is ~5 KiB and M4 stacks are small. */
     memset(rep, 0, sizeof *rep);
     rep->n_params = set->count;
-    const fit_context fc = {set, read, ctx, n, flags, opt, ws, whiten};
+    const fit_context fc = {set, read, ctx, n, flags, opt, ws, whiten, model};
     ws->current = *model;
 
     dhc_status st = flag_out_of_range(&fc, &model->arm);

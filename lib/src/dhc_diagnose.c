@@ -94,6 +94,70 @@ double dhc_chi2_log10_sf(double chi2, size_t dof)
     return (log_prefix + log(h)) / LN10;
 }
 
+/* ln of the continued fraction of the regularized incomplete beta I_x(a, b), valid for
+ * x < (a + 1) / (a + b + 2) (modified Lentz). */
+static double ln_beta_fraction(double a, double b, double x)
+{
+    const double tiny = DBL_MIN / DBL_EPSILON;
+    double c = 1.0;
+    double d = 1.0 - (a + b) * x / (a + 1.0);
+    d = fabs(d) < tiny ? tiny : d;
+    d = 1.0 / d;
+    double h = d;
+    for (size_t m = 1U; m < GAMMA_MAX_TERMS; ++m) {
+        const double dm = (double)m;
+        /* even step */
+        double an = dm * (b - dm) * x / ((a + 2.0 * dm - 1.0) * (a + 2.0 * dm));
+        d = 1.0 + an * d;
+        d = fabs(d) < tiny ? tiny : d;
+        c = 1.0 + an / c;
+        c = fabs(c) < tiny ? tiny : c;
+        d = 1.0 / d;
+        h *= d * c;
+        /* odd step */
+        an = -(a + dm) * (a + b + dm) * x / ((a + 2.0 * dm) * (a + 2.0 * dm + 1.0));
+        d = 1.0 + an * d;
+        d = fabs(d) < tiny ? tiny : d;
+        c = 1.0 + an / c;
+        c = fabs(c) < tiny ? tiny : c;
+        d = 1.0 / d;
+        const double del = d * c;
+        h *= del;
+        if (fabs(del - 1.0) < GAMMA_EPS) {
+            break;
+        }
+    }
+    return log(h);
+}
+
+/* ln I_x(a, b) for a = na / 2, b = nb / 2 (half-integers: ln_gamma_half is exact). */
+static double ln_incomplete_beta(size_t na, size_t nb, double x)
+{
+    const double a = 0.5 * (double)na;
+    const double b = 0.5 * (double)nb;
+    const double ln_front = a * log(x) + b * log1p(-x) + ln_gamma_half(na + nb) -
+                            ln_gamma_half(na) - ln_gamma_half(nb);
+    if (x < (a + 1.0) / (a + b + 2.0)) {
+        return ln_front + ln_beta_fraction(a, b, x) - log(a);
+    }
+    /* symmetry: I_x(a, b) = 1 - I_{1-x}(b, a), the second small here */
+    const double other = exp(ln_front + ln_beta_fraction(b, a, 1.0 - x) - log(b));
+    return log1p(-fmin(other, 1.0));
+}
+
+double dhc_f_log10_sf(double f, size_t d1, size_t d2)
+{
+    if (d1 == 0U || d2 == 0U || !(f > 0.0)) {
+        return 0.0;
+    }
+    if (!dhc_is_finite(f)) {
+        return -HUGE_VAL;
+    }
+    /* P(F > f) = I_x(d2 / 2, d1 / 2), x = d2 / (d2 + d1 f) */
+    const double x = (double)d2 / ((double)d2 + (double)d1 * f);
+    return ln_incomplete_beta(d2, d1, x) / LN10;
+}
+
 static int base_has_effect(const dhc_param_set *base, dhc_effect e, size_t joint)
 {
     for (size_t k = 0U; k < base->count; ++k) {

@@ -350,6 +350,37 @@ dhc_status dhc_lsq_std_errors(const dhc_lsq_factor *fac, double sigma2, double *
     return DHC_OK;
 }
 
+dhc_status dhc_lsq_prediction_variance(const dhc_lsq_factor *fac, double sigma2,
+                                       const double *row, size_t len, double *variance)
+{
+    if (!fac_valid(fac) || row == NULL || variance == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    const size_t n = fac->n;
+    if (len < n) {
+        return DHC_ERR_DIMENSION;
+    }
+    if (!dhc_is_finite(sigma2) || !finite_all(row, n)) {
+        return DHC_ERR_NONFINITE;
+    }
+    if (!(sigma2 >= 0.0)) {
+        return DHC_ERR_ARGUMENT;
+    }
+    /* j1^T N11^-1 j1 = |L^-1 S j1|^2 with L L^T = S N11 S (pivoted order) */
+    double y[DHC_MAX_PARAMS];
+    for (size_t i = 0U; i < fac->rank; ++i) {
+        y[i] = row[fac->perm[i]] * fac->scale[fac->perm[i]];
+    }
+    const tri_view l = analysed_factor(fac);
+    tri_forward(&l, fac->rank, y);
+    double sum = 0.0;
+    for (size_t i = 0U; i < fac->rank; ++i) {
+        sum += y[i] * y[i];
+    }
+    *variance = sigma2 * sum;
+    return dhc_is_finite(*variance) ? DHC_OK : DHC_ERR_NONFINITE;
+}
+
 dhc_status dhc_lsq_confounded(const dhc_normal_eq *ne, const dhc_lsq_factor *fac, size_t j,
                               uint8_t *partner, size_t len, size_t *count)
 {

@@ -19,6 +19,31 @@ static dhc_diagnose_workspace dws;
 static dhc_diagnosis diag;
 static dhc_param_set set;
 
+/* F tails against closed forms: F(1, 1) = 1 - (2/pi) atan(sqrt f); F(2, d2) =
+ * (1 + 2 f / d2)^(-d2/2); F(d1, 2) = 1 - (d1 f / (2 + d1 f))^(d1/2); far into the tail
+ * in logs (F(2, d2) at f = 1e4: 1e-10 and below, no underflow). */
+static void test_f_tail_matches_closed_forms(void)
+{
+    const double fs[6] = {0.05, 0.7, 1.0, 3.0, 12.0, 250.0};
+    for (size_t i = 0U; i < 6U; ++i) {
+        const double f = fs[i];
+        const double p11 = 1.0 - 2.0 / TEST_PI * atan(sqrt(f));
+        TEST_ASSERT_DOUBLE_WITHIN(1e-10, log10(p11), dhc_f_log10_sf(f, 1U, 1U));
+        for (size_t d = 1U; d <= 40U; d += 13U) {
+            const double p2d = pow(1.0 + 2.0 * f / (double)d, -0.5 * (double)d);
+            TEST_ASSERT_DOUBLE_WITHIN(1e-10, log10(p2d), dhc_f_log10_sf(f, 2U, d));
+            const double x = (double)d * f / (2.0 + (double)d * f);
+            const double pd2 = 1.0 - pow(x, 0.5 * (double)d);
+            TEST_ASSERT_DOUBLE_WITHIN(1e-9 * fabs(log10(pd2)) + 1e-10, log10(pd2),
+                                      dhc_f_log10_sf(f, d, 2U));
+        }
+    }
+    const double far = dhc_f_log10_sf(1e4, 2U, 30U);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, -15.0 * log10(1.0 + 2e4 / 30.0), far);
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, dhc_f_log10_sf(0.0, 3U, 4U));
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, dhc_f_log10_sf(2.0, 0U, 4U));
+}
+
 static void test_chi2_tail_matches_closed_forms(void)
 {
     /* 2 dof: P(X > x) = exp(-x/2); 4 dof: exp(-x/2)(1 + x/2); 1 dof: erfc(sqrt(x/2)). */
@@ -212,6 +237,7 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_chi2_tail_matches_closed_forms);
+    RUN_TEST(test_f_tail_matches_closed_forms);
     RUN_TEST(test_clean_data_flag_no_candidate);
     RUN_TEST(test_hidden_compliance_of_the_shoulder_is_named_first);
     RUN_TEST(test_hidden_joint_scale_is_named_first);

@@ -364,6 +364,74 @@ static void test_decrement_is_the_ssr_the_solution_removes(void)
     TEST_ASSERT_EQUAL(DHC_ERR_DIMENSION, dhc_lsq_decrement(&ne, &fac2, &dec));
 }
 
+/* The variance of a linear function of the parameters, sigma2 j^T N^-1 j, against the
+ * elimination reference (N^-1 j solved column by column); with a duplicated column the
+ * held parameter's entry is ignored: the variance of the identifiable block's function. */
+static void test_prediction_variance_is_j_ninv_j(void)
+{
+    const size_t m = 60U;
+    const size_t p = 5U;
+    const double x_true[5] = {0.3, -1.0, 2.0, 0.5, -0.25};
+    random_jacobian(m, p, -1.0, 1.0);
+    make_residuals(m, p, x_true, 0.2);
+    accumulate_all(&ne, m, p, NULL);
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_lsq_analyse(&ne, 1e-10, &fac));
+    const double j[5] = {1.0, -2.0, 0.5, 3.0, 0.25};
+    double ninv_j[5];
+    gauss_solve(ne.jtj, j, p, ninv_j);
+    double ref = 0.0;
+    for (size_t k = 0U; k < p; ++k) {
+        ref += j[k] * ninv_j[k];
+    }
+    double var = -1.0;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_lsq_prediction_variance(&fac, 0.04, j, p, &var));
+    assert_close(0.04 * ref, var, 1e-10, 1e-14);
+    /* the std errors are the variance of the unit rows */
+    double std[5];
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_lsq_std_errors(&fac, 0.04, std, p));
+    for (size_t k = 0U; k < p; ++k) {
+        double e[5] = {0.0};
+        e[k] = 1.0;
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_lsq_prediction_variance(&fac, 0.04, e, p, &var));
+        assert_close(std[k] * std[k], var, 1e-10, 1e-14);
+    }
+    /* column 4 a copy of column 0: held; j over the other four */
+    for (size_t e = 0U; e < m; ++e) {
+        jac_buf[e * p + 4U] = jac_buf[e * p + 0U];
+    }
+    accumulate_all(&ne, m, p, NULL);
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_lsq_analyse(&ne, 1e-10, &fac));
+    TEST_ASSERT_EQUAL_size_t(4U, fac.rank);
+    size_t held = fac.identifiable[4] ? 0U : 4U;
+    static double n4[16];
+    size_t idx[4];
+    size_t q = 0U;
+    for (size_t k = 0U; k < p; ++k) {
+        if (k != held) {
+            idx[q++] = k;
+        }
+    }
+    double j4[4];
+    for (size_t a = 0U; a < 4U; ++a) {
+        j4[a] = j[idx[a]];
+        for (size_t b = 0U; b < 4U; ++b) {
+            n4[a * 4U + b] = ne.jtj[idx[a] * p + idx[b]];
+        }
+    }
+    double x4[4];
+    gauss_solve(n4, j4, 4U, x4);
+    ref = 0.0;
+    for (size_t a = 0U; a < 4U; ++a) {
+        ref += j4[a] * x4[a];
+    }
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_lsq_prediction_variance(&fac, 1.0, j, p, &var));
+    assert_close(ref, var, 1e-9, 1e-14);
+    TEST_ASSERT_EQUAL(DHC_ERR_DIMENSION, dhc_lsq_prediction_variance(&fac, 1.0, j, p - 1U, &var));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_lsq_prediction_variance(&fac, -1.0, j, p, &var));
+    const double bad[5] = {0.0, (double)NAN, 0.0, 0.0, 0.0};
+    TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, dhc_lsq_prediction_variance(&fac, 1.0, bad, p, &var));
+}
+
 static void test_weighted_step_is_the_weighted_solution(void)
 {
     const size_t m = 30U;
@@ -937,6 +1005,7 @@ int main(void)
     RUN_TEST(test_add_rejects_bad_input_leaving_accumulator_unchanged);
     RUN_TEST(test_step_is_the_least_squares_solution);
     RUN_TEST(test_decrement_is_the_ssr_the_solution_removes);
+    RUN_TEST(test_prediction_variance_is_j_ninv_j);
     RUN_TEST(test_weighted_step_is_the_weighted_solution);
     RUN_TEST(test_streaming_result_is_independent_of_chunking);
     RUN_TEST(test_duplicate_and_zero_columns_are_unidentifiable);

@@ -165,9 +165,23 @@ int dhcal_geometry_set(const dhc_model *model, dhcal_geometry g, dhc_param_set *
     return DHCAL_IO_OK;
 }
 
-void dhcal_calib_options_for(const dhcal_noise *noise, dhc_calib_options *opt)
+double dhcal_reach_mm(const dhc_model *model)
+{
+    double reach = dhc_vec3_norm(model->arm.tool_mm);
+    for (size_t i = 0U; i < model->arm.n_joints; ++i) {
+        const dhc_joint *j = &model->arm.joint[i];
+        reach += sqrt(j->a_mm * j->a_mm + j->d_mm * j->d_mm);
+    }
+    return reach;
+}
+
+void dhcal_calib_options_for(const dhc_model *model, const dhcal_noise *noise,
+                             dhc_calib_options *opt)
 {
     dhc_calib_default_options(opt);
+    /* a link parameter the data pin only to half its physical range or worse is held */
+    opt->max_std_angle_rad = 0.5 * DHCAL_PLAUSIBLE_ANGLE_DEG * PI / 180.0;
+    opt->max_std_length_mm = 0.5 * DHCAL_PLAUSIBLE_LENGTH_SHARE * dhcal_reach_mm(model);
     if (noise != NULL && noise->on) {
         for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
             opt->joint_noise_rad[j] = noise->joint_rad;
@@ -190,7 +204,7 @@ int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhcal
     }
     set_drift_reference(&out->model, s);
     dhc_calib_options opt;
-    dhcal_calib_options_for(&out->noise, &opt);
+    dhcal_calib_options_for(start, &out->noise, &opt);
     out->status = dhc_calib_fit(&out->model, &out->set, dhcal_samples_read, s, s->n, s->flags,
                                 &opt, &calib_ws, &out->rep);
     if (out->status == DHC_ERR_UNDERDETERMINED) {
@@ -398,4 +412,297 @@ double dhcal_param_display(const dhc_param_set *set, size_t k, double value)
 {
     const int degrees = dhc_params_is_angle(set, k) || set->id[k].kind == (uint8_t)DHC_P_COMPLIANCE;
     return degrees ? value * 180.0 / PI : value;
+}
+
+int dhcal_implausible(const dhc_model *nominal, const dhcal_fit *fit, char *why, size_t cap)
+{
+    const double max_len = DHCAL_PLAUSIBLE_LENGTH_SHARE * dhcal_reach_mm(nominal);
+    const double max_ang = DHCAL_PLAUSIBLE_ANGLE_DEG * PI / 180.0;
+    for (size_t k = 0U; k < fit->set.count; ++k) {
+        const uint8_t kind = fit->set.id[k].kind;
+        if (kind > (uint8_t)DHC_P_BETA || !fit->rep.identifiable[k]) {
+            continue;
+        }
+        const double moved = fit->rep.value[k] - dhc_params_value(&fit->set, nominal, k);
+        const int angle = kind == (uint8_t)DHC_P_THETA || kind == (uint8_t)DHC_P_ALPHA ||
+                          kind == (uint8_t)DHC_P_BETA;
+        if (fabs(moved) > (angle ? max_ang : max_len)) {
+            char name[48];
+            (void)dhc_params_name(&fit->set, k, name, sizeof name);
+            snprintf(why, cap, "%s moved %.4g %s from its nominal value (physical bound %.4g)",
+                     name, angle ? moved * 180.0 / PI : moved, angle ? "deg" : "mm",
+                     angle ? DHCAL_PLAUSIBLE_ANGLE_DEG : max_len);
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* Row order for grouping repeats: joint angles, lexicographically (qsort has no context). */
+static const dhcal_samples *repeat_sort_samples;
+
+static int compare_poses(const void *a, const void *b)
+{
+    const dhc_sample *sa = &repeat_sort_samples->samples[*(const size_t *)a];
+    const dhc_sample *sb = &repeat_sort_samples->samples[*(const size_t *)b];
+    for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
+        if (sa->q_rad[j] < sb->q_rad[j] - DHCAL_REPEAT_TOL_RAD) {
+            return -1;
+        }
+        if (sa->q_rad[j] > sb->q_rad[j] + DHCAL_REPEAT_TOL_RAD) {
+            return 1;
+        }
+    }
+    return 0;
+}
+
+static int same_pose(const dhc_sample *a, const dhc_sample *b)
+{
+    for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
+        if (fabs(a->q_rad[j] - b->q_rad[j]) > DHCAL_REPEAT_TOL_RAD) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* Pure-error sum of squares of the position (or wire) residuals over groups of repeated
+ * poses, its degrees of freedom, and the groups. */
+static void pure_error(const dhcal_samples *s, const double *resid, double *ss, size_t *dof,
+                       size_t *groups, size_t *rows)
+{
+    *ss = 0.0;
+    *dof = 0U;
+    *groups = 0U;
+    *rows = 0U;
+    size_t *idx = malloc((s->n > 0U ? s->n : 1U) * sizeof *idx);
+    if (idx == NULL) {
+        return;
+    }
+    size_t m = 0U;
+    for (size_t i = 0U; i < s->n; ++i) {
+        if (s->flags[i] == (uint8_t)DHC_SAMPLE_USED) {
+            idx[m++] = i;
+        }
+    }
+    repeat_sort_samples = s;
+    qsort(idx, m, sizeof *idx, compare_poses);
+    for (size_t a = 0U; a < m;) {
+        size_t b = a + 1U;
+        while (b < m && same_pose(&s->samples[idx[a]], &s->samples[idx[b]])) {
+            ++b;
+        }
+        if (b - a >= 2U) {
+            double mean[3] = {0.0, 0.0, 0.0};
+            for (size_t k = a; k < b; ++k) {
+                for (size_t c = 0U; c < 3U; ++c) {
+                    mean[c] += resid[3U * idx[k] + c] / (double)(b - a);
+                }
+            }
+            for (size_t k = a; k < b; ++k) {
+                for (size_t c = 0U; c < 3U; ++c) {
+                    const double d = resid[3U * idx[k] + c] - mean[c];
+                    *ss += d * d;
+                }
+            }
+            *dof += 3U * (b - a - 1U);
+            *groups += 1U;
+            *rows += b - a;
+        }
+        a = b;
+    }
+    free(idx);
+}
+
+/* Per-coordinate variance the noise model predicts for the position rows of sample i. */
+static double predicted_row_variance(const dhcal_fit *fit, const dhc_sample *smp)
+{
+    const size_t n = fit->model.arm.n_joints;
+    dhc_param_set thetas;
+    dhc_params_clear(&thetas);
+    for (size_t j = 0U; j < n; ++j) {
+        (void)dhc_params_add(&thetas, &fit->model, DHC_P_THETA, j, 0U);
+    }
+    double buf[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_JOINTS];
+    dhc_mat jq;
+    const double meas2 = fit->noise.meas_mm * fit->noise.meas_mm;
+    if (dhc_mat_init(&jq, dhc_sample_rows(smp), n, buf, sizeof buf / sizeof buf[0]) != DHC_OK ||
+        dhc_model_jacobian(&fit->model, &thetas, smp, 1000.0, &jq, NULL) != DHC_OK) {
+        return meas2;
+    }
+    double sum = 0.0;
+    for (size_t r = 0U; r < 3U; ++r) {
+        for (size_t j = 0U; j < n; ++j) {
+            sum += DHC_MAT_AT(&jq, r, j) * DHC_MAT_AT(&jq, r, j);
+        }
+    }
+    return meas2 + fit->noise.joint_rad * fit->noise.joint_rad * sum / 3.0;
+}
+
+int dhcal_assess(const dhcal_fit *fit, const dhcal_samples *s, dhcal_adequacy *out)
+{
+    memset(out, 0, sizeof *out);
+    out->source = "none";
+    out->verdict = "unknown";
+    double *resid = calloc(3U * (s->n > 0U ? s->n : 1U), sizeof *resid);
+    double *err = calloc(s->n > 0U ? s->n : 1U, sizeof *err);
+    dhcal_error_stats es;
+    if (resid == NULL || err == NULL ||
+        dhcal_samples_errors(&fit->model, s, resid, err, &es) != DHCAL_IO_OK || es.used == 0U) {
+        free(resid);
+        free(err);
+        return DHCAL_IO_FAILED;
+    }
+    const double ss = es.rms_mm * es.rms_mm * (double)es.used; /* sum of |e|^2 */
+    if (fit->noise.on) {
+        out->source = "given";
+        const size_t dof = fit->rep.rows > fit->rep.rank ? fit->rep.rows - fit->rep.rank : 0U;
+        double var = 0.0;
+        for (size_t i = 0U; i < s->n; ++i) {
+            if (s->flags[i] == (uint8_t)DHC_SAMPLE_USED) {
+                var += predicted_row_variance(fit, &s->samples[i]) / (double)es.used;
+            }
+        }
+        out->have_noise = 1;
+        out->noise_mm = sqrt(var);
+        if (dof > 0U) {
+            out->have_test = 1;
+            out->lack_of_fit_log10_p =
+                dhc_chi2_log10_sf(fit->rep.sigma * fit->rep.sigma * (double)dof, dof);
+        }
+        out->have_systematic = 1;
+        out->systematic_mm = sqrt(fmax(0.0, ss / (double)es.used - 3.0 * var));
+    } else {
+        double ss_pe;
+        size_t dof_pe;
+        pure_error(s, resid, &ss_pe, &dof_pe, &out->repeat_groups, &out->repeat_rows);
+        /* the residual rows' degrees of freedom: position (or wire) rows less their share
+         * of the parameters (all of them when the fit saw no orientation rows) */
+        const double pos_rows = 3.0 * (double)es.used;
+        const double rows = fit->rep.rows > 0U ? (double)fit->rep.rows : pos_rows;
+        const double dof_res = pos_rows - (double)fit->rep.rank * pos_rows / rows;
+        const double dof_lof = floor(dof_res) - (double)dof_pe;
+        if (dof_pe >= 3U && ss_pe > 0.0) {
+            const double sigma2 = ss_pe / (double)dof_pe;
+            out->source = "repeats";
+            out->have_noise = 1;
+            out->noise_mm = sqrt(sigma2);
+            out->have_systematic = 1;
+            out->systematic_mm = sqrt(fmax(0.0, ss / (double)es.used - 3.0 * sigma2));
+            if (dof_lof >= 1.0) {
+                const double f = fmax(0.0, (ss - ss_pe) / dof_lof) / sigma2;
+                out->have_test = 1;
+                out->lack_of_fit_log10_p = dhc_f_log10_sf(f, (size_t)dof_lof, dof_pe);
+            }
+        }
+    }
+    if (out->have_test) {
+        out->verdict = out->lack_of_fit_log10_p < DHCAL_LACK_OF_FIT_LOG10_ALPHA
+                           ? "systematic_error"
+                           : "fits_noise";
+    }
+    free(resid);
+    free(err);
+    return DHCAL_IO_OK;
+}
+
+static dhc_normal_eq extrapolation_ne;
+static dhc_lsq_factor extrapolation_fac;
+
+int dhcal_extrapolate(const dhcal_fit *fit, const dhcal_samples *s, const dhcal_samples *held,
+                      dhcal_extrapolation *out)
+{
+    memset(out, 0, sizeof *out);
+    const size_t n = fit->model.arm.n_joints;
+    double lo[DHC_MAX_JOINTS];
+    double hi[DHC_MAX_JOINTS];
+    size_t used = 0U;
+    for (size_t i = 0U; i < s->n; ++i) {
+        if (s->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
+            continue;
+        }
+        for (size_t j = 0U; j < n; ++j) {
+            const double q = s->samples[i].q_rad[j];
+            lo[j] = used == 0U ? q : fmin(lo[j], q);
+            hi[j] = used == 0U ? q : fmax(hi[j], q);
+        }
+        used++;
+    }
+    if (used == 0U) {
+        return DHCAL_IO_FAILED;
+    }
+    for (size_t i = 0U; i < held->n; ++i) {
+        int outside = 0;
+        for (size_t j = 0U; j < n; ++j) {
+            const double q = held->samples[i].q_rad[j];
+            outside |= q < lo[j] - 1e-9 || q > hi[j] + 1e-9;
+        }
+        out->outside_range += outside ? 1U : 0U;
+    }
+    /* the identifiable parameters' normal equations over the training rows, at the fit */
+    static dhc_param_set id_set;
+    dhc_params_clear(&id_set);
+    for (size_t k = 0U; k < fit->set.count; ++k) {
+        if (fit->rep.identifiable[k]) {
+            id_set.id[id_set.count++] = fit->set.id[k];
+        }
+    }
+    if (id_set.count == 0U || dhc_normal_eq_init(&extrapolation_ne, id_set.count) != DHC_OK) {
+        return DHCAL_IO_FAILED;
+    }
+    dhc_calib_options opt;
+    dhcal_calib_options_for(&fit->model, &fit->noise, &opt);
+    static double buf[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS];
+    for (size_t i = 0U; i < s->n; ++i) {
+        if (s->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
+            continue;
+        }
+        const dhc_sample *smp = &s->samples[i];
+        const size_t rows = dhc_sample_rows(smp);
+        dhc_mat jac;
+        double r[DHC_MAX_ROWS_PER_SAMPLE];
+        size_t got;
+        if (dhc_mat_init(&jac, rows, id_set.count, buf, sizeof buf / sizeof buf[0]) != DHC_OK ||
+            dhc_model_residual(&fit->model, smp, opt.orientation_weight_mm_per_rad, r, &got) !=
+                DHC_OK ||
+            dhc_model_jacobian(&fit->model, &id_set, smp, opt.orientation_weight_mm_per_rad,
+                               &jac, NULL) != DHC_OK) {
+            return DHCAL_IO_FAILED;
+        }
+        dhc_model_residual_slope(smp, r, opt.orientation_weight_mm_per_rad, &jac);
+        if (fit->noise.on &&
+            dhc_sample_whiten(&fit->model, smp, opt.joint_noise_rad, opt.meas_noise_mm,
+                              opt.orientation_weight_mm_per_rad, r, &jac) != DHC_OK) {
+            return DHCAL_IO_FAILED;
+        }
+        if (dhc_normal_eq_add(&extrapolation_ne, &jac, r, NULL, rows) != DHC_OK) {
+            return DHCAL_IO_FAILED;
+        }
+    }
+    if (dhc_lsq_analyse(&extrapolation_ne, opt.rank_rel_tol, &extrapolation_fac) != DHC_OK) {
+        return DHCAL_IO_FAILED;
+    }
+    const double sigma2 = fit->rep.sigma * fit->rep.sigma;
+    const dhc_model steady = dhcal_model_without_drift(&fit->model);
+    double sum = 0.0;
+    for (size_t i = 0U; i < held->n; ++i) {
+        const dhc_sample *smp = &held->samples[i];
+        dhc_mat jac;
+        if (dhc_mat_init(&jac, dhc_sample_rows(smp), id_set.count, buf,
+                         sizeof buf / sizeof buf[0]) != DHC_OK ||
+            dhc_model_jacobian(&steady, &id_set, smp, opt.orientation_weight_mm_per_rad, &jac,
+                               NULL) != DHC_OK) {
+            return DHCAL_IO_FAILED;
+        }
+        for (size_t r = 0U; r < 3U; ++r) {
+            double v;
+            if (dhc_lsq_prediction_variance(&extrapolation_fac, sigma2, &DHC_MAT_AT(&jac, r, 0U),
+                                            id_set.count, &v) != DHC_OK) {
+                return DHCAL_IO_FAILED;
+            }
+            sum += v;
+        }
+    }
+    out->predicted_std_mm = held->n > 0U ? sqrt(sum / (double)held->n) : 0.0;
+    return DHCAL_IO_OK;
 }

@@ -50,8 +50,15 @@ dhc_model dhcal_model_without_drift(const dhc_model *model);
 int dhcal_parse_effects(const char *list, const dhc_model *model, dhc_param_set *set,
                         dhcal_error *err);
 
-/* The library's fit options with the noise model (NULL or off: unweighted). */
-void dhcal_calib_options_for(const dhcal_noise *noise, dhc_calib_options *opt);
+/* The arm's reach: the sum of its links' lengths and the tool's, mm (an upper bound of the
+ * tool point's distance from the base origin). */
+double dhcal_reach_mm(const dhc_model *model);
+
+/* The library's fit options for the model: the noise model (NULL or off: unweighted), and
+ * link parameters held at their input values when the data determine them only to half
+ * their physical range (DHCAL_PLAUSIBLE_*) or worse. */
+void dhcal_calib_options_for(const dhc_model *model, const dhcal_noise *noise,
+                             dhc_calib_options *opt);
 
 /* Fits the parameters of set, starting from start (a previous solution: the fit can only
  * lower its SSR), to s (flags updated with outliers); evaluates the fitted rows into
@@ -89,5 +96,48 @@ const char *dhcal_effect_signature(dhc_effect effect);
 
 /* A parameter value in file units: angles and compliances in degrees, the rest as is. */
 double dhcal_param_display(const dhc_param_set *set, size_t k, double value);
+
+/* A link parameter far outside its physical range: a joint offset or twist moved by more
+ * than DHCAL_PLAUSIBLE_ANGLE_DEG from nominal, a length by more than
+ * DHCAL_PLAUSIBLE_LENGTH_SHARE of the arm's nominal reach. Such a model fits its rows but is
+ * no calibration (few rows, gross errors). Returns 1 and the first such parameter in why. */
+#define DHCAL_PLAUSIBLE_ANGLE_DEG 30.0
+#define DHCAL_PLAUSIBLE_LENGTH_SHARE 0.5
+int dhcal_implausible(const dhc_model *nominal, const dhcal_fit *fit, char *why, size_t cap);
+
+/* How well the fitted model explains the data, against a noise reference: the noise model
+ * given (--noise; the whitened SSR is chi-square), or repeated poses in the data (rows with
+ * the same joint angles: their scatter is the noise, the robot's repeatability included;
+ * the lack-of-fit F test). Without a reference the verdict is "unknown". */
+typedef struct {
+    const char *source;          /* "given" | "repeats" | "none" */
+    int have_noise;
+    double noise_mm;             /* per coordinate */
+    int have_test;
+    double lack_of_fit_log10_p;
+    int have_systematic;
+    double systematic_mm;        /* RMS (3-D) of the error beyond the noise */
+    const char *verdict;         /* "fits_noise" | "systematic_error" | "unknown" */
+    size_t repeat_groups;
+    size_t repeat_rows;
+} dhcal_adequacy;
+
+/* Lack of fit below this log10 p is a systematic error (p < 1 %). */
+#define DHCAL_LACK_OF_FIT_LOG10_ALPHA (-2.0)
+/* Rows whose joint angles agree to this (rad) are repeats of one pose. */
+#define DHCAL_REPEAT_TOL_RAD 1e-7
+
+int dhcal_assess(const dhcal_fit *fit, const dhcal_samples *s, dhcal_adequacy *out);
+
+/* Held-out rows beyond the training rows' joint ranges, and the positioning uncertainty the
+ * calibration predicts there: the RMS over held-out rows of sqrt(trace) of the tool point's
+ * covariance from the identifiable parameters' covariance (dhc_lsq_prediction_variance). */
+typedef struct {
+    size_t outside_range;
+    double predicted_std_mm;
+} dhcal_extrapolation;
+
+int dhcal_extrapolate(const dhcal_fit *fit, const dhcal_samples *s, const dhcal_samples *held,
+                      dhcal_extrapolation *out);
 
 #endif /* DHCAL_ANALYSIS_H */

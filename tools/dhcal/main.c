@@ -15,6 +15,7 @@
 #include "dhcal_io.h"
 #include "dhcal_model_map.h"
 #include "dhcal_plot.h"
+#include "dhcal_refine.h"
 
 #define EXIT_COMPUTE 1
 #define EXIT_USAGE 2
@@ -30,6 +31,7 @@ typedef struct {
     const char *noise;
     const char *geometry;
     int json;
+    int cv; /* fit: report the cross-validated RMS too */
 } options;
 
 static const char *const common_help =
@@ -59,6 +61,7 @@ static const char *const usage_text =
     "  compare    the model against the measurements, no fitting: per-row error, RMS, max\n"
     "  fit        least-squares calibration of the model\n"
     "  diagnose   fit, then rank the physical effects the model still misses\n"
+    "  refine     the loop compare -> diagnose -> add -> refit, chosen by cross-validation\n"
     "  plot       residual and error plots (SVG) of a fit and its diagnosis\n"
     "'dhcal <command> --help' describes each.\n"
     "exit codes: 0 success, 1 computation failed, 2 bad input or usage\n";
@@ -71,17 +74,29 @@ static void print_command_help(const char *command)
                "fitting: per-row error, RMS and maximum (mm; wire-length space for L1..L3).\n");
     } else if (strcmp(command, "fit") == 0) {
         printf("usage: dhcal fit --model M.json --data D.csv [--effects LIST] [--heldout H.csv]\n"
-               "                 [--out C.json] [--json]\n"
+               "                 [--geometry LEVEL] [--noise J,M] [--cv] [--out C.json] [--json]\n"
                "Fits joint offsets and link geometry (Hayati's beta where consecutive axes\n"
                "are nominally parallel) plus --effects. Reports parameters with standard\n"
                "errors, parameters the data cannot identify and what they trade off with,\n"
-               "and outlier rows (left out). --out writes the calibrated model (same schema;\n"
-               "it loads again as --model) only when the fit succeeds.\n");
+               "outlier rows (left out), the adequacy of the model against a noise reference\n"
+               "(--noise, or repeated poses), and with --heldout the rows outside the training\n"
+               "ranges and the uncertainty the calibration predicts there. --cv adds the\n"
+               "cross-validated RMS. --out writes the calibrated model (same schema; it loads\n"
+               "again as --model) only when the fit succeeds and is physically plausible.\n");
     } else if (strcmp(command, "diagnose") == 0) {
         printf("usage: dhcal diagnose --model M.json --data D.csv [--effects LIST] [--json]\n"
                "Fits, then scores every effect the model does not have yet against the\n"
                "remaining residual (score test, Holm-corrected at 0.1 %%): the share of the\n"
                "residual each would explain, whether that is significant, and look-alikes.\n");
+    } else if (strcmp(command, "refine") == 0) {
+        printf("usage: dhcal refine --model M.json --data D.csv [--effects START] [--heldout H.csv]\n"
+               "                    [--noise J,M] [--geometry LEVEL] [--out C.json] [--json]\n"
+               "From the base model plus START (e.g. base_frame,tool_offset), adds the candidate\n"
+               "effect of the diagnosis that lowers the cross-validated RMS most (leave-one-out\n"
+               "below 30 rows, else 5 folds), refits from the previous solution, and repeats\n"
+               "while that RMS falls by 1 %% or more. With few rows and no --geometry, cross-\n"
+               "validation also picks how much geometry to fit. --heldout rows are evaluated\n"
+               "at every step, never used to choose. --out writes the final model.\n");
     } else if (strcmp(command, "plot") == 0) {
         printf("usage: dhcal plot --model M.json --data D.csv --out DIR [--effects LIST]\n"
                "Writes SVG files into DIR: residual components against each joint angle\n"
@@ -122,6 +137,10 @@ static int parse_args(int argc, char **argv, options *o)
             o->json = 1;
             continue;
         }
+        if (strcmp(a, "--cv") == 0) {
+            o->cv = 1;
+            continue;
+        }
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
             print_command_help(o->command);
             return -1;
@@ -157,9 +176,9 @@ static int parse_args(int argc, char **argv, options *o)
         }
         *slot = argv[++i];
     }
-    const char *known[4] = {"compare", "fit", "diagnose", "plot"};
+    const char *known[5] = {"compare", "fit", "diagnose", "plot", "refine"};
     int ok = 0;
-    for (size_t k = 0U; k < 4U; ++k) {
+    for (size_t k = 0U; k < 5U; ++k) {
         ok |= strcmp(o->command, known[k]) == 0;
     }
     if (!ok) {
@@ -173,8 +192,12 @@ static int parse_args(int argc, char **argv, options *o)
     if (strcmp(o->command, "plot") == 0 && o->out == NULL) {
         return usage_error("plot needs --out DIR");
     }
-    if (o->out != NULL && strcmp(o->command, "fit") != 0 && strcmp(o->command, "plot") != 0) {
-        return usage_error("--out is for fit (calibrated model) and plot (directory)");
+    if (o->out != NULL && strcmp(o->command, "fit") != 0 && strcmp(o->command, "plot") != 0 &&
+        strcmp(o->command, "refine") != 0) {
+        return usage_error("--out is for fit and refine (calibrated model) and plot (directory)");
+    }
+    if (o->cv && strcmp(o->command, "fit") != 0) {
+        return usage_error("--cv is for fit (refine always cross-validates)");
     }
     return 0;
 }
@@ -294,6 +317,169 @@ static int cmd_compare(const options *o, session *s)
 
 /* ---------------------------------------------------------------- fit reporting */
 
+/* What a report adds to a fit: adequacy, extrapolation to the held-out rows, CV. */
+typedef struct {
+    int have_adequacy;
+    dhcal_adequacy adequacy;
+    int have_extrapolation;
+    dhcal_extrapolation extrapolation;
+    int have_cv;
+    dhcal_cv cv;
+} fit_extras;
+
+static void compute_extras(const dhcal_fit *f, const session *s, fit_extras *x)
+{
+    memset(x, 0, sizeof *x);
+    x->have_adequacy = dhcal_assess(f, &s->samples, &x->adequacy) == DHCAL_IO_OK;
+    x->have_extrapolation =
+        s->have_held && dhcal_extrapolate(f, &s->samples, &s->held, &x->extrapolation) ==
+                            DHCAL_IO_OK;
+}
+
+static void json_number_or_null(cJSON *obj, const char *key, int have, double v)
+{
+    if (have) {
+        cJSON_AddNumberToObject(obj, key, v);
+    } else {
+        cJSON_AddNullToObject(obj, key);
+    }
+}
+
+static void json_extras(cJSON *obj, const dhcal_fit *f, const fit_extras *x)
+{
+    cJSON_AddStringToObject(obj, "geometry", dhcal_geometry_name(f->geometry));
+    if (x->have_cv) {
+        cJSON_AddNumberToObject(obj, "cv_rms_mm", x->cv.rms_mm);
+    }
+    if (x->have_extrapolation) {
+        cJSON_AddNumberToObject(obj, "heldout_outside_range", (double)x->extrapolation.outside_range);
+        cJSON_AddNumberToObject(obj, "predicted_std_mm", x->extrapolation.predicted_std_mm);
+    }
+    if (x->have_adequacy) {
+        const dhcal_adequacy *a = &x->adequacy;
+        cJSON *j = cJSON_AddObjectToObject(obj, "adequacy");
+        json_number_or_null(j, "noise_mm", a->have_noise, a->noise_mm);
+        cJSON_AddStringToObject(j, "noise_source", a->source);
+        json_number_or_null(j, "lack_of_fit_log10_p", a->have_test, a->lack_of_fit_log10_p);
+        json_number_or_null(j, "systematic_mm", a->have_systematic, a->systematic_mm);
+        cJSON_AddStringToObject(j, "verdict", a->verdict);
+    }
+}
+
+/* Where a systematic error shows: the apparent joint error's RMS per joint (deg) and the
+ * residual's linear trend over the session (mm from first to last row). */
+static void text_where(const dhcal_fit *f, const session *s)
+{
+    const size_t n = s->samples.n;
+    const size_t nj = f->model.arm.n_joints;
+    double *dq = calloc(n * nj + 1U, sizeof *dq);
+    double *moment = calloc(n * nj + 1U, sizeof *moment);
+    double *resid = calloc(3U * n + 1U, sizeof *resid);
+    double *err = calloc(n + 1U, sizeof *err);
+    dhcal_error_stats es;
+    if (dq == NULL || moment == NULL || resid == NULL || err == NULL ||
+        dhcal_apparent_joint_errors(&f->model, &s->samples, 0, dq, moment) != DHCAL_IO_OK ||
+        dhcal_samples_errors(&f->model, &s->samples, resid, err, &es) != DHCAL_IO_OK) {
+        free(dq);
+        free(moment);
+        free(resid);
+        free(err);
+        return;
+    }
+    printf("  where it shows: apparent joint errors RMS");
+    for (size_t j = 0U; j < nj; ++j) {
+        double ss = 0.0;
+        size_t m = 0U;
+        for (size_t i = 0U; i < n; ++i) {
+            if (s->samples.flags[i] == (uint8_t)DHC_SAMPLE_USED) {
+                ss += dq[i * nj + j] * dq[i * nj + j];
+                m++;
+            }
+        }
+        printf("%s joint %zu %.4f deg", j == 0U ? "" : ",", j + 1U, m > 0U ? sqrt(ss / (double)m) : 0.0);
+    }
+    /* trend over time: least-squares slope of each residual coordinate against t */
+    double st = 0.0;
+    double stt = 0.0;
+    double sr[3] = {0.0, 0.0, 0.0};
+    double str[3] = {0.0, 0.0, 0.0};
+    double tmin = 0.0;
+    double tmax = 0.0;
+    size_t m = 0U;
+    for (size_t i = 0U; i < n; ++i) {
+        if (s->samples.flags[i] != (uint8_t)DHC_SAMPLE_USED) {
+            continue;
+        }
+        const double t = s->samples.samples[i].t_s;
+        tmin = m == 0U ? t : fmin(tmin, t);
+        tmax = m == 0U ? t : fmax(tmax, t);
+        st += t;
+        stt += t * t;
+        for (size_t c = 0U; c < 3U; ++c) {
+            sr[c] += resid[3U * i + c];
+            str[c] += t * resid[3U * i + c];
+        }
+        m++;
+    }
+    const double den = (double)m * stt - st * st;
+    double drift = 0.0;
+    for (size_t c = 0U; c < 3U && den > 0.0; ++c) {
+        const double slope = ((double)m * str[c] - st * sr[c]) / den;
+        drift += slope * slope;
+    }
+    printf("; over the session (%s) the residual moves %.4f mm\n",
+           s->data.has_time ? "t_s" : "row order", sqrt(drift) * (tmax - tmin));
+    free(dq);
+    free(moment);
+    free(resid);
+    free(err);
+}
+
+static void text_extras(const dhcal_fit *f, const session *s, const fit_extras *x,
+                        int diagnosed_nothing)
+{
+    if (x->have_cv) {
+        printf("cross-validated RMS %.4f mm (%zu folds)\n", x->cv.rms_mm, x->cv.folds);
+    }
+    if (x->have_extrapolation) {
+        printf("held-out rows outside the training rows' joint ranges: %zu of %zu; the "
+               "calibration predicts a positioning uncertainty of %.4f mm RMS there\n",
+               x->extrapolation.outside_range, s->held.n, x->extrapolation.predicted_std_mm);
+    }
+    if (!x->have_adequacy) {
+        return;
+    }
+    const dhcal_adequacy *a = &x->adequacy;
+    if (strcmp(a->source, "none") == 0) {
+        printf("adequacy: no noise reference (give --noise J,M, or measure some poses more than "
+               "once): whether the model fits the noise cannot be judged from these data\n");
+        return;
+    }
+    char ref[160];
+    if (strcmp(a->source, "given") == 0) {
+        snprintf(ref, sizeof ref, "the noise model given");
+    } else {
+        snprintf(ref, sizeof ref, "%zu repeated poses (%zu rows)", a->repeat_groups,
+                 a->repeat_rows);
+    }
+    if (!a->have_test) {
+        printf("adequacy: noise %.4f mm per coordinate from %s; too few rows for a lack-of-fit "
+               "test\n", a->noise_mm, ref);
+        return;
+    }
+    if (strcmp(a->verdict, "fits_noise") == 0) {
+        printf("adequacy: the model fits these data to their noise (%.4f mm per coordinate "
+               "from %s; lack of fit log10 p %.1f)\n",
+               a->noise_mm, ref, a->lack_of_fit_log10_p);
+        return;
+    }
+    printf("adequacy: a systematic error of %.4f mm RMS remains beyond the noise (%.4f mm per "
+           "coordinate from %s; lack of fit log10 p %.1f)%s\n",
+           a->systematic_mm, a->noise_mm, ref, a->lack_of_fit_log10_p,
+           diagnosed_nothing ? "; no effect of the catalogue explains it" : "");
+    text_where(f, s);
+}
+
 static void json_fit(cJSON *obj, const dhcal_fit *f, const session *s, const double *row_err)
 {
     cJSON_AddNumberToObject(obj, "rms_mm", f->rep.rms_mm);
@@ -398,6 +584,11 @@ static void text_fit(const dhcal_fit *f, const session *s, const options *o, con
             continue;
         }
         (void)dhc_params_name(&f->set, k, name, sizeof name);
+        if (rep->unsupported[k]) {
+            printf("held at nominal: %s (these data determine it only to more than half its "
+                   "physical range)\n", name);
+            continue;
+        }
         printf("%s: %s (kept at nominal)",
                rep->rank < rep->structural_rank && rep->structurally_identifiable[k]
                    ? "not identified from these data"
@@ -442,12 +633,41 @@ static int do_fit(const options *o, session *s, dhcal_fit *fit, double **row_err
     return 0;
 }
 
+/* A fitted model outside its physical range is refused as a calibration (exit 1). */
+static int refuse_implausible(const session *s, const dhcal_fit *fit, const char *out)
+{
+    char why[200];
+    if (!dhcal_implausible(&s->model, fit, why, sizeof why)) {
+        return 0;
+    }
+    fprintf(stderr,
+            "dhcal: not a calibration: %s; the rows cannot support this much geometry (try "
+            "--geometry lengths or offsets, or dhcal refine, which chooses by "
+            "cross-validation)%s\n",
+            why, out != NULL ? "; --out not written" : "");
+    return EXIT_COMPUTE;
+}
+
 static int cmd_fit(const options *o, session *s)
 {
     static dhcal_fit fit;
+    static fit_extras extras;
     double *row_err = NULL;
     int rc = do_fit(o, s, &fit, &row_err);
-    if (rc == 0 && o->out != NULL && fit.status == DHC_OK) {
+    const int implausible = rc == 0 ? refuse_implausible(s, &fit, o->out) : 0;
+    if (rc == 0) {
+        compute_extras(&fit, s, &extras);
+        if (o->cv) {
+            dhcal_error err;
+            memset(&err, 0, sizeof err);
+            extras.have_cv = dhcal_cross_validate(&fit.model, &fit.set, &s->noise, &s->samples,
+                                                  &extras.cv, &err) == DHCAL_IO_OK;
+            if (!extras.have_cv) {
+                fprintf(stderr, "dhcal: %s\n", err.msg);
+            }
+        }
+    }
+    if (rc == 0 && o->out != NULL && fit.status == DHC_OK && implausible == 0) {
         static dhcal_model out;
         dhcal_model_from_lib(&fit.model, &s->file_model, &out);
         dhcal_error err;
@@ -461,10 +681,13 @@ static int cmd_fit(const options *o, session *s)
         if (o->json) {
             cJSON *obj = cJSON_CreateObject();
             json_fit(obj, &fit, s, row_err);
+            json_extras(obj, &fit, &extras);
             rc = print_json(obj);
         } else {
             text_fit(&fit, s, o, row_err);
+            text_extras(&fit, s, &extras, 0);
         }
+        rc = rc == 0 ? implausible : rc;
         if (fit.status != DHC_OK) {
             fprintf(stderr, "dhcal: the fit did not converge in %zu iterations%s\n",
                     fit.rep.iterations, o->out != NULL ? "; --out not written" : "");
@@ -509,8 +732,8 @@ static void text_diagnosis(const dhcal_fit *fit, const dhc_diagnosis *d)
     }
     const dhc_candidate_result *top = d->count > 0U ? &d->c[0] : NULL;
     if (top == NULL || !top->significant) {
-        printf("no missing effect found: nothing explains a significant share of the residual; "
-               "the model fits these data to their noise level\n");
+        printf("no missing effect found: no effect of the catalogue explains a significant "
+               "share of the residual (whether the model fits the noise: see adequacy)\n");
     } else {
         dhcal_effect_label(top->effect, top->joint, label, sizeof label);
         printf("found %s: add '%s' (explains %.0f%% of the residual, significant)\n",
@@ -554,6 +777,7 @@ static int cmd_diagnose(const options *o, session *s)
 {
     static dhcal_fit fit;
     static dhc_diagnosis diag;
+    static fit_extras extras;
     double *row_err = NULL;
     int rc = do_fit(o, s, &fit, &row_err);
     dhcal_error err;
@@ -563,9 +787,11 @@ static int cmd_diagnose(const options *o, session *s)
         rc = EXIT_COMPUTE;
     }
     if (rc == 0) {
+        compute_extras(&fit, s, &extras);
         if (o->json) {
             cJSON *obj = cJSON_CreateObject();
             json_fit(obj, &fit, s, row_err);
+            json_extras(obj, &fit, &extras);
             cJSON *cands = cJSON_AddArrayToObject(obj, "candidates");
             for (size_t i = 0U; i < diag.count; ++i) {
                 const dhc_candidate_result *c = &diag.c[i];
@@ -593,9 +819,120 @@ static int cmd_diagnose(const options *o, session *s)
         } else {
             text_fit(&fit, s, o, row_err);
             text_diagnosis(&fit, &diag);
+            text_extras(&fit, s, &extras, diag.count == 0U || !diag.c[0].significant);
         }
     }
     free(row_err);
+    return rc;
+}
+
+/* ---------------------------------------------------------------- refine */
+
+static int cmd_refine(const options *o, session *s)
+{
+    static dhcal_refine_result res;
+    static fit_extras extras;
+    dhcal_error err;
+    memset(&err, 0, sizeof err);
+    int rc = dhcal_run_refine(&s->model, o->effects, o->geometry != NULL ? &s->geometry : NULL,
+                              &s->noise, &s->samples, s->have_held ? &s->held : NULL, &res,
+                              &err);
+    if (rc != DHCAL_IO_OK) {
+        fprintf(stderr, "dhcal: %s\n", err.msg);
+        return rc == DHCAL_IO_BAD_INPUT ? EXIT_USAGE : EXIT_COMPUTE;
+    }
+    const dhcal_fit *fit = &res.fit;
+    const int implausible = refuse_implausible(s, fit, o->out);
+    double *row_err = calloc(s->samples.n + 1U, sizeof *row_err);
+    dhcal_error_stats es;
+    if (row_err == NULL ||
+        dhcal_samples_errors(&fit->model, &s->samples, NULL, row_err, &es) != DHCAL_IO_OK) {
+        free(row_err);
+        fprintf(stderr, "dhcal: evaluation failed\n");
+        return EXIT_COMPUTE;
+    }
+    compute_extras(fit, s, &extras);
+    extras.have_cv = 1;
+    extras.cv = res.cv;
+    rc = 0;
+    if (o->out != NULL && fit->status == DHC_OK && implausible == 0) {
+        static dhcal_model out;
+        dhcal_model_from_lib(&fit->model, &s->file_model, &out);
+        if (dhcal_model_save(o->out, &out, &err) != DHCAL_IO_OK) {
+            fprintf(stderr, "dhcal: %s\n", err.msg);
+            rc = EXIT_COMPUTE;
+        }
+    }
+    if (o->json) {
+        cJSON *obj = cJSON_CreateObject();
+        json_fit(obj, fit, s, row_err);
+        json_extras(obj, fit, &extras);
+        cJSON *effects = cJSON_AddArrayToObject(obj, "effects");
+        char list[DHCAL_EFFECTS_CAP];
+        snprintf(list, sizeof list, "%s", res.effects);
+        for (char *tok = strtok(list, ","); tok != NULL; tok = strtok(NULL, ",")) {
+            cJSON_AddItemToArray(effects, cJSON_CreateString(tok));
+        }
+        cJSON *steps = cJSON_AddArrayToObject(obj, "steps");
+        for (size_t k = 0U; k < res.n_steps; ++k) {
+            const dhcal_refine_step *st = &res.step[k];
+            cJSON *j = cJSON_CreateObject();
+            if (st->added[0] != '\0') {
+                cJSON_AddStringToObject(j, "added", st->added);
+            } else {
+                cJSON_AddNullToObject(j, "added");
+            }
+            cJSON *e = cJSON_AddArrayToObject(j, "effects");
+            snprintf(list, sizeof list, "%s", st->effects);
+            for (char *tok = strtok(list, ","); tok != NULL; tok = strtok(NULL, ",")) {
+                cJSON_AddItemToArray(e, cJSON_CreateString(tok));
+            }
+            cJSON_AddNumberToObject(j, "rms_mm", st->rms_mm);
+            cJSON_AddNumberToObject(j, "cv_rms_mm", st->cv_rms_mm);
+            if (st->have_heldout) {
+                cJSON_AddNumberToObject(j, "heldout_rms_mm", st->heldout_rms_mm);
+                cJSON_AddNumberToObject(j, "heldout_mean_mm", st->heldout_mean_mm);
+            }
+            cJSON_AddItemToArray(steps, j);
+        }
+        if (res.geometry_chosen) {
+            cJSON_AddStringToObject(obj, "geometry_why", res.geometry_why);
+        }
+        cJSON_AddStringToObject(obj, "stopped", res.stopped_why);
+        const int prc = print_json(obj);
+        rc = rc != 0 ? rc : prc;
+    } else {
+        printf("refine of '%s' to %s: base model (%s geometry)%s%s\n", s->file_model.name,
+               o->data, dhcal_geometry_name(fit->geometry), o->effects != NULL ? " + " : "",
+               o->effects != NULL ? o->effects : "");
+        if (res.geometry_chosen) {
+            printf("%s\n", res.geometry_why);
+        }
+        printf("%-5s %-24s %10s %12s %s\n", "step", "added", "RMS mm", "CV RMS mm",
+               s->have_held ? "held-out RMS / mean mm" : "");
+        for (size_t k = 0U; k < res.n_steps; ++k) {
+            const dhcal_refine_step *st = &res.step[k];
+            printf("%-5zu %-24s %10.4f %12.4f", k, st->added[0] != '\0' ? st->added : "(start)",
+                   st->rms_mm, st->cv_rms_mm);
+            if (st->have_heldout) {
+                printf("   %.4f / %.4f", st->heldout_rms_mm, st->heldout_mean_mm);
+            }
+            printf("\n");
+        }
+        printf("stopped: %s\nfinal effects: %s\n\n", res.stopped_why,
+               res.effects[0] != '\0' ? res.effects : "(none)");
+        text_fit(fit, s, o, row_err);
+        text_extras(fit, s, &extras, 1);
+    }
+    free(row_err);
+    if (rc == 0 && implausible != 0) {
+        rc = implausible;
+    }
+    if (rc == 0 && fit->status != DHC_OK) {
+        fprintf(stderr, "dhcal: the final fit did not converge in %zu iterations%s\n",
+                fit->rep.iterations, o->out != NULL ? "; --out not written" : "");
+        rc = EXIT_COMPUTE;
+    }
     return rc;
 }
 
@@ -735,6 +1072,8 @@ int main(int argc, char **argv)
             rc = cmd_fit(&o, &s);
         } else if (strcmp(o.command, "diagnose") == 0) {
             rc = cmd_diagnose(&o, &s);
+        } else if (strcmp(o.command, "refine") == 0) {
+            rc = cmd_refine(&o, &s);
         } else {
             rc = cmd_plot(&o, &s);
         }

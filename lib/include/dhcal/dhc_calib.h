@@ -50,6 +50,9 @@ typedef struct {
                                     test real data meet; 0 turns it off */
     size_t max_identifiability_checks; /* re-analyses at the converged estimate that may
                                     free parameters found unidentifiable at the start (3) */
+    double max_std_angle_rad;    /* a joint offset or twist whose standard error exceeds this
+                                    is held at its input value (0: no bound, the default) */
+    double max_std_length_mm;    /* ... a length (a, d) likewise (0: no bound) */
     double orientation_weight_mm_per_rad; /* rad residuals count as this many mm (1000) */
     double outlier_threshold;    /* |error| / robust sigma above this is an outlier (6); 0 off */
     double outlier_floor_mm;     /* robust sigma is at least this (1e-6 mm: noise-free data);
@@ -85,6 +88,8 @@ typedef struct {
                                identifiable), kept at its input value */
     size_t freed;           /* parameters unidentifiable at the input values that the
                                analysis at the estimate found identifiable and fitted */
+    uint8_t unsupported[DHC_MAX_PARAMS]; /* 1: held at its input value because the data
+                               determine it only to more than max_std_* */
     size_t outliers;        /* samples flagged DHC_SAMPLE_OUTLIER */
     double rms_mm;          /* sqrt(mean |position error|^2) over used samples; for wire
                                samples the error is the vector of 3 wire residuals */

@@ -127,4 +127,9 @@ dhc_status dhc_diagnose(const dhc_model *model, const dhc_param_set *base,
  * far into the tail (no underflow to -inf before ~1e300). dof >= 1, chi2 >= 0. */
 double dhc_chi2_log10_sf(double chi2, size_t dof);
 
+/* log10 of the upper tail P(X > f) of Fisher's F with (d1, d2) degrees of freedom: the
+ * lack-of-fit test against replicated measurements (regularized incomplete beta by its
+ * continued fraction, in logs). d1, d2 >= 1, f >= 0; 0 for f <= 0. */
+double dhc_f_log10_sf(double f, size_t d1, size_t d2);
+
 #endif /* DHC_DIAGNOSE_H */

@@ -98,6 +98,15 @@ dhc_status dhc_lsq_decrement(const dhc_normal_eq *ne, const dhc_lsq_factor *fac,
 dhc_status dhc_lsq_std_errors(const dhc_lsq_factor *fac, double sigma2, double *std,
                               size_t len);
 
+/* Variance that the identifiable parameters' covariance sigma2 N11^-1 gives a linear
+ * function of them: sigma2 j1^T N11^-1 j1 for the row j (n entries, one per parameter;
+ * entries of unidentifiable parameters are ignored: they are held, not estimated). The
+ * positioning uncertainty of a predicted point is the sum over its three rows.
+ * DHC_ERR_ARGUMENT (NULL, sigma2 < 0, fac not analysed), DHC_ERR_DIMENSION (len < n),
+ * DHC_ERR_NONFINITE (non-finite row or sigma2). O(r^2), one n-double stack array. */
+dhc_status dhc_lsq_prediction_variance(const dhc_lsq_factor *fac, double sigma2,
+                                       const double *row, size_t len, double *variance);
+
 /* For an unidentifiable parameter j: the parameters it is confounded with, i.e. those with
  * a non-negligible coefficient in the null-space combination v (v_j = 1,
  * v_id = -N11^-1 N1j, scaled units). partner[k] is set to 1 for each partner k (other
