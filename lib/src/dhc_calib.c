@@ -15,6 +15,13 @@
 #define LAMBDA_START 1e-3
 /* freeing a parameter at the estimate asks this much more of its pivot than the fit does */
 #define FREE_TOL_FACTOR 1e4
+/* robust start: triggered when max error > ROBUST_TRIGGER x median error at the input;
+ * keeps the ROBUST_KEEP share closest to it in each of ROBUST_CSTEPS trimmed fits; leaves
+ * out samples beyond ROBUST_K robust sigmas of the result */
+#define ROBUST_TRIGGER 5.0
+#define ROBUST_KEEP 0.75
+#define ROBUST_CSTEPS 2U
+#define ROBUST_K 10.0
 /* link parameters held back for want of support, at most, in one fit */
 #define MAX_HOLDS 8U
 #define LAMBDA_MAX 1e12
@@ -44,6 +51,8 @@ void dhc_calib_default_options(dhc_calib_options *opt)
     opt->outlier_threshold = 6.0;
     opt->outlier_floor_mm = 1e-6;
     opt->joint_margin_rad = 0.1;
+    opt->reach_margin = 0.1;
+    opt->robust_start = 1;
     opt->max_outlier_rounds = 3U;
     opt->structural_seed = 12345U;
     for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
@@ -448,10 +457,10 @@ typedef struct {
     double max_e2;
 } error_scan;
 
-/* One pass over the used samples; with flag_above, samples with e2 above limit2 are
- * flagged as outliers. */
+/* One pass over the used samples; with mark other than DHC_SAMPLE_USED, samples with e2
+ * above limit2 are flagged with it. */
 static dhc_status scan_errors(const fit_context *fc, const dhc_model *model, double limit2,
-                              int flag_above, error_scan *out)
+                              uint8_t mark, error_scan *out)
 {
     memset(out, 0, sizeof *out);
     for (size_t i = 0U; i < fc->n; ++i) {
@@ -469,25 +478,25 @@ static dhc_status scan_errors(const fit_context *fc, const dhc_model *model, dou
         out->max_e2 = fmax(out->max_e2, e2);
         if (e2 <= limit2) {
             out->at_most++;
-        } else if (flag_above) {
-            fc->flags[i] = (uint8_t)DHC_SAMPLE_OUTLIER;
+        } else if (mark != (uint8_t)DHC_SAMPLE_USED) {
+            fc->flags[i] = mark;
         }
     }
     return DHC_OK;
 }
 
-/* Median of the squared sample errors by bisection on the value (each step one pass over
- * the data): the library keeps no per-sample storage, so no sort. */
-static dhc_status median_error2(const fit_context *fc, const dhc_model *model,
-                                const error_scan *all, double *median)
+/* A quantile (share 0.5: the median) of the squared sample errors by bisection on the value
+ * (each step one pass over the data): the library keeps no per-sample storage, so no sort. */
+static dhc_status quantile_error2(const fit_context *fc, const dhc_model *model,
+                                  const error_scan *all, double share, double *median)
 {
     double lo = 0.0;
     double hi = all->max_e2;
-    const size_t half = (all->used + 1U) / 2U;
+    const size_t half = (size_t)ceil(share * (double)all->used);
     for (size_t it = 0U; it < MEDIAN_BISECTIONS && hi - lo > MEDIAN_REL_PRECISION * hi; ++it) {
         const double mid = 0.5 * (lo + hi);
         error_scan scan;
-        const dhc_status st = scan_errors(fc, model, mid, 0, &scan);
+        const dhc_status st = scan_errors(fc, model, mid, (uint8_t)DHC_SAMPLE_USED, &scan);
         if (st != DHC_OK) {
             return st;
         }
@@ -501,6 +510,14 @@ static dhc_status median_error2(const fit_context *fc, const dhc_model *model,
     return DHC_OK;
 }
 
+/* Enough equations to tell a bad row from the rest: twice the parameters the model can
+ * identify. Below that, trimming or flagging a row leaves a fit that passes through the
+ * remaining rows whatever they are. */
+static int redundant(const pass_totals *tot, const dhc_calib_report *rep)
+{
+    return tot->rows >= 2U * rep->structural_rank;
+}
+
 /* Flags samples whose error is many robust sigmas; returns how many were newly flagged. */
 static dhc_status flag_outliers(const fit_context *fc, const dhc_model *model, size_t *flagged)
 {
@@ -509,21 +526,93 @@ static dhc_status flag_outliers(const fit_context *fc, const dhc_model *model, s
         return DHC_OK;
     }
     error_scan all;
-    dhc_status st = scan_errors(fc, model, HUGE_VAL, 0, &all);
+    dhc_status st = scan_errors(fc, model, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, &all);
     if (st != DHC_OK || all.used < 3U) {
         return st;
     }
     double median;
-    st = median_error2(fc, model, &all, &median);
+    st = quantile_error2(fc, model, &all, 0.5, &median);
     if (st != DHC_OK) {
         return st;
     }
     const double chi2_median = 2U * all.pose > all.used ? CHI2_MEDIAN_6DOF : CHI2_MEDIAN_3DOF;
     const double sigma = fmax(sqrt(median / chi2_median), fc->opt->outlier_floor_mm);
     error_scan kept;
-    st = scan_errors(fc, model, sq(fc->opt->outlier_threshold * sigma), 1, &kept);
+    st = scan_errors(fc, model, sq(fc->opt->outlier_threshold * sigma),
+                     (uint8_t)DHC_SAMPLE_OUTLIER, &kept);
     *flagged = kept.used - kept.at_most;
     return st;
+}
+
+int dhc_sample_is_outlier(uint8_t flag)
+{
+    return flag >= (uint8_t)DHC_SAMPLE_OUTLIER;
+}
+
+/* The arm's reach: its links' and tool's lengths, an upper bound of the tool point's
+ * distance from the base origin. */
+static double arm_reach(const dhc_arm *arm)
+{
+    double reach = dhc_vec3_norm(arm->tool_mm);
+    for (size_t i = 0U; i < arm->n_joints; ++i) {
+        reach += sqrt(sq(arm->joint[i].a_mm) + sq(arm->joint[i].d_mm));
+    }
+    return reach;
+}
+
+/* A sample measured farther from the base than the arm reaches (a tool point, or a wire
+ * longer than its anchor's distance from the base plus the reach). */
+static int beyond_reach(const dhc_model *model, const dhc_sample *s, double limit)
+{
+    const double *b = model->arm.base.pos;
+    if (s->kind != (uint8_t)DHC_MEAS_WIRES) {
+        const double d[3] = {s->p_mm[0] - b[0], s->p_mm[1] - b[1], s->p_mm[2] - b[2]};
+        return dhc_vec3_norm(d) > limit;
+    }
+    for (size_t k = 0U; k < 3U; ++k) {
+        double anchor[3];
+        double d[3];
+        dhc_measurer_anchor_world(&model->measurer, k, anchor);
+        dhc_vec3_sub(anchor, b, d);
+        if (s->wire_mm[k] > dhc_vec3_norm(d) + limit) {
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* Flags samples beyond reach, unless most are: then the model's base is off, not the rows. */
+static dhc_status flag_beyond_reach(const fit_context *fc, const dhc_model *model)
+{
+    if (!(fc->opt->reach_margin > 0.0)) {
+        return DHC_OK;
+    }
+    const double limit = (1.0 + fc->opt->reach_margin) * arm_reach(&model->arm);
+    size_t used = 0U;
+    size_t beyond = 0U;
+    for (int apply = 0; apply <= 1; ++apply) {
+        for (size_t i = 0U; i < fc->n; ++i) {
+            if (fc->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
+                continue;
+            }
+            const dhc_status st = fc->read(fc->ctx, i, &fc->ws->sample);
+            if (st != DHC_OK) {
+                return st;
+            }
+            const int far = dhc_sample_check(model, &fc->ws->sample) == DHC_OK &&
+                            beyond_reach(model, &fc->ws->sample, limit);
+            if (!apply) {
+                used++;
+                beyond += far ? 1U : 0U;
+            } else if (far) {
+                fc->flags[i] = (uint8_t)DHC_SAMPLE_BEYOND_REACH;
+            }
+        }
+        if (!apply && 2U * beyond >= used) {
+            return DHC_OK;
+        }
+    }
+    return DHC_OK;
 }
 
 /* Samples whose joint angles lie far outside the model's ranges are not this arm's poses. */
@@ -545,7 +634,7 @@ static dhc_status flag_out_of_range(const fit_context *fc, const dhc_arm *arm)
              * angle used to pass as an outlier). */
             if (dhc_is_finite(q) &&
                 (q < arm->joint[j].min_rad - m || q > arm->joint[j].max_rad + m)) {
-                fc->flags[i] = (uint8_t)DHC_SAMPLE_OUTLIER;
+                fc->flags[i] = (uint8_t)DHC_SAMPLE_JOINT_RANGE;
                 break;
             }
         }
@@ -857,6 +946,78 @@ static dhc_status fit_to_convergence(const fit_context *fc, dhc_calib_report *re
     }
 }
 
+/* Robust sigma of the used samples at the model: from the median squared error. */
+static dhc_status robust_sigma(const fit_context *fc, const dhc_model *model, double *sigma)
+{
+    error_scan all;
+    dhc_status st = scan_errors(fc, model, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, &all);
+    double median = 0.0;
+    if (st == DHC_OK && all.used > 0U) {
+        st = quantile_error2(fc, model, &all, 0.5, &median);
+    }
+    const double chi2_median = 2U * all.pose > all.used ? CHI2_MEDIAN_6DOF : CHI2_MEDIAN_3DOF;
+    *sigma = fmax(sqrt(median / chi2_median), fc->opt->outlier_floor_mm);
+    return st;
+}
+
+static void unmark(const fit_context *fc, uint8_t mark)
+{
+    for (size_t i = 0U; i < fc->n; ++i) {
+        if (fc->flags[i] == mark) {
+            fc->flags[i] = (uint8_t)DHC_SAMPLE_USED;
+        }
+    }
+}
+
+/* A high-breakdown start before gross errors can drag the fit: when some sample's error at
+ * the input model is far above the median's, fit only the ROBUST_KEEP share of samples
+ * closest to the model, twice (least trimmed squares' concentration steps), and leave out
+ * the samples beyond ROBUST_K robust sigmas of that fit (DHC_SAMPLE_ROBUST). The fit then
+ * starts from it. A trimmed fit that fails leaves everything as it was. */
+static dhc_status robust_start(const fit_context *fc, dhc_calib_report *rep, pass_totals *tot)
+{
+    dhc_calib_workspace *const ws = fc->ws;
+    if (!fc->opt->robust_start || !redundant(tot, rep)) {
+        return DHC_OK;
+    }
+    error_scan all;
+    dhc_status st = scan_errors(fc, &ws->current, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, &all);
+    double median = 0.0;
+    if (st == DHC_OK && all.used >= 4U) {
+        st = quantile_error2(fc, &ws->current, &all, 0.5, &median);
+    }
+    if (st != DHC_OK || all.used < 4U || !(all.max_e2 > sq(ROBUST_TRIGGER) * median)) {
+        return st;
+    }
+    const dhc_model input = ws->current;
+    for (size_t step = 0U; step < ROBUST_CSTEPS; ++step) {
+        error_scan now;
+        double keep2 = 0.0;
+        st = scan_errors(fc, &ws->current, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, &now);
+        if (st == DHC_OK) {
+            st = quantile_error2(fc, &ws->current, &now, ROBUST_KEEP, &keep2);
+        }
+        if (st == DHC_OK) {
+            st = scan_errors(fc, &ws->current, keep2, (uint8_t)DHC_SAMPLE_ROBUST, &now);
+        }
+        int converged = 0;
+        if (st == DHC_OK) {
+            st = fit_to_convergence(fc, rep, tot, &converged);
+        }
+        unmark(fc, (uint8_t)DHC_SAMPLE_ROBUST);
+        if (st != DHC_OK) {
+            ws->current = input; /* the trimmed rows could not be fitted: no robust start */
+            return st == DHC_ERR_NONFINITE || st == DHC_ERR_ARGUMENT ? st : DHC_OK;
+        }
+    }
+    double sigma;
+    st = robust_sigma(fc, &ws->current, &sigma);
+    error_scan kept;
+    return st == DHC_OK ? scan_errors(fc, &ws->current, sq(ROBUST_K * sigma),
+                                      (uint8_t)DHC_SAMPLE_ROBUST, &kept)
+                        : st;
+}
+
 static void fill_report(const fit_context *fc, const pass_totals *tot, dhc_calib_report *rep)
 {
     const dhc_calib_workspace *const ws = fc->ws;
@@ -884,7 +1045,7 @@ static void fill_report(const fit_context *fc, const pass_totals *tot, dhc_calib
     }
     rep->outliers = 0U;
     for (size_t i = 0U; i < fc->n; ++i) {
-        rep->outliers += fc->flags[i] == (uint8_t)DHC_SAMPLE_OUTLIER ? 1U : 0U;
+        rep->outliers += dhc_sample_is_outlier(fc->flags[i]) ? 1U : 0U;
     }
 }
 
@@ -912,6 +1073,9 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
     ws->current = *model;
 
     dhc_status st = flag_out_of_range(&fc, &model->arm);
+    if (st == DHC_OK) {
+        st = flag_beyond_reach(&fc, model);
+    }
     if (st != DHC_OK) {
         return st;
     }
@@ -924,6 +1088,9 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
         return DHC_ERR_NO_DATA;
     }
     st = structural_rank(&fc, model, &tot.traits, rep);
+    if (st == DHC_OK) {
+        st = robust_start(&fc, rep, &tot);
+    }
     if (st != DHC_OK) {
         return st;
     }
@@ -939,7 +1106,7 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
             return DHC_ERR_UNDERDETERMINED;
         }
         size_t flagged = 0U;
-        if (round < opt->max_outlier_rounds) {
+        if (round < opt->max_outlier_rounds && redundant(&tot, rep)) {
             st = flag_outliers(&fc, &ws->current, &flagged);
             if (st != DHC_OK) {
                 return st;

@@ -174,8 +174,46 @@ static void test_poses_outside_the_joint_ranges_are_outliers(void)
     dhc_calib_options opt;
     dhc_calib_default_options(&opt);
     TEST_ASSERT_EQUAL(DHC_OK, fit(&arm, &opt));
-    TEST_ASSERT_EQUAL(DHC_SAMPLE_OUTLIER, data.flags[3]);
+    TEST_ASSERT_EQUAL(DHC_SAMPLE_JOINT_RANGE, data.flags[3]);
     TEST_ASSERT_EQUAL(1U, rep.outliers);
+}
+
+/* Gross rows of a small set, as real ones come: a placeholder pose near 300 deg and a point
+ * 1.3 m from the shoulder of an arm that reaches 0.75 m, each flagged with its reason before
+ * it can drag the fit; a row 30 mm off (a wrong target copied) is left out by the robust
+ * start, and the rest fits to the noise. */
+static void test_gross_rows_are_screened_with_their_reasons(void)
+{
+    dhc_arm truth;
+    dhc_arm arm;
+    table3_arms(&truth, &arm);
+    test_rng rng = {51ULL};
+    test_measure(&data, &truth, 40U, DHC_MEAS_POSITION, &rng);
+    add_noise(&data, 0.05, &rng);
+    data.s[5].q_rad[0] = 300.0 * TEST_DEG;        /* placeholder angles: beyond +-170 */
+    dhc_vec3_set(data.s[11].p_mm, 900.0, 900.0, 700.0); /* 1.46 m from the base origin */
+    data.s[23].p_mm[1] += 30.0;
+    dhc_calib_options opt;
+    dhc_calib_default_options(&opt);
+    TEST_ASSERT_EQUAL(DHC_OK, fit(&arm, &opt));
+    TEST_ASSERT_EQUAL(DHC_SAMPLE_JOINT_RANGE, data.flags[5]);
+    TEST_ASSERT_EQUAL(DHC_SAMPLE_BEYOND_REACH, data.flags[11]);
+    TEST_ASSERT_EQUAL(DHC_SAMPLE_ROBUST, data.flags[23]);
+    TEST_ASSERT_EQUAL(3U, rep.outliers);
+    TEST_ASSERT_TRUE(dhc_sample_is_outlier(data.flags[23]));
+    TEST_ASSERT_FALSE(dhc_sample_is_outlier((uint8_t)DHC_SAMPLE_EXCLUDED));
+    TEST_ASSERT_TRUE(rep.rms_mm < 0.12);
+    /* the base itself off by metres: every row "beyond reach" is the base's fault, none is
+     * flagged for it */
+    for (size_t i = 0U; i < data.n; ++i) {
+        data.flags[i] = (uint8_t)DHC_SAMPLE_USED;
+        data.s[i].p_mm[0] += 5000.0;
+    }
+    dhc_arm far = arm;
+    TEST_ASSERT_TRUE(fit(&far, &opt) == DHC_OK || rep.outliers < data.n / 2U);
+    for (size_t i = 0U; i < data.n; ++i) {
+        TEST_ASSERT_TRUE(data.flags[i] != (uint8_t)DHC_SAMPLE_BEYOND_REACH);
+    }
 }
 
 /* A tilt between the nominally parallel axes 2 and 3: with Hayati's beta the base model
@@ -328,6 +366,7 @@ int main(void)
     RUN_TEST(test_standard_errors_match_the_spread_of_repeated_fits);
     RUN_TEST(test_gross_errors_are_flagged_left_out_and_the_fit_repeated);
     RUN_TEST(test_poses_outside_the_joint_ranges_are_outliers);
+    RUN_TEST(test_gross_rows_are_screened_with_their_reasons);
     RUN_TEST(test_tilted_parallel_axes_fit_to_the_noise_floor_with_beta);
     RUN_TEST(test_iteration_limit_reports_not_converged_with_the_best_iterate);
     RUN_TEST(test_failures_leave_the_arm_unchanged);

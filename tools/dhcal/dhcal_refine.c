@@ -171,8 +171,23 @@ static int fit_start(const dhc_model *nominal, const char *effects,
     if (rc != DHCAL_IO_OK) {
         return rc;
     }
-    size_t rows_per_sample = s->n > 0U ? dhc_sample_rows(&s->samples[0]) : 3U;
+    /* the rows the screens keep (joint ranges, reach, gross errors) decide whether they are
+     * few: a full fit flags them */
+    uint8_t *flags0 = malloc(s->n);
+    if (flags0 == NULL) {
+        snprintf(err->msg, sizeof err->msg, "out of memory");
+        return DHCAL_IO_FAILED;
+    }
+    memcpy(flags0, s->flags, s->n);
+    static dhcal_fit probe;
+    dhcal_error e_probe;
+    memset(&e_probe, 0, sizeof e_probe);
+    probe.geometry = DHCAL_GEOMETRY_FULL;
+    (void)dhcal_run_fit(nominal, effects, DHCAL_GEOMETRY_FULL, noise, s, held, &probe, &e_probe);
+    const size_t rows_per_sample = s->n > 0U ? dhc_sample_rows(&s->samples[0]) : 3U;
     const size_t equations = used_rows(s) * rows_per_sample;
+    memcpy(s->flags, flags0, s->n);
+    free(flags0);
     const int few = equations < DHCAL_FEW_ROWS_PER_PARAM * set.count;
     if (geometry != NULL || !few) {
         out->fit.geometry = geometry != NULL ? *geometry : DHCAL_GEOMETRY_FULL;
@@ -183,7 +198,7 @@ static int fit_start(const dhc_model *nominal, const char *effects,
         return rc;
     }
     /* few rows: every level from the same flags, the best plausible cross-validation wins */
-    uint8_t *flags0 = malloc(s->n);
+    flags0 = malloc(s->n);
     if (flags0 == NULL) {
         snprintf(err->msg, sizeof err->msg, "out of memory");
         return DHCAL_IO_FAILED;

@@ -317,6 +317,27 @@ static int cmd_compare(const options *o, session *s)
 
 /* ---------------------------------------------------------------- fit reporting */
 
+/* The contract's name of an outlier's reason (DESIGN.md 3b). */
+static const char *outlier_reason(uint8_t flag)
+{
+    switch (flag) {
+    case DHC_SAMPLE_JOINT_RANGE: return "joint_range";
+    case DHC_SAMPLE_BEYOND_REACH: return "beyond_reach";
+    case DHC_SAMPLE_ROBUST: return "robust";
+    default: return "residual";
+    }
+}
+
+static const char *outlier_words(uint8_t flag)
+{
+    switch (flag) {
+    case DHC_SAMPLE_JOINT_RANGE: return "a joint angle beyond its range";
+    case DHC_SAMPLE_BEYOND_REACH: return "farther from the base than the arm reaches";
+    case DHC_SAMPLE_ROBUST: return "far from the robust start";
+    default: return "far from the fit";
+    }
+}
+
 /* What a report adds to a fit: adequacy, extrapolation to the held-out rows, CV. */
 typedef struct {
     int have_adequacy;
@@ -527,10 +548,11 @@ static void json_fit(cJSON *obj, const dhcal_fit *f, const session *s, const dou
     }
     cJSON *outl = cJSON_AddArrayToObject(obj, "outliers");
     for (size_t i = 0U; i < s->samples.n; ++i) {
-        if (s->samples.flags[i] == (uint8_t)DHC_SAMPLE_OUTLIER) {
+        if (dhc_sample_is_outlier(s->samples.flags[i])) {
             cJSON *r = cJSON_CreateObject();
             cJSON_AddNumberToObject(r, "row", (double)(i + 1U));
             cJSON_AddNumberToObject(r, "error_mm", row_err[i]);
+            cJSON_AddStringToObject(r, "reason", outlier_reason(s->samples.flags[i]));
             cJSON_AddItemToArray(outl, r);
         }
     }
@@ -605,9 +627,9 @@ static void text_fit(const dhcal_fit *f, const session *s, const options *o, con
         printf("%s\n", partners == 0U ? ": does not change what was measured" : "");
     }
     for (size_t i = 0U; i < s->samples.n; ++i) {
-        if (s->samples.flags[i] == (uint8_t)DHC_SAMPLE_OUTLIER) {
-            printf("outlier: row %zu (line %zu), error %.4f mm, left out\n", i + 1U,
-                   s->data.rows[i].line, row_err[i]);
+        if (dhc_sample_is_outlier(s->samples.flags[i])) {
+            printf("outlier: row %zu (line %zu), error %.4f mm, left out: %s\n", i + 1U,
+                   s->data.rows[i].line, row_err[i], outlier_words(s->samples.flags[i]));
         }
     }
 }

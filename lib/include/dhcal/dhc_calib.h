@@ -33,9 +33,16 @@ typedef dhc_status (*dhc_sample_reader)(void *ctx, size_t index, dhc_sample *out
 /* Sample flags (the caller's array of n bytes). */
 enum {
     DHC_SAMPLE_USED = 0,
-    DHC_SAMPLE_EXCLUDED = 1, /* set by the caller: not used */
-    DHC_SAMPLE_OUTLIER = 2   /* set by the fit: left out as an outlier */
+    DHC_SAMPLE_EXCLUDED = 1,     /* set by the caller: not used */
+    DHC_SAMPLE_OUTLIER = 2,      /* set by the fit: far from the fit (many robust sigmas) */
+    DHC_SAMPLE_JOINT_RANGE = 3,  /* ... a joint angle beyond its range: not this arm's pose */
+    DHC_SAMPLE_BEYOND_REACH = 4, /* ... measured farther from the base than the arm reaches */
+    DHC_SAMPLE_ROBUST = 5        /* ... far from the robust start (gross, before it could drag
+                                    the fit) */
 };
+
+/* 1 for the flags the fit sets (every kind of outlier), 0 for used and excluded samples. */
+int dhc_sample_is_outlier(uint8_t flag);
 
 typedef struct {
     size_t max_iterations;       /* LM iterations per fit round (default 100) */
@@ -59,6 +66,14 @@ typedef struct {
                                     with the noise model on, errors and this floor are in
                                     whitened (unit-free) units */
     double joint_margin_rad;     /* a joint angle beyond its range by more is an outlier (0.1) */
+    double reach_margin;         /* a point farther from the base origin than (1 + this) times
+                                    the arm's reach is an outlier (0.1); screened only while
+                                    most samples are within reach (else the base, not the
+                                    rows, is off); 0 off */
+    int robust_start;            /* 1: when some sample's error at the input model exceeds the
+                                    median's ROBUST_TRIGGER times, a trimmed fit (the 3/4 of the
+                                    samples closest to it, twice) starts the fit and samples far
+                                    from it are left out first (1) */
     size_t max_outlier_rounds;   /* refits after removing outliers (3) */
     uint32_t structural_seed;    /* seed of the random poses used for the structural rank */
     /* Noise model (errors in variables; all 0 by default = off, unweighted least squares).
@@ -90,7 +105,7 @@ typedef struct {
                                analysis at the estimate found identifiable and fitted */
     uint8_t unsupported[DHC_MAX_PARAMS]; /* 1: held at its input value because the data
                                determine it only to more than max_std_* */
-    size_t outliers;        /* samples flagged DHC_SAMPLE_OUTLIER */
+    size_t outliers;        /* samples flagged as any kind of outlier */
     double rms_mm;          /* sqrt(mean |position error|^2) over used samples; for wire
                                samples the error is the vector of 3 wire residuals */
     double max_mm;          /* largest such error over used samples */
@@ -147,7 +162,8 @@ dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_sample *s,
                              double weight_mm_per_rad, double *r, dhc_mat *jac);
 
 /* Fits the parameters of set to the samples. flags (n bytes) marks samples the caller
- * excludes; the fit adds DHC_SAMPLE_OUTLIER marks and refits without them.
+ * excludes; the fit adds outlier marks (DHC_SAMPLE_OUTLIER and the kinds after it, each
+ * naming its reason) and refits without them.
  * Identifiability is judged on the data at the input values (the set is kept fixed through
  * the iterations: which of two nearly dependent columns pivoting drops would otherwise
  * change with the iterate) and judged again at the converged estimate: parameters that
