@@ -45,6 +45,19 @@ static double ln_gamma_half(size_t dof)
     return s;
 }
 
+/* One term (an, bn) of a continued fraction by the modified Lentz method: updates c and d
+ * and returns the factor by which the fraction's value changes. */
+static double lentz_step(double an, double bn, double *c, double *d)
+{
+    const double tiny = DBL_MIN / DBL_EPSILON;
+    *d = bn + an * *d;
+    *d = fabs(*d) < tiny ? tiny : *d;
+    *c = bn + an / *c;
+    *c = fabs(*c) < tiny ? tiny : *c;
+    *d = 1.0 / *d;
+    return *d * *c;
+}
+
 double dhc_chi2_log10_sf(double chi2, size_t dof)
 {
     if (dof == 0U || !(chi2 > 0.0)) {
@@ -80,12 +93,7 @@ double dhc_chi2_log10_sf(double chi2, size_t dof)
     for (size_t i = 1U; i < GAMMA_MAX_TERMS; ++i) {
         const double an = -(double)i * ((double)i - a);
         b += 2.0;
-        d = an * d + b;
-        d = fabs(d) < tiny ? tiny : d;
-        c = b + an / c;
-        c = fabs(c) < tiny ? tiny : c;
-        d = 1.0 / d;
-        const double del = d * c;
+        const double del = lentz_step(an, b, &c, &d);
         h *= del;
         if (fabs(del - 1.0) < GAMMA_EPS) {
             break;
@@ -106,22 +114,10 @@ static double ln_beta_fraction(double a, double b, double x)
     double h = d;
     for (size_t m = 1U; m < GAMMA_MAX_TERMS; ++m) {
         const double dm = (double)m;
-        /* even step */
-        double an = dm * (b - dm) * x / ((a + 2.0 * dm - 1.0) * (a + 2.0 * dm));
-        d = 1.0 + an * d;
-        d = fabs(d) < tiny ? tiny : d;
-        c = 1.0 + an / c;
-        c = fabs(c) < tiny ? tiny : c;
-        d = 1.0 / d;
-        h *= d * c;
-        /* odd step */
-        an = -(a + dm) * (a + b + dm) * x / ((a + 2.0 * dm) * (a + 2.0 * dm + 1.0));
-        d = 1.0 + an * d;
-        d = fabs(d) < tiny ? tiny : d;
-        c = 1.0 + an / c;
-        c = fabs(c) < tiny ? tiny : c;
-        d = 1.0 / d;
-        const double del = d * c;
+        /* even step, then odd step */
+        h *= lentz_step(dm * (b - dm) * x / ((a + 2.0 * dm - 1.0) * (a + 2.0 * dm)), 1.0, &c, &d);
+        const double del = lentz_step(
+            -(a + dm) * (a + b + dm) * x / ((a + 2.0 * dm) * (a + 2.0 * dm + 1.0)), 1.0, &c, &d);
         h *= del;
         if (fabs(del - 1.0) < GAMMA_EPS) {
             break;
