@@ -739,7 +739,7 @@ static void candidate_params(const dhcal_fit *fit, const dhc_candidate_result *c
     }
 }
 
-static void text_diagnosis(const dhcal_fit *fit, const dhc_diagnosis *d)
+static void text_diagnosis(const dhcal_fit *fit, const dhc_diagnosis *d, const char *effects)
 {
     char label[64];
     if (fit->noise.on) {
@@ -768,7 +768,9 @@ static void text_diagnosis(const dhcal_fit *fit, const dhc_diagnosis *d)
                    "cannot tell the two apart\n",
                    other, 100.0 * l->explained);
         }
-        printf("next: dhcal fit --effects %s ... and compare the held-out error\n", label);
+        printf("next: dhcal fit --effects %s%s%s ... and compare the held-out error (or dhcal "
+               "refine, which repeats this while cross-validation improves)\n",
+               effects != NULL ? effects : "", effects != NULL ? "," : "", label);
     }
     printf("%-22s %6s %10s %12s %s\n", "candidate", "params", "explained", "log10(p)", "");
     size_t unseen = 0U;
@@ -840,7 +842,7 @@ static int cmd_diagnose(const options *o, session *s)
             rc = print_json(obj);
         } else {
             text_fit(&fit, s, o, row_err);
-            text_diagnosis(&fit, &diag);
+            text_diagnosis(&fit, &diag, o->effects);
             text_extras(&fit, s, &extras, diag.count == 0U || !diag.c[0].significant);
         }
     }
