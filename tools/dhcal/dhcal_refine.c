@@ -30,8 +30,8 @@ int dhcal_cross_validate(const dhc_model *start, const dhc_param_set *set,
     }
     const size_t folds = used < DHCAL_CV_LOO_BELOW ? used : DHCAL_CV_FOLDS;
     /* fold of each row: its rank among the used rows, modulo folds (SIZE_MAX: not used) */
-    size_t *fold_of = malloc(s->n * sizeof *fold_of);
-    uint8_t *flags = malloc(s->n);
+    size_t *fold_of = malloc((s->n + 1U) * sizeof *fold_of);
+    uint8_t *flags = malloc(s->n + 1U);
     if (fold_of == NULL || flags == NULL) {
         free(fold_of);
         free(flags);
@@ -173,7 +173,7 @@ static int fit_start(const dhc_model *nominal, const char *effects,
     }
     /* the rows the screens keep (joint ranges, reach, gross errors) decide whether they are
      * few: a full fit flags them */
-    uint8_t *flags0 = malloc(s->n);
+    uint8_t *flags0 = malloc(s->n + 1U);
     if (flags0 == NULL) {
         snprintf(err->msg, sizeof err->msg, "out of memory");
         return DHCAL_IO_FAILED;
@@ -198,7 +198,7 @@ static int fit_start(const dhc_model *nominal, const char *effects,
         return rc;
     }
     /* few rows: every level from the same flags, the best plausible cross-validation wins */
-    flags0 = malloc(s->n);
+    flags0 = malloc(s->n + 1U);
     if (flags0 == NULL) {
         snprintf(err->msg, sizeof err->msg, "out of memory");
         return DHCAL_IO_FAILED;
@@ -279,8 +279,8 @@ int dhcal_run_refine(const dhc_model *nominal, const char *start_effects,
         return rc;
     }
     record_step(out, "", out->effects, &out->fit, &out->cv);
-    uint8_t *flags_cur = malloc(s->n);
-    uint8_t *flags_best = malloc(s->n);
+    uint8_t *flags_cur = malloc(s->n + 1U);
+    uint8_t *flags_best = malloc(s->n + 1U);
     if (flags_cur == NULL || flags_best == NULL) {
         free(flags_cur);
         free(flags_best);

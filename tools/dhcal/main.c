@@ -894,7 +894,8 @@ static int cmd_refine(const options *o, session *s)
         cJSON *effects = cJSON_AddArrayToObject(obj, "effects");
         char list[DHCAL_EFFECTS_CAP];
         snprintf(list, sizeof list, "%s", res.effects);
-        for (char *tok = strtok(list, ","); tok != NULL; tok = strtok(NULL, ",")) {
+        for (char *save = NULL, *tok = strtok_r(list, ",", &save); tok != NULL;
+             tok = strtok_r(NULL, ",", &save)) {
             cJSON_AddItemToArray(effects, cJSON_CreateString(tok));
         }
         cJSON *steps = cJSON_AddArrayToObject(obj, "steps");
@@ -908,7 +909,8 @@ static int cmd_refine(const options *o, session *s)
             }
             cJSON *e = cJSON_AddArrayToObject(j, "effects");
             snprintf(list, sizeof list, "%s", st->effects);
-            for (char *tok = strtok(list, ","); tok != NULL; tok = strtok(NULL, ",")) {
+            for (char *save = NULL, *tok = strtok_r(list, ",", &save); tok != NULL;
+                 tok = strtok_r(NULL, ",", &save)) {
                 cJSON_AddItemToArray(e, cJSON_CreateString(tok));
             }
             cJSON_AddNumberToObject(j, "rms_mm", st->rms_mm);
