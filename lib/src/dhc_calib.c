@@ -678,7 +678,7 @@ static dhc_status analyse_keeping_set(const fit_context *fc, dhc_calib_report *r
         if (st != DHC_OK) {
             continue;
         }
-        if (!ws->fac.identifiable[j] && ws->scratch[j] > DBL_MIN) {
+        if (!ws->fac.identifiable[j] && ws->scratch[j] > DHC_LSQ_ZERO_DIAG) {
             ws->fac.scale[j] = 1.0 / sqrt(ws->scratch[j]);
         }
         if (first) {

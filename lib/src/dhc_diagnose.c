@@ -236,7 +236,7 @@ static dhc_status prepare_batch(batch_state *b)
     dhc_diagnose_workspace *const ws = b->ws;
     for (size_t k = 0U; k < b->p; ++k) {
         const double d = ws->ne.jtj[k * b->p + k];
-        b->ws->scale[k] = d > DBL_MIN ? 1.0 / sqrt(d) : 0.0;
+        b->ws->scale[k] = d > DHC_LSQ_ZERO_DIAG ? 1.0 / sqrt(d) : 0.0;
     }
     if (b->nb == 0U) {
         b->rank_a = 0U;

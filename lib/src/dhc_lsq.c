@@ -172,15 +172,17 @@ dhc_status dhc_lsq_analyse(const dhc_normal_eq *ne, double rel_tol, dhc_lsq_fact
     for (size_t i = 0U; i < n; ++i) {
         const double d = ne->jtj[i * n + i];
         /* Column scaling makes the rank test unit-free, so "zero" here must be absolute: a
-         * diagonal is a sum of squares, and below DBL_MIN its square root is not reliable. */
-        fac->scale[i] = d > DBL_MIN ? 1.0 / sqrt(d) : 1.0;
+         * diagonal is a sum of squares, and near DBL_MIN its products are subnormal. */
+        fac->scale[i] = d > DHC_LSQ_ZERO_DIAG ? 1.0 / sqrt(d) : 1.0;
     }
-    /* A column whose diagonal is at or below DBL_MIN is zero to the analysis: its sums are
-     * subnormal, where a pivot tolerance relative to them underflows to 0 and rounding can
-     * make a semi-definite block look indefinite or accept a pivot of noise (fuzzing). */
+    /* A column whose diagonal is at or below DHC_LSQ_ZERO_DIAG is zero to the analysis: its
+     * products are subnormal, where a pivot tolerance relative to them underflows to 0 and
+     * rounding can make a semi-definite block look indefinite or accept a pivot of noise
+     * (fuzzing: two columns of diagonals 1e-302 and 1e-304 looked indefinite). */
     for (size_t i = 0U; i < n; ++i) {
         for (size_t j = 0U; j < n; ++j) {
-            const int live = ne->jtj[i * n + i] > DBL_MIN && ne->jtj[j * n + j] > DBL_MIN;
+            const int live =
+                ne->jtj[i * n + i] > DHC_LSQ_ZERO_DIAG && ne->jtj[j * n + j] > DHC_LSQ_ZERO_DIAG;
             fac->factor[i * n + j] =
                 j <= i && live ? ne->jtj[i * n + j] * fac->scale[i] * fac->scale[j] : 0.0;
         }

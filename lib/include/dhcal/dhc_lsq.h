@@ -16,12 +16,19 @@
 #ifndef DHC_LSQ_H
 #define DHC_LSQ_H
 
+#include <float.h>
 #include <stddef.h>
 #include <stdint.h>
 
 #include "dhc_config.h"
 #include "dhc_linalg.h"
 #include "dhc_status.h"
+
+/* A column whose diagonal (sum of squares) is at or below this is zero to the analysis:
+ * its products are subnormal, where the sums keep too few digits for a scaled rank test
+ * (a pair of such columns can look indefinite). DBL_MIN / DBL_EPSILON ~ 1e-292: far below
+ * any measured column in any unit. */
+#define DHC_LSQ_ZERO_DIAG (DBL_MIN / DBL_EPSILON)
 
 typedef struct {
     size_t n;      /* parameters (columns) */
@@ -36,7 +43,7 @@ typedef struct {
     size_t rank;
     size_t perm[DHC_MAX_PARAMS];       /* pivot order: perm[k] = parameter index */
     double scale[DHC_MAX_PARAMS];      /* column scale: 1 / sqrt(diag(J^T W J)); 1 for a
-                                          diagonal <= DBL_MIN, a column that then counts
+                                          diagonal <= DHC_LSQ_ZERO_DIAG, a column that counts
                                           as zero (never identifiable) */
     double factor[DHC_MAX_PARAMS * DHC_MAX_PARAMS]; /* L of the scaled, pivoted matrix */
     uint8_t identifiable[DHC_MAX_PARAMS];
