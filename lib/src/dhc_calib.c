@@ -980,41 +980,38 @@ static dhc_status robust_start(const fit_context *fc, dhc_calib_report *rep, pas
     if (!fc->opt->robust_start || !redundant(tot, rep)) {
         return DHC_OK;
     }
-    error_scan all;
-    dhc_status st = scan_errors(fc, &ws->current, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, &all);
-    double median = 0.0;
-    if (st == DHC_OK && all.used >= 4U) {
-        st = quantile_error2(fc, &ws->current, &all, 0.5, &median);
+    /* one scan and one level reused throughout: this is on the M4's deepest call chain */
+    error_scan scan;
+    double level = 0.0;
+    dhc_status st = scan_errors(fc, &ws->current, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, &scan);
+    if (st == DHC_OK && scan.used >= 4U) {
+        st = quantile_error2(fc, &ws->current, &scan, 0.5, &level);
     }
-    if (st != DHC_OK || all.used < 4U || !(all.max_e2 > sq(ROBUST_TRIGGER) * median)) {
+    if (st != DHC_OK || scan.used < 4U || !(scan.max_e2 > sq(ROBUST_TRIGGER) * level)) {
         return st;
     }
-    const dhc_model input = ws->current;
-    for (size_t step = 0U; step < ROBUST_CSTEPS; ++step) {
-        error_scan now;
-        double keep2 = 0.0;
-        st = scan_errors(fc, &ws->current, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, &now);
+    /* ws->current is still the caller's model (fc->input): no copy, the M4 stack is small */
+    for (size_t step = 0U; step < ROBUST_CSTEPS && st == DHC_OK; ++step) {
+        st = scan_errors(fc, &ws->current, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, &scan);
         if (st == DHC_OK) {
-            st = quantile_error2(fc, &ws->current, &now, ROBUST_KEEP, &keep2);
+            st = quantile_error2(fc, &ws->current, &scan, ROBUST_KEEP, &level);
         }
         if (st == DHC_OK) {
-            st = scan_errors(fc, &ws->current, keep2, (uint8_t)DHC_SAMPLE_ROBUST, &now);
+            st = scan_errors(fc, &ws->current, level, (uint8_t)DHC_SAMPLE_ROBUST, &scan);
         }
         int converged = 0;
         if (st == DHC_OK) {
             st = fit_to_convergence(fc, rep, tot, &converged);
         }
         unmark(fc, (uint8_t)DHC_SAMPLE_ROBUST);
-        if (st != DHC_OK) {
-            ws->current = input; /* the trimmed rows could not be fitted: no robust start */
-            return st == DHC_ERR_NONFINITE || st == DHC_ERR_ARGUMENT ? st : DHC_OK;
-        }
     }
-    double sigma;
-    st = robust_sigma(fc, &ws->current, &sigma);
-    error_scan kept;
-    return st == DHC_OK ? scan_errors(fc, &ws->current, sq(ROBUST_K * sigma),
-                                      (uint8_t)DHC_SAMPLE_ROBUST, &kept)
+    if (st != DHC_OK) {
+        ws->current = *fc->input; /* the trimmed rows could not be fitted: no robust start */
+        return st == DHC_ERR_NONFINITE || st == DHC_ERR_ARGUMENT ? st : DHC_OK;
+    }
+    st = robust_sigma(fc, &ws->current, &level);
+    return st == DHC_OK ? scan_errors(fc, &ws->current, sq(ROBUST_K * level),
+                                      (uint8_t)DHC_SAMPLE_ROBUST, &scan)
                         : st;
 }
 
