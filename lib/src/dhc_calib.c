@@ -290,20 +290,19 @@ static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *mod
         double r[DHC_MAX_ROWS_PER_SAMPLE];
         double rw[DHC_MAX_ROWS_PER_SAMPLE]; /* whitened (a copy of r with the model off) */
         size_t got_rows;
-        st = dhc_model_residual(model, s, w, r, &got_rows);
-        if (st == DHC_OK) {
-            memcpy(rw, r, sizeof r);
-        }
         dhc_mat jac;
-        if (st == DHC_OK && accumulate) {
+        if (accumulate) {
+            /* residual and slope from one evaluation of the model */
             st = dhc_mat_init(&jac, rows, p, ws->jac_buf,
                               sizeof ws->jac_buf / sizeof ws->jac_buf[0]);
             if (st == DHC_OK) {
-                st = dhc_model_jacobian(model, fc->set, s, w, &jac, NULL);
+                st = dhc_model_linearize(model, fc->set, s, w, r, &got_rows, &jac);
             }
+        } else {
+            st = dhc_model_residual(model, s, w, r, &got_rows);
         }
-        if (st == DHC_OK && accumulate) {
-            dhc_model_residual_slope(s, r, w, &jac);
+        if (st == DHC_OK) {
+            memcpy(rw, r, sizeof r);
         }
         if (st == DHC_OK && fc->whiten) {
             /* the covariance at `weights`: its own residual gives the orientation slope (in
@@ -518,6 +517,23 @@ static int redundant(const pass_totals *tot, const dhc_calib_report *rep)
     return tot->rows >= 2U * rep->structural_rank;
 }
 
+/* Robust sigma of the used samples at the model, from their median squared error; *used
+ * counts them. */
+static dhc_status robust_sigma(const fit_context *fc, const dhc_model *model, double *sigma,
+                               size_t *used)
+{
+    error_scan all;
+    dhc_status st = scan_errors(fc, model, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, &all);
+    double median = 0.0;
+    if (st == DHC_OK && all.used > 0U) {
+        st = quantile_error2(fc, model, &all, 0.5, &median);
+    }
+    const double chi2_median = 2U * all.pose > all.used ? CHI2_MEDIAN_6DOF : CHI2_MEDIAN_3DOF;
+    *sigma = fmax(sqrt(median / chi2_median), fc->opt->outlier_floor_mm);
+    *used = all.used;
+    return st;
+}
+
 /* Flags samples whose error is many robust sigmas; returns how many were newly flagged. */
 static dhc_status flag_outliers(const fit_context *fc, const dhc_model *model, size_t *flagged)
 {
@@ -525,18 +541,12 @@ static dhc_status flag_outliers(const fit_context *fc, const dhc_model *model, s
     if (fc->opt->outlier_threshold <= 0.0) {
         return DHC_OK;
     }
-    error_scan all;
-    dhc_status st = scan_errors(fc, model, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, &all);
-    if (st != DHC_OK || all.used < 3U) {
+    double sigma;
+    size_t used;
+    dhc_status st = robust_sigma(fc, model, &sigma, &used);
+    if (st != DHC_OK || used < 3U) {
         return st;
     }
-    double median;
-    st = quantile_error2(fc, model, &all, 0.5, &median);
-    if (st != DHC_OK) {
-        return st;
-    }
-    const double chi2_median = 2U * all.pose > all.used ? CHI2_MEDIAN_6DOF : CHI2_MEDIAN_3DOF;
-    const double sigma = fmax(sqrt(median / chi2_median), fc->opt->outlier_floor_mm);
     error_scan kept;
     st = scan_errors(fc, model, sq(fc->opt->outlier_threshold * sigma),
                      (uint8_t)DHC_SAMPLE_OUTLIER, &kept);
@@ -547,17 +557,6 @@ static dhc_status flag_outliers(const fit_context *fc, const dhc_model *model, s
 int dhc_sample_is_outlier(uint8_t flag)
 {
     return flag >= (uint8_t)DHC_SAMPLE_OUTLIER;
-}
-
-/* The arm's reach: its links' and tool's lengths, an upper bound of the tool point's
- * distance from the base origin. */
-static double arm_reach(const dhc_arm *arm)
-{
-    double reach = dhc_vec3_norm(arm->tool_mm);
-    for (size_t i = 0U; i < arm->n_joints; ++i) {
-        reach += sqrt(sq(arm->joint[i].a_mm) + sq(arm->joint[i].d_mm));
-    }
-    return reach;
 }
 
 /* A sample measured farther from the base than the arm reaches (a tool point, or a wire
@@ -581,16 +580,32 @@ static int beyond_reach(const dhc_model *model, const dhc_sample *s, double limi
     return 0;
 }
 
-/* Flags samples beyond reach, unless most are: then the model's base is off, not the rows. */
-static dhc_status flag_beyond_reach(const fit_context *fc, const dhc_model *model)
+/* A joint angle far outside the model's range: not this arm's pose. A non-finite angle is
+ * not a pose at all: left to the sample check, which stops the fit with DHC_ERR_NONFINITE
+ * (as it always did for NaN; an infinite angle used to pass as an outlier). */
+static int outside_joint_range(const fit_context *fc, const dhc_arm *arm, const dhc_sample *s)
 {
-    if (!(fc->opt->reach_margin > 0.0)) {
-        return DHC_OK;
+    const double m = fc->opt->joint_margin_rad;
+    for (size_t j = 0U; j < arm->n_joints; ++j) {
+        const double q = s->q_rad[j];
+        if (dhc_is_finite(q) && (q < arm->joint[j].min_rad - m || q > arm->joint[j].max_rad + m)) {
+            return 1;
+        }
     }
-    const double limit = (1.0 + fc->opt->reach_margin) * arm_reach(&model->arm);
+    return 0;
+}
+
+/* The physical screens, before any fit, in one read of the samples: angles beyond the joint
+ * ranges, then points beyond the arm's reach. The reach flags go on in a second pass, and
+ * only when fewer than half of the samples in range are beyond reach: when most are, the
+ * model's base is off, not the rows. */
+static dhc_status screen_physical(const fit_context *fc, const dhc_model *model)
+{
+    const int reach_on = fc->opt->reach_margin > 0.0;
+    const double limit = (1.0 + fc->opt->reach_margin) * dhc_arm_reach(&model->arm);
     size_t used = 0U;
     size_t beyond = 0U;
-    for (int apply = 0; apply <= 1; ++apply) {
+    for (int apply_reach = 0; apply_reach <= 1; ++apply_reach) {
         for (size_t i = 0U; i < fc->n; ++i) {
             if (fc->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
                 continue;
@@ -599,44 +614,22 @@ static dhc_status flag_beyond_reach(const fit_context *fc, const dhc_model *mode
             if (st != DHC_OK) {
                 return st;
             }
-            const int far = dhc_sample_check(model, &fc->ws->sample) == DHC_OK &&
-                            beyond_reach(model, &fc->ws->sample, limit);
-            if (!apply) {
+            const dhc_sample *const s = &fc->ws->sample;
+            if (!apply_reach && outside_joint_range(fc, &model->arm, s)) {
+                fc->flags[i] = (uint8_t)DHC_SAMPLE_JOINT_RANGE;
+                continue;
+            }
+            const int far = reach_on && dhc_sample_check(model, s) == DHC_OK &&
+                            beyond_reach(model, s, limit);
+            if (!apply_reach) {
                 used++;
                 beyond += far ? 1U : 0U;
             } else if (far) {
                 fc->flags[i] = (uint8_t)DHC_SAMPLE_BEYOND_REACH;
             }
         }
-        if (!apply && 2U * beyond >= used) {
+        if (beyond == 0U || 2U * beyond >= used) {
             return DHC_OK;
-        }
-    }
-    return DHC_OK;
-}
-
-/* Samples whose joint angles lie far outside the model's ranges are not this arm's poses. */
-static dhc_status flag_out_of_range(const fit_context *fc, const dhc_arm *arm)
-{
-    for (size_t i = 0U; i < fc->n; ++i) {
-        if (fc->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
-            continue;
-        }
-        const dhc_status st = fc->read(fc->ctx, i, &fc->ws->sample);
-        if (st != DHC_OK) {
-            return st;
-        }
-        for (size_t j = 0U; j < arm->n_joints; ++j) {
-            const double q = fc->ws->sample.q_rad[j];
-            const double m = fc->opt->joint_margin_rad;
-            /* A non-finite angle is not a pose at all: left to the sample check, which
-             * stops the fit with DHC_ERR_NONFINITE (as it always did for NaN; an infinite
-             * angle used to pass as an outlier). */
-            if (dhc_is_finite(q) &&
-                (q < arm->joint[j].min_rad - m || q > arm->joint[j].max_rad + m)) {
-                fc->flags[i] = (uint8_t)DHC_SAMPLE_JOINT_RANGE;
-                break;
-            }
         }
     }
     return DHC_OK;
@@ -696,18 +689,24 @@ static double residual_variance(const fit_context *fc, const pass_totals *tot)
     return dof > 0.0 ? tot->ssr / dof : 0.0;
 }
 
-/* Convergence relative to the noise the fit estimates, before a step: a full Gauss-Newton
- * step from here promises an SSR decrease below (noise_rel_tol sigma)^2, i.e. what is left
- * is under noise_rel_tol standard errors (Mahalanobis). ws->ne and ws->fac: the current
- * estimate's accumulation and analysis. */
-static int nothing_left_to_gain(const fit_context *fc, const pass_totals *tot)
+/* The SSR decrease a full Gauss-Newton step from the current estimate promises (ws->ne and
+ * ws->fac: its accumulation and analysis); HUGE_VAL when it cannot be had. */
+static double current_decrement(const fit_context *fc)
+{
+    double decrement;
+    return dhc_lsq_decrement(&fc->ws->ne, &fc->ws->fac, &decrement) == DHC_OK ? decrement
+                                                                             : HUGE_VAL;
+}
+
+/* Convergence relative to the noise the fit estimates, before a step: the decrement is
+ * below (noise_rel_tol sigma)^2, i.e. what is left is under noise_rel_tol standard errors
+ * (Mahalanobis). */
+static int nothing_left_to_gain(const fit_context *fc, const pass_totals *tot,
+                                double decrement)
 {
     const double tol = fc->opt->noise_rel_tol;
     const double sigma2 = residual_variance(fc, tot);
-    double decrement;
-    return tol > 0.0 && sigma2 > 0.0 &&
-           dhc_lsq_decrement(&fc->ws->ne, &fc->ws->fac, &decrement) == DHC_OK &&
-           decrement <= tol * tol * sigma2;
+    return tol > 0.0 && sigma2 > 0.0 && decrement <= tol * tol * sigma2;
 }
 
 /* ... and after accepted steps whose gains shrink geometrically (ratio q = gain / previous
@@ -767,10 +766,12 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
     if (st == DHC_OK) {
         st = analyse_keeping_set(fc, rep);
     }
+    /* one decrement per accumulation: the tests before and after a step share it */
+    double decrement = st == DHC_OK ? current_decrement(fc) : HUGE_VAL;
     for (size_t it = 0U; st == DHC_OK && it < fc->opt->max_iterations; ++it) {
         rep->iterations++;
         /* A perfect fit leaves nothing to improve; relative tests would divide by ~0. */
-        if (tot->ssr <= 1e-30 * (double)tot->rows || nothing_left_to_gain(fc, tot)) {
+        if (tot->ssr <= 1e-30 * (double)tot->rows || nothing_left_to_gain(fc, tot, decrement)) {
             *converged = 1;
             break;
         }
@@ -802,11 +803,7 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
             }
             /* "the SSR stopped falling" judged by what an undamped step would still take,
              * not by the damped step just taken (damping makes that small long before) */
-            double decrement = HUGE_VAL;
-            if (st == DHC_OK &&
-                dhc_lsq_decrement(&ws->ne, &ws->fac, &decrement) != DHC_OK) {
-                decrement = HUGE_VAL;
-            }
+            decrement = st == DHC_OK ? current_decrement(fc) : HUGE_VAL;
             if (decrement <= fc->opt->ssr_rel_tol * tot->ssr || step <= fc->opt->step_rel_tol ||
                 little_left_to_gain(fc, tot, gain, previous_gain)) {
                 *converged = 1;
@@ -851,8 +848,6 @@ static dhc_status free_identifiable(const fit_context *fc, dhc_calib_report *rep
     return *freed == 0U ? analyse_keeping_set(fc, rep) : DHC_OK;
 }
 
-/* Levenberg-Marquardt, then identifiability judged at the estimate; again while that frees
- * parameters (at most max_identifiability_checks times). */
 /* The standard error beyond which the data do not pin a link parameter inside its
  * physical range (options max_std_*; 0: no bound for that kind). */
 static double support_bound(const fit_context *fc, uint8_t kind)
@@ -910,6 +905,9 @@ static dhc_status hold_unsupported(const fit_context *fc, const pass_totals *tot
     return st;
 }
 
+/* Levenberg-Marquardt, then identifiability judged at the estimate (again while that frees
+ * parameters, at most max_identifiability_checks times), then the worst unsupported link
+ * parameter held and the fit repeated (at most MAX_HOLDS times). */
 static dhc_status fit_to_convergence(const fit_context *fc, dhc_calib_report *rep,
                                      pass_totals *tot, int *converged)
 {
@@ -944,20 +942,6 @@ static dhc_status fit_to_convergence(const fit_context *fc, dhc_calib_report *re
         }
         holds++;
     }
-}
-
-/* Robust sigma of the used samples at the model: from the median squared error. */
-static dhc_status robust_sigma(const fit_context *fc, const dhc_model *model, double *sigma)
-{
-    error_scan all;
-    dhc_status st = scan_errors(fc, model, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, &all);
-    double median = 0.0;
-    if (st == DHC_OK && all.used > 0U) {
-        st = quantile_error2(fc, model, &all, 0.5, &median);
-    }
-    const double chi2_median = 2U * all.pose > all.used ? CHI2_MEDIAN_6DOF : CHI2_MEDIAN_3DOF;
-    *sigma = fmax(sqrt(median / chi2_median), fc->opt->outlier_floor_mm);
-    return st;
 }
 
 static void unmark(const fit_context *fc, uint8_t mark)
@@ -1009,7 +993,8 @@ static dhc_status robust_start(const fit_context *fc, dhc_calib_report *rep, pas
         ws->current = *fc->input; /* the trimmed rows could not be fitted: no robust start */
         return st == DHC_ERR_NONFINITE || st == DHC_ERR_ARGUMENT ? st : DHC_OK;
     }
-    st = robust_sigma(fc, &ws->current, &level);
+    size_t used;
+    st = robust_sigma(fc, &ws->current, &level, &used);
     return st == DHC_OK ? scan_errors(fc, &ws->current, sq(ROBUST_K * level),
                                       (uint8_t)DHC_SAMPLE_ROBUST, &scan)
                         : st;
@@ -1069,10 +1054,7 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
     const fit_context fc = {set, read, ctx, n, flags, opt, ws, whiten, model};
     ws->current = *model;
 
-    dhc_status st = flag_out_of_range(&fc, &model->arm);
-    if (st == DHC_OK) {
-        st = flag_beyond_reach(&fc, model);
-    }
+    dhc_status st = screen_physical(&fc, model);
     if (st != DHC_OK) {
         return st;
     }

@@ -353,18 +353,16 @@ static dhc_status accumulate(const dhc_model *model, dhc_sample_reader read, voi
         }
         st = read(ctx, i, &ws->sample);
         double r[DHC_MAX_ROWS_PER_SAMPLE];
-        size_t k = 0U;
-        if (st == DHC_OK) {
-            st = dhc_model_residual(model, &ws->sample, opt->orientation_weight_mm_per_rad, r, &k);
-        }
+        size_t k = dhc_sample_rows(&ws->sample);
         dhc_mat jac;
         if (st == DHC_OK) {
             st = dhc_mat_init(&jac, k, p, ws->jac_buf,
                               sizeof ws->jac_buf / sizeof ws->jac_buf[0]);
         }
         if (st == DHC_OK) {
-            st = dhc_model_jacobian(model, &ws->set, &ws->sample, opt->orientation_weight_mm_per_rad,
-                                    &jac, NULL);
+            /* residual and slope from one evaluation, as the fit linearises them */
+            st = dhc_model_linearize(model, &ws->set, &ws->sample,
+                                     opt->orientation_weight_mm_per_rad, r, &k, &jac);
         }
         if (st == DHC_OK) {
             /* off: returns at once, r and jac untouched */

@@ -352,3 +352,19 @@ dhc_status dhc_joint_jacobian(const dhc_arm *arm, const double *q_rad, size_t q_
     }
     return DHC_OK;
 }
+
+dhc_status dhc_model_linearize(const dhc_model *model, const dhc_param_set *set,
+                               const dhc_sample *s, double weight_mm_per_rad,
+                               double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows, dhc_mat *jac)
+{
+    dhc_prediction pred;
+    memset(&pred, 0, sizeof pred);
+    dhc_status st = dhc_model_jacobian(model, set, s, weight_mm_per_rad, jac, &pred);
+    if (st == DHC_OK) {
+        st = dhc_model_residual_of(s, &pred, weight_mm_per_rad, r, rows);
+    }
+    if (st == DHC_OK) {
+        dhc_model_residual_slope(s, r, weight_mm_per_rad, jac);
+    }
+    return st;
+}

@@ -30,6 +30,16 @@ dhc_status dhc_arm_init(dhc_arm *arm, size_t n_joints)
     return DHC_OK;
 }
 
+double dhc_arm_reach(const dhc_arm *arm)
+{
+    double reach = dhc_vec3_norm(arm->tool_mm);
+    for (size_t i = 0U; i < arm->n_joints; ++i) {
+        const dhc_joint *j = &arm->joint[i];
+        reach += sqrt(j->a_mm * j->a_mm + j->d_mm * j->d_mm);
+    }
+    return reach;
+}
+
 void dhc_arm_choose_conventions(dhc_arm *arm, double parallel_tol)
 {
     DHC_ASSERT(arm != NULL);

@@ -253,21 +253,28 @@ dhc_status dhc_model_residual(const dhc_model *model, const dhc_sample *s,
     dhc_prediction pred;
     memset(&pred, 0, sizeof pred);
     const dhc_status st = dhc_model_predict(model, s, &pred);
-    if (st != DHC_OK) {
-        return st;
+    return st == DHC_OK ? dhc_model_residual_of(s, &pred, weight_mm_per_rad, r, rows) : st;
+}
+
+dhc_status dhc_model_residual_of(const dhc_sample *s, const dhc_prediction *pred,
+                                 double weight_mm_per_rad, double r[DHC_MAX_ROWS_PER_SAMPLE],
+                                 size_t *rows)
+{
+    if (s == NULL || pred == NULL || r == NULL || rows == NULL) {
+        return DHC_ERR_ARGUMENT;
     }
     double out[DHC_MAX_ROWS_PER_SAMPLE];
     if (s->kind == (uint8_t)DHC_MEAS_WIRES) {
-        dhc_vec3_sub(s->wire_mm, pred.wire_mm, out);
+        dhc_vec3_sub(s->wire_mm, pred->wire_mm, out);
     } else {
-        dhc_vec3_sub(s->p_mm, pred.p_mm, out);
+        dhc_vec3_sub(s->p_mm, pred->p_mm, out);
     }
     const size_t n = dhc_sample_rows(s);
     if (s->kind == (uint8_t)DHC_MEAS_POSE) {
         /* R_meas = exp([w]) R_model  =>  w = log(R_meas R_model^T) */
         dhc_mat3 err;
         double w[3];
-        dhc_rot_mul_t(&s->rot, &pred.rot, &err);
+        dhc_rot_mul_t(&s->rot, &pred->rot, &err);
         dhc_rot_log(&err, w);
         for (size_t k = 0U; k < 3U; ++k) {
             out[3U + k] = weight_mm_per_rad * w[k];

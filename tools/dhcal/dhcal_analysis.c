@@ -165,23 +165,13 @@ int dhcal_geometry_set(const dhc_model *model, dhcal_geometry g, dhc_param_set *
     return DHCAL_IO_OK;
 }
 
-double dhcal_reach_mm(const dhc_model *model)
-{
-    double reach = dhc_vec3_norm(model->arm.tool_mm);
-    for (size_t i = 0U; i < model->arm.n_joints; ++i) {
-        const dhc_joint *j = &model->arm.joint[i];
-        reach += sqrt(j->a_mm * j->a_mm + j->d_mm * j->d_mm);
-    }
-    return reach;
-}
-
 void dhcal_calib_options_for(const dhc_model *model, const dhcal_noise *noise,
                              dhc_calib_options *opt)
 {
     dhc_calib_default_options(opt);
     /* a link parameter the data pin only to half its physical range or worse is held */
     opt->max_std_angle_rad = 0.5 * DHCAL_PLAUSIBLE_ANGLE_DEG * PI / 180.0;
-    opt->max_std_length_mm = 0.5 * DHCAL_PLAUSIBLE_LENGTH_SHARE * dhcal_reach_mm(model);
+    opt->max_std_length_mm = 0.5 * DHCAL_PLAUSIBLE_LENGTH_SHARE * dhc_arm_reach(&model->arm);
     if (noise != NULL && noise->on) {
         for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
             opt->joint_noise_rad[j] = noise->joint_rad;
@@ -416,7 +406,7 @@ double dhcal_param_display(const dhc_param_set *set, size_t k, double value)
 
 int dhcal_implausible(const dhc_model *nominal, const dhcal_fit *fit, char *why, size_t cap)
 {
-    const double max_len = DHCAL_PLAUSIBLE_LENGTH_SHARE * dhcal_reach_mm(nominal);
+    const double max_len = DHCAL_PLAUSIBLE_LENGTH_SHARE * dhc_arm_reach(&nominal->arm);
     const double max_ang = DHCAL_PLAUSIBLE_ANGLE_DEG * PI / 180.0;
     for (size_t k = 0U; k < fit->set.count; ++k) {
         const uint8_t kind = fit->set.id[k].kind;
@@ -438,13 +428,10 @@ int dhcal_implausible(const dhc_model *nominal, const dhcal_fit *fit, char *why,
     return 0;
 }
 
-/* Row order for grouping repeats: joint angles, lexicographically (qsort has no context). */
-static const dhcal_samples *repeat_sort_samples;
-
-static int compare_poses(const void *a, const void *b)
+/* Joint angles, lexicographically, equal within DHCAL_REPEAT_TOL_RAD: the order that groups
+ * repeats, and the test of one. */
+static int pose_order(const dhc_sample *sa, const dhc_sample *sb)
 {
-    const dhc_sample *sa = &repeat_sort_samples->samples[*(const size_t *)a];
-    const dhc_sample *sb = &repeat_sort_samples->samples[*(const size_t *)b];
     for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
         if (sa->q_rad[j] < sb->q_rad[j] - DHCAL_REPEAT_TOL_RAD) {
             return -1;
@@ -456,14 +443,13 @@ static int compare_poses(const void *a, const void *b)
     return 0;
 }
 
-static int same_pose(const dhc_sample *a, const dhc_sample *b)
+/* qsort of row indices has no context: the samples sorted are held here */
+static const dhcal_samples *repeat_sort_samples;
+
+static int compare_poses(const void *a, const void *b)
 {
-    for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
-        if (fabs(a->q_rad[j] - b->q_rad[j]) > DHCAL_REPEAT_TOL_RAD) {
-            return 0;
-        }
-    }
-    return 1;
+    return pose_order(&repeat_sort_samples->samples[*(const size_t *)a],
+                      &repeat_sort_samples->samples[*(const size_t *)b]);
 }
 
 /* Pure-error sum of squares of the position (or wire) residuals over groups of repeated
@@ -489,7 +475,7 @@ static void pure_error(const dhcal_samples *s, const double *resid, double *ss, 
     qsort(idx, m, sizeof *idx, compare_poses);
     for (size_t a = 0U; a < m;) {
         size_t b = a + 1U;
-        while (b < m && same_pose(&s->samples[idx[a]], &s->samples[idx[b]])) {
+        while (b < m && pose_order(&s->samples[idx[a]], &s->samples[idx[b]]) == 0) {
             ++b;
         }
         if (b - a >= 2U) {
@@ -663,13 +649,10 @@ int dhcal_extrapolate(const dhcal_fit *fit, const dhcal_samples *s, const dhcal_
         double r[DHC_MAX_ROWS_PER_SAMPLE];
         size_t got;
         if (dhc_mat_init(&jac, rows, id_set.count, buf, sizeof buf / sizeof buf[0]) != DHC_OK ||
-            dhc_model_residual(&fit->model, smp, opt.orientation_weight_mm_per_rad, r, &got) !=
-                DHC_OK ||
-            dhc_model_jacobian(&fit->model, &id_set, smp, opt.orientation_weight_mm_per_rad,
-                               &jac, NULL) != DHC_OK) {
+            dhc_model_linearize(&fit->model, &id_set, smp, opt.orientation_weight_mm_per_rad, r,
+                                &got, &jac) != DHC_OK) {
             return DHCAL_IO_FAILED;
         }
-        dhc_model_residual_slope(smp, r, opt.orientation_weight_mm_per_rad, &jac);
         if (fit->noise.on &&
             dhc_sample_whiten(&fit->model, smp, opt.joint_noise_rad, opt.meas_noise_mm,
                               opt.orientation_weight_mm_per_rad, r, &jac) != DHC_OK) {

@@ -50,10 +50,6 @@ dhc_model dhcal_model_without_drift(const dhc_model *model);
 int dhcal_parse_effects(const char *list, const dhc_model *model, dhc_param_set *set,
                         dhcal_error *err);
 
-/* The arm's reach: the sum of its links' lengths and the tool's, mm (an upper bound of the
- * tool point's distance from the base origin). */
-double dhcal_reach_mm(const dhc_model *model);
-
 /* The library's fit options for the model: the noise model (NULL or off: unweighted), and
  * link parameters held at their input values when the data determine them only to half
  * their physical range (DHCAL_PLAUSIBLE_*) or worse. */

@@ -157,7 +157,10 @@ static void record_step(dhcal_refine_result *out, const char *added, const char 
 
 /* The start: the geometry level given, or for few rows the level cross-validation likes
  * best among those whose fit is plausible (a model far outside its physical range is no
- * calibration, however well it fits). */
+ * calibration, however well it fits). The full fit comes first: the rows its screens keep
+ * (joint ranges, reach, gross errors) decide whether they are few, and it is the start
+ * itself when they are not. Every level's fit starts from the same flags; s->flags end as
+ * the chosen fit's. */
 static int fit_start(const dhc_model *nominal, const char *effects,
                      const dhcal_geometry *geometry, const dhcal_noise *noise,
                      dhcal_samples *s, const dhcal_samples *held, dhcal_refine_result *out,
@@ -171,51 +174,62 @@ static int fit_start(const dhc_model *nominal, const char *effects,
     if (rc != DHCAL_IO_OK) {
         return rc;
     }
-    /* the rows the screens keep (joint ranges, reach, gross errors) decide whether they are
-     * few: a full fit flags them */
-    uint8_t *flags0 = malloc(s->n + 1U);
-    if (flags0 == NULL) {
+    /* the caller's flags, and the flags each level's fit left, kept: no level fitted twice */
+    uint8_t *flags = malloc(3U * (s->n + 1U));
+    if (flags == NULL) {
         snprintf(err->msg, sizeof err->msg, "out of memory");
         return DHCAL_IO_FAILED;
     }
+    uint8_t *const flags0 = flags;
+    uint8_t *const flags_full = flags + s->n + 1U;
+    uint8_t *const flags_best = flags + 2U * (s->n + 1U);
     memcpy(flags0, s->flags, s->n);
-    static dhcal_fit probe;
-    dhcal_error e_probe;
-    memset(&e_probe, 0, sizeof e_probe);
-    probe.geometry = DHCAL_GEOMETRY_FULL;
-    (void)dhcal_run_fit(nominal, effects, DHCAL_GEOMETRY_FULL, noise, s, held, &probe, &e_probe);
+    static dhcal_fit full;
+    dhcal_error e_full;
+    memset(&e_full, 0, sizeof e_full);
+    full.geometry = DHCAL_GEOMETRY_FULL;
+    const int rc_full =
+        dhcal_run_fit(nominal, effects, DHCAL_GEOMETRY_FULL, noise, s, held, &full, &e_full);
+    memcpy(flags_full, s->flags, s->n);
     const size_t rows_per_sample = s->n > 0U ? dhc_sample_rows(&s->samples[0]) : 3U;
     const size_t equations = used_rows(s) * rows_per_sample;
-    memcpy(s->flags, flags0, s->n);
-    free(flags0);
     const int few = equations < DHCAL_FEW_ROWS_PER_PARAM * set.count;
     if (geometry != NULL || !few) {
-        out->fit.geometry = geometry != NULL ? *geometry : DHCAL_GEOMETRY_FULL;
-        rc = dhcal_run_fit(nominal, effects, out->fit.geometry, noise, s, held, &out->fit, err);
+        const dhcal_geometry level = geometry != NULL ? *geometry : DHCAL_GEOMETRY_FULL;
+        if (level == DHCAL_GEOMETRY_FULL) {
+            rc = rc_full;
+            out->fit = full;
+            *err = e_full;
+        } else {
+            memcpy(s->flags, flags0, s->n);
+            out->fit.geometry = level;
+            rc = dhcal_run_fit(nominal, effects, level, noise, s, held, &out->fit, err);
+        }
+        free(flags);
         if (rc == DHCAL_IO_OK) {
             rc = dhcal_cross_validate(&out->fit.model, &out->fit.set, noise, s, &out->cv, err);
         }
         return rc;
     }
-    /* few rows: every level from the same flags, the best plausible cross-validation wins */
-    flags0 = malloc(s->n + 1U);
-    if (flags0 == NULL) {
-        snprintf(err->msg, sizeof err->msg, "out of memory");
-        return DHCAL_IO_FAILED;
-    }
-    memcpy(flags0, s->flags, s->n);
+    /* few rows: the best plausible cross-validation wins */
     static dhcal_fit trial;
     int best = -1;
     dhcal_cv best_cv = {0.0, 0U, 0U};
     char reasons[3][200] = {"", "", ""};
     for (int g = 0; g < 3; ++g) {
-        memcpy(s->flags, flags0, s->n);
         out->geometry_cv_mm[g] = -1.0;
         dhcal_error e2;
         memset(&e2, 0, sizeof e2);
-        trial.geometry = (dhcal_geometry)g;
-        if (dhcal_run_fit(nominal, effects, (dhcal_geometry)g, noise, s, held, &trial, &e2) !=
-            DHCAL_IO_OK) {
+        int rc_g = rc_full;
+        if (g == (int)DHCAL_GEOMETRY_FULL) {
+            trial = full;
+            memcpy(s->flags, flags_full, s->n);
+        } else {
+            memcpy(s->flags, flags0, s->n);
+            trial.geometry = (dhcal_geometry)g;
+            rc_g = dhcal_run_fit(nominal, effects, (dhcal_geometry)g, noise, s, held, &trial, &e2);
+        }
+        if (rc_g != DHCAL_IO_OK) {
             snprintf(reasons[g], sizeof reasons[g], "cannot be fitted");
             continue;
         }
@@ -233,21 +247,20 @@ static int fit_start(const dhc_model *nominal, const char *effects,
         if (best < 0 || cv.rms_mm < best_cv.rms_mm) {
             best = g;
             best_cv = cv;
+            out->fit = trial;
+            memcpy(flags_best, s->flags, s->n);
         }
     }
     if (best < 0) {
-        free(flags0);
+        free(flags);
         snprintf(err->msg, sizeof err->msg,
                  "%zu equations for %zu parameters: no geometry level gives a plausible "
                  "model (offsets: %s; lengths: %s; full: %s)",
                  equations, set.count, reasons[0], reasons[1], reasons[2]);
         return DHCAL_IO_FAILED;
     }
-    /* the winner again, so that s->flags are its own */
-    memcpy(s->flags, flags0, s->n);
-    free(flags0);
-    out->fit.geometry = (dhcal_geometry)best;
-    rc = dhcal_run_fit(nominal, effects, (dhcal_geometry)best, noise, s, held, &out->fit, err);
+    memcpy(s->flags, flags_best, s->n);
+    free(flags);
     out->cv = best_cv;
     out->geometry_chosen = 1;
     char *w = out->geometry_why;
@@ -264,7 +277,7 @@ static int fit_start(const dhc_model *nominal, const char *effects,
     if (n > 0 && (size_t)n < cap) {
         snprintf(w + n, cap - (size_t)n, ")");
     }
-    return rc;
+    return DHCAL_IO_OK;
 }
 
 int dhcal_run_refine(const dhc_model *nominal, const char *start_effects,

@@ -55,4 +55,11 @@ dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set,
 dhc_status dhc_joint_jacobian(const dhc_arm *arm, const double *q_rad, size_t q_len,
                               int with_orientation, dhc_mat *jac);
 
+/* A sample linearised for least squares: the residual r (dhc_model_residual) and its slope
+ * -dr/dparam in jac (rows x set->count: dhc_model_jacobian, orientation rows turned by
+ * dhc_model_residual_slope), from one evaluation of the model. Errors of both. */
+dhc_status dhc_model_linearize(const dhc_model *model, const dhc_param_set *set,
+                               const dhc_sample *s, double weight_mm_per_rad,
+                               double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows, dhc_mat *jac);
+
 #endif /* DHC_JACOBIAN_H */

@@ -52,6 +52,10 @@ dhc_status dhc_arm_init(dhc_arm *arm, size_t n_joints);
  * otherwise. Call once on the nominal model, before fitting. */
 void dhc_arm_choose_conventions(dhc_arm *arm, double parallel_tol);
 
+/* The arm's reach, mm: its links' lengths sqrt(a^2 + d^2) and the tool's summed, an upper
+ * bound of the tool point's distance from the base origin. */
+double dhc_arm_reach(const dhc_arm *arm);
+
 /* A_i for joint index i at joint angle q_rad. DHC_ERR_ARGUMENT when i >= n_joints. */
 dhc_status dhc_joint_transform(const dhc_arm *arm, size_t i, double q_rad, dhc_frame *out);
 

@@ -152,6 +152,12 @@ dhc_status dhc_model_residual(const dhc_model *model, const dhc_sample *s,
                               double weight_mm_per_rad, double r[DHC_MAX_ROWS_PER_SAMPLE],
                               size_t *rows);
 
+/* The residual of a sample from a prediction already made (dhc_model_predict, or the one
+ * dhc_model_jacobian returns): as dhc_model_residual without evaluating the model again. */
+dhc_status dhc_model_residual_of(const dhc_sample *s, const dhc_prediction *pred,
+                                 double weight_mm_per_rad, double r[DHC_MAX_ROWS_PER_SAMPLE],
+                                 size_t *rows);
+
 /* The slope of a pose sample's residual: dhc_model_jacobian gives how the prediction moves
  * (orientation rows: world rotation increments omega, times the weight), but the
  * orientation residual w = log(R_meas R_pred^T) moves by J_r^-1(w) omega, J_r the right
