@@ -543,8 +543,10 @@ fw_fault fw_autocal_configured(const fw_autocal_config *cfg, dhc_model *model,
     if (geo_out != NULL) {
         *geo_out = geo_model;
     }
+    /* the controller measures wires at one temperature and keeps no time */
+    static const dhc_candidate_scope wires_only = {1, 0, 0};
     const size_t nc = cfg->diagnose != 0
-                          ? dhc_diagnose_candidates(&geo_model, &set, 1, 0.0, cands,
+                          ? dhc_diagnose_candidates(&geo_model, &set, &wires_only, cands,
                                                     DHC_MAX_CANDIDATES)
                           : 0U;
     if (nc > 0U &&

@@ -166,10 +166,85 @@ static int base_has_effect(const dhc_param_set *base, dhc_effect e, size_t joint
     return 0;
 }
 
-size_t dhc_diagnose_candidates(const dhc_model *model, const dhc_param_set *base, int wires,
-                               double temp_span_c, dhc_candidate *out, size_t cap)
+dhc_status dhc_covariate_pose_r2(size_t n_joints, dhc_covariate which, dhc_sample_reader read,
+                                 void *ctx, size_t n, const uint8_t *flags, dhc_normal_eq *ne,
+                                 dhc_lsq_factor *fac, double *r2)
 {
-    if (model == NULL || base == NULL || out == NULL) {
+    if (read == NULL || flags == NULL || ne == NULL || fac == NULL || r2 == NULL ||
+        n_joints == 0U || n_joints > DHC_MAX_JOINTS) {
+        return DHC_ERR_ARGUMENT;
+    }
+    const size_t p = 1U + 2U * n_joints;
+    dhc_sample smp;
+    /* centred first, so the regression's SSR is the part the pose does not explain */
+    double mean = 0.0;
+    size_t used = 0U;
+    for (size_t i = 0U; i < n; ++i) {
+        if (flags[i] != (uint8_t)DHC_SAMPLE_USED) {
+            continue;
+        }
+        const dhc_status st = read(ctx, i, &smp);
+        if (st != DHC_OK) {
+            return st;
+        }
+        const double c = which == DHC_COVARIATE_TIME ? smp.t_s : smp.temp_c;
+        if (!dhc_is_finite(c)) {
+            return DHC_ERR_NONFINITE;
+        }
+        used++;
+        mean += (c - mean) / (double)used;
+    }
+    *r2 = 1.0;
+    if (used <= p) {
+        return DHC_OK;
+    }
+    dhc_status st = dhc_normal_eq_init(ne, p);
+    double row[1U + 2U * DHC_MAX_JOINTS];
+    for (size_t i = 0U; st == DHC_OK && i < n; ++i) {
+        if (flags[i] != (uint8_t)DHC_SAMPLE_USED) {
+            continue;
+        }
+        st = read(ctx, i, &smp);
+        dhc_mat jac;
+        if (st == DHC_OK) {
+            st = dhc_mat_init(&jac, 1U, p, row, p);
+        }
+        if (st == DHC_OK) {
+            row[0] = 1.0;
+            for (size_t j = 0U; j < n_joints; ++j) {
+                row[1U + 2U * j] = sin(smp.q_rad[j]);
+                row[2U + 2U * j] = cos(smp.q_rad[j]);
+            }
+            const double r = (which == DHC_COVARIATE_TIME ? smp.t_s : smp.temp_c) - mean;
+            st = dhc_normal_eq_add(ne, &jac, &r, NULL, 1U);
+        }
+    }
+    if (st != DHC_OK) {
+        return st;
+    }
+    if (!(ne->ssr > 0.0)) {
+        return DHC_OK;
+    }
+    double explained = 0.0;
+    st = dhc_lsq_analyse(ne, 1e-10, fac);
+    if (st == DHC_OK) {
+        st = dhc_lsq_decrement(ne, fac, &explained);
+    }
+    if (st != DHC_OK) {
+        return st;
+    }
+    const double plain = fmin(fmax(explained / ne->ssr, 0.0), 1.0);
+    /* adjusted for the regressors a random covariate would fit by chance */
+    const double dof = (double)(used - fac->rank);
+    *r2 = dof > 0.0 ? fmax(1.0 - (1.0 - plain) * (double)(used - 1U) / dof, 0.0) : 1.0;
+    return DHC_OK;
+}
+
+size_t dhc_diagnose_candidates(const dhc_model *model, const dhc_param_set *base,
+                               const dhc_candidate_scope *scope, dhc_candidate *out,
+                               size_t cap)
+{
+    if (model == NULL || base == NULL || scope == NULL || out == NULL) {
         return 0U;
     }
     size_t n = 0U;
@@ -178,8 +253,10 @@ size_t dhc_diagnose_candidates(const dhc_model *model, const dhc_param_set *base
         const int measurer = effect == DHC_EFFECT_MEASURER_SCALE ||
                              effect == DHC_EFFECT_MEASURER_OFFSET ||
                              effect == DHC_EFFECT_MEASURER_ANCHORS;
-        if ((measurer && !(wires && model->measurer.present)) ||
-            (effect == DHC_EFFECT_THERMAL_SCALE && !(temp_span_c > 0.0))) {
+        const int drift = effect == DHC_EFFECT_DRIFT_SCALE || effect == DHC_EFFECT_DRIFT_OFFSET;
+        if ((measurer && !(scope->wires && model->measurer.present)) ||
+            (effect == DHC_EFFECT_THERMAL_SCALE && !scope->temperature) ||
+            (drift && !scope->time)) {
             continue;
         }
         const size_t joints = dhc_effect_is_per_joint(effect) ? model->arm.n_joints : 1U;

@@ -11,6 +11,9 @@ hidden_effects.py's independent model of the paper's 3-DOF arm (pure Python):
            (2 (15 deg)^2)) x 0.3 deg (a damaged gear tooth region), 10 poses measured three
            times each: refine ends with the verdict systematic_error (the repeats are the
            reference); the same rows without repeats (one of each): unknown.
+  diagnose --cv  each candidate's cv_rms_mm as `fit --cv` with it added gives it.
+  sweep    the bump, rows measured in the order of joint 2 (time a function of the pose): no
+           drift candidate is scored or added.
   clean    geometry errors only, repeats: fits_noise.
 
 Usage: test_user_loop.py --dhcal PATH [--work DIR] [--wrapper CMD]
@@ -50,11 +53,13 @@ def write_csv(path, rows):
             f.write(",".join("%.6f" % v for v in q) + "," + ",".join("%.6f" % v for v in p) + "\n")
 
 
-def measure(arm, poses, rng, bump=False):
+def measure(arm, poses, rng, bump=False, joint_error=None):
     rows = []
     for q_deg in poses:
         q = [math.radians(v) for v in q_deg]
-        if bump:
+        if joint_error:
+            q_eff = joint_error(q)
+        elif bump:
             q_eff = list(q)
             q_eff[1] += math.radians(0.3) * math.exp(-((q_deg[1] - 60.0) ** 2) / (2 * 15.0 ** 2))
         else:
@@ -143,6 +148,50 @@ def main():
     if out:
         c.check("outside, once: unknown (no noise reference)",
                 out["adequacy"]["verdict"] == "unknown", str(out["adequacy"]))
+
+    # ---- diagnose --cv: each candidate's CV RMS as a fit with it added cross-validates
+    # (a catalogue error, 2-per-rev of joint 1, on clean rows: no outlier for either path)
+    rng = he._rng("user-loop-cv", 1, "all")
+    arm = he.true_arm(rng)
+    twice = os.path.join(work, "twice-per-rev.csv")
+    write_csv(twice, measure(arm, [q for q, _ in he.sample_poses(rng, 60, arm)], rng,
+                             joint_error=lambda q: [q[0] + math.radians(0.05) * math.sin(2 * q[0]),
+                                                    q[1], q[2]]))
+    r, out = run([a.dhcal, "diagnose", "--model", model, "--data", twice, "--cv", "--json"],
+                 a.wrapper)
+    c.check("diagnose --cv: exits 0", r.returncode == 0, r.stderr.strip())
+    tried = [k for k in (out or {}).get("candidates", []) if "cv_rms_mm" in k]
+    c.check("diagnose --cv: candidates carry cv_rms_mm", len(tried) > 0,
+            str([k["effect"] for k in tried]))
+    for k in tried[:2]:
+        label = k["effect"] + (":%d" % k["joint"] if k["joint"] is not None else "")
+        r2, fit = run([a.dhcal, "fit", "--model", model, "--data", twice, "--effects", label,
+                       "--cv", "--json"], a.wrapper)
+        ok = fit is not None and abs(fit["cv_rms_mm"] - k["cv_rms_mm"]) <= 0.02 * fit["cv_rms_mm"]
+        c.check("diagnose --cv: %s's CV RMS matches fit --cv with it (2 %%)" % label, ok,
+                "%s vs %s" % (k["cv_rms_mm"], fit and fit["cv_rms_mm"]))
+
+    # ---- a sweep: rows measured in the order of joint 2, the bump error of joint 2 growing
+    # with it; time (the row number) is then a function of the pose, and a drift fitted to it
+    # would be the bump in disguise
+    rng = he._rng("user-loop-sweep", 1, "all")
+    arm = he.true_arm(rng)
+    poses = sorted((q for q, _ in he.sample_poses(rng, 120, arm)), key=lambda q: q[1])
+    sweep = os.path.join(work, "sweep.csv")
+    write_csv(sweep, measure(arm, poses, rng, bump=True))
+    r, out = run([a.dhcal, "diagnose", "--model", model, "--data", sweep, "--json"], a.wrapper)
+    c.check("sweep: diagnose exits 0", r.returncode == 0, r.stderr.strip())
+    if out:
+        c.check("sweep: time is in step with the pose", out["time_pose_r2"] > 0.5,
+                "%.3f" % out["time_pose_r2"])
+        c.check("sweep: no drift candidate scored",
+                not any(k["effect"].startswith("drift") for k in out["candidates"]),
+                str([k["effect"] for k in out["candidates"][:3]]))
+    r, out = run([a.dhcal, "refine", "--model", model, "--data", sweep, "--json"], a.wrapper)
+    c.check("sweep: refine exits 0", r.returncode == 0, r.stderr.strip())
+    if out:
+        c.check("sweep: refine adds no drift", not any(e.startswith("drift") for e in out["effects"]),
+                str(out["effects"]))
 
     # ---- clean, with repeats: fits the noise
     rng = he._rng("user-loop-clean", 1, "all")

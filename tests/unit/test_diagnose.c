@@ -12,6 +12,8 @@
 void setUp(void) {}
 void tearDown(void) {}
 
+/* pose only: no wires, no temperature, no time that varies apart from the pose */
+static const dhc_candidate_scope no_covariates = {0, 0, 0};
 static test_dataset data;
 static dhc_calib_workspace cws;
 static dhc_calib_report rep;
@@ -111,7 +113,7 @@ static void fit_and_diagnose(dhc_model *fitted)
     TEST_ASSERT_EQUAL(DHC_OK, dhc_calib_fit(fitted, &set, test_read_sample, &data, data.n,
                                             data.flags, &opt, &cws, &rep));
     dhc_candidate cands[DHC_MAX_CANDIDATES];
-    const size_t nc = dhc_diagnose_candidates(fitted, &set, 0, 0.0, cands, DHC_MAX_CANDIDATES);
+    const size_t nc = dhc_diagnose_candidates(fitted, &set, &no_covariates, cands, DHC_MAX_CANDIDATES);
     dhc_diagnose_options dopt;
     dhc_diagnose_default_options(&dopt);
     TEST_ASSERT_EQUAL(DHC_OK, dhc_diagnose(fitted, &set, rep.identifiable, rep.sigma * rep.sigma,
@@ -225,12 +227,151 @@ static void test_bad_arguments_are_refused(void)
                                                      &data, data.n, data.flags, &dopt, &dws, &diag));
     /* ... and the candidate list leaves it out. */
     dhc_candidate cands[DHC_MAX_CANDIDATES];
-    const size_t nc = dhc_diagnose_candidates(&m, &set, 0, 0.0, cands, DHC_MAX_CANDIDATES);
+    const size_t nc = dhc_diagnose_candidates(&m, &set, &no_covariates, cands, DHC_MAX_CANDIDATES);
     for (size_t i = 0U; i < nc; ++i) {
         TEST_ASSERT_FALSE(cands[i].effect == DHC_EFFECT_JOINT_SCALE && cands[i].joint == 0U);
         TEST_ASSERT_TRUE(cands[i].effect != DHC_EFFECT_MEASURER_SCALE); /* no wire data */
         TEST_ASSERT_TRUE(cands[i].effect != DHC_EFFECT_THERMAL_SCALE);  /* no temperature span */
     }
+}
+
+/* Adjusted R^2 of t on (1, sin q_j, cos q_j) by modified Gram-Schmidt over the rows: a second
+ * method beside the library's normal equations. */
+static double r2_by_gram_schmidt(const test_dataset *d, size_t nj, int use_time)
+{
+    static double col[1U + 2U * DHC_MAX_JOINTS][TEST_MAX_SAMPLES];
+    static double y[TEST_MAX_SAMPLES];
+    const size_t p = 1U + 2U * nj;
+    const size_t n = d->n;
+    double mean = 0.0;
+    for (size_t i = 0U; i < n; ++i) {
+        y[i] = use_time ? d->s[i].t_s : d->s[i].temp_c;
+        mean += y[i] / (double)n;
+        col[0][i] = 1.0;
+        for (size_t j = 0U; j < nj; ++j) {
+            col[1U + 2U * j][i] = sin(d->s[i].q_rad[j]);
+            col[2U + 2U * j][i] = cos(d->s[i].q_rad[j]);
+        }
+    }
+    double sst = 0.0;
+    for (size_t i = 0U; i < n; ++i) {
+        sst += (y[i] - mean) * (y[i] - mean);
+    }
+    for (size_t c = 0U; c < p; ++c) {
+        double nn = 0.0;
+        for (size_t i = 0U; i < n; ++i) {
+            nn += col[c][i] * col[c][i];
+        }
+        const double norm = sqrt(nn);
+        for (size_t i = 0U; i < n; ++i) {
+            col[c][i] /= norm;
+        }
+        double yc = 0.0;
+        for (size_t i = 0U; i < n; ++i) {
+            yc += y[i] * col[c][i];
+        }
+        for (size_t i = 0U; i < n; ++i) {
+            y[i] -= yc * col[c][i];
+        }
+        for (size_t k = c + 1U; k < p; ++k) {
+            double dot = 0.0;
+            for (size_t i = 0U; i < n; ++i) {
+                dot += col[k][i] * col[c][i];
+            }
+            for (size_t i = 0U; i < n; ++i) {
+                col[k][i] -= dot * col[c][i];
+            }
+        }
+    }
+    double ssr = 0.0;
+    for (size_t i = 0U; i < n; ++i) {
+        ssr += y[i] * y[i];
+    }
+    return 1.0 - (ssr / sst) * (double)(n - 1U) / (double)(n - p);
+}
+
+/* Rows measured layer by layer (the order follows joint 2) make time a function of the pose;
+ * a shuffled order does not. Both against a second method; the edge cases are conservative
+ * (a constant covariate, too few rows: nothing tells it apart from the pose). */
+static void test_time_in_step_with_the_pose(void)
+{
+    static dhc_normal_eq ne;
+    static dhc_lsq_factor fac;
+    const dhc_model m = nominal_model();
+    const size_t nj = m.arm.n_joints;
+    test_rng rng = {20261124ULL};
+    test_measure_model(&data, &m, 150U, DHC_MEAS_POSITION, &rng);
+    double r2 = -1.0;
+    /* random times: the pose predicts nothing beyond chance */
+    for (size_t i = 0U; i < data.n; ++i) {
+        data.s[i].t_s = 3600.0 * test_uniform(&rng);
+    }
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_covariate_pose_r2(nj, DHC_COVARIATE_TIME, test_read_sample,
+                                                    &data, data.n, data.flags, &ne, &fac, &r2));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, fmax(r2_by_gram_schmidt(&data, nj, 1), 0.0), r2);
+    TEST_ASSERT_TRUE(r2 < 0.1);
+    /* a sweep: rows sorted by joint 2, time the row number (plus a little jitter) */
+    for (size_t i = 1U; i < data.n; ++i) {
+        for (size_t k = i; k > 0U && data.s[k - 1U].q_rad[1] > data.s[k].q_rad[1]; --k) {
+            const dhc_sample tmp = data.s[k];
+            data.s[k] = data.s[k - 1U];
+            data.s[k - 1U] = tmp;
+        }
+    }
+    for (size_t i = 0U; i < data.n; ++i) {
+        data.s[i].t_s = (double)i + test_range(&rng, -5.0, 5.0);
+    }
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_covariate_pose_r2(nj, DHC_COVARIATE_TIME, test_read_sample,
+                                                    &data, data.n, data.flags, &ne, &fac, &r2));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, r2_by_gram_schmidt(&data, nj, 1), r2);
+    TEST_ASSERT_TRUE(r2 > DHC_COVARIATE_IN_STEP_R2);
+    /* a temperature that is an exact function of the pose */
+    for (size_t i = 0U; i < data.n; ++i) {
+        data.s[i].temp_c = 20.0 + 2.0 * sin(data.s[i].q_rad[0]) - cos(data.s[i].q_rad[2]);
+    }
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_covariate_pose_r2(nj, DHC_COVARIATE_TEMPERATURE,
+                                                    test_read_sample, &data, data.n, data.flags,
+                                                    &ne, &fac, &r2));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 1.0, r2);
+    /* rows left out do not count; a constant, or too few rows, is in step */
+    for (size_t i = 0U; i < data.n; ++i) {
+        data.s[i].temp_c = 21.0;
+    }
+    data.s[3].temp_c = NAN;
+    data.flags[3] = (uint8_t)DHC_SAMPLE_OUTLIER;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_covariate_pose_r2(nj, DHC_COVARIATE_TEMPERATURE,
+                                                    test_read_sample, &data, data.n, data.flags,
+                                                    &ne, &fac, &r2));
+    TEST_ASSERT_EQUAL_DOUBLE(1.0, r2);
+    r2 = 0.0;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_covariate_pose_r2(nj, DHC_COVARIATE_TIME, test_read_sample,
+                                                    &data, 1U + 2U * nj, data.flags, &ne, &fac,
+                                                    &r2));
+    TEST_ASSERT_EQUAL_DOUBLE(1.0, r2);
+    data.flags[3] = (uint8_t)DHC_SAMPLE_USED;
+    TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE,
+                      dhc_covariate_pose_r2(nj, DHC_COVARIATE_TEMPERATURE, test_read_sample, &data,
+                                            data.n, data.flags, &ne, &fac, &r2));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
+                      dhc_covariate_pose_r2(0U, DHC_COVARIATE_TIME, test_read_sample, &data,
+                                            data.n, data.flags, &ne, &fac, &r2));
+    /* the candidate list follows the scope */
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &m));
+    dhc_candidate cands[DHC_MAX_CANDIDATES];
+    const dhc_candidate_scope timed = {0, 1, 1};
+    size_t drift = 0U;
+    size_t thermal = 0U;
+    const size_t nc = dhc_diagnose_candidates(&m, &set, &timed, cands, DHC_MAX_CANDIDATES);
+    for (size_t i = 0U; i < nc; ++i) {
+        drift += cands[i].effect == DHC_EFFECT_DRIFT_SCALE ||
+                 cands[i].effect == DHC_EFFECT_DRIFT_OFFSET;
+        thermal += cands[i].effect == DHC_EFFECT_THERMAL_SCALE;
+    }
+    TEST_ASSERT_EQUAL(2U, drift);
+    TEST_ASSERT_EQUAL(1U, thermal);
+    const size_t nc0 = dhc_diagnose_candidates(&m, &set, &no_covariates, cands,
+                                               DHC_MAX_CANDIDATES);
+    TEST_ASSERT_EQUAL(nc - 3U, nc0);
 }
 
 int main(void)
@@ -244,5 +385,6 @@ int main(void)
     RUN_TEST(test_hidden_backlash_is_named_first);
     RUN_TEST(test_explained_sum_matches_the_ssr_drop_of_a_refit);
     RUN_TEST(test_bad_arguments_are_refused);
+    RUN_TEST(test_time_in_step_with_the_pose);
     return UNITY_END();
 }

@@ -192,6 +192,13 @@ int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhcal
     if (noise != NULL) {
         out->noise = *noise;
     }
+    /* outliers judged afresh by this model: an earlier fit's marks would leave out rows a
+     * better model explains, and the fit would depend on the path that led to it */
+    for (size_t i = 0U; i < s->n; ++i) {
+        if (dhc_sample_is_outlier(s->flags[i])) {
+            s->flags[i] = (uint8_t)DHC_SAMPLE_USED;
+        }
+    }
     set_drift_reference(&out->model, s);
     dhc_calib_options opt;
     dhcal_calib_options_for(start, &out->noise, &opt);
@@ -247,19 +254,59 @@ int dhcal_run_fit(const dhc_model *nominal, const char *effects, dhcal_geometry 
     return dhcal_fit_from(nominal, &set, noise, s, held, out, err);
 }
 
-int dhcal_run_diagnose(const dhcal_fit *fit, const dhcal_samples *s, dhc_diagnosis *out,
-                       dhcal_error *err)
+int dhcal_session_covariates(const dhcal_fit *fit, const dhcal_samples *s,
+                             dhcal_covariates *cov, dhcal_error *err)
 {
+    static dhc_normal_eq ne;
+    static dhc_lsq_factor fac;
+    memset(cov, 0, sizeof *cov);
     double tmin = 0.0;
     double tmax = 0.0;
+    size_t used = 0U;
     for (size_t i = 0U; i < s->n; ++i) {
+        if (s->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
+            continue;
+        }
         const double t = s->samples[i].temp_c;
-        tmin = i == 0U ? t : fmin(tmin, t);
-        tmax = i == 0U ? t : fmax(tmax, t);
+        tmin = used == 0U ? t : fmin(tmin, t);
+        tmax = used == 0U ? t : fmax(tmax, t);
+        used++;
+    }
+    cov->temperature_varies = tmax > tmin;
+    cov->time_from_rows = s->source == NULL || !s->source->has_time;
+    /* NOLINTNEXTLINE(performance-no-int-to-ptr): a round trip of a valid pointer. */
+    void *const ctx = (void *)(uintptr_t)s;
+    const size_t nj = fit->model.arm.n_joints;
+    dhc_status st = dhc_covariate_pose_r2(nj, DHC_COVARIATE_TIME, dhcal_samples_read, ctx, s->n,
+                                          s->flags, &ne, &fac, &cov->time_r2);
+    if (st == DHC_OK && cov->temperature_varies) {
+        st = dhc_covariate_pose_r2(nj, DHC_COVARIATE_TEMPERATURE, dhcal_samples_read, ctx, s->n,
+                                   s->flags, &ne, &fac, &cov->temperature_r2);
+    }
+    if (st != DHC_OK) {
+        snprintf(err->msg, sizeof err->msg, "diagnosis failed: %s", dhc_status_str(st));
+        return DHCAL_IO_FAILED;
+    }
+    cov->scope.wires = s->wires;
+    cov->scope.time = cov->time_r2 < DHC_COVARIATE_IN_STEP_R2;
+    cov->scope.temperature =
+        cov->temperature_varies && cov->temperature_r2 < DHC_COVARIATE_IN_STEP_R2;
+    return DHCAL_IO_OK;
+}
+
+int dhcal_run_diagnose(const dhcal_fit *fit, const dhcal_samples *s, dhc_diagnosis *out,
+                       dhcal_covariates *cov, dhcal_error *err)
+{
+    dhcal_covariates own;
+    if (cov == NULL) {
+        cov = &own;
+    }
+    if (dhcal_session_covariates(fit, s, cov, err) != DHCAL_IO_OK) {
+        return DHCAL_IO_FAILED;
     }
     dhc_candidate cands[DHC_MAX_CANDIDATES];
-    const size_t nc = dhc_diagnose_candidates(&fit->model, &fit->set, s->wires, tmax - tmin,
-                                              cands, DHC_MAX_CANDIDATES);
+    const size_t nc = dhc_diagnose_candidates(&fit->model, &fit->set, &cov->scope, cands,
+                                              DHC_MAX_CANDIDATES);
     dhc_diagnose_options opt;
     dhc_diagnose_default_options(&opt);
     if (fit->noise.on) {
@@ -281,6 +328,12 @@ int dhcal_run_diagnose(const dhcal_fit *fit, const dhcal_samples *s, dhc_diagnos
     const dhc_status st =
         dhc_diagnose(&fit->model, &fit->set, fit->rep.identifiable, sigma2, cands, nc,
                      dhcal_samples_read, ctx, s->n, s->flags, &opt, &diag_ws, out);
+    if (st == DHC_ERR_CAPACITY) {
+        snprintf(err->msg, sizeof err->msg,
+                 "the model's %zu parameters leave no room for another effect (%u at most)",
+                 fit->set.count, DHC_MAX_PARAMS);
+        return DHCAL_IO_FAILED;
+    }
     if (st != DHC_OK) {
         snprintf(err->msg, sizeof err->msg, "diagnosis failed: %s", dhc_status_str(st));
         return DHCAL_IO_FAILED;

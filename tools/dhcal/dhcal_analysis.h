@@ -57,7 +57,8 @@ void dhcal_calib_options_for(const dhc_model *model, const dhcal_noise *noise,
                              dhc_calib_options *opt);
 
 /* Fits the parameters of set, starting from start (a previous solution: the fit can only
- * lower its SSR), to s (flags updated with outliers); evaluates the fitted rows into
+ * lower its SSR), to s (flags updated with outliers, judged afresh: an earlier fit's outlier
+ * marks are cleared first, rows the caller excluded stay out); evaluates the fitted rows into
  * out->train and held (may be NULL) into out->heldout. out->geometry is kept as the caller
  * set it. DHCAL_IO_OK when the library returned DHC_OK or DHC_ERR_NOT_CONVERGED (see
  * out->status), DHCAL_IO_FAILED with a plain-words message otherwise (under-determined
@@ -72,9 +73,24 @@ int dhcal_run_fit(const dhc_model *nominal, const char *effects, dhcal_geometry 
                   const dhcal_noise *noise, dhcal_samples *s, const dhcal_samples *held,
                   dhcal_fit *out, dhcal_error *err);
 
-/* Ranks every candidate effect the fit's model can take against its residuals. */
+/* Whether the session's covariates vary apart from the pose (dhc_covariate_pose_r2 over the
+ * fitted rows): drift and thermal candidates are tried only when they do. */
+typedef struct {
+    double time_r2;        /* of t_s, or of the row number when the data have no t_s */
+    int time_from_rows;    /* no t_s column: t is the row number */
+    int temperature_varies;
+    double temperature_r2; /* when it varies */
+    dhc_candidate_scope scope;
+} dhcal_covariates;
+
+/* The covariates of the fit's used rows (flags of s). DHCAL_IO_FAILED with the reason. */
+int dhcal_session_covariates(const dhcal_fit *fit, const dhcal_samples *s,
+                             dhcal_covariates *cov, dhcal_error *err);
+
+/* Ranks every candidate effect the fit's model can take against its residuals; cov (may be
+ * NULL) receives what decided the drift and thermal candidates. */
 int dhcal_run_diagnose(const dhcal_fit *fit, const dhcal_samples *s, dhc_diagnosis *out,
-                       dhcal_error *err);
+                       dhcal_covariates *cov, dhcal_error *err);
 
 /* Per row: the apparent joint error dq = pinv(J_q) r (degrees; J_q the joint Jacobian of
  * what was measured, tool point or wire lengths) and the gravity moment about each joint

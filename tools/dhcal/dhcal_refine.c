@@ -280,6 +280,72 @@ static int fit_start(const dhc_model *nominal, const char *effects,
     return DHCAL_IO_OK;
 }
 
+int dhcal_try_candidates(const dhcal_fit *fit, const dhc_diagnosis *diag,
+                         const dhcal_noise *noise, dhcal_samples *s, const dhcal_samples *held,
+                         dhcal_trials *out, dhcal_fit *best_fit, uint8_t *best_flags,
+                         dhcal_error *err)
+{
+    memset(out, 0, sizeof *out);
+    out->best = DHC_MAX_CANDIDATES;
+    uint8_t *flags0 = malloc(s->n + 1U);
+    if (flags0 == NULL) {
+        snprintf(err->msg, sizeof err->msg, "out of memory");
+        return DHCAL_IO_FAILED;
+    }
+    memcpy(flags0, s->flags, s->n);
+    static dhcal_fit trial;
+    static dhc_param_set set;
+    out->workspace_std_mm = dhcal_workspace_std_mm(fit, s);
+    size_t tried = 0U;
+    for (size_t c = 0U; c < diag->count && tried < DHCAL_REFINE_CANDIDATES; ++c) {
+        const dhc_candidate_result *cand = &diag->c[c];
+        if (!cand->significant) {
+            continue;
+        }
+        tried++;
+        set = fit->set;
+        if (dhc_params_add_effect(&set, &fit->model, cand->effect, cand->joint) != DHC_OK) {
+            continue;
+        }
+        memcpy(s->flags, flags0, s->n);
+        trial.geometry = fit->geometry;
+        dhcal_error e2;
+        memset(&e2, 0, sizeof e2);
+        if (dhcal_fit_from(&fit->model, &set, noise, s, held, &trial, &e2) != DHCAL_IO_OK) {
+            continue;
+        }
+        dhcal_trial *t = &out->trial[c];
+        t->tried = 1;
+        /* supported where the arm will be used, not only where it was measured: an
+         * effect fitted on a slice of its joint's turn (a harmonic of a joint that moved
+         * half a turn, compliance about a nearly vertical axis) can fit the rows well
+         * and extrapolate by millimetres */
+        t->workspace_std_mm = dhcal_workspace_std_mm(&trial, s);
+        if (!(t->workspace_std_mm <=
+              DHCAL_REFINE_MAX_UNCERTAINTY_GROWTH * out->workspace_std_mm)) {
+            t->unsupported = 1;
+            continue;
+        }
+        if (dhcal_cross_validate(&trial.model, &trial.set, noise, s, &t->cv, &e2) !=
+            DHCAL_IO_OK) {
+            t->tried = 0;
+            continue;
+        }
+        if (out->best == DHC_MAX_CANDIDATES || t->cv.rms_mm < out->trial[out->best].cv.rms_mm) {
+            out->best = c;
+            if (best_fit != NULL) {
+                *best_fit = trial;
+            }
+            if (best_flags != NULL) {
+                memcpy(best_flags, s->flags, s->n);
+            }
+        }
+    }
+    memcpy(s->flags, flags0, s->n);
+    free(flags0);
+    return DHCAL_IO_OK;
+}
+
 int dhcal_run_refine(const dhc_model *nominal, const char *start_effects,
                      const dhcal_geometry *geometry, const dhcal_noise *noise,
                      dhcal_samples *s, const dhcal_samples *held, dhcal_refine_result *out,
@@ -292,82 +358,50 @@ int dhcal_run_refine(const dhc_model *nominal, const char *start_effects,
         return rc;
     }
     record_step(out, "", out->effects, &out->fit, &out->cv);
-    uint8_t *flags_cur = malloc(s->n + 1U);
     uint8_t *flags_best = malloc(s->n + 1U);
-    if (flags_cur == NULL || flags_best == NULL) {
-        free(flags_cur);
-        free(flags_best);
+    if (flags_best == NULL) {
         snprintf(err->msg, sizeof err->msg, "out of memory");
         return DHCAL_IO_FAILED;
     }
     static dhc_diagnosis diag;
-    static dhcal_fit trial;
+    static dhcal_trials trials;
     static dhcal_fit best;
     snprintf(out->stopped_why, sizeof out->stopped_why, "the step limit (%u) was reached",
              DHCAL_REFINE_MAX_STEPS);
     for (size_t step = 0U; step < DHCAL_REFINE_MAX_STEPS; ++step) {
-        memcpy(flags_cur, s->flags, s->n);
         dhcal_error e2;
         memset(&e2, 0, sizeof e2);
-        if (dhcal_run_diagnose(&out->fit, s, &diag, &e2) != DHCAL_IO_OK) {
-            snprintf(out->stopped_why, sizeof out->stopped_why, "the diagnosis failed: %.180s",
+        if (dhcal_run_diagnose(&out->fit, s, &diag, NULL, &e2) != DHCAL_IO_OK) {
+            snprintf(out->stopped_why, sizeof out->stopped_why, "%.200s",
                      e2.msg);
             break;
         }
-        double best_cv = out->cv.rms_mm;
-        char best_label[64] = "";
-        const double ws_current = dhcal_workspace_std_mm(&out->fit, s);
-        dhcal_cv best_cvr = out->cv;
-        size_t tried = 0U;
-        for (size_t c = 0U; c < diag.count && tried < DHCAL_REFINE_CANDIDATES; ++c) {
-            const dhc_candidate_result *cand = &diag.c[c];
-            if (!cand->significant) {
-                continue;
-            }
-            tried++;
-            static dhc_param_set set;
-            set = out->fit.set;
-            if (dhc_params_add_effect(&set, &out->fit.model, cand->effect, cand->joint) !=
-                DHC_OK) {
-                continue;
-            }
-            memcpy(s->flags, flags_cur, s->n);
-            trial.geometry = out->fit.geometry;
-            if (dhcal_fit_from(&out->fit.model, &set, noise, s, held, &trial, &e2) !=
-                DHCAL_IO_OK) {
-                continue;
-            }
-            dhcal_cv cv;
-            /* supported where the arm will be used, not only where it was measured: an
-             * effect fitted on a slice of its joint's turn (a harmonic of a joint that moved
-             * half a turn, compliance about a nearly vertical axis) can fit the rows well
-             * and extrapolate by millimetres */
-            const double ws = dhcal_workspace_std_mm(&trial, s);
-            if (!(ws <= DHCAL_REFINE_MAX_UNCERTAINTY_GROWTH * ws_current)) {
-                char lab[64];
-                dhcal_effect_label(cand->effect, cand->joint, lab, sizeof lab);
-                const size_t len = strlen(out->skipped);
-                snprintf(out->skipped + len, sizeof out->skipped - len,
-                         "%s%s (%.3f -> %.3f mm)", len > 0U ? ", " : "", lab, ws_current, ws);
-                continue;
-            }
-            if (dhcal_cross_validate(&trial.model, &trial.set, noise, s, &cv, &e2) !=
-                DHCAL_IO_OK) {
-                continue;
-            }
-            if (cv.rms_mm < best_cv) {
-                best_cv = cv.rms_mm;
-                best_cvr = cv;
-                dhcal_effect_label(cand->effect, cand->joint, best_label, sizeof best_label);
-                best = trial;
-                memcpy(flags_best, s->flags, s->n);
-            }
-        }
-        if (tried == 0U) {
+        if (diag.count == 0U || !diag.c[0].significant) {
             snprintf(out->stopped_why, sizeof out->stopped_why,
                      "no candidate effect adds significantly to the model");
-            memcpy(s->flags, flags_cur, s->n);
             break;
+        }
+        if (dhcal_try_candidates(&out->fit, &diag, noise, s, held, &trials, &best, flags_best,
+                                 &e2) != DHCAL_IO_OK) {
+            snprintf(out->stopped_why, sizeof out->stopped_why, "%.200s", e2.msg);
+            break;
+        }
+        for (size_t c = 0U; c < diag.count; ++c) {
+            if (trials.trial[c].unsupported) {
+                char lab[64];
+                dhcal_effect_label(diag.c[c].effect, diag.c[c].joint, lab, sizeof lab);
+                const size_t len = strlen(out->skipped);
+                snprintf(out->skipped + len, sizeof out->skipped - len, "%s%s (%.3f -> %.3f mm)",
+                         len > 0U ? ", " : "", lab, trials.workspace_std_mm,
+                         trials.trial[c].workspace_std_mm);
+            }
+        }
+        char best_label[64] = "";
+        double best_cv = out->cv.rms_mm;
+        if (trials.best < diag.count) {
+            dhcal_effect_label(diag.c[trials.best].effect, diag.c[trials.best].joint,
+                               best_label, sizeof best_label);
+            best_cv = trials.trial[trials.best].cv.rms_mm;
         }
         if (best_label[0] == '\0' || !(best_cv <= (1.0 - DHCAL_REFINE_MIN_GAIN) * out->cv.rms_mm)) {
             snprintf(out->stopped_why, sizeof out->stopped_why,
@@ -375,16 +409,14 @@ int dhcal_run_refine(const dhc_model *nominal, const char *start_effects,
                      "(best: %s, %.4f -> %.4f mm)",
                      100.0 * DHCAL_REFINE_MIN_GAIN, best_label[0] != '\0' ? best_label : "none",
                      out->cv.rms_mm, best_cv);
-            memcpy(s->flags, flags_cur, s->n);
             break;
         }
         out->fit = best;
-        out->cv = best_cvr;
+        out->cv = trials.trial[trials.best].cv;
         memcpy(s->flags, flags_best, s->n);
         list_append(out->effects, sizeof out->effects, best_label);
         record_step(out, best_label, out->effects, &out->fit, &out->cv);
     }
-    free(flags_cur);
     free(flags_best);
     return DHCAL_IO_OK;
 }

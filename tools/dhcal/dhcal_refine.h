@@ -43,6 +43,30 @@ int dhcal_cross_validate(const dhc_model *start, const dhc_param_set *set,
                          const dhcal_noise *noise, const dhcal_samples *s, dhcal_cv *out,
                          dhcal_error *err);
 
+/* A diagnosis candidate tried as refine tries it: added to the fit's set, refitted from the
+ * fit's solution, and cross-validated unless the positioning uncertainty it predicts over
+ * the joint ranges grows by more than DHCAL_REFINE_MAX_UNCERTAINTY_GROWTH. */
+typedef struct {
+    int tried;               /* refitted */
+    int unsupported;         /* not cross-validated: the uncertainty grew too much */
+    double workspace_std_mm; /* with the candidate (dhcal_workspace_std_mm) */
+    dhcal_cv cv;             /* when tried and supported */
+} dhcal_trial;
+
+typedef struct {
+    dhcal_trial trial[DHC_MAX_CANDIDATES]; /* per diagnosis candidate, in its order */
+    double workspace_std_mm;               /* of the fit without any */
+    size_t best;                           /* lowest CV RMS; DHC_MAX_CANDIDATES: none */
+} dhcal_trials;
+
+/* Tries the diagnosis' best significant candidates (DHCAL_REFINE_CANDIDATES at most).
+ * best_fit and best_flags (s->n entries; both may be NULL) receive the refit of out->best
+ * and its flags; s->flags end as they started. DHCAL_IO_FAILED when memory runs out. */
+int dhcal_try_candidates(const dhcal_fit *fit, const dhc_diagnosis *diag,
+                         const dhcal_noise *noise, dhcal_samples *s, const dhcal_samples *held,
+                         dhcal_trials *out, dhcal_fit *best_fit, uint8_t *best_flags,
+                         dhcal_error *err);
+
 typedef struct {
     char added[64];                    /* the effect added; "" for the start */
     char effects[DHCAL_EFFECTS_CAP];   /* the effect list after the step */

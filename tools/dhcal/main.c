@@ -84,10 +84,13 @@ static void print_command_help(const char *command)
                "cross-validated RMS. --out writes the calibrated model (same schema; it loads\n"
                "again as --model) only when the fit succeeds and is physically plausible.\n");
     } else if (strcmp(command, "diagnose") == 0) {
-        printf("usage: dhcal diagnose --model M.json --data D.csv [--effects LIST] [--json]\n"
+        printf("usage: dhcal diagnose --model M.json --data D.csv [--effects LIST] [--cv] [--json]\n"
                "Fits, then scores every effect the model does not have yet against the\n"
                "remaining residual (score test, Holm-corrected at 0.1 %%): the share of the\n"
-               "residual each would explain, whether that is significant, and look-alikes.\n");
+               "residual each would explain, whether that is significant, and look-alikes.\n"
+               "Drift (thermal) candidates are scored only when the time (temperature) varies\n"
+               "apart from the pose. --cv refits the best significant candidates as refine\n"
+               "does and adds each one's cross-validated RMS.\n");
     } else if (strcmp(command, "refine") == 0) {
         printf("usage: dhcal refine --model M.json --data D.csv [--effects START] [--heldout H.csv]\n"
                "                    [--noise J,M] [--geometry LEVEL] [--out C.json] [--json]\n"
@@ -196,8 +199,8 @@ static int parse_args(int argc, char **argv, options *o)
         strcmp(o->command, "refine") != 0) {
         return usage_error("--out is for fit and refine (calibrated model) and plot (directory)");
     }
-    if (o->cv && strcmp(o->command, "fit") != 0) {
-        return usage_error("--cv is for fit (refine always cross-validates)");
+    if (o->cv && strcmp(o->command, "fit") != 0 && strcmp(o->command, "diagnose") != 0) {
+        return usage_error("--cv is for fit and diagnose (refine always cross-validates)");
     }
     return 0;
 }
@@ -670,6 +673,35 @@ static int refuse_implausible(const session *s, const dhcal_fit *fit, const char
     return EXIT_COMPUTE;
 }
 
+/* A drift or thermal effect the user asked for, fitted to rows whose time or temperature
+ * moved in step with the pose: it may be a pose effect in disguise. */
+static void text_covariates_fitted(const dhcal_fit *fit, const dhcal_samples *samples)
+{
+    int drift = 0;
+    int thermal = 0;
+    for (size_t k = 0U; k < fit->set.count; ++k) {
+        const dhc_effect e = dhc_params_effect_of(&fit->set.id[k]);
+        drift |= e == DHC_EFFECT_DRIFT_SCALE || e == DHC_EFFECT_DRIFT_OFFSET;
+        thermal |= e == DHC_EFFECT_THERMAL_SCALE;
+    }
+    dhcal_covariates cov;
+    dhcal_error err;
+    if ((!drift && !thermal) || dhcal_session_covariates(fit, samples, &cov, &err) != DHCAL_IO_OK) {
+        return;
+    }
+    if (drift && !cov.scope.time) {
+        printf("caution: drift fitted to rows measured in step with the pose (the joint angles "
+               "predict %.0f%% of the variation of %s): it may be an error of the pose in "
+               "disguise, and need not hold at other poses\n",
+               100.0 * cov.time_r2, cov.time_from_rows ? "the row number" : "t_s");
+    }
+    if (thermal && cov.temperature_varies && !cov.scope.temperature) {
+        printf("caution: thermal_scale fitted to a temperature that changed in step with the "
+               "pose (the joint angles predict %.0f%% of its variation)\n",
+               100.0 * cov.temperature_r2);
+    }
+}
+
 static int cmd_fit(const options *o, session *s)
 {
     static dhcal_fit fit;
@@ -707,6 +739,7 @@ static int cmd_fit(const options *o, session *s)
             rc = print_json(obj);
         } else {
             text_fit(&fit, s, o, row_err);
+            text_covariates_fitted(&fit, &s->samples);
             text_extras(&fit, s, &extras, 0);
         }
         rc = rc == 0 ? implausible : rc;
@@ -739,7 +772,44 @@ static void candidate_params(const dhcal_fit *fit, const dhc_candidate_result *c
     }
 }
 
-static void text_diagnosis(const dhcal_fit *fit, const dhc_diagnosis *d, const char *effects)
+/* Why drift or thermal candidates were left out: the session covariate moved in step with
+ * the pose, so an error that grows with it cannot be told from one that depends on the pose. */
+static void text_covariates(const dhcal_covariates *cov)
+{
+    if (!cov->scope.time) {
+        printf("not tried: drift_scale, drift_offset: the rows were measured in step with the "
+               "pose (the joint angles predict %.0f%% of the variation of %s), so a drift "
+               "cannot be told from an error that depends on the pose; to test for drift, "
+               "measure one reference pose again and again through the session, or the poses "
+               "in a shuffled order\n",
+               100.0 * cov->time_r2, cov->time_from_rows ? "the row number" : "t_s");
+    }
+    if (cov->temperature_varies && !cov->scope.temperature) {
+        printf("not tried: thermal_scale: the temperature changed in step with the pose (the "
+               "joint angles predict %.0f%% of its variation)\n",
+               100.0 * cov->temperature_r2);
+    }
+}
+
+/* diagnose --cv: the fit's own cross-validation and each candidate's, as refine tries them */
+static int cross_validate_candidates(const dhcal_fit *fit, const dhc_diagnosis *diag,
+                                     session *s, fit_extras *extras, dhcal_trials *trials)
+{
+    dhcal_error err;
+    memset(&err, 0, sizeof err);
+    extras->have_cv = dhcal_cross_validate(&fit->model, &fit->set, &s->noise, &s->samples,
+                                           &extras->cv, &err) == DHCAL_IO_OK;
+    if (!extras->have_cv ||
+        dhcal_try_candidates(fit, diag, &s->noise, &s->samples, s->have_held ? &s->held : NULL,
+                             trials, NULL, NULL, &err) != DHCAL_IO_OK) {
+        fprintf(stderr, "dhcal: %s\n", err.msg);
+        return EXIT_COMPUTE;
+    }
+    return 0;
+}
+
+static void text_diagnosis(const dhcal_fit *fit, const dhc_diagnosis *d, const char *effects,
+                           const dhcal_trials *trials)
 {
     char label[64];
     if (fit->noise.on) {
@@ -772,7 +842,8 @@ static void text_diagnosis(const dhcal_fit *fit, const dhc_diagnosis *d, const c
                "refine, which repeats this while cross-validation improves)\n",
                effects != NULL ? effects : "", effects != NULL ? "," : "", label);
     }
-    printf("%-22s %6s %10s %12s %s\n", "candidate", "params", "explained", "log10(p)", "");
+    printf("%-22s %6s %10s %12s %-12s%s\n", "candidate", "params", "explained", "log10(p)", "",
+           trials != NULL ? "CV RMS mm" : "");
     size_t unseen = 0U;
     for (size_t i = 0U; i < d->count; ++i) {
         const dhc_candidate_result *c = &d->c[i];
@@ -781,8 +852,16 @@ static void text_diagnosis(const dhcal_fit *fit, const dhc_diagnosis *d, const c
             continue;
         }
         dhcal_effect_label(c->effect, c->joint, label, sizeof label);
-        printf("%-22s %6zu %9.1f%% %12.1f %s\n", label, c->rank, 100.0 * c->explained, c->log10_p,
-               c->significant ? "significant" : "");
+        char cv[48] = "";
+        if (trials != NULL && trials->trial[i].tried) {
+            if (trials->trial[i].unsupported) {
+                snprintf(cv, sizeof cv, "(unsupported over the joint ranges)");
+            } else {
+                snprintf(cv, sizeof cv, "%.4f", trials->trial[i].cv.rms_mm);
+            }
+        }
+        printf("%-22s %6zu %9.1f%% %12.1f %-12s%s\n", label, c->rank, 100.0 * c->explained,
+               c->log10_p, c->significant ? "significant" : "", cv);
     }
     if (unseen > 0U) {
         printf("cannot be seen in these data (looks exactly like what the fit already adjusts):");
@@ -802,20 +881,29 @@ static int cmd_diagnose(const options *o, session *s)
     static dhcal_fit fit;
     static dhc_diagnosis diag;
     static fit_extras extras;
+    dhcal_covariates cov;
     double *row_err = NULL;
     int rc = do_fit(o, s, &fit, &row_err);
     dhcal_error err;
     memset(&err, 0, sizeof err);
-    if (rc == 0 && dhcal_run_diagnose(&fit, &s->samples, &diag, &err) != DHCAL_IO_OK) {
+    if (rc == 0 && dhcal_run_diagnose(&fit, &s->samples, &diag, &cov, &err) != DHCAL_IO_OK) {
         fprintf(stderr, "dhcal: %s\n", err.msg);
         rc = EXIT_COMPUTE;
     }
+    static dhcal_trials trials;
+    memset(&trials, 0, sizeof trials);
     if (rc == 0) {
         compute_extras(&fit, s, &extras);
+        if (o->cv) {
+            rc = cross_validate_candidates(&fit, &diag, s, &extras, &trials);
+        }
+    }
+    if (rc == 0) {
         if (o->json) {
             cJSON *obj = cJSON_CreateObject();
             json_fit(obj, &fit, s, row_err);
             json_extras(obj, &fit, &extras);
+            cJSON_AddNumberToObject(obj, "time_pose_r2", cov.time_r2);
             cJSON *cands = cJSON_AddArrayToObject(obj, "candidates");
             for (size_t i = 0U; i < diag.count; ++i) {
                 const dhc_candidate_result *c = &diag.c[i];
@@ -831,6 +919,9 @@ static int cmd_diagnose(const options *o, session *s)
                 cJSON_AddNumberToObject(j, "log10_p", c->rank > 0U ? c->log10_p : 0.0);
                 cJSON_AddNumberToObject(j, "dof", (double)c->rank);
                 candidate_params(&fit, c, cJSON_AddArrayToObject(j, "params"));
+                if (trials.trial[i].tried && !trials.trial[i].unsupported) {
+                    cJSON_AddNumberToObject(j, "cv_rms_mm", trials.trial[i].cv.rms_mm);
+                }
                 if (c->lookalike < diag.count) {
                     char label[64];
                     dhcal_effect_label(diag.c[c->lookalike].effect, diag.c[c->lookalike].joint,
@@ -842,7 +933,8 @@ static int cmd_diagnose(const options *o, session *s)
             rc = print_json(obj);
         } else {
             text_fit(&fit, s, o, row_err);
-            text_diagnosis(&fit, &diag, o->effects);
+            text_diagnosis(&fit, &diag, o->effects, o->cv ? &trials : NULL);
+            text_covariates(&cov);
             text_extras(&fit, s, &extras, diag.count == 0U || !diag.c[0].significant);
         }
     }
@@ -977,7 +1069,7 @@ static int cmd_plot(const options *o, session *s)
     }
     dhcal_error err;
     memset(&err, 0, sizeof err);
-    if (dhcal_run_diagnose(&before, &s->samples, &diag, &err) != DHCAL_IO_OK) {
+    if (dhcal_run_diagnose(&before, &s->samples, &diag, NULL, &err) != DHCAL_IO_OK) {
         fprintf(stderr, "dhcal: %s\n", err.msg);
         return EXIT_COMPUTE;
     }

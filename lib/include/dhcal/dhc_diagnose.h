@@ -102,12 +102,41 @@ typedef struct {
 
 void dhc_diagnose_default_options(dhc_diagnose_options *opt);
 
+/* What the samples can show beyond the pose, i.e. which candidates they can test. */
+typedef struct {
+    int wires;       /* wire samples are used and the model has a measurer: measurer effects */
+    int temperature; /* the temperature varies and not in step with the pose: thermal_scale */
+    int time;        /* the time varies and not in step with the pose: drift_scale, drift_offset */
+} dhc_candidate_scope;
+
+/* A session covariate is in step with the pose when the pose predicts this much of it
+ * (adjusted R^2, dhc_covariate_pose_r2): rows measured in the order of a workspace sweep
+ * (layer by layer, say) make any pose-dependent error grow with time as well, so a drift
+ * fitted to them is a pose effect in disguise and extrapolates to other poses by chance. */
+#define DHC_COVARIATE_IN_STEP_R2 0.5
+
+typedef enum {
+    DHC_COVARIATE_TIME = 0,       /* dhc_sample.t_s */
+    DHC_COVARIATE_TEMPERATURE = 1 /* dhc_sample.temp_c */
+} dhc_covariate;
+
+/* How much of a covariate the pose predicts: the adjusted R^2 of its least-squares fit on
+ * 1, sin q_j, cos q_j (j < n_joints) over the used rows (flags DHC_SAMPLE_USED), clamped
+ * to [0, 1]; 1 when the covariate is constant or there are no more rows than regressors
+ * (nothing tells it apart from the pose). ne and fac are scratch. DHC_ERR_ARGUMENT (NULL,
+ * n_joints 0 or above DHC_MAX_JOINTS), DHC_ERR_NONFINITE (a non-finite covariate or angle),
+ * errors of read. Two passes, O(n n_joints^2). */
+dhc_status dhc_covariate_pose_r2(size_t n_joints, dhc_covariate which, dhc_sample_reader read,
+                                 void *ctx, size_t n, const uint8_t *flags, dhc_normal_eq *ne,
+                                 dhc_lsq_factor *fac, double *r2);
+
 /* Every candidate the model can express that is not already in base: per-joint effects on
- * every joint, base_frame, tool_offset, thermal_scale when the samples' temperatures vary
- * (temp_span_c > 0), measurer effects when the model has a measurer and wire samples are
- * used (wires). Returns the number written (at most cap). */
-size_t dhc_diagnose_candidates(const dhc_model *model, const dhc_param_set *base, int wires,
-                               double temp_span_c, dhc_candidate *out, size_t cap);
+ * every joint, base_frame, tool_offset, and the effects scope admits (thermal_scale, drift,
+ * measurer effects when the model also has a measurer). Returns the number written (at most
+ * cap). */
+size_t dhc_diagnose_candidates(const dhc_model *model, const dhc_param_set *base,
+                               const dhc_candidate_scope *scope, dhc_candidate *out,
+                               size_t cap);
 
 /* Scores the candidates against the fitted model. base and identifiable are the fit's
  * parameter set and its identifiable flags (dhc_calib_report), sigma2 its noise variance per
