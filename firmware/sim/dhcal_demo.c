@@ -30,7 +30,6 @@
 #include "fw_sim_port.h"
 
 #define MAX_TARGETS 64U
-#define PI 3.14159265358979323846
 
 static dhs_scenario_file sf;
 static fw_sim sim;
@@ -331,8 +330,8 @@ static void where_it_fails(const dhc_model *m, size_t n, FILE *log)
     fprintf(log, "    the geometric model fails most at (q deg -> |wire residual| mm):\n");
     for (size_t k = 0U; k < 3U && wv[k] >= 0.0; ++k) {
         const dhc_sample *s = &samples[worst[k]];
-        fprintf(log, "      (%7.1f %7.1f %7.1f) -> %.4f\n", s->q_rad[0] * 180.0 / PI,
-                s->q_rad[1] * 180.0 / PI, s->q_rad[2] * 180.0 / PI, wv[k]);
+        fprintf(log, "      (%7.1f %7.1f %7.1f) -> %.4f\n", s->q_rad[0] * 180.0 / DHC_PI,
+                s->q_rad[1] * 180.0 / DHC_PI, s->q_rad[2] * 180.0 / DHC_PI, wv[k]);
     }
 }
 
@@ -357,8 +356,8 @@ static int write_outputs(const char *dir, size_t n, const char *effect)
     }
     fprintf(f, "q1,q2,q3,dir1,dir2,dir3,L1,L2,L3\n");
     for (size_t i = 0U; i < n; ++i) {
-        fprintf(f, "%.9f,%.9f,%.9f,%d,%d,%d,%.6f,%.6f,%.6f\n", samples[i].q_rad[0] * 180.0 / PI,
-                samples[i].q_rad[1] * 180.0 / PI, samples[i].q_rad[2] * 180.0 / PI,
+        fprintf(f, "%.9f,%.9f,%.9f,%d,%d,%d,%.6f,%.6f,%.6f\n", samples[i].q_rad[0] * 180.0 / DHC_PI,
+                samples[i].q_rad[1] * 180.0 / DHC_PI, samples[i].q_rad[2] * 180.0 / DHC_PI,
                 samples[i].dir[0], samples[i].dir[1], samples[i].dir[2], samples[i].wire_mm[0],
                 samples[i].wire_mm[1], samples[i].wire_mm[2]);
     }
@@ -451,7 +450,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "dhcal-demo: %s\n", err.msg);
         return 1;
     }
-    const double q_start[3] = {0.0, 60.0 * PI / 180.0, -60.0 * PI / 180.0};
+    const double q_start[3] = {0.0, 60.0 * DHC_PI / 180.0, -60.0 * DHC_PI / 180.0};
     if (sf.sc.n_joints != 3U || !nominal.measurer.present ||
         fw_sim_init(&sim, &sf.sc, 7U, q_start, &port) != DHC_OK) {
         fprintf(stderr, "dhcal-demo: the scenario must be a 3-joint arm with a measurer\n");
@@ -592,7 +591,7 @@ int main(int argc, char **argv)
          * takes at the desk (largest joint sd, in degrees) */
         double joint_sd_deg = 0.0;
         for (size_t j = 0U; j < 3U; ++j) {
-            joint_sd_deg = fmax(joint_sd_deg, res.joint_noise_rad[j] * 180.0 / PI);
+            joint_sd_deg = fmax(joint_sd_deg, res.joint_noise_rad[j] * 180.0 / DHC_PI);
         }
         printf("\"noise_model\": {\"joint_deg\": %.6g, \"meas_mm\": %.6g}}\n", joint_sd_deg,
                res.meas_noise_mm);

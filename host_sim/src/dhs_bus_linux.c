@@ -1,6 +1,6 @@
 /* dhs_bus_linux.c - dhs_bus on SocketCAN, and quadrature edges on gpio-sim (dhs_bus_linux.h).
- * The socket is the firmware's own transport (firmware/linux/fw_linux_can.c, compiled into
- * dhcal-sim): the two ends of the test share its poll loop, filters and size checks. */
+ * The socket is the firmware's own transport (dhcal_socketcan, firmware/can/linux): the two
+ * ends of the test share its poll loop, filters and size checks. */
 #ifndef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 200809L
 #endif

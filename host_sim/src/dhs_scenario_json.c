@@ -17,8 +17,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define SJ_PI 3.14159265358979323846
-#define DEG (SJ_PI / 180.0)
 #define PATH_CAP 192U
 /* Marks a NaN/Infinity token replaced before the second parse (see parse_text). */
 #define NAN_MARK "\x01nan-or-infinity"
@@ -253,7 +251,7 @@ static int get_frame(const ctx *c, const cJSON *obj, const char *path, const cha
         return rc;
     }
     for (size_t k = 0U; k < 3U; ++k) {
-        rpy[k] *= DEG;
+        rpy[k] *= DHC_DEG;
     }
     dhc_frame_from_xyz_rpy(xyz, rpy, out);
     return DHCAL_IO_OK;
@@ -327,7 +325,7 @@ static int parse_joint(const ctx *c, const cJSON *obj, const char *path, int is_
         return rc;
     }
     if (o != NULL) {
-        double backlash_deg = j->backlash_rad / DEG;
+        double backlash_deg = j->backlash_rad / DHC_DEG;
         if ((rc = get_num(c, o, p, "ratio", 0, POS, &j->gear_ratio)) != DHCAL_IO_OK ||
             (rc = get_num(c, o, p, "backlash_deg", 0, NONNEG, &backlash_deg)) != DHCAL_IO_OK) {
             return rc;
@@ -337,7 +335,7 @@ static int parse_joint(const ctx *c, const cJSON *obj, const char *path, int is_
             child(q, p, "backlash_deg");
             return fail(c, q, "must be below 10 deg, got %.17g", backlash_deg);
         }
-        j->backlash_rad = backlash_deg * DEG;
+        j->backlash_rad = backlash_deg * DHC_DEG;
         const cJSON *k = cJSON_GetObjectItemCaseSensitive(o, "stiffness_nm_per_rad");
         if (k != NULL && cJSON_IsNull(k)) {
             j->stiffness_nm_per_rad = DHS_RIGID; /* explicit null: rigid */
@@ -499,11 +497,11 @@ static int parse_truth(const ctx *c, const cJSON *root, dhs_scenario *sc)
                 }
             }
             dhc_joint *j = &sc->truth.joint[i];
-            j->theta_offset_rad += err[0] * DEG;
+            j->theta_offset_rad += err[0] * DHC_DEG;
             j->d_mm += err[1];
             j->a_mm += err[2];
-            j->alpha_rad += err[3] * DEG;
-            j->beta_rad += err[4] * DEG;
+            j->alpha_rad += err[3] * DHC_DEG;
+            j->beta_rad += err[4] * DHC_DEG;
         }
     }
     dhc_frame base_err;
@@ -532,7 +530,7 @@ static int parse_truth(const ctx *c, const cJSON *root, dhs_scenario *sc)
                 return rc;
             }
         }
-        dhs_scenario_add_random_errors(sc, s[0] * DEG, s[1], s[2], s[3] * DEG, s[4] * DEG);
+        dhs_scenario_add_random_errors(sc, s[0] * DHC_DEG, s[1], s[2], s[3] * DHC_DEG, s[4] * DHC_DEG);
     }
     return DHCAL_IO_OK;
 }

@@ -3,7 +3,6 @@
 
 #include <math.h>
 
-#define DHC_PI 3.14159265358979323846
 
 dhc_status dhc_arm_init(dhc_arm *arm, size_t n_joints)
 {

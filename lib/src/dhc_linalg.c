@@ -8,7 +8,6 @@
  * far above the rounding of a Schur complement (~n DBL_EPSILON), far below real differences. */
 #define PIVOT_TIE_REL 1e-9
 
-#define DHC_PI 3.14159265358979323846
 
 /* Below this angle the Rodrigues coefficients switch to their Taylor series: the dropped
  * terms are theta^4/120 ~ 1e-18, under one ulp of the leading 1. */

@@ -1,4 +1,4 @@
-/* test_dhcal_io.c - the CLI's model JSON and measurement CSV: every kind of bad input gets
+/* test_dhcal_io.c - the file layer (io/), model JSON and measurement CSV: every bad input gets
  * DHCAL_IO_BAD_INPUT and one message naming the file and line (CSV) or JSON path (model);
  * good files load exactly; saved models load back to the same arm; a failed save leaves
  * the old file alone. Files are written into a fresh mkdtemp directory per test. */

@@ -9,7 +9,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define PI 3.14159265358979323846
 
 /* Big library workspaces: static, this is a single-threaded command-line program. */
 static dhc_calib_workspace calib_ws;
@@ -85,7 +84,7 @@ int dhcal_parse_noise(const char *text, dhcal_noise *out, dhcal_error *err)
         return DHCAL_IO_BAD_INPUT;
     }
     out->on = 1;
-    out->joint_rad = joint_deg * PI / 180.0;
+    out->joint_rad = joint_deg * DHC_PI / 180.0;
     out->meas_mm = meas_mm;
     return DHCAL_IO_OK;
 }
@@ -170,7 +169,7 @@ void dhcal_calib_options_for(const dhc_model *model, const dhcal_noise *noise,
 {
     dhc_calib_default_options(opt);
     /* a link parameter the data pin only to half its physical range or worse is held */
-    opt->max_std_angle_rad = 0.5 * DHCAL_PLAUSIBLE_ANGLE_DEG * PI / 180.0;
+    opt->max_std_angle_rad = 0.5 * DHCAL_PLAUSIBLE_ANGLE_DEG * DHC_PI / 180.0;
     opt->max_std_length_mm = 0.5 * DHCAL_PLAUSIBLE_LENGTH_SHARE * dhc_arm_reach(&model->arm);
     if (noise != NULL && noise->on) {
         for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
@@ -412,7 +411,7 @@ int dhcal_apparent_joint_errors(const dhc_model *model, const dhcal_samples *s, 
                 m += tau[j][k];
             }
             const double modelled = with_effects ? pred.q_eff_rad[j] - smp->q_rad[j] : 0.0;
-            dq_deg[i * nj + j] = (dq[j] + modelled) * 180.0 / PI;
+            dq_deg[i * nj + j] = (dq[j] + modelled) * 180.0 / DHC_PI;
             moment_mm[i * nj + j] = m;
         }
     }
@@ -454,13 +453,13 @@ const char *dhcal_effect_signature(dhc_effect effect)
 double dhcal_param_display(const dhc_param_set *set, size_t k, double value)
 {
     const int degrees = dhc_params_is_angle(set, k) || set->id[k].kind == (uint8_t)DHC_P_COMPLIANCE;
-    return degrees ? value * 180.0 / PI : value;
+    return degrees ? value * 180.0 / DHC_PI : value;
 }
 
 int dhcal_implausible(const dhc_model *nominal, const dhcal_fit *fit, char *why, size_t cap)
 {
     const double max_len = DHCAL_PLAUSIBLE_LENGTH_SHARE * dhc_arm_reach(&nominal->arm);
-    const double max_ang = DHCAL_PLAUSIBLE_ANGLE_DEG * PI / 180.0;
+    const double max_ang = DHCAL_PLAUSIBLE_ANGLE_DEG * DHC_PI / 180.0;
     for (size_t k = 0U; k < fit->set.count; ++k) {
         const uint8_t kind = fit->set.id[k].kind;
         if (kind > (uint8_t)DHC_P_BETA || !fit->rep.identifiable[k]) {
@@ -473,7 +472,7 @@ int dhcal_implausible(const dhc_model *nominal, const dhcal_fit *fit, char *why,
             char name[48];
             (void)dhc_params_name(&fit->set, k, name, sizeof name);
             snprintf(why, cap, "%s moved %.4g %s from its nominal value (physical bound %.4g)",
-                     name, angle ? moved * 180.0 / PI : moved, angle ? "deg" : "mm",
+                     name, angle ? moved * 180.0 / DHC_PI : moved, angle ? "deg" : "mm",
                      angle ? DHCAL_PLAUSIBLE_ANGLE_DEG : max_len);
             return 1;
         }

@@ -31,6 +31,10 @@
 #include "dhc_config.h"
 #include "dhc_status.h"
 
+/* pi and one degree in radians: files and people speak degrees, the library radians. */
+#define DHC_PI 3.14159265358979323846
+#define DHC_DEG (DHC_PI / 180.0)
+
 /* ---------------------------------------------------------------- 3-vectors */
 
 void dhc_vec3_set(double out[3], double x, double y, double z);

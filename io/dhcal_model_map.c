@@ -7,8 +7,6 @@
 
 #include "dhcal/dhc_params.h"
 
-#define PI 3.14159265358979323846
-#define DEG (PI / 180.0)
 
 static int bad(dhcal_error *err, const char *path, const char *name, const char *what,
                size_t got)
@@ -53,8 +51,8 @@ int dhcal_model_to_lib(const dhcal_model *file, const char *path, dhc_model *out
             if (k != 2U) {
                 return bad(err, path, ev->name, "expected [A_deg, B_deg]", k);
             }
-            fx->harmonic_sin_rad = v[0] * DEG;
-            fx->harmonic_cos_rad = v[1] * DEG;
+            fx->harmonic_sin_rad = v[0] * DHC_DEG;
+            fx->harmonic_cos_rad = v[1] * DHC_DEG;
             break;
         case DHC_EFFECT_JOINT_HARMONIC2:
         case DHC_EFFECT_JOINT_HARMONIC3:
@@ -63,8 +61,8 @@ int dhcal_model_to_lib(const dhcal_model *file, const char *path, dhc_model *out
                 return bad(err, path, ev->name, "expected [A_deg, B_deg]", k);
             }
             const size_t order = (size_t)((unsigned)effect - (unsigned)DHC_EFFECT_JOINT_HARMONIC2);
-            fx->harmonic_hi_sin_rad[order] = v[0] * DEG;
-            fx->harmonic_hi_cos_rad[order] = v[1] * DEG;
+            fx->harmonic_hi_sin_rad[order] = v[0] * DHC_DEG;
+            fx->harmonic_hi_cos_rad[order] = v[1] * DHC_DEG;
             break;
         }
         case DHC_EFFECT_DRIFT_SCALE:
@@ -85,7 +83,7 @@ int dhcal_model_to_lib(const dhcal_model *file, const char *path, dhc_model *out
             if (k != 1U) {
                 return bad(err, path, ev->name, "expected [b_deg]", k);
             }
-            fx->backlash_rad = v[0] * DEG;
+            fx->backlash_rad = v[0] * DHC_DEG;
             break;
         case DHC_EFFECT_JOINT_COMPLIANCE:
             if (k != n - j) {
@@ -93,7 +91,7 @@ int dhcal_model_to_lib(const dhcal_model *file, const char *path, dhc_model *out
                            "expected one value per joint from this one to the last", k);
             }
             for (size_t m = 0U; m < k; ++m) {
-                fx->compliance[j + m] = v[m] * DEG;
+                fx->compliance[j + m] = v[m] * DHC_DEG;
             }
             break;
         case DHC_EFFECT_MEASURER_SCALE:
@@ -164,27 +162,27 @@ void dhcal_model_from_lib(const dhc_model *m, const dhcal_model *template_model,
             put_effect(out, DHC_EFFECT_JOINT_SCALE, j, &fx->scale, 1U);
         }
         if (fabs(fx->harmonic_sin_rad) > 0.0 || fabs(fx->harmonic_cos_rad) > 0.0) {
-            const double v[2] = {fx->harmonic_sin_rad / DEG, fx->harmonic_cos_rad / DEG};
+            const double v[2] = {fx->harmonic_sin_rad / DHC_DEG, fx->harmonic_cos_rad / DHC_DEG};
             put_effect(out, DHC_EFFECT_JOINT_HARMONIC, j, v, 2U);
         }
         for (size_t order = 0U; order + 1U < DHC_HARMONIC_MAX_ORDER; ++order) {
             if (fabs(fx->harmonic_hi_sin_rad[order]) > 0.0 ||
                 fabs(fx->harmonic_hi_cos_rad[order]) > 0.0) {
-                const double v[2] = {fx->harmonic_hi_sin_rad[order] / DEG,
-                                     fx->harmonic_hi_cos_rad[order] / DEG};
+                const double v[2] = {fx->harmonic_hi_sin_rad[order] / DHC_DEG,
+                                     fx->harmonic_hi_cos_rad[order] / DHC_DEG};
                 put_effect(out,
                            (dhc_effect)((unsigned)DHC_EFFECT_JOINT_HARMONIC2 + (unsigned)order),
                            j, v, 2U);
             }
         }
         if (fabs(fx->backlash_rad) > 0.0) {
-            const double v = fx->backlash_rad / DEG;
+            const double v = fx->backlash_rad / DHC_DEG;
             put_effect(out, DHC_EFFECT_JOINT_BACKLASH, j, &v, 1U);
         }
         double c[DHC_MAX_JOINTS];
         int any = 0;
         for (size_t i = j; i < n; ++i) {
-            c[i - j] = fx->compliance[i] / DEG;
+            c[i - j] = fx->compliance[i] / DHC_DEG;
             any |= fabs(c[i - j]) > 0.0;
         }
         if (any) {

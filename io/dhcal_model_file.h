@@ -1,31 +1,20 @@
-/* dhcal_io.h - the CLI's file formats (DESIGN.md section 3): model JSON and measurement CSV.
+/* dhcal_model_file.h - the model file: JSON (docs/formats.md).
  *
- * Host-only code (heap and stdio allowed). Every loader validates every field; on bad input
- * it returns DHCAL_IO_BAD_INPUT and writes one message naming the file and the line (CSV)
- * or the JSON path (model) into err->msg, e.g.
- *     data.csv:14: column 'q2': "abc" is not a number
+ * Host-only code (heap and stdio allowed). Units in files: mm and degrees; in memory mm and
+ * radians (dhc_arm). A defect is reported with its JSON path, e.g.
  *     model.json: joints[1].a_mm: expected a number, got a string
- * Units in files: mm and degrees. In memory: mm and radians (dhc_arm).
- * Missing files, unreadable files and every defect of the content are DHCAL_IO_BAD_INPUT;
- * DHCAL_IO_FAILED is kept for out of memory and for failures to write.
  * No state of its own: calls on different objects may run concurrently, except that cJSON
  * records its last parse error in a global (harmless: this code never reads it).
  */
-#ifndef DHCAL_IO_H
-#define DHCAL_IO_H
+#ifndef DHCAL_MODEL_FILE_H
+#define DHCAL_MODEL_FILE_H
 
 #include <stddef.h>
 
 #include "dhcal/dhc_kinematics.h"
+#include "dhcal_error.h"
 
-enum { DHCAL_IO_OK = 0, DHCAL_IO_FAILED = 1, DHCAL_IO_BAD_INPUT = 2 };
-
-typedef struct {
-    char msg[1024];
-} dhcal_error;
-
-/* Longest CSV line accepted (bytes, not counting the newline) and largest model file. */
-#define DHCAL_CSV_MAX_LINE 65536U
+/* Largest model file accepted (bytes). */
 #define DHCAL_MODEL_MAX_BYTES 1048576U
 
 #define DHCAL_MAX_EFFECTS 32U
@@ -79,50 +68,9 @@ int dhcal_model_load(const char *path, dhcal_model *model, dhcal_error *err);
  * path) and on counts beyond the limits; nothing is written then. */
 int dhcal_model_save(const char *path, const dhcal_model *model, dhcal_error *err);
 
-/* One data line of a measurement CSV. */
-typedef struct {
-    size_t line;                  /* 1-based line number in the file (for messages) */
-    double q_rad[DHC_MAX_JOINTS];
-    double xyz_mm[3];             /* has_xyz */
-    double wires_mm[3];           /* has_wires: raw L1, L2, L3 */
-    double quat[4];               /* has_quat: w, x, y, z (normalised on load) */
-    int dir[DHC_MAX_JOINTS];      /* has_dir: -1 or +1 */
-    double temp_c;                /* has_temp */
-    double t_s;                   /* has_time: time of the measurement, s (drift) */
-} dhcal_row;
-
-typedef struct {
-    size_t n_rows;
-    size_t n_joints;
-    int has_xyz, has_wires, has_quat, has_dir, has_temp, has_time;
-    dhcal_row *rows; /* heap, n_rows entries */
-} dhcal_dataset;
-
-/* Loads a measurement CSV for an arm with n_joints joints: '#' comment lines, then a
- * header naming columns in any order: q1..qN (deg, required), and x,y,z and/or L1,L2,L3
- * (at least one complete group), optional qw,qx,qy,qz, dir1..dirN, temp_c, t_s (seconds,
- * any origin, within +-1e9). Rejects: an
- * empty file, a header without rows, unknown / repeated / partial-group / missing columns,
- * a q column beyond n_joints, short or long rows, fields that are not numbers (strtod must
- * consume the whole trimmed field), NaN/Inf, joint angles beyond [-720, 720] deg, lengths
- * beyond 1e5 mm, wire lengths <= 0, quaternions of norm outside 1 +- 1e-3, dir not -1/+1,
- * temp_c outside [-60, 150], a NUL byte or other binary garbage, lines over 64 KiB.
- * Row numbers in messages are file line numbers. Accepted: CRLF line endings, a UTF-8 BOM,
- * spaces and tabs around fields and column names, blank lines and '#' comment lines
- * anywhere (leading whitespace allowed before '#'). A column group (x,y,z / L1..L3 /
- * qw..qz / dir1..dirN) is all or nothing. Numbers are decimal: [+-]digits[.digits][e[+-]digits]
- * (no hex, no nan/inf); an overflowing exponent is rejected, an underflowing one reads as
- * the tiny or zero double it rounds to.
- * n_joints outside 1..DHC_MAX_JOINTS is DHCAL_IO_FAILED (a caller error).
- * Cost: O(file size) time; memory one line buffer (<= 64 KiB) plus the rows.
- * On error *data is empty (rows NULL), so dhcal_dataset_free is always safe. */
-int dhcal_csv_load(const char *path, size_t n_joints, dhcal_dataset *data, dhcal_error *err);
-/* Frees the rows and empties *data; NULL and already-empty datasets are fine. */
-void dhcal_dataset_free(dhcal_dataset *data);
-
 /* The effect names a model file and --effects accept, from the library's catalogue
  * ("base_frame, tool_offset, joint_scale:i, ..."), into buf (snprintf rules); returns the
  * full length. */
 size_t dhcal_effect_catalogue(char *buf, size_t cap);
 
-#endif /* DHCAL_IO_H */
+#endif /* DHCAL_MODEL_FILE_H */

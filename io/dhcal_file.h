@@ -14,7 +14,7 @@
 
 #include <stddef.h>
 
-#include "dhcal_io.h" /* dhcal_error, DHCAL_IO_OK / DHCAL_IO_FAILED */
+#include "dhcal_error.h"
 
 /* path := data[0..len), atomically:
  *   1. creates "<path>.tmp.<pid>.<k>" (k = 0..99, the first free one) in path's directory

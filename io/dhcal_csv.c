@@ -1,0 +1,661 @@
+/* dhcal_csv.c - the measurement CSV (dhcal_csv.h).
+ *
+ * The reader trusts nothing it has not checked and stops at the first defect with one
+ * message that names the file and the line. Lines grow a heap buffer up to
+ * DHCAL_CSV_MAX_LINE; no fixed-size line buffer.
+ */
+#include "dhcal_csv.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dhcal_io_common.h"
+
+/* Value ranges of the CSV (docs/formats.md). */
+#define CSV_Q_MAX_DEG 720.0
+#define TEMP_MIN_C (-60.0)
+#define TEMP_MAX_C 150.0
+#define TIME_MAX_S 1e9
+
+/* ------------------------------------------------------------------ CSV: lines */
+
+typedef struct {
+    FILE *f;
+    const char *path;
+    dhcal_error *err;
+    char *buf; /* heap, cap bytes, NUL-terminated line after next_line */
+    size_t cap;
+    size_t len;
+    size_t line_no; /* of the line in buf, 1-based */
+} csv_reader;
+
+/* Reads the next line (newline and a CR before it removed, NUL-terminated) and rejects NUL
+ * and control bytes. *got = 0 at the end of the file. */
+static int next_line(csv_reader *r, int *got)
+{
+    *got = 0;
+    r->len = 0U;
+    int any = 0;
+    int c;
+    while ((c = getc(r->f)) != EOF) {
+        any = 1;
+        if (c == '\n') {
+            break;
+        }
+        if (r->len >= DHCAL_CSV_MAX_LINE) {
+            return dhcal_error_set(r->err, DHCAL_IO_BAD_INPUT, "%s:%zu: line longer than %u bytes",
+                             r->path, r->line_no + 1U, DHCAL_CSV_MAX_LINE);
+        }
+        if (r->len + 1U >= r->cap) {
+            size_t cap = r->cap * 2U;
+            if (cap > DHCAL_CSV_MAX_LINE + 1U) {
+                cap = DHCAL_CSV_MAX_LINE + 1U;
+            }
+            char *const grown = realloc(r->buf, cap);
+            if (grown == NULL) {
+                return dhcal_error_set(r->err, DHCAL_IO_FAILED, "%s:%zu: out of memory", r->path,
+                                 r->line_no + 1U);
+            }
+            r->buf = grown;
+            r->cap = cap;
+        }
+        r->buf[r->len++] = (char)c;
+    }
+    if (ferror(r->f)) {
+        return dhcal_error_set(r->err, DHCAL_IO_BAD_INPUT, "%s:%zu: read error: %s", r->path,
+                         r->line_no + 1U, strerror(errno));
+    }
+    if (!any) {
+        return DHCAL_IO_OK;
+    }
+    r->line_no++;
+    if (r->len > 0U && r->buf[r->len - 1U] == '\r') {
+        r->len--;
+    }
+    r->buf[r->len] = '\0';
+    if (r->line_no == 1U && r->len >= 3U && memcmp(r->buf, "\xEF\xBB\xBF", 3U) == 0) {
+        r->len -= 3U;
+        memmove(r->buf, r->buf + 3U, r->len + 1U);
+    }
+    for (size_t k = 0U; k < r->len; ++k) {
+        const unsigned char b = (unsigned char)r->buf[k];
+        if (b == 0U) {
+            return dhcal_error_set(r->err, DHCAL_IO_BAD_INPUT,
+                             "%s:%zu: NUL byte at column %zu (binary file?)", r->path,
+                             r->line_no, k + 1U);
+        }
+        if ((b < 0x20U && b != '\t') || b == 0x7fU) {
+            return dhcal_error_set(r->err, DHCAL_IO_BAD_INPUT,
+                             "%s:%zu: control byte 0x%02x at column %zu (binary file?)",
+                             r->path, r->line_no, (unsigned)b, k + 1U);
+        }
+    }
+    *got = 1;
+    return DHCAL_IO_OK;
+}
+
+static int is_blank(char c)
+{
+    return c == ' ' || c == '\t';
+}
+
+/* Trims blanks around [*s, *s + *n). */
+static void trim(const char **s, size_t *n)
+{
+    while (*n > 0U && is_blank(**s)) {
+        ++*s;
+        --*n;
+    }
+    while (*n > 0U && is_blank((*s)[*n - 1U])) {
+        --*n;
+    }
+}
+
+/* Blank lines and '#' comment lines carry no data. */
+static int is_skipped(const char *line)
+{
+    while (is_blank(*line)) {
+        ++line;
+    }
+    return *line == '\0' || *line == '#';
+}
+
+/* Splits the line in place at commas into trimmed, NUL-terminated (start, length) spans;
+ * spans is a heap array grown as needed. Returns the field count, or 0 when out of memory. */
+typedef struct {
+    const char *s;
+    size_t n;
+} span;
+
+static size_t split_fields(char *line, size_t len, span **spans, size_t *cap)
+{
+    size_t count = 0U;
+    const char *start = line;
+    for (size_t k = 0U; k <= len; ++k) {
+        if (k == len || line[k] == ',') {
+            if (count == *cap) {
+                const size_t grown_cap = *cap == 0U ? 32U : *cap * 2U;
+                span *const grown = realloc(*spans, grown_cap * sizeof **spans);
+                if (grown == NULL) {
+                    return 0U;
+                }
+                *spans = grown;
+                *cap = grown_cap;
+            }
+            span f = {start, (size_t)(line + k - start)};
+            trim(&f.s, &f.n);
+            /* Trimming only moves the end left: the terminator lands inside this field. */
+            line[(size_t)(f.s - line) + f.n] = '\0';
+            (*spans)[count++] = f;
+            start = line + k + 1U;
+        }
+    }
+    return count;
+}
+
+/* ------------------------------------------------------------------ CSV: columns */
+
+typedef enum {
+    COL_Q,
+    COL_XYZ,
+    COL_WIRE,
+    COL_QUAT,
+    COL_DIR,
+    COL_TEMP,
+    COL_TIME,
+    COL_KIND_COUNT
+} col_kind;
+
+typedef struct {
+    col_kind kind;
+    size_t idx; /* joint (0-based), axis, wire or quaternion component */
+} csv_col;
+
+/* Each column can appear once, so a valid header has at most this many. */
+#define CSV_MAX_COLS (2U * DHC_MAX_JOINTS + 11U)
+#define SEEN_WIDTH (DHC_MAX_JOINTS > 4U ? DHC_MAX_JOINTS : 4U)
+
+static const char *const XYZ_NAMES[3] = {"x", "y", "z"};
+static const char *const WIRE_NAMES[3] = {"L1", "L2", "L3"};
+static const char *const QUAT_NAMES[4] = {"qw", "qx", "qy", "qz"};
+
+static const char *col_name(csv_col c, char buf[16])
+{
+    switch (c.kind) {
+    case COL_Q:
+        (void)snprintf(buf, 16U, "q%zu", c.idx + 1U);
+        return buf;
+    case COL_XYZ:
+        return XYZ_NAMES[c.idx];
+    case COL_WIRE:
+        return WIRE_NAMES[c.idx];
+    case COL_QUAT:
+        return QUAT_NAMES[c.idx];
+    case COL_DIR:
+        (void)snprintf(buf, 16U, "dir%zu", c.idx + 1U);
+        return buf;
+    case COL_TIME:
+        return "t_s";
+    case COL_TEMP:
+    case COL_KIND_COUNT:
+    default:
+        return "temp_c";
+    }
+}
+
+/* A 1-based index written "1", "2", ... (no sign, no leading zero). Returns 0 when s is not
+ * one; values above 1e6 read as 1e6 (beyond any joint count). */
+static size_t parse_index(const char *s)
+{
+    if (*s < '1' || *s > '9') {
+        return 0U;
+    }
+    size_t v = 0U;
+    for (; *s != '\0'; ++s) {
+        if (*s < '0' || *s > '9') {
+            return 0U;
+        }
+        if (v < 1000000U) {
+            v = v * 10U + (size_t)(*s - '0');
+        }
+    }
+    return v;
+}
+
+/* Column of a header name; 0 when the name is unknown, -1 for a joint index beyond
+ * n_joints (with *beyond set to the index). */
+static int classify(const char *name, size_t n_joints, csv_col *col, size_t *beyond)
+{
+    size_t k = 0U;
+    if (dhcal_find_name(name, XYZ_NAMES, 3U, &k)) {
+        *col = (csv_col){COL_XYZ, k};
+        return 1;
+    }
+    if (dhcal_find_name(name, WIRE_NAMES, 3U, &k)) {
+        *col = (csv_col){COL_WIRE, k};
+        return 1;
+    }
+    if (dhcal_find_name(name, QUAT_NAMES, 4U, &k)) {
+        *col = (csv_col){COL_QUAT, k};
+        return 1;
+    }
+    if (strcmp(name, "temp_c") == 0) {
+        *col = (csv_col){COL_TEMP, 0U};
+        return 1;
+    }
+    if (strcmp(name, "t_s") == 0) {
+        *col = (csv_col){COL_TIME, 0U};
+        return 1;
+    }
+    col_kind kind = COL_Q;
+    if (name[0] == 'q') {
+        k = parse_index(name + 1);
+    } else if (strncmp(name, "dir", 3U) == 0) {
+        kind = COL_DIR;
+        k = parse_index(name + 3);
+    }
+    if (k == 0U) {
+        return 0;
+    }
+    if (k > n_joints) {
+        *beyond = k;
+        return -1;
+    }
+    *col = (csv_col){kind, k - 1U};
+    return 1;
+}
+
+typedef struct {
+    csv_reader rd;
+    size_t n_joints;
+    size_t n_cols;
+    csv_col cols[CSV_MAX_COLS];
+    size_t header_line;
+    int has_quat;
+    span *spans;
+    size_t spans_cap;
+} csv_ctx;
+
+/* "missing 'z'" for a group some but not all of whose columns are present. */
+static int check_group(csv_ctx *c, const size_t *seen, size_t n, col_kind kind, int *present)
+{
+    size_t have = 0U;
+    size_t first_missing = n;
+    for (size_t i = 0U; i < n; ++i) {
+        if (seen[i] != 0U) {
+            ++have;
+        } else if (first_missing == n) {
+            first_missing = i;
+        }
+    }
+    *present = have == n;
+    if (have == 0U || have == n) {
+        return DHCAL_IO_OK;
+    }
+    char nb[16];
+    const char *group = kind == COL_XYZ    ? "x,y,z"
+                        : kind == COL_WIRE ? "L1,L2,L3"
+                        : kind == COL_QUAT ? "qw,qx,qy,qz"
+                                           : "dir1..dirN";
+    return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
+                     "%s:%zu: column group %s is incomplete: missing '%s'", c->rd.path,
+                     c->header_line, group, col_name((csv_col){kind, first_missing}, nb));
+}
+
+static int parse_header(csv_ctx *c, dhcal_dataset *data)
+{
+    const char *const path = c->rd.path;
+    const size_t line = c->rd.line_no;
+    c->header_line = line;
+    const size_t n = split_fields(c->rd.buf, c->rd.len, &c->spans, &c->spans_cap);
+    if (n == 0U) {
+        return dhcal_error_set(c->rd.err, DHCAL_IO_FAILED, "%s:%zu: out of memory", path, line);
+    }
+    size_t seen[COL_KIND_COUNT][SEEN_WIDTH] = {{0U}};
+    char sb[DHCAL_QUOTE_CAP];
+    for (size_t k = 0U; k < n; ++k) {
+        const span f = c->spans[k];
+        if (f.n == 0U) {
+            return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
+                             "%s:%zu: header column %zu has no name", path, line, k + 1U);
+        }
+        csv_col col = {COL_Q, 0U};
+        size_t beyond = 0U;
+        const int cls = classify(f.s, c->n_joints, &col, &beyond);
+        if (cls < 0) {
+            return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
+                             "%s:%zu: column '%s' is beyond the model's %zu joints", path, line,
+                             dhcal_quote(f.s, f.n, sb), c->n_joints);
+        }
+        if (cls == 0) {
+            return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
+                             "%s:%zu: unknown column '%s' (known: q1..q%zu, x,y,z, L1,L2,L3, "
+                             "qw,qx,qy,qz, dir1..dir%zu, temp_c, t_s)",
+                             path, line, dhcal_quote(f.s, f.n, sb), c->n_joints, c->n_joints);
+        }
+        size_t *const slot = &seen[col.kind][col.idx];
+        if (*slot != 0U) {
+            return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
+                             "%s:%zu: column '%s' repeated (columns %zu and %zu)", path, line,
+                             dhcal_quote(f.s, f.n, sb), *slot, k + 1U);
+        }
+        *slot = k + 1U;
+        /* Cannot overflow: every column is distinct, CSV_MAX_COLS counts them all. */
+        c->cols[c->n_cols++] = col;
+    }
+    for (size_t j = 0U; j < c->n_joints; ++j) {
+        if (seen[COL_Q][j] == 0U) {
+            return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
+                             "%s:%zu: missing column 'q%zu' (the model has %zu joints)", path,
+                             line, j + 1U, c->n_joints);
+        }
+    }
+    int rc = check_group(c, seen[COL_XYZ], 3U, COL_XYZ, &data->has_xyz);
+    if (rc == DHCAL_IO_OK) {
+        rc = check_group(c, seen[COL_WIRE], 3U, COL_WIRE, &data->has_wires);
+    }
+    if (rc == DHCAL_IO_OK) {
+        rc = check_group(c, seen[COL_QUAT], 4U, COL_QUAT, &data->has_quat);
+    }
+    if (rc == DHCAL_IO_OK) {
+        rc = check_group(c, seen[COL_DIR], c->n_joints, COL_DIR, &data->has_dir);
+    }
+    if (rc != DHCAL_IO_OK) {
+        return rc;
+    }
+    if (!data->has_xyz && !data->has_wires) {
+        return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
+                         "%s:%zu: no position columns: need x,y,z or L1,L2,L3", path, line);
+    }
+    data->has_temp = seen[COL_TEMP][0] != 0U;
+    data->has_time = seen[COL_TIME][0] != 0U;
+    c->has_quat = data->has_quat;
+    return DHCAL_IO_OK;
+}
+
+/* ------------------------------------------------------------------ CSV: values */
+
+static int is_digit(char ch)
+{
+    return ch >= '0' && ch <= '9';
+}
+
+/* Decimal number syntax: [+-] (digits [. digits*] | . digits) [(e|E) [+-] digits]. */
+static int is_decimal(const char *s)
+{
+    size_t digits = 0U;
+    if (*s == '+' || *s == '-') {
+        ++s;
+    }
+    for (; is_digit(*s); ++s) {
+        ++digits;
+    }
+    if (*s == '.') {
+        for (++s; is_digit(*s); ++s) {
+            ++digits;
+        }
+    }
+    if (digits == 0U) {
+        return 0;
+    }
+    if (*s == 'e' || *s == 'E') {
+        ++s;
+        if (*s == '+' || *s == '-') {
+            ++s;
+        }
+        if (!is_digit(*s)) {
+            return 0;
+        }
+        while (is_digit(*s)) {
+            ++s;
+        }
+    }
+    return *s == '\0';
+}
+
+/* A trimmed field (NUL-terminated by split_fields) to a finite double. */
+static int parse_value(csv_ctx *c, csv_col col, span f, double *out)
+{
+    char nb[16];
+    char sb[DHCAL_QUOTE_CAP];
+    const char *const name = col_name(col, nb);
+    if (f.n == 0U) {
+        return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT, "%s:%zu: column '%s': empty field",
+                         c->rd.path, c->rd.line_no, name);
+    }
+    char *end = NULL;
+    const double v = strtod(f.s, &end);
+    const int whole = end == f.s + f.n;
+    if (whole && !isfinite(v)) {
+        /* "nan", "inf", "1e999": strtod takes them all, the data cannot. */
+        return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
+                         "%s:%zu: column '%s': \"%s\" is not a finite number", c->rd.path,
+                         c->rd.line_no, name, dhcal_quote(f.s, f.n, sb));
+    }
+    if (!whole || !is_decimal(f.s)) {
+        return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
+                         "%s:%zu: column '%s': \"%s\" is not a number", c->rd.path,
+                         c->rd.line_no, name, dhcal_quote(f.s, f.n, sb));
+    }
+    *out = v;
+    return DHCAL_IO_OK;
+}
+
+static int out_of_range(csv_ctx *c, csv_col col, span f, const char *range)
+{
+    char nb[16];
+    char sb[DHCAL_QUOTE_CAP];
+    return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT, "%s:%zu: column '%s': %s is outside %s",
+                     c->rd.path, c->rd.line_no, col_name(col, nb), dhcal_quote(f.s, f.n, sb), range);
+}
+
+static int parse_row(csv_ctx *c, dhcal_row *row)
+{
+    const size_t n = split_fields(c->rd.buf, c->rd.len, &c->spans, &c->spans_cap);
+    if (n == 0U) {
+        return dhcal_error_set(c->rd.err, DHCAL_IO_FAILED, "%s:%zu: out of memory", c->rd.path,
+                         c->rd.line_no);
+    }
+    if (n != c->n_cols) {
+        return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
+                         "%s:%zu: %zu fields, but the header (line %zu) has %zu columns",
+                         c->rd.path, c->rd.line_no, n, c->header_line, c->n_cols);
+    }
+    memset(row, 0, sizeof *row);
+    row->line = c->rd.line_no;
+    for (size_t k = 0U; k < n; ++k) {
+        const csv_col col = c->cols[k];
+        const span f = c->spans[k];
+        double v = 0.0;
+        const int rc = parse_value(c, col, f, &v);
+        if (rc != DHCAL_IO_OK) {
+            return rc;
+        }
+        switch (col.kind) {
+        case COL_Q:
+            if (v < -CSV_Q_MAX_DEG || v > CSV_Q_MAX_DEG) {
+                return out_of_range(c, col, f, "[-720, 720] deg");
+            }
+            row->q_rad[col.idx] = v * DHC_DEG;
+            break;
+        case COL_XYZ:
+            if (v < -LEN_MAX_MM || v > LEN_MAX_MM) {
+                return out_of_range(c, col, f, "[-1e5, 1e5] mm");
+            }
+            row->xyz_mm[col.idx] = v;
+            break;
+        case COL_WIRE:
+            if (!(v > 0.0) || v > LEN_MAX_MM) {
+                return out_of_range(c, col, f, "(0, 1e5] mm");
+            }
+            row->wires_mm[col.idx] = v;
+            break;
+        case COL_QUAT:
+            row->quat[col.idx] = v;
+            break;
+        case COL_DIR:
+            /* Exactly -1 or +1; written as two comparisons because of -Wfloat-equal. */
+            if (!((v >= 1.0 && v <= 1.0) || (v >= -1.0 && v <= -1.0))) {
+                char nb[16];
+                char sb[DHCAL_QUOTE_CAP];
+                return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
+                                 "%s:%zu: column '%s': %s is not -1 or +1", c->rd.path,
+                                 c->rd.line_no, col_name(col, nb), dhcal_quote(f.s, f.n, sb));
+            }
+            row->dir[col.idx] = v > 0.0 ? 1 : -1;
+            break;
+        case COL_TIME:
+            if (v < -TIME_MAX_S || v > TIME_MAX_S) {
+                return out_of_range(c, col, f, "[-1e9, 1e9] s");
+            }
+            row->t_s = v;
+            break;
+        case COL_TEMP:
+        case COL_KIND_COUNT:
+        default:
+            if (v < TEMP_MIN_C || v > TEMP_MAX_C) {
+                return out_of_range(c, col, f, "[-60, 150] degC");
+            }
+            row->temp_c = v;
+            break;
+        }
+    }
+    if (c->has_quat) {
+        /* Each component is finite, but their squares may overflow: the norm then is inf
+         * and fails the test like any other wrong norm. */
+        const double norm = sqrt(row->quat[0] * row->quat[0] + row->quat[1] * row->quat[1] +
+                                 row->quat[2] * row->quat[2] + row->quat[3] * row->quat[3]);
+        if (!(fabs(norm - 1.0) <= UNIT_NORM_TOL)) {
+            return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
+                             "%s:%zu: quaternion qw,qx,qy,qz has norm %.6g, not 1 "
+                             "(tolerance 1e-3)",
+                             c->rd.path, c->rd.line_no, norm);
+        }
+        for (size_t i = 0U; i < 4U; ++i) {
+            row->quat[i] /= norm;
+        }
+    }
+    return DHCAL_IO_OK;
+}
+
+static int push_row(dhcal_dataset *data, size_t *cap, dhcal_row **slot)
+{
+    if (data->n_rows == *cap) {
+        const size_t grown_cap = *cap == 0U ? 64U : *cap * 2U;
+        if (grown_cap > SIZE_MAX / sizeof *data->rows) {
+            return 0;
+        }
+        dhcal_row *const grown = realloc(data->rows, grown_cap * sizeof *data->rows);
+        if (grown == NULL) {
+            return 0;
+        }
+        data->rows = grown;
+        *cap = grown_cap;
+    }
+    *slot = &data->rows[data->n_rows];
+    return 1;
+}
+
+static int csv_read_all(csv_ctx *c, dhcal_dataset *data)
+{
+    int got = 0;
+    int rc;
+    size_t rows_cap = 0U;
+    int have_header = 0;
+    while ((rc = next_line(&c->rd, &got)) == DHCAL_IO_OK && got) {
+        if (is_skipped(c->rd.buf)) {
+            continue;
+        }
+        if (!have_header) {
+            rc = parse_header(c, data);
+            if (rc != DHCAL_IO_OK) {
+                return rc;
+            }
+            have_header = 1;
+            continue;
+        }
+        dhcal_row *row = NULL;
+        if (!push_row(data, &rows_cap, &row)) {
+            return dhcal_error_set(c->rd.err, DHCAL_IO_FAILED, "%s:%zu: out of memory for %zu rows",
+                             c->rd.path, c->rd.line_no, data->n_rows + 1U);
+        }
+        rc = parse_row(c, row);
+        if (rc != DHCAL_IO_OK) {
+            return rc;
+        }
+        data->n_rows++;
+    }
+    if (rc != DHCAL_IO_OK) {
+        return rc;
+    }
+    if (!have_header) {
+        if (c->rd.line_no == 0U) {
+            return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT, "%s: empty file (no header line)",
+                             c->rd.path);
+        }
+        return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
+                         "%s:%zu: end of file before the header line (only comments or blank "
+                         "lines)",
+                         c->rd.path, c->rd.line_no);
+    }
+    if (data->n_rows == 0U) {
+        return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT, "%s:%zu: header but no data rows",
+                         c->rd.path, c->header_line);
+    }
+    return DHCAL_IO_OK;
+}
+
+int dhcal_csv_load(const char *path, size_t n_joints, dhcal_dataset *data, dhcal_error *err)
+{
+    memset(data, 0, sizeof *data);
+    if (n_joints == 0U || n_joints > DHC_MAX_JOINTS) {
+        return dhcal_error_set(err, DHCAL_IO_FAILED, "%s: joint count %zu outside 1..%u", path,
+                         n_joints, DHC_MAX_JOINTS);
+    }
+    csv_ctx *const c = calloc(1U, sizeof *c);
+    if (c == NULL) {
+        return dhcal_error_set(err, DHCAL_IO_FAILED, "%s: out of memory", path);
+    }
+    c->rd.path = path;
+    c->rd.err = err;
+    c->n_joints = n_joints;
+    c->rd.f = fopen(path, "rb");
+    const int open_errno = errno;
+    /* The first line may be empty: the buffer must hold its terminator from the start. */
+    c->rd.cap = 256U;
+    c->rd.buf = calloc(c->rd.cap, 1U);
+    int rc;
+    if (c->rd.buf == NULL) {
+        rc = dhcal_error_set(err, DHCAL_IO_FAILED, "%s: out of memory", path);
+        if (c->rd.f != NULL) {
+            (void)fclose(c->rd.f);
+        }
+    } else if (c->rd.f == NULL) {
+        rc = dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s: cannot open: %s", path,
+                       strerror(open_errno));
+    } else {
+        data->n_joints = n_joints;
+        rc = csv_read_all(c, data);
+        (void)fclose(c->rd.f);
+    }
+    free(c->rd.buf);
+    free(c->spans);
+    free(c);
+    if (rc != DHCAL_IO_OK) {
+        dhcal_dataset_free(data);
+    }
+    return rc;
+}
+
+void dhcal_dataset_free(dhcal_dataset *data)
+{
+    if (data == NULL) {
+        return;
+    }
+    free(data->rows);
+    memset(data, 0, sizeof *data);
+}

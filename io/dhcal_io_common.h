@@ -1,0 +1,39 @@
+/* dhcal_io_common.h - what the file layer's readers and writers share (private to io/). */
+#ifndef DHCAL_IO_COMMON_H
+#define DHCAL_IO_COMMON_H
+
+#include <stddef.h>
+
+#include "dhcal/dhc_linalg.h"
+#include "dhcal_error.h"
+
+/* Value ranges of the file formats (docs/formats.md), shared by the model file and the CSV. */
+#define LEN_MAX_MM 1e5
+#define UNIT_NORM_TOL 1e-3
+
+#if defined(__GNUC__)
+#define IO_PRINTF(fmt_index, first_arg) __attribute__((format(printf, fmt_index, first_arg)))
+#else
+#define IO_PRINTF(fmt_index, first_arg)
+#endif
+
+/* Writes the message into err and returns code. */
+int dhcal_error_set(dhcal_error *err, int code, const char *fmt, ...) IO_PRINTF(3, 4);
+
+/* Quoted text from a file, for a message: at most DHCAL_QUOTE_MAX bytes, bytes outside
+ * printable ASCII as \xNN, so that garbage and megabyte fields cannot flood or corrupt a
+ * terminal. Returns out. */
+#define DHCAL_QUOTE_MAX 40U
+#define DHCAL_QUOTE_CAP (4U * DHCAL_QUOTE_MAX + 8U)
+const char *dhcal_quote(const char *s, size_t n, char out[DHCAL_QUOTE_CAP]);
+
+/* a == b for the finite values used here, spelled without == because of -Wfloat-equal. */
+static inline int same_double(double a, double b)
+{
+    return !(a < b) && !(a > b);
+}
+
+/* 1 and the index of name among names[0..n-1] in *idx when it is there, else 0. */
+int dhcal_find_name(const char *name, const char *const *names, size_t n, size_t *idx);
+
+#endif /* DHCAL_IO_COMMON_H */
