@@ -1147,8 +1147,8 @@ static int cmd_plot(const options *o, session *s)
             printf("RMS before %.4f mm, after %s %.4f mm\n", es_b.rms_mm, label[0] != '\0' ? label : "(no effect named)", es_a.rms_mm);
         } else {
             cJSON *obj = cJSON_CreateObject();
-            cJSON_AddNumberToObject(obj, "es_b.rms_mmefore_mm", es_b.rms_mm);
-            cJSON_AddNumberToObject(obj, "es_a.rms_mmfter_mm", es_a.rms_mm);
+            cJSON_AddNumberToObject(obj, "rms_before_mm", es_b.rms_mm);
+            cJSON_AddNumberToObject(obj, "rms_after_mm", es_a.rms_mm);
             cJSON_AddStringToObject(obj, "effect", label);
             cJSON *files = cJSON_AddArrayToObject(obj, "files");
             const char *names[4] = {"residuals.svg", "joints.svg", "errors.svg", "candidates.svg"};
