@@ -166,6 +166,11 @@ static int base_has_effect(const dhc_param_set *base, dhc_effect e, size_t joint
     return 0;
 }
 
+static double covariate_of(const dhc_sample *smp, dhc_covariate which)
+{
+    return which == DHC_COVARIATE_TIME ? smp->t_s : smp->temp_c;
+}
+
 dhc_status dhc_covariate_pose_r2(size_t n_joints, dhc_covariate which, dhc_sample_reader read,
                                  void *ctx, size_t n, const uint8_t *flags, dhc_normal_eq *ne,
                                  dhc_lsq_factor *fac, double *r2)
@@ -187,7 +192,7 @@ dhc_status dhc_covariate_pose_r2(size_t n_joints, dhc_covariate which, dhc_sampl
         if (st != DHC_OK) {
             return st;
         }
-        const double c = which == DHC_COVARIATE_TIME ? smp.t_s : smp.temp_c;
+        const double c = covariate_of(&smp, which);
         if (!dhc_is_finite(c)) {
             return DHC_ERR_NONFINITE;
         }
@@ -215,7 +220,7 @@ dhc_status dhc_covariate_pose_r2(size_t n_joints, dhc_covariate which, dhc_sampl
                 row[1U + 2U * j] = sin(smp.q_rad[j]);
                 row[2U + 2U * j] = cos(smp.q_rad[j]);
             }
-            const double r = (which == DHC_COVARIATE_TIME ? smp.t_s : smp.temp_c) - mean;
+            const double r = covariate_of(&smp, which) - mean;
             st = dhc_normal_eq_add(ne, &jac, &r, NULL, 1U);
         }
     }
