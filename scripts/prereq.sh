@@ -120,8 +120,18 @@ probe_demo() {
   probe_build_tools && probe_host_c && probe_cjson && probe_pip
 }
 
+# The installed package is used from C++ (tests/install): g++ compiles, links and runs.
+probe_host_cxx() {
+  prereq_cmd c++ || return 1
+  printf '%s\n' '#include <cmath>' '#include <string>' \
+    'int main() { std::string s("dhcal"); return std::sqrt(4.0) == 2.0 && s.size() == 5 ? 0 : 1; }' >x.cpp
+  c++ -std=c++17 -o x x.cpp >log 2>&1 || prereq_fail "c++ cannot link C++: $(tail -3 log)" ||
+    return 1
+  ./x || prereq_fail "c++'s program did not run"
+}
+
 probe_host() {
-  probe_demo
+  probe_demo && probe_host_cxx
 }
 
 probe_static() {

@@ -9,6 +9,7 @@ Usage: test_cli.py --dhcal PATH [--wrapper 'CMD ARGS']
 """
 import json
 import os
+import re
 import shlex
 import shutil
 import subprocess
@@ -149,6 +150,38 @@ class Cli(unittest.TestCase):
                      ['fit', '--model', self.model, '--data', self.data, '--effects',
                       'joint_scale:9']):
             self.assertEqual(self.run_dhcal(*args).returncode, 2, args)
+
+    def test_usage_errors_name_the_option(self):
+        base = ['fit', '--model', self.model, '--data', self.data]
+        for args, words in ((base + ['--out'], ("'--out' needs a value",)),
+                            (base + ['--model', self.model], ("'--model' given twice",)),
+                            (base + ['stray'], ("unexpected argument 'stray'",)),
+                            (base + ['--cv=yes'], ("unknown option '--cv=yes'",))):
+            r = self.run_dhcal(*args)
+            self.assertEqual(r.returncode, 2, args)
+            for w in words:
+                self.assertIn(w, r.stderr, args)
+            self.assertIn('usage: dhcal', r.stderr, args)
+
+    def test_option_value_after_an_equals_sign(self):
+        spaced = self.run_dhcal('compare', '--model', self.model, '--data', self.data, '--json')
+        joined = self.run_dhcal('compare', '--model=' + self.model, '--data=' + self.data,
+                                '--json')
+        self.assertEqual(spaced.returncode, 0, spaced.stderr)
+        self.assertEqual(joined.returncode, 0, joined.stderr)
+        self.assertEqual(json.loads(joined.stdout)['rms_mm'],
+                         json.loads(spaced.stdout)['rms_mm'])
+
+    def test_version_is_the_library_header_s(self):
+        header = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'lib',
+                              'include', 'dhcal', 'dhc_version.h')
+        with open(header) as f:
+            parts = {k: v for k, v in re.findall(r'#define DHCAL_VERSION_(MAJOR|MINOR|PATCH) (\d+)',
+                                                f.read())}
+        r = self.run_dhcal('--version')
+        self.assertEqual(r.returncode, 0)
+        self.assertEqual(r.stdout.strip(),
+                         'dhcal %s.%s.%s' % (parts['MAJOR'], parts['MINOR'], parts['PATCH']))
 
     def test_bad_noise_models_exit_2_and_leave_out_untouched(self):
         for bad in ('0.001', 'x,0.01', '0.001,0', '0.001,-1', '-0.001,0.01', '2,0.01',

@@ -5,11 +5,13 @@
 #endif
 
 #include <cjson/cJSON.h>
+#include <getopt.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "dhcal/dhc_version.h"
 #include "dhcal_analysis.h"
 #include "dhcal_data.h"
 #include "dhcal_io.h"
@@ -62,7 +64,7 @@ static const char *const usage_text =
     "  diagnose   fit, then rank the physical effects the model still misses\n"
     "  refine     the loop compare -> diagnose -> add -> refit, chosen by cross-validation\n"
     "  plot       residual and error plots (SVG) of a fit and its diagnosis\n"
-    "'dhcal <command> --help' describes each.\n"
+    "'dhcal <command> --help' describes each; 'dhcal --version' prints the version.\n"
     "exit codes: 0 success, 1 computation failed, 2 bad input or usage\n";
 
 static void print_command_help(const char *command)
@@ -132,51 +134,64 @@ static int parse_args(int argc, char **argv, options *o)
         fputs(usage_text, stdout);
         return -1;
     }
-    for (int i = 2; i < argc; ++i) {
-        const char *a = argv[i];
+    if (strcmp(o->command, "--version") == 0) {
+        printf("dhcal %s\n", DHCAL_VERSION_STRING);
+        return -1;
+    }
+    enum { OPT_JSON = 1, OPT_CV, OPT_HELP, OPT_MODEL, OPT_DATA, OPT_HELDOUT, OPT_OUT,
+           OPT_EFFECTS, OPT_NOISE, OPT_GEOMETRY };
+    static const struct option long_options[] = {
+        {"json", no_argument, NULL, OPT_JSON},
+        {"cv", no_argument, NULL, OPT_CV},
+        {"help", no_argument, NULL, OPT_HELP},
+        {"model", required_argument, NULL, OPT_MODEL},
+        {"data", required_argument, NULL, OPT_DATA},
+        {"heldout", required_argument, NULL, OPT_HELDOUT},
+        {"out", required_argument, NULL, OPT_OUT},
+        {"effects", required_argument, NULL, OPT_EFFECTS},
+        {"noise", required_argument, NULL, OPT_NOISE},
+        {"geometry", required_argument, NULL, OPT_GEOMETRY},
+        {NULL, 0, NULL, 0}};
+    /* The command stands where getopt expects the program's name. Errors are ours
+     * (opterr 0, ':' first): they name the option and end with the usage. */
+    opterr = 0;
+    optind = 1;
+    char **args = argv + 1;
+    const int n_args = argc - 1;
+    int c;
+    while ((c = getopt_long(n_args, args, ":h", long_options, NULL)) != -1) {
+        const char *given = args[optind - 1];
+        char msg[300];
         const char **slot = NULL;
-        if (strcmp(a, "--json") == 0) {
-            o->json = 1;
-            continue;
-        }
-        if (strcmp(a, "--cv") == 0) {
-            o->cv = 1;
-            continue;
-        }
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            print_command_help(o->command);
-            return -1;
-        }
-        if (strcmp(a, "--model") == 0) {
-            slot = &o->model;
-        } else if (strcmp(a, "--data") == 0) {
-            slot = &o->data;
-        } else if (strcmp(a, "--heldout") == 0) {
-            slot = &o->heldout;
-        } else if (strcmp(a, "--out") == 0) {
-            slot = &o->out;
-        } else if (strcmp(a, "--effects") == 0) {
-            slot = &o->effects;
-        } else if (strcmp(a, "--noise") == 0) {
-            slot = &o->noise;
-        } else if (strcmp(a, "--geometry") == 0) {
-            slot = &o->geometry;
-        } else {
-            char msg[300];
-            snprintf(msg, sizeof msg, "unknown option '%.200s'", a);
+        switch (c) {
+        case OPT_JSON: o->json = 1; continue;
+        case OPT_CV: o->cv = 1; continue;
+        case 'h':
+        case OPT_HELP: print_command_help(o->command); return -1;
+        case OPT_MODEL: slot = &o->model; break;
+        case OPT_DATA: slot = &o->data; break;
+        case OPT_HELDOUT: slot = &o->heldout; break;
+        case OPT_OUT: slot = &o->out; break;
+        case OPT_EFFECTS: slot = &o->effects; break;
+        case OPT_NOISE: slot = &o->noise; break;
+        case OPT_GEOMETRY: slot = &o->geometry; break;
+        case ':':
+            snprintf(msg, sizeof msg, "option '%.200s' needs a value", given);
             return usage_error(msg);
-        }
-        if (i + 1 >= argc) {
-            char msg[300];
-            snprintf(msg, sizeof msg, "option '%s' needs a value", a);
+        default:
+            snprintf(msg, sizeof msg, "unknown option '%.200s'", given);
             return usage_error(msg);
         }
         if (*slot != NULL) {
-            char msg[300];
-            snprintf(msg, sizeof msg, "option '%s' given twice", a);
+            snprintf(msg, sizeof msg, "option '--%s' given twice", long_options[c - 1].name);
             return usage_error(msg);
         }
-        *slot = argv[++i];
+        *slot = optarg;
+    }
+    if (optind < n_args) {
+        char msg[300];
+        snprintf(msg, sizeof msg, "unexpected argument '%.200s'", args[optind]);
+        return usage_error(msg);
     }
     const char *known[5] = {"compare", "fit", "diagnose", "plot", "refine"};
     int ok = 0;

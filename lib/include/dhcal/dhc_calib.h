@@ -26,6 +26,10 @@
 #include "dhc_params.h"
 #include "dhc_status.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* Fills *out with measurement `index` (0-based, < n). Any status other than DHC_OK aborts
  * the fit with that status. */
 typedef dhc_status (*dhc_sample_reader)(void *ctx, size_t index, dhc_sample *out);
@@ -188,5 +192,9 @@ dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_sample *s,
 dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_reader read,
                          void *ctx, size_t n, uint8_t *flags, const dhc_calib_options *opt,
                          dhc_calib_workspace *ws, dhc_calib_report *rep);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* DHC_CALIB_H */

@@ -27,6 +27,10 @@
 #include "dhc_params.h"
 #include "dhc_status.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 #ifndef DHC_MAX_CANDIDATES
 #define DHC_MAX_CANDIDATES 64U
 #endif
@@ -160,5 +164,9 @@ double dhc_chi2_log10_sf(double chi2, size_t dof);
  * lack-of-fit test against replicated measurements (regularized incomplete beta by its
  * continued fraction, in logs). d1, d2 >= 1, f >= 0; 0 for f <= 0. */
 double dhc_f_log10_sf(double f, size_t d1, size_t d2);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* DHC_DIAGNOSE_H */

@@ -29,6 +29,10 @@
 #include "dhc_params.h"
 #include "dhc_status.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* jac must be (3 or 6) x set->count; every parameter must be geometric (theta..tool_z).
  * tool_world_mm / tool_rot (may be NULL) receive the tool point and last-link orientation.
  * DHC_ERR_DIMENSION for a wrong jac shape or q_len < n_joints; DHC_ERR_NONFINITE for a
@@ -61,5 +65,9 @@ dhc_status dhc_joint_jacobian(const dhc_arm *arm, const double *q_rad, size_t q_
 dhc_status dhc_model_linearize(const dhc_model *model, const dhc_param_set *set,
                                const dhc_sample *s, double weight_mm_per_rad,
                                double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows, dhc_mat *jac);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* DHC_JACOBIAN_H */

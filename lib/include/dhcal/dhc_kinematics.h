@@ -20,6 +20,10 @@
 #include "dhc_linalg.h"
 #include "dhc_status.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef enum {
     DHC_CONV_DH = 0,    /* parameters theta, d, a, alpha */
     DHC_CONV_HAYATI = 1 /* parameters theta, a, alpha, beta; d fixed */
@@ -82,5 +86,9 @@ dhc_status dhc_forward(const dhc_arm *arm, const double *q_rad, size_t q_len, dh
  * Axes that are exactly parallel have no unique common normal: DHC_ERR_SINGULAR then. The
  * base frame is kept; a change of frame 0 about/along axis 1 is folded into joint 1. */
 dhc_status dhc_arm_to_standard_dh(const dhc_arm *arm, dhc_arm *out);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* DHC_KINEMATICS_H */

@@ -31,6 +31,10 @@
 #include "dhc_config.h"
 #include "dhc_status.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* pi and one degree in radians: files and people speak degrees, the library radians. */
 #define DHC_PI 3.14159265358979323846
 #define DHC_DEG (DHC_PI / 180.0)
@@ -162,5 +166,9 @@ double dhc_chol_condition_estimate(const dhc_mat *l, size_t k);
 
 /* 1 when x is finite (not NaN, not infinite). Works under -ffast-math free builds. */
 int dhc_is_finite(double x);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* DHC_LINALG_H */

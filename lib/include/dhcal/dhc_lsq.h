@@ -24,6 +24,10 @@
 #include "dhc_linalg.h"
 #include "dhc_status.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* A column whose diagonal (sum of squares) is at or below this is zero to the analysis:
  * its products are subnormal, where the sums keep too few digits for a scaled rank test
  * (a pair of such columns can look indefinite). DBL_MIN / DBL_EPSILON ~ 1e-292: far below
@@ -125,5 +129,9 @@ dhc_status dhc_lsq_prediction_variance(const dhc_lsq_factor *fac, double sigma2,
  * DHC_ERR_DIMENSION (fac->n != ne->n, len < n). O(r^2), one n-double stack array. */
 dhc_status dhc_lsq_confounded(const dhc_normal_eq *ne, const dhc_lsq_factor *fac, size_t j,
                               uint8_t *partner, size_t len, size_t *count);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* DHC_LSQ_H */

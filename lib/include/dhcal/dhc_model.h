@@ -30,6 +30,10 @@
 #include "dhc_linalg.h"
 #include "dhc_status.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 /* Highest order of a joint harmonic (joint_harmonic2 .. joint_harmonic4). */
 #define DHC_HARMONIC_MAX_ORDER 4U
 
@@ -168,5 +172,9 @@ dhc_status dhc_model_residual_of(const dhc_sample *s, const dhc_prediction *pred
  * errors of 1e-8 rad or less, are left unchanged. r as dhc_model_residual gives it. */
 void dhc_model_residual_slope(const dhc_sample *s, const double *r, double weight_mm_per_rad,
                               dhc_mat *jac);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* DHC_MODEL_H */

@@ -17,6 +17,10 @@
 #include "dhc_model.h"
 #include "dhc_status.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef enum {
     DHC_P_THETA = 0, /* joint offset theta_offset_i, rad */
     DHC_P_D,         /* d_i, mm */
@@ -124,5 +128,9 @@ size_t dhc_params_name(const dhc_param_set *set, size_t k, char *buf, size_t cap
 
 /* 1 when the parameter is an angle (front ends show degrees), 0 otherwise. */
 int dhc_params_is_angle(const dhc_param_set *set, size_t k);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* DHC_PARAMS_H */

@@ -2,6 +2,10 @@
 #ifndef DHC_STATUS_H
 #define DHC_STATUS_H
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef enum {
     DHC_OK = 0,
     DHC_ERR_ARGUMENT,       /* a NULL pointer or an argument outside its documented range */
@@ -18,5 +22,9 @@ typedef enum {
 
 /* A short constant English phrase for a status ("ok", "singular", ...). Never NULL. */
 const char *dhc_status_str(dhc_status status);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* DHC_STATUS_H */

@@ -17,6 +17,10 @@
 #include "dhc_linalg.h"
 #include "dhc_status.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef struct {
     double a_mm; /* height of P1 */
     double b_mm; /* half spacing of P2, P3 */
@@ -46,5 +50,9 @@ dhc_status dhc_trilat_world(const dhc_measurer *m, const double len_mm[3], doubl
 /* Wire lengths from a world point (the forward model the measurer calibration uses).
  * Total on finite inputs; no status. O(1). */
 void dhc_trilat_lengths(const dhc_measurer *m, const double q_world_mm[3], double len_mm[3]);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* DHC_TRILAT_H */

@@ -1,0 +1,21 @@
+/* dhcal.h - the numeric core in one include: kinematics, the identification Jacobian,
+ * streaming least squares, calibration, diagnosis and trilateration, with the version.
+ * C and C++ hosts alike (each header declares its functions extern "C" for C++). */
+#ifndef DHCAL_H
+#define DHCAL_H
+
+#include "dhc_version.h"
+
+#include "dhc_calib.h"
+#include "dhc_config.h"
+#include "dhc_diagnose.h"
+#include "dhc_jacobian.h"
+#include "dhc_kinematics.h"
+#include "dhc_linalg.h"
+#include "dhc_lsq.h"
+#include "dhc_model.h"
+#include "dhc_params.h"
+#include "dhc_status.h"
+#include "dhc_trilat.h"
+
+#endif /* DHCAL_H */

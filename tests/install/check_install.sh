@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# check_install.sh BUILD_DIR VERSION: installs the build into a fresh prefix, then builds and
+# runs tests/install/consumer against it twice: as a CMake project of its own
+# (find_package(dhcal CONFIG), dhcal::dhcal) and with pkg-config (dhcal.pc). Nothing of the
+# dhcal tree is on either include path: only the installed files.
+set -euo pipefail
+build=$1
+version=$2
+here=$(cd "$(dirname "$0")" && pwd)
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+prefix=$work/prefix
+
+cmake --install "$build" --prefix "$prefix" >"$work/install.log"
+for f in include/dhcal/dhcal.h include/dhcal/dhc_version.h; do
+  [ -f "$prefix/$f" ] || { echo "FAIL: $f not installed"; exit 1; }
+done
+lib=$(find "$prefix" -name libdhcal.a | head -1)
+[ -n "$lib" ] || { echo "FAIL: libdhcal.a not installed"; exit 1; }
+echo "installed: ${lib#"$prefix"/}"
+got=$("$prefix/bin/dhcal" --version)
+[ "$got" = "dhcal $version" ] || { echo "FAIL: installed dhcal --version says '$got'"; exit 1; }
+echo "installed: bin/dhcal ($got)"
+
+echo "--- find_package(dhcal CONFIG)"
+cmake -S "$here/consumer" -B "$work/consumer" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+      -DCMAKE_PREFIX_PATH="$prefix" -DDHCAL_EXPECTED_VERSION="$version" >"$work/configure.log" \
+  || { cat "$work/configure.log"; exit 1; }
+cmake --build "$work/consumer" >"$work/build.log" || { cat "$work/build.log"; exit 1; }
+"$work/consumer/consumer"
+
+echo "--- pkg-config --cflags --libs dhcal"
+pcdir=$(dirname "$(find "$prefix" -name dhcal.pc | head -1)")
+got=$(PKG_CONFIG_PATH=$pcdir pkg-config --modversion dhcal)
+[ "$got" = "$version" ] || { echo "FAIL: pkg-config says version $got, the tree $version"; exit 1; }
+# shellcheck disable=SC2046 # the flags are words
+c++ -std=c++17 -Wall -Wextra -Werror -pedantic -DEXPECTED_VERSION="\"$version\"" \
+    "$here/consumer/consumer.cpp" -o "$work/consumer-pc" \
+    $(PKG_CONFIG_PATH=$pcdir pkg-config --cflags --libs dhcal)
+"$work/consumer-pc"
