@@ -15,6 +15,16 @@ cmake --install "$build" --prefix "$prefix" >"$work/install.log"
 for f in include/dhcal/dhcal.h include/dhcal/dhc_version.h; do
   [ -f "$prefix/$f" ] || { echo "FAIL: $f not installed"; exit 1; }
 done
+# Every public header is reachable from dhcal.h, and every one that declares functions
+# declares them extern "C" for C++ hosts.
+for h in "$prefix"/include/dhcal/*.h; do
+  name=$(basename "$h")
+  case $name in dhcal.h) continue ;; esac
+  grep -q "#include \"$name\"" "$prefix/include/dhcal/dhcal.h" ||
+    { echo "FAIL: dhcal.h does not include $name"; exit 1; }
+  case $name in dhc_config.h | dhc_version.h) continue ;; esac
+  grep -q 'extern "C"' "$h" || { echo "FAIL: $name has no extern \"C\" block"; exit 1; }
+done
 lib=$(find "$prefix" -name libdhcal.a | head -1)
 [ -n "$lib" ] || { echo "FAIL: libdhcal.a not installed"; exit 1; }
 echo "installed: ${lib#"$prefix"/}"
