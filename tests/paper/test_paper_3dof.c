@@ -2,54 +2,31 @@
  * position only, 3 and 10 poses) and the identifiability of the built arm (Table 3). */
 #include <math.h>
 
-#include "dhc_test_arms.h"
-#include "dhc_test_samples.h"
+#include "dhc_test_paper.h"
 #include "dhcal/dhc_calib.h"
 #include "unity.h"
 
 void setUp(void) {}
 void tearDown(void) {}
 
-static test_dataset data;
-static dhc_calib_workspace ws;
-static dhc_calib_report rep;
-static dhc_param_set set;
-
-static void paper_arms(dhc_arm *truth, dhc_arm *nominal)
-{
-    test_arm_from_table(truth, TEST_TABLE1, 3U, TEST_PAPER_OFFSET_DEG);
-    test_arm_from_table(nominal, TEST_TABLE2, 3U, 0.0);
-    dhc_arm_choose_conventions(nominal, 1e-3);
-}
+static test_paper_fit paper;
 
 static dhc_status calibrate(dhc_arm *arm, size_t poses, uint64_t seed)
 {
-    dhc_arm truth;
-    dhc_arm nominal;
-    paper_arms(&truth, &nominal);
-    test_rng rng = {seed};
-    test_measure(&data, &truth, poses, DHC_MEAS_POSITION, &rng);
-    dhc_model model = test_model_of(&nominal);
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &model));
-    dhc_calib_options opt;
-    dhc_calib_default_options(&opt);
-    const dhc_status st =
-        dhc_calib_fit(&model, &set, test_read_sample, &data, data.n, data.flags, &opt, &ws, &rep);
-    *arm = model.arm;
-    return st;
+    return test_paper_calibrate(&paper, 3U, DHC_MEAS_POSITION, poses, seed, arm);
 }
 
 static void test_ten_positions_reproduce_the_true_tool_point_everywhere(void)
 {
     dhc_arm cal;
     TEST_ASSERT_EQUAL(DHC_OK, calibrate(&cal, 10U, 0xABCDULL));
-    TEST_ASSERT_TRUE(rep.converged);
-    TEST_ASSERT_EQUAL(12U, rep.n_params);
-    TEST_ASSERT_EQUAL(11U, rep.structural_rank);
-    TEST_ASSERT_EQUAL(11U, rep.rank);
+    TEST_ASSERT_TRUE(paper.rep.converged);
+    TEST_ASSERT_EQUAL(12U, paper.rep.n_params);
+    TEST_ASSERT_EQUAL(11U, paper.rep.structural_rank);
+    TEST_ASSERT_EQUAL(11U, paper.rep.rank);
     dhc_arm truth;
     dhc_arm nominal;
-    paper_arms(&truth, &nominal);
+    test_paper_arms(3U, &truth, &nominal);
     test_rng fresh = {0x5EEDULL};
     double max_mm;
     double max_rad;
@@ -62,14 +39,14 @@ static void test_twist_of_the_last_link_is_named_unidentifiable_without_partners
     dhc_arm cal;
     TEST_ASSERT_EQUAL(DHC_OK, calibrate(&cal, 10U, 0xABCDULL));
     /* alpha3 turns the tool frame about the point it measures: no position changes. */
-    const size_t alpha3 = test_param_index(&set, DHC_P_ALPHA, 2U);
-    TEST_ASSERT_TRUE(alpha3 < set.count);
-    TEST_ASSERT_EQUAL(0, rep.identifiable[alpha3]);
-    TEST_ASSERT_EQUAL(0, rep.structurally_identifiable[alpha3]);
-    for (size_t k = 0U; k < set.count; ++k) {
-        TEST_ASSERT_EQUAL(0, rep.confounded[alpha3][k]);
+    const size_t alpha3 = test_param_index(&paper.set, DHC_P_ALPHA, 2U);
+    TEST_ASSERT_TRUE(alpha3 < paper.set.count);
+    TEST_ASSERT_EQUAL(0, paper.rep.identifiable[alpha3]);
+    TEST_ASSERT_EQUAL(0, paper.rep.structurally_identifiable[alpha3]);
+    for (size_t k = 0U; k < paper.set.count; ++k) {
+        TEST_ASSERT_EQUAL(0, paper.rep.confounded[alpha3][k]);
         if (k != alpha3) {
-            TEST_ASSERT_EQUAL(1, rep.identifiable[k]);
+            TEST_ASSERT_EQUAL(1, paper.rep.identifiable[k]);
         }
     }
     TEST_ASSERT_EQUAL_DOUBLE(0.0, cal.joint[2].alpha_rad); /* kept at nominal */
@@ -95,9 +72,9 @@ static void test_three_positions_under_determine_the_model(void)
 {
     dhc_arm cal;
     TEST_ASSERT_EQUAL(DHC_ERR_UNDERDETERMINED, calibrate(&cal, 3U, 0xABCDULL));
-    TEST_ASSERT_EQUAL(9U, rep.rows);
-    TEST_ASSERT_EQUAL(11U, rep.structural_rank);
-    TEST_ASSERT_TRUE(rep.rank < rep.structural_rank);
+    TEST_ASSERT_EQUAL(9U, paper.rep.rows);
+    TEST_ASSERT_EQUAL(11U, paper.rep.structural_rank);
+    TEST_ASSERT_TRUE(paper.rep.rank < paper.rep.structural_rank);
 }
 
 /* The built arm of Table 3 with an unknown tool point, as PHYSICS.md describes it: the
@@ -116,42 +93,45 @@ static void test_tool_point_trades_off_against_link_parameters(void)
     truth.joint[2].a_mm = 344.0;
     dhc_vec3_set(truth.tool_mm, 20.0, 5.0, -3.0);
     test_rng rng = {99ULL};
-    test_measure(&data, &truth, 40U, DHC_MEAS_POSITION, &rng);
+    test_measure(&paper.data, &truth, 40U, DHC_MEAS_POSITION, &rng);
     dhc_model model = test_model_of(&nominal);
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &model));
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(&set, &model, DHC_EFFECT_TOOL_OFFSET, 0U));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&paper.set, &model));
+    TEST_ASSERT_EQUAL(DHC_OK,
+                      dhc_params_add_effect(&paper.set, &model, DHC_EFFECT_TOOL_OFFSET, 0U));
     dhc_calib_options opt;
     dhc_calib_default_options(&opt);
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_calib_fit(&model, &set, test_read_sample, &data, data.n,
-                                            data.flags, &opt, &ws, &rep));
+    TEST_ASSERT_EQUAL(DHC_OK,
+                      dhc_calib_fit(&model, &paper.set, test_read_sample, &paper.data,
+                                    paper.data.n, paper.data.flags, &opt, &paper.ws,
+                                    &paper.rep));
     const dhc_arm cal = model.arm;
-    TEST_ASSERT_EQUAL(15U, rep.n_params);
-    TEST_ASSERT_EQUAL(rep.structural_rank, rep.rank);
+    TEST_ASSERT_EQUAL(15U, paper.rep.n_params);
+    TEST_ASSERT_EQUAL(paper.rep.structural_rank, paper.rep.rank);
     /* Counted by hand: theta1 d1 a1 alpha1 place axis 2, theta2 beta2 a2 alpha2 place axis 3
      * (8). Beyond axis 3 the tool point only traces circles about it, seen in frame 2 as a
      * radius, a phase and a height: 3 of theta3 d3 a3 alpha3 tool_x tool_y tool_z. */
-    TEST_ASSERT_EQUAL(11U, rep.rank);
+    TEST_ASSERT_EQUAL(11U, paper.rep.rank);
     for (size_t k = 0U; k < 8U; ++k) {
-        TEST_ASSERT_EQUAL(1, rep.identifiable[k]);
+        TEST_ASSERT_EQUAL(1, paper.rep.identifiable[k]);
     }
     /* Every unidentifiable one is confounded with something: none is simply inert. */
     for (size_t k = 8U; k < 15U; ++k) {
-        if (!rep.identifiable[k]) {
+        if (!paper.rep.identifiable[k]) {
             size_t partners = 0U;
             for (size_t m = 0U; m < 15U; ++m) {
-                partners += rep.confounded[k][m];
+                partners += paper.rep.confounded[k][m];
             }
             TEST_ASSERT_TRUE(partners > 0U);
         }
     }
-    const size_t a3 = test_param_index(&set, DHC_P_A, 2U);
-    const size_t tool_x = test_param_index(&set, DHC_P_TOOL_X, 0U);
+    const size_t a3 = test_param_index(&paper.set, DHC_P_A, 2U);
+    const size_t tool_x = test_param_index(&paper.set, DHC_P_TOOL_X, 0U);
     /* a3 and tool x both lengthen the last link: exactly one of them is identified, and
      * the other names it as partner. */
-    TEST_ASSERT_EQUAL(1, rep.identifiable[a3] + rep.identifiable[tool_x]);
-    const size_t lost = rep.identifiable[a3] ? tool_x : a3;
-    const size_t kept = rep.identifiable[a3] ? a3 : tool_x;
-    TEST_ASSERT_EQUAL(1, rep.confounded[lost][kept]);
+    TEST_ASSERT_EQUAL(1, paper.rep.identifiable[a3] + paper.rep.identifiable[tool_x]);
+    const size_t lost = paper.rep.identifiable[a3] ? tool_x : a3;
+    const size_t kept = paper.rep.identifiable[a3] ? a3 : tool_x;
+    TEST_ASSERT_EQUAL(1, paper.rep.confounded[lost][kept]);
     /* Whatever is identified reproduces the true tool point. */
     test_rng fresh = {7ULL};
     double max_mm;

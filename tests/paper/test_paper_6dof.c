@@ -3,55 +3,32 @@
  * noise-free, calibrated from 10 and from 2 random poses. */
 #include <math.h>
 
-#include "dhc_test_arms.h"
-#include "dhc_test_samples.h"
+#include "dhc_test_paper.h"
 #include "dhcal/dhc_calib.h"
 #include "unity.h"
 
 void setUp(void) {}
 void tearDown(void) {}
 
-static test_dataset data;
-static dhc_calib_workspace ws;
-static dhc_calib_report rep;
-static dhc_param_set set;
-
-static void paper_arms(dhc_arm *truth, dhc_arm *nominal)
-{
-    test_arm_from_table(truth, TEST_TABLE1, 6U, TEST_PAPER_OFFSET_DEG);
-    test_arm_from_table(nominal, TEST_TABLE2, 6U, 0.0);
-    dhc_arm_choose_conventions(nominal, 1e-3);
-}
+static test_paper_fit paper;
 
 static dhc_status calibrate(dhc_arm *arm, size_t poses, uint64_t seed)
 {
-    dhc_arm truth;
-    dhc_arm nominal;
-    paper_arms(&truth, &nominal);
-    test_rng rng = {seed};
-    test_measure(&data, &truth, poses, DHC_MEAS_POSE, &rng);
-    dhc_model model = test_model_of(&nominal);
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &model));
-    dhc_calib_options opt;
-    dhc_calib_default_options(&opt);
-    const dhc_status st =
-        dhc_calib_fit(&model, &set, test_read_sample, &data, data.n, data.flags, &opt, &ws, &rep);
-    *arm = model.arm;
-    return st;
+    return test_paper_calibrate(&paper, 6U, DHC_MEAS_POSE, poses, seed, arm);
 }
 
 static void test_ten_poses_reproduce_the_true_arm_everywhere(void)
 {
     dhc_arm cal;
     TEST_ASSERT_EQUAL(DHC_OK, calibrate(&cal, 10U, 0xC0FFEEULL));
-    TEST_ASSERT_TRUE(rep.converged);
-    TEST_ASSERT_EQUAL(24U, rep.n_params);
-    TEST_ASSERT_EQUAL(24U, rep.structural_rank);
-    TEST_ASSERT_EQUAL(24U, rep.rank);
-    TEST_ASSERT_EQUAL(0U, rep.outliers);
+    TEST_ASSERT_TRUE(paper.rep.converged);
+    TEST_ASSERT_EQUAL(24U, paper.rep.n_params);
+    TEST_ASSERT_EQUAL(24U, paper.rep.structural_rank);
+    TEST_ASSERT_EQUAL(24U, paper.rep.rank);
+    TEST_ASSERT_EQUAL(0U, paper.rep.outliers);
     dhc_arm truth;
     dhc_arm nominal;
-    paper_arms(&truth, &nominal);
+    test_paper_arms(6U, &truth, &nominal);
     test_rng fresh = {0xF00DULL};
     double max_mm;
     double max_rad;
@@ -73,33 +50,35 @@ static void test_parameters_identifiable_at_the_estimate_are_freed(void)
 {
     dhc_arm truth;
     dhc_arm nominal;
-    paper_arms(&truth, &nominal);
+    test_paper_arms(6U, &truth, &nominal);
     test_rng rng = {0x5EEDULL};
-    test_measure(&data, &truth, 60U, DHC_MEAS_POSITION, &rng);
+    test_measure(&paper.data, &truth, 60U, DHC_MEAS_POSITION, &rng);
     dhc_calib_options opt;
     dhc_calib_default_options(&opt);
     for (size_t checks = 0U; checks < 2U; ++checks) {
         opt.max_identifiability_checks = checks == 0U ? 0U : 3U;
         dhc_model model = test_model_of(&nominal);
-        TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &model));
-        for (size_t i = 0U; i < data.n; ++i) {
-            data.flags[i] = (uint8_t)DHC_SAMPLE_USED;
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&paper.set, &model));
+        for (size_t i = 0U; i < paper.data.n; ++i) {
+            paper.data.flags[i] = (uint8_t)DHC_SAMPLE_USED;
         }
-        TEST_ASSERT_EQUAL(DHC_OK, dhc_calib_fit(&model, &set, test_read_sample, &data, data.n,
-                                                data.flags, &opt, &ws, &rep));
+        TEST_ASSERT_EQUAL(DHC_OK,
+                          dhc_calib_fit(&model, &paper.set, test_read_sample, &paper.data,
+                                        paper.data.n, paper.data.flags, &opt, &paper.ws,
+                                        &paper.rep));
         test_rng fresh = {0xF00DULL};
         double max_mm;
         double max_rad;
         test_compare_arms(&model.arm, &truth, 100U, &fresh, &max_mm, &max_rad);
         if (checks == 0U) {
-            TEST_ASSERT_EQUAL(0U, rep.freed);
-            TEST_ASSERT_TRUE(rep.rank < 23U); /* at nominal even rich data identify fewer */
-            TEST_ASSERT_TRUE(rep.rms_mm > 0.05);
+            TEST_ASSERT_EQUAL(0U, paper.rep.freed);
+            TEST_ASSERT_TRUE(paper.rep.rank < 23U); /* at nominal even rich data identify fewer */
+            TEST_ASSERT_TRUE(paper.rep.rms_mm > 0.05);
         } else {
-            TEST_ASSERT_TRUE(rep.freed >= 1U);
-            TEST_ASSERT_EQUAL(23U, rep.structural_rank); /* 24 less alpha6 from positions */
-            TEST_ASSERT_EQUAL(rep.structural_rank, rep.rank);
-            TEST_ASSERT_TRUE(rep.rms_mm < 1e-6);
+            TEST_ASSERT_TRUE(paper.rep.freed >= 1U);
+            TEST_ASSERT_EQUAL(23U, paper.rep.structural_rank); /* 24 less alpha6 from positions */
+            TEST_ASSERT_EQUAL(paper.rep.structural_rank, paper.rep.rank);
+            TEST_ASSERT_TRUE(paper.rep.rms_mm < 1e-6);
             TEST_ASSERT_TRUE(max_mm < 1e-5);
         }
     }
@@ -128,8 +107,8 @@ static void test_parallel_axes_use_hayati_beta_and_the_others_plain_dh(void)
     for (size_t h = 0U; h < 3U; ++h) {
         const size_t j = hayati[h];
         TEST_ASSERT_EQUAL(DHC_CONV_HAYATI, cal.joint[j].convention);
-        TEST_ASSERT_TRUE(test_param_index(&set, DHC_P_BETA, j) < set.count);
-        TEST_ASSERT_EQUAL(set.count, test_param_index(&set, DHC_P_D, j));
+        TEST_ASSERT_TRUE(test_param_index(&paper.set, DHC_P_BETA, j) < paper.set.count);
+        TEST_ASSERT_EQUAL(paper.set.count, test_param_index(&paper.set, DHC_P_D, j));
         TEST_ASSERT_EQUAL_DOUBLE(TEST_TABLE2[j].d_mm, cal.joint[j].d_mm);
     }
     TEST_ASSERT_EQUAL(DHC_CONV_DH, cal.joint[5].convention);
@@ -143,11 +122,11 @@ static void test_two_poses_under_determine_the_model(void)
     dhc_arm cal;
     dhc_arm truth;
     dhc_arm nominal;
-    paper_arms(&truth, &nominal);
+    test_paper_arms(6U, &truth, &nominal);
     TEST_ASSERT_EQUAL(DHC_ERR_UNDERDETERMINED, calibrate(&cal, 2U, 0xC0FFEEULL));
-    TEST_ASSERT_EQUAL(12U, rep.rows);
-    TEST_ASSERT_EQUAL(24U, rep.structural_rank);
-    TEST_ASSERT_TRUE(rep.rank <= 12U);
+    TEST_ASSERT_EQUAL(12U, paper.rep.rows);
+    TEST_ASSERT_EQUAL(24U, paper.rep.structural_rank);
+    TEST_ASSERT_TRUE(paper.rep.rank <= 12U);
     /* Nothing half-fitted leaks out: the arm is still the nominal one. */
     for (size_t i = 0U; i < 6U; ++i) {
         TEST_ASSERT_EQUAL_DOUBLE(nominal.joint[i].theta_offset_rad, cal.joint[i].theta_offset_rad);
