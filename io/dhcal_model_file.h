@@ -49,7 +49,7 @@ typedef struct {
  * and used as given). A frame object ("base", "measurer.frame") has optional xyz_mm and
  * rpy_deg (default 0); an absent frame is the identity, so a measurer without "frame"
  * sits at the world origin, axes aligned. "measurer" needs "anchors_mm" (3 points).
- * "effects" keys are effect names of DESIGN.md section 3: joint effects with ":i"
+ * "effects" keys are effect names of docs/effects.md, section 3: joint effects with ":i"
  * (1 <= i <= joints), the others without; each value is an array of 1..32 numbers.
  * The file must be at most DHCAL_MODEL_MAX_BYTES, without NUL or control bytes.
  * Syntax errors are reported as "path:line:column: ..." (cJSON's error position).

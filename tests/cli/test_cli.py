@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """The dhcal program as a person runs it: exit codes, messages naming file and line, and
---out never created, truncated or overwritten by a failed run (DESIGN.md section 3).
+--out never created, truncated or overwritten by a failed run (docs/cli.md, 1.3).
 
 Usage: test_cli.py --dhcal PATH [--wrapper 'CMD ARGS']
   (the data come from examples/ and are written per case). --wrapper runs every dhcal

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The dhcal-sim program as a person runs it: exit codes, one message naming the scenario
 file and the JSON path for every defect, --out never touched by a failed run, identical
-bytes for identical arguments, the CSV contract of DESIGN.md section 3.
+bytes for identical arguments, the CSV contract of docs/formats.md, sections 3 and 4.2.
 
 Usage: test_sim_cli.py --sim PATH [--dhcal PATH]
   Scenarios are copied from host_sim/scenarios/ and mutated per case in a temporary

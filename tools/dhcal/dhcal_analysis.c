@@ -89,7 +89,7 @@ int dhcal_parse_noise(const char *text, dhcal_noise *out, dhcal_error *err)
     return DHCAL_IO_OK;
 }
 
-/* t0 of the session's drift: the mean time of the rows fitted (DESIGN.md 3b), unless the
+/* t0 of the session's drift: the mean time of the rows fitted (docs/effects.md, 1), unless the
  * model already carries a drift with its own t0. */
 static void set_drift_reference(dhc_model *model, const dhcal_samples *s)
 {

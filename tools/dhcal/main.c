@@ -1,5 +1,5 @@
 /* dhcal - the command line: compare a model with measurements, fit it, find the missing
- * physical effect, plot it. Contract: DESIGN.md section 3 (flags, exit codes, JSON keys). */
+ * physical effect, plot it. Contract: docs/cli.md, section 1 (flags, exit codes, JSON keys). */
 #ifndef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 200809L
 #endif
@@ -34,7 +34,7 @@ typedef struct {
 } options;
 
 static const char *const common_help =
-    "  --model M.json     nominal model (DESIGN.md section 3)\n"
+    "  --model M.json     nominal model (docs/formats.md, section 2)\n"
     "  --data D.csv       measurements: q1..qN in deg; x,y,z in mm or raw wire lengths\n"
     "                     L1,L2,L3 (fitted in wire-length space when the model has a\n"
     "                     measurer); optional dir1..dirN, temp_c, t_s, qw,qx,qy,qz\n"
@@ -319,7 +319,7 @@ static int cmd_compare(const options *o, session *s)
 
 /* ---------------------------------------------------------------- fit reporting */
 
-/* The contract's name of an outlier's reason (DESIGN.md 3b). */
+/* The contract's name of an outlier's reason (docs/cli.md, 1.4, `fit`). */
 static const char *outlier_reason(uint8_t flag)
 {
     switch (flag) {

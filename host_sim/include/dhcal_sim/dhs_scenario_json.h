@@ -1,12 +1,12 @@
 /* dhs_scenario_json.h - scenario files (JSON) for dhcal-sim. Host only (stdio, heap, cJSON).
  *
- * A scenario file, every key but the marked ones optional (defaults: PHYSICS.md's plant
- * table; units in the key names; a key that is not listed here is an error):
+ * A scenario file, every key but the marked ones optional (docs/formats.md, section 6;
+ * defaults in 6.5; units in the key names; a key that is not listed here is an error):
  * {
  *   "name": "joint_compliance_2",          label for comments in outputs
  *   "comment": "...",                       free text, ignored
  *   "seed": 7,                              REQUIRED integer 0..2^53: fixes random errors
- *   "model": "paper-3dof-model.json",       REQUIRED nominal model file (DESIGN.md sec. 3),
+ *   "model": "paper-3dof-model.json",       REQUIRED nominal model file (formats.md 2),
  *                                           relative to this file's directory
  *   "truth": {                              the arm as built = nominal + these errors
  *     "joints": [{"theta_offset_deg", "d_mm", "a_mm", "alpha_deg", "beta_deg"}, ...],
