@@ -187,6 +187,24 @@ class Cli(unittest.TestCase):
         self.assertIn('under-determine', r.stderr)
         self.assert_out_untouched('previous calibration\n')
 
+    def test_cross_validation_that_cannot_run_fails_with_exit_1(self):
+        # Four rows (12 equations) determine the base model; leave-one-out leaves three,
+        # which do not (test_under_determined_data_fail_with_exit_1): every fold fails.
+        rows = [l for l in GOOD_CSV.splitlines() if not l.startswith('#')]
+        four = self.write('four.csv', '\n'.join(rows[:5]) + '\n')
+        self.write('calibrated.json', 'previous calibration\n')
+        plain = self.fit(None, four, '--json')
+        self.assertEqual(plain.returncode, 0, plain.stderr)
+        self.write('calibrated.json', 'previous calibration\n')
+        for cmd in ('fit', 'diagnose'):
+            args = ['--out', self.out] if cmd == 'fit' else []
+            r = self.run_dhcal(cmd, '--model', self.model, '--data', four, '--cv', '--json',
+                               *args)
+            self.assertEqual(r.returncode, 1, '%s --cv: %s' % (cmd, r.stderr))
+            self.assertIn('cross-validation', r.stderr)
+            self.assertEqual(r.stdout, '', '%s --cv printed a report without cv_rms_mm' % cmd)
+            self.assert_out_untouched('previous calibration\n')
+
     # ---- success: --out replaced atomically and loads again
     def test_successful_fit_writes_a_model_that_loads_again(self):
         self.write('calibrated.json', 'previous calibration\n')

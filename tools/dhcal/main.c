@@ -715,8 +715,11 @@ static int cmd_fit(const options *o, session *s)
             memset(&err, 0, sizeof err);
             extras.have_cv = dhcal_cross_validate(&fit.model, &fit.set, &s->noise, &s->samples,
                                                   &extras.cv, &err) == DHCAL_IO_OK;
+            /* asked for and not computable: a failed computation, as for diagnose --cv; a
+             * script must not take a report without cv_rms_mm for a success */
             if (!extras.have_cv) {
                 fprintf(stderr, "dhcal: %s\n", err.msg);
+                rc = EXIT_COMPUTE;
             }
         }
     }
