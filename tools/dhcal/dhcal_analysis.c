@@ -456,6 +456,19 @@ double dhcal_param_display(const dhc_param_set *set, size_t k, double value)
     return degrees ? value * 180.0 / DHC_PI : value;
 }
 
+double dhcal_param_fitted(const dhcal_fit *fit, const dhc_model *input, size_t k)
+{
+    const size_t axis = (size_t)fit->set.id[k].kind - (size_t)DHC_P_BASE_RX;
+    if (axis >= 3U) {
+        return dhcal_param_display(&fit->set, k, fit->rep.value[k]);
+    }
+    dhc_mat3 turned;
+    double w_rad[3];
+    dhc_rot_mul_t(&fit->model.arm.base.rot, &input->arm.base.rot, &turned);
+    dhc_rot_log(&turned, w_rad);
+    return w_rad[axis] * 180.0 / DHC_PI;
+}
+
 int dhcal_implausible(const dhc_model *nominal, const dhcal_fit *fit, char *why, size_t cap)
 {
     const double max_len = DHCAL_PLAUSIBLE_LENGTH_SHARE * dhc_arm_reach(&nominal->arm);

@@ -531,7 +531,7 @@ static void json_fit(cJSON *obj, const dhcal_fit *f, const session *s, const dou
         if (f->rep.identifiable[k]) {
             cJSON *p = cJSON_CreateObject();
             cJSON_AddStringToObject(p, "name", name);
-            cJSON_AddNumberToObject(p, "value", dhcal_param_display(&f->set, k, f->rep.value[k]));
+            cJSON_AddNumberToObject(p, "value", dhcal_param_fitted(f, &s->model, k));
             cJSON_AddNumberToObject(p, "std", dhcal_param_display(&f->set, k, f->rep.std_err[k]));
             cJSON_AddItemToArray(params, p);
             continue;
@@ -596,7 +596,7 @@ static void text_fit(const dhcal_fit *f, const session *s, const options *o, con
         (void)dhc_params_name(&f->set, k, name, sizeof name);
         const int degrees = dhc_params_is_angle(&f->set, k);
         const int compliance = f->set.id[k].kind == (uint8_t)DHC_P_COMPLIANCE;
-        printf("%-18s %16.8g %12.3g %s\n", name, dhcal_param_display(&f->set, k, rep->value[k]),
+        printf("%-18s %16.8g %12.3g %s\n", name, dhcal_param_fitted(f, &s->model, k),
                dhcal_param_display(&f->set, k, rep->std_err[k]),
                degrees ? "deg" : compliance ? "deg/mm" : f->set.id[k].kind == (uint8_t)DHC_P_JOINT_SCALE ||
                                                            f->set.id[k].kind == (uint8_t)DHC_P_MEAS_SCALE
