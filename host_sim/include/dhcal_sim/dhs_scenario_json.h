@@ -32,7 +32,8 @@
  *     "controller": {"gear_ratio": 100, "encoder_lines": 500}   what the controller
  *                                           believes (default: the gear's ratio, lines)
  *   }, ...],
- *   "payload": {"mass_kg": 0, "com_mm": nominal tool point, "inertia_kgm2": [0,0,0]},
+ *   "payload": {"mass_kg": 0, "com_mm": the true tool point (nominal + truth.tool_mm),
+ *               "inertia_kgm2": [0,0,0]},
  *   "drive": {"dac_range_v": 10, "adc_range_v": 10},
  *   "measurer": {                           needs the model's measurer; without this key
  *     "anchor_errors_mm": [[3],[3],[3]],    the measurer is built exactly, noise-free
