@@ -261,6 +261,20 @@ class Cli(unittest.TestCase):
                 checked += 1
         self.assertGreaterEqual(checked, 2)
 
+    def test_text_report_gives_each_parameter_its_unit(self):
+        # docs/cli.md, 1.4: drift_scale in 1/s, drift_offset in mm/s, compliance in deg/mm.
+        r = self.run_dhcal('fit', '--model', self.model, '--data', self.data, '--effects',
+                           'joint_compliance:2,drift_scale,drift_offset')
+        self.assertEqual(r.returncode, 0, r.stderr)
+        units = {}
+        for line in r.stdout.splitlines():
+            f = line.split()
+            if len(f) >= 3 and f[0] in ('theta1', 'a2', 'drift_scale', 'drift_offset_x',
+                                        'compliance2_2'):
+                units[f[0]] = f[3] if len(f) > 3 else ''
+        self.assertEqual(units, {'theta1': 'deg', 'a2': 'mm', 'drift_scale': '1/s',
+                                 'drift_offset_x': 'mm/s', 'compliance2_2': 'deg/mm'})
+
     def test_json_keys_follow_the_design(self):
         r = self.run_dhcal('diagnose', '--model', self.model, '--data', self.data, '--json')
         self.assertEqual(r.returncode, 0, r.stderr)

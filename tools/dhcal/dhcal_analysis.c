@@ -456,6 +456,22 @@ double dhcal_param_display(const dhc_param_set *set, size_t k, double value)
     return degrees ? value * 180.0 / DHC_PI : value;
 }
 
+const char *dhcal_param_unit(const dhc_param_set *set, size_t k)
+{
+    if (dhc_params_is_angle(set, k)) {
+        return "deg";
+    }
+    switch ((dhc_param_kind)set->id[k].kind) {
+    case DHC_P_COMPLIANCE: return "deg/mm";
+    case DHC_P_JOINT_SCALE:
+    case DHC_P_MEAS_SCALE: return "";
+    case DHC_P_THERMAL: return "1/K";
+    case DHC_P_DRIFT_SCALE: return "1/s";
+    case DHC_P_DRIFT_OFFSET: return "mm/s";
+    default: return "mm";
+    }
+}
+
 double dhcal_param_fitted(const dhcal_fit *fit, const dhc_model *input, size_t k)
 {
     const size_t axis = (size_t)fit->set.id[k].kind - (size_t)DHC_P_BASE_RX;

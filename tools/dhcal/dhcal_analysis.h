@@ -109,6 +109,10 @@ const char *dhcal_effect_signature(dhc_effect effect);
 /* A parameter value in file units: angles and compliances in degrees, the rest as is. */
 double dhcal_param_display(const dhc_param_set *set, size_t k, double value);
 
+/* The unit of dhcal_param_display's value: "deg", "deg/mm", "mm", "mm/s", "1/K", "1/s",
+ * or "" for a scale. */
+const char *dhcal_param_unit(const dhc_param_set *set, size_t k);
+
 /* The fitted value of parameter k as reported, in file units. base_rx, base_ry, base_rz
  * have no value in the model (the fit composes them into the base's rotation, so
  * dhc_params_value reads 0): they report the rotation the fit composed into the input's base,

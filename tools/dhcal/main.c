@@ -594,14 +594,8 @@ static void text_fit(const dhcal_fit *f, const session *s, const options *o, con
             continue;
         }
         (void)dhc_params_name(&f->set, k, name, sizeof name);
-        const int degrees = dhc_params_is_angle(&f->set, k);
-        const int compliance = f->set.id[k].kind == (uint8_t)DHC_P_COMPLIANCE;
         printf("%-18s %16.8g %12.3g %s\n", name, dhcal_param_fitted(f, &s->model, k),
-               dhcal_param_display(&f->set, k, rep->std_err[k]),
-               degrees ? "deg" : compliance ? "deg/mm" : f->set.id[k].kind == (uint8_t)DHC_P_JOINT_SCALE ||
-                                                           f->set.id[k].kind == (uint8_t)DHC_P_MEAS_SCALE
-                                                       ? ""
-                                                       : f->set.id[k].kind == (uint8_t)DHC_P_THERMAL ? "1/K" : "mm");
+               dhcal_param_display(&f->set, k, rep->std_err[k]), dhcal_param_unit(&f->set, k));
     }
     for (size_t k = 0U; k < f->set.count; ++k) {
         if (rep->identifiable[k]) {
