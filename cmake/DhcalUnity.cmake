@@ -1,4 +1,5 @@
-# Unity 2.6.1 as the static library `dhcal_unity` (DESIGN.md section 7), from the first of:
+# Unity 2.6.1 as the static library `dhcal_unity` (docs/conventions.md, section 11), from
+# the first of:
 #   1. an installed CMake package (find_package(unity CONFIG), exactly 2.6.1);
 #   2. -DUNITY_ROOT=DIR, a directory holding unity.c, unity.h and unity_internals.h;
 #   3. scripts/fetch-unity: the pinned, SHA-256-checked PyPI wheel, unpacked into the build

@@ -1,4 +1,4 @@
-# Warning set of STYLE.md practice 9, as an interface target every dhcal target links.
+# Warning set of docs/conventions.md, section 10, as an interface target every dhcal target links.
 add_library(dhcal_warnings INTERFACE)
 target_compile_options(dhcal_warnings INTERFACE
   -Wall -Wextra -pedantic -Wconversion -Wsign-conversion -Wdouble-promotion -Wfloat-equal

@@ -37,7 +37,7 @@ int dhcal_samples_build(const dhc_model *model, const dhcal_dataset *data, const
             s->dir[j] = (int8_t)(data->has_dir ? row->dir[j] : 0);
         }
         s->temp_c = data->has_temp ? row->temp_c : model->thermal_ref_c;
-        /* drift's clock: the t_s column, else the 0-based row number (DESIGN.md 3b) */
+        /* drift's clock: the t_s column, else the 0-based row number (docs/formats.md, 3.2) */
         s->t_s = data->has_time ? row->t_s : (double)i;
         if (out->wires) {
             memcpy(s->wire_mm, row->wires_mm, sizeof s->wire_mm);

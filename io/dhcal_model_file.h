@@ -49,7 +49,7 @@ typedef struct {
  * and used as given). A frame object ("base", "measurer.frame") has optional xyz_mm and
  * rpy_deg (default 0); an absent frame is the identity, so a measurer without "frame"
  * sits at the world origin, axes aligned. "measurer" needs "anchors_mm" (3 points).
- * "effects" keys are effect names of DESIGN.md section 3: joint effects with ":i"
+ * "effects" keys are effect names of docs/effects.md, section 3: joint effects with ":i"
  * (1 <= i <= joints), the others without; each value is an array of 1..32 numbers.
  * The file must be at most DHCAL_MODEL_MAX_BYTES, without NUL or control bytes.
  * Syntax errors are reported as "path:line:column: ..." (cJSON's error position).
@@ -63,7 +63,8 @@ int dhcal_model_load(const char *path, dhcal_model *model, dhcal_error *err);
  * 0666 less the umask), fsyncs it, then renames it over path, so a failure never
  * truncates an existing file and leaves no temporary behind. Lengths and effect values are
  * written with the shortest of %.15g..%.17g that reads back to the same double; angles in
- * degrees with %.15g: loading the file gives the same arm to about 1e-15 rad.
+ * degrees with the shortest of those that reads back to the same radians: loading the file
+ * gives the same arm to about 1e-15 (docs/formats.md, 2.7).
  * DHCAL_IO_FAILED with a message on I/O errors, on a non-finite value (named by its JSON
  * path) and on counts beyond the limits; nothing is written then. */
 int dhcal_model_save(const char *path, const dhcal_model *model, dhcal_error *err);

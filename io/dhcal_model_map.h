@@ -4,11 +4,16 @@
  * Effects in the file's "effects" object (units as in every file: mm and degrees):
  *   "joint_scale:i":      [s]                              (unitless)
  *   "joint_harmonic:i":   [A_deg, B_deg]                   dq = A sin q + B cos q
+ *   "joint_harmonic<k>:i", k = 2, 3, 4: [A_deg, B_deg]     dq = A sin(k q) + B cos(k q)
  *   "joint_backlash:i":   [b_deg]                          full play
  *   "joint_compliance:i": [c_ii, c_i(i+1), ..., c_iN]      deg per mm of gravity moment arm
  *   "measurer_scale":     [s]
  *   "measurer_offset":    [o1_mm, o2_mm, o3_mm]
  *   "thermal_scale":      [k_per_K] or [k_per_K, T0_C]     (T0 default 20 C)
+ *   "drift_scale":        [k_per_s, t0_s]                  offset from the base origin
+ *                                                          scales by 1 + k (t - t0)
+ *   "drift_offset":       [vx, vy, vz (mm/s, world), t0_s] the point moves by v (t - t0)
+ * The two drifts share one t0: where both are given, the last one read sets it.
  * base_frame, tool_offset and measurer_anchors have no entry here: they are the model's
  * "base", "tool_mm" and "measurer.anchors_mm".
  */

@@ -44,7 +44,7 @@ static const char *const dataset_help =
     "  --poses N          number of random poses (1..1000000)\n"
     "  --plan P.csv       targets instead: '#' comments, header q1..qN [dir1..dirN] (deg,\n"
     "                     +-1), one pose per line; directions random where not given\n"
-    "  --out D.csv        the dataset (DESIGN.md section 3): q1..qN (deg, from the encoder\n"
+    "  --out D.csv        the dataset, a measurement CSV: q1..qN (deg, from the encoder\n"
     "                     counts), dir1..dirN, and x,y,z (mm, true tool point + noise)\n"
     "  --wires            L1,L2,L3 instead of x,y,z: the measurer's wire counters (mm)\n"
     "  --seed K           run seed: poses, directions, noise (default: the scenario's seed;\n"

@@ -1,4 +1,4 @@
-/* dhs_scenario.c - scenario defaults (PHYSICS.md's plant table), checks, random errors. */
+/* dhs_scenario.c - scenario defaults (docs/formats.md, 6.5), checks, random errors. */
 #include "dhcal_sim/dhs_scenario.h"
 
 #include <math.h>

@@ -2,7 +2,7 @@
 """Acceptance data with one hidden effect: the paper's 3-DOF arm (Table 3).
 
 Pure Python (stdlib only) and independent of the C library: its own forward kinematics,
-gravity moments and wire geometry, written from DESIGN.md section 3 and PHYSICS.md.
+gravity moments and wire geometry, written from docs/effects.md, sections 1 and 3.
 
 Arm, joint i (1-based):  A_i = Rz(q_i + theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i) Ry(beta_i)
   nominal alpha = (90, 0, 0) deg, a = (0, 400, 345) mm, d = (433, 0, 0) mm, theta = beta = 0;
@@ -11,7 +11,7 @@ True arm = nominal + random geometric errors (Gaussian, standard deviations ERR_
   theta_i 0.2 deg, a_i 0.5 mm, d_1 and d_3 0.5 mm, alpha_i 0.2 deg, Hayati beta_2 0.05 deg
   (axes 2-3 nominally parallel: beta_2 replaces d_2, which stays exactly 0).
 
-Hidden effects (q in rad; the library's definitions, DESIGN.md section 3):
+Hidden effects (q in rad; the library's definitions, docs/effects.md, section 1):
   joint_scale:i       q_eff_i = q_i + s q_i
   joint_harmonic:i    q_eff_i = q_i + A sin q_i + B cos q_i
   joint_backlash:i    q_eff_i = q_i + (b/2) dir_i          (dir_i = +-1, random per pose)
@@ -98,7 +98,8 @@ EFFECT_SIZE = {
     "joint_harmonic": 1e-3,     # rad, A and B each
     "joint_backlash": 0.3,      # deg, full play b (> 0)
     # rad/mm (> 0: the joint yields to the gravity moment). Chosen for 0.5-1.5 mm at the
-    # tool (PHYSICS.md): joint 2 sees up to ~745 mm of moment arm, joint 3 only ~345 mm.
+    # tool (docs/effects.md, section 3): joint 2 sees up to ~745 mm of moment arm, joint 3
+    # only ~345 mm.
     "joint_compliance:2": {"c22": 1.2e-6, "c23": 1.8e-6},
     "joint_compliance:3": {"c33": 1.0e-5},
     "measurer_scale": 1e-3,     # 1
@@ -170,7 +171,7 @@ def norm(a):
 
 
 def pose_from_xyz_rpy(xyz, rpy_deg):
-    """T = Trans(xyz) Rz(yaw) Ry(pitch) Rx(roll), rpy = [roll, pitch, yaw] (DESIGN.md)."""
+    """T = Trans(xyz) Rz(yaw) Ry(pitch) Rx(roll), rpy = [roll, pitch, yaw] (docs/formats.md, 1)."""
     roll, pitch, yaw = (math.radians(v) for v in rpy_deg)
     return mat_mul(trans(*xyz), mat_mul(rot_z(yaw), mat_mul(rot_y(pitch), rot_x(roll))))
 
@@ -321,7 +322,7 @@ def _magnitude(rng, size, signed=True):
 
 
 def draw_effect(case, rng):
-    """Values of the hidden effect (units of DESIGN/lib: rad, rad/mm, 1)."""
+    """Values of the hidden effect (the library's units: rad, rad/mm, 1)."""
     name, joint = parse_case(case)
     if name == "clean":
         return {}
@@ -361,7 +362,7 @@ def pose_times(case, rng, n):
 
 
 def drifted(case, effect, p, t, t0):
-    """The measured point after the session's drift (DESIGN.md 3b), base at the origin."""
+    """The measured point after the session's drift (docs/effects.md, 1), base at the origin."""
     name, _ = parse_case(case)
     if name == "drift_offset":
         return [p[k] + effect["v_mm_per_s"][k] * (t - t0) for k in range(3)]

@@ -130,7 +130,7 @@ class Measurer(unittest.TestCase):
                 self.assertAlmostEqual(a, b, delta=1e-7)
 
     def test_paper_closed_form_agrees(self):
-        # DESIGN/lib: y = (L3^2 - L2^2)/(4b), z = (L2^2 + L3^2 - 2(L1^2 - a^2 + b^2 + c^2))
+        # dhc_trilat.h: y = (L3^2 - L2^2)/(4b), z = (L2^2 + L3^2 - 2(L1^2 - a^2 + b^2 + c^2))
         # / (4(a - c)), x = +sqrt(L1^2 - y^2 - (z - a)^2) in the measurer frame.
         a, b, c = 1200.0, 600.0, 300.0
         rng = random.Random(23)
@@ -163,7 +163,7 @@ class Measurer(unittest.TestCase):
 
 
 class Effects(unittest.TestCase):
-    """The exact models of DESIGN.md section 3, noise-free."""
+    """The exact models of docs/effects.md, section 1, noise-free."""
 
     def check(self, case, dq_fn):
         sc = he.Scenario(case, 3)

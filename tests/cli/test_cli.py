@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """The dhcal program as a person runs it: exit codes, messages naming file and line, and
---out never created, truncated or overwritten by a failed run (DESIGN.md section 3).
+--out never created, truncated or overwritten by a failed run (docs/cli.md, 1.3).
 
 Usage: test_cli.py --dhcal PATH [--wrapper 'CMD ARGS']
   (the data come from examples/ and are written per case). --wrapper runs every dhcal
@@ -8,6 +8,7 @@ Usage: test_cli.py --dhcal PATH [--wrapper 'CMD ARGS']
   that reports through its own exit code then fails the case's exit-code assertion.
 """
 import json
+import math
 import os
 import re
 import shlex
@@ -26,6 +27,24 @@ WRAPPER = []
 GOOD_MODEL = open(os.path.join(EXAMPLE, 'model.json')).read()
 GOOD_CSV = open(os.path.join(EXAMPLE, 'train.csv')).read()
 HEADER = 'q1,q2,q3,x,y,z'
+
+
+def rot_from_rpy_deg(rpy_deg):
+    """R = Rz(yaw) Ry(pitch) Rx(roll) (docs/formats.md, section 1), as nested lists."""
+    r, p, y = (math.radians(v) for v in rpy_deg)
+    cr, sr, cp, sp = math.cos(r), math.sin(r), math.cos(p), math.sin(p)
+    cy, sy = math.cos(y), math.sin(y)
+    return [[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr]]
+
+
+def rotation_vector_deg(r):
+    """Axis times angle (deg) of a rotation below a half turn."""
+    angle = math.acos(max(-1.0, min(1.0, (r[0][0] + r[1][1] + r[2][2] - 1.0) / 2.0)))
+    skew = [r[2][1] - r[1][2], r[0][2] - r[2][0], r[1][0] - r[0][1]]
+    k = angle / (2.0 * math.sin(angle)) if angle > 1e-12 else 0.5
+    return [math.degrees(k * v) for v in skew]
 
 
 class Cli(unittest.TestCase):
@@ -220,6 +239,24 @@ class Cli(unittest.TestCase):
         self.assertIn('under-determine', r.stderr)
         self.assert_out_untouched('previous calibration\n')
 
+    def test_cross_validation_that_cannot_run_fails_with_exit_1(self):
+        # Four rows (12 equations) determine the base model; leave-one-out leaves three,
+        # which do not (test_under_determined_data_fail_with_exit_1): every fold fails.
+        rows = [l for l in GOOD_CSV.splitlines() if not l.startswith('#')]
+        four = self.write('four.csv', '\n'.join(rows[:5]) + '\n')
+        self.write('calibrated.json', 'previous calibration\n')
+        plain = self.fit(None, four, '--json')
+        self.assertEqual(plain.returncode, 0, plain.stderr)
+        self.write('calibrated.json', 'previous calibration\n')
+        for cmd in ('fit', 'diagnose'):
+            args = ['--out', self.out] if cmd == 'fit' else []
+            r = self.run_dhcal(cmd, '--model', self.model, '--data', four, '--cv', '--json',
+                               *args)
+            self.assertEqual(r.returncode, 1, '%s --cv: %s' % (cmd, r.stderr))
+            self.assertIn('cross-validation', r.stderr)
+            self.assertEqual(r.stdout, '', '%s --cv printed a report without cv_rms_mm' % cmd)
+            self.assert_out_untouched('previous calibration\n')
+
     # ---- success: --out replaced atomically and loads again
     def test_successful_fit_writes_a_model_that_loads_again(self):
         self.write('calibrated.json', 'previous calibration\n')
@@ -233,6 +270,43 @@ class Cli(unittest.TestCase):
         with open(self.out) as f:
             saved = json.load(f)
         self.assertIn('joint_compliance:2', saved['effects'])
+
+    def test_base_rotation_parameters_report_the_rotation_fitted(self):
+        # A nominal base turned by a few degrees: the fit turns it back. base_rx..rz report
+        # that turn, the rotation vector of R_out R_in^T, computed here from the two files.
+        model = json.loads(GOOD_MODEL)
+        model['base'] = {'xyz_mm': [2.0, -1.0, 3.0], 'rpy_deg': [1.5, -2.0, 3.0]}
+        turned = self.write('turned.json', json.dumps(model))
+        r = self.fit(turned, None, '--effects', 'base_frame', '--json')
+        self.assertEqual(r.returncode, 0, r.stderr)
+        reported = {p['name']: p['value'] for p in json.loads(r.stdout)['parameters']}
+        with open(self.out) as f:
+            fitted = json.load(f)['base']['rpy_deg']
+        r_in, r_out = rot_from_rpy_deg(model['base']['rpy_deg']), rot_from_rpy_deg(fitted)
+        turn = [[sum(r_out[i][m] * r_in[j][m] for m in range(3)) for j in range(3)]
+                for i in range(3)]
+        expected = rotation_vector_deg(turn)
+        self.assertGreater(math.sqrt(sum(v * v for v in expected)), 3.0)  # not a null test
+        checked = 0
+        for axis, name in enumerate(('base_rx', 'base_ry', 'base_rz')):
+            if name in reported:  # base_rz trades off with theta1: one of them is held
+                self.assertAlmostEqual(reported[name], expected[axis], delta=1e-9, msg=name)
+                checked += 1
+        self.assertGreaterEqual(checked, 2)
+
+    def test_text_report_gives_each_parameter_its_unit(self):
+        # docs/cli.md, 1.4: drift_scale in 1/s, drift_offset in mm/s, compliance in deg/mm.
+        r = self.run_dhcal('fit', '--model', self.model, '--data', self.data, '--effects',
+                           'joint_compliance:2,drift_scale,drift_offset')
+        self.assertEqual(r.returncode, 0, r.stderr)
+        units = {}
+        for line in r.stdout.splitlines():
+            f = line.split()
+            if len(f) >= 3 and f[0] in ('theta1', 'a2', 'drift_scale', 'drift_offset_x',
+                                        'compliance2_2'):
+                units[f[0]] = f[3] if len(f) > 3 else ''
+        self.assertEqual(units, {'theta1': 'deg', 'a2': 'mm', 'drift_scale': '1/s',
+                                 'drift_offset_x': 'mm/s', 'compliance2_2': 'deg/mm'})
 
     def test_json_keys_follow_the_design(self):
         r = self.run_dhcal('diagnose', '--model', self.model, '--data', self.data, '--json')

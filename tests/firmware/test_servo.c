@@ -1,6 +1,6 @@
 /* test_servo.c - counters, converter codes, trajectories and the joint position loop, the
- * loop closed around a DC-motor joint model written out in the test (PHYSICS.md's plant
- * defaults). */
+ * loop closed around a DC-motor joint model written out in the test (the plant
+ * defaults of docs/formats.md, 6.5). */
 #include <math.h>
 #include <string.h>
 

@@ -6,7 +6,7 @@
  * measurer all work), 10 simulated seconds, five runs; the same with rigid joints (3
  * coordinates) for comparison. Prints the speed factor (simulated time / CPU time) of the
  * best run (the least disturbed by other processes) and the median.
- *   --goal G  says whether the best all-effects run reaches G (default 200, DESIGN.md 8)
+ *   --goal G  says whether the best all-effects run reaches G (default 200, docs/README.md)
  *   --min F   exits 1 when it is below F (a regression guard; the CTest `bench` entry uses
  *             a generous floor, bench/sim-speed the goal itself)
  * A benchmark, not a timed unit test (tests/host_sim/CMakeLists.txt).
@@ -101,7 +101,7 @@ int main(int argc, char **argv)
     if (best < 0.0) {
         return 1;
     }
-    printf("goal %.0f x real time (DESIGN.md section 8): %s in this run\n", goal,
+    printf("goal %.0f x real time: %s in this run\n", goal,
            best >= goal ? "met" : "NOT met");
     if (min_factor > 0.0 && best < min_factor) {
         printf("bench_sim: FAILED: best run below %.0f x real time\n", min_factor);

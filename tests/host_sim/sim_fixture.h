@@ -140,7 +140,7 @@ static inline void sim_fixture_paper_arm(dhs_scenario *sc, int variant)
 
 /* PD on the motor encoder (joint angle from unwrapped counts, nominal counts per rad) with
  * tacho velocity feedback, output through the 12-bit DAC. Gains give a ~10 Hz position loop
- * for the default drive (PHYSICS.md's 5-20 Hz). */
+ * for the default drive (5-20 Hz, docs/formats.md, 6.5). */
 typedef struct {
     uint16_t last[DHC_MAX_JOINTS];
     int64_t counts[DHC_MAX_JOINTS];

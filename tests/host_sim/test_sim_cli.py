@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The dhcal-sim program as a person runs it: exit codes, one message naming the scenario
 file and the JSON path for every defect, --out never touched by a failed run, identical
-bytes for identical arguments, the CSV contract of DESIGN.md section 3.
+bytes for identical arguments, the CSV contract of docs/formats.md, sections 3 and 4.2.
 
 Usage: test_sim_cli.py --sim PATH [--dhcal PATH]
   Scenarios are copied from host_sim/scenarios/ and mutated per case in a temporary
@@ -248,6 +248,25 @@ class SimCli(unittest.TestCase):
         r = self.sim('dataset', '--scenario', good, '--poses', '60', '--seed', '8', '--out', other)
         self.assertEqual(r.returncode, 0, r.stderr)
         self.assertNotEqual(read(other, 'rb'), outs[0])
+
+    def test_payload_sits_at_the_true_tool_point_by_default(self):
+        # A payload loads the compliant joint 2 through its moment arm: where its centre of
+        # mass sits shows in the deflection. Without com_mm it is the true tool point, the
+        # nominal one (here the origin of the last frame) moved by truth.tool_mm.
+        base = json.loads(read(os.path.join(SCENARIOS, 'joint_compliance_2.json')))
+        base.setdefault('truth', {})['tool_mm'] = [80.0, 0.0, -40.0]
+        rows = {}
+        for label, com in (('default', None), ('true', [80.0, 0.0, -40.0]),
+                           ('nominal', [0.0, 0.0, 0.0])):
+            sc = copy.deepcopy(base)
+            sc['payload'] = {'mass_kg': 5.0}
+            if com is not None:
+                sc['payload']['com_mm'] = com
+            r = self.dataset(self.scenario(sc), poses='20')
+            self.assertEqual(r.returncode, 0, r.stderr)
+            rows[label] = [l for l in read(self.out).splitlines() if not l.startswith('#')]
+        self.assertEqual(rows['default'], rows['true'])
+        self.assertNotEqual(rows['default'], rows['nominal'])
 
     def test_plan_gives_the_targets_and_directions(self):
         good = self.scenario()

@@ -1,6 +1,6 @@
-/* test_sim_scenario.c - scenario defaults and checks (dhs_scenario.h): PHYSICS.md's plant
- * table as the defaults, every bad value refused with the field and joint named, random
- * geometric errors reproducible from the seed and placed by convention.
+/* test_sim_scenario.c - scenario defaults and checks (dhs_scenario.h): the plant of
+ * docs/formats.md, 6.5, as the defaults, every bad value refused with the field and joint
+ * named, random geometric errors reproducible from the seed and placed by convention.
  */
 #include <math.h>
 #include <string.h>

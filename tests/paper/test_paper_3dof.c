@@ -77,7 +77,7 @@ static void test_three_positions_under_determine_the_model(void)
     TEST_ASSERT_TRUE(paper.rep.rank < paper.rep.structural_rank);
 }
 
-/* The built arm of Table 3 with an unknown tool point, as PHYSICS.md describes it: the
+/* The built arm of Table 3 with an unknown tool point (docs/effects.md, section 5): the
  * tool offset along the common 2-3 axis, along link 3 and across it trade off against
  * link parameters. Position data cannot separate them; the fit must say which. */
 static void test_tool_point_trades_off_against_link_parameters(void)

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Real arms measured by others (issue #12): dhcal on the laser-tracker data in
-../shared/realdata (read there, never copied into the repository). Skips with the reason,
+--realdata DIR, by default ../shared/realdata beside the repository (read there, never
+copied into it). Skips with the reason,
 exit 77, when the folder is absent.
 
 Each case runs the dhcal program as a user would and checks what it prints against the

@@ -1,6 +1,7 @@
 # cmake -DNM=<nm> -DARCHIVE=<lib.a> -P check_no_heap_no_stdio.cmake
 # Fails when any object in ARCHIVE references the heap or stdio: lib/ promises neither
-# (DESIGN.md), and on the target either would drag in newlib's syscalls and sbrk.
+# (docs/architecture.md, section 3), and on the target either would drag in newlib's
+# syscalls and sbrk.
 # Reads undefined symbols (nm -u), so it sees what the code calls, whatever the headers.
 foreach(v NM ARCHIVE)
   if(NOT DEFINED ${v})

@@ -12,7 +12,7 @@ void tearDown(void) {}
 
 #define PI 3.14159265358979323846
 
-/* The paper's measurer (DESIGN.md section 3): anchors (0,0,1200), (0,600,300), (0,-600,300)
+/* The paper's measurer (docs/formats.md, section 2): anchors (0,0,1200), (0,600,300), (0,-600,300)
  * and T_Meas = xyz (1300, 0, 0), rpy (0, 0, 180 deg). */
 #define PAPER_A 1200.0
 #define PAPER_B 600.0

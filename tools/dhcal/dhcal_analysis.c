@@ -89,7 +89,7 @@ int dhcal_parse_noise(const char *text, dhcal_noise *out, dhcal_error *err)
     return DHCAL_IO_OK;
 }
 
-/* t0 of the session's drift: the mean time of the rows fitted (DESIGN.md 3b), unless the
+/* t0 of the session's drift: the mean time of the rows fitted (docs/effects.md, 1), unless the
  * model already carries a drift with its own t0. */
 static void set_drift_reference(dhc_model *model, const dhcal_samples *s)
 {
@@ -454,6 +454,35 @@ double dhcal_param_display(const dhc_param_set *set, size_t k, double value)
 {
     const int degrees = dhc_params_is_angle(set, k) || set->id[k].kind == (uint8_t)DHC_P_COMPLIANCE;
     return degrees ? value * 180.0 / DHC_PI : value;
+}
+
+const char *dhcal_param_unit(const dhc_param_set *set, size_t k)
+{
+    if (dhc_params_is_angle(set, k)) {
+        return "deg";
+    }
+    switch ((dhc_param_kind)set->id[k].kind) {
+    case DHC_P_COMPLIANCE: return "deg/mm";
+    case DHC_P_JOINT_SCALE:
+    case DHC_P_MEAS_SCALE: return "";
+    case DHC_P_THERMAL: return "1/K";
+    case DHC_P_DRIFT_SCALE: return "1/s";
+    case DHC_P_DRIFT_OFFSET: return "mm/s";
+    default: return "mm";
+    }
+}
+
+double dhcal_param_fitted(const dhcal_fit *fit, const dhc_model *input, size_t k)
+{
+    const size_t axis = (size_t)fit->set.id[k].kind - (size_t)DHC_P_BASE_RX;
+    if (axis >= 3U) {
+        return dhcal_param_display(&fit->set, k, fit->rep.value[k]);
+    }
+    dhc_mat3 turned;
+    double w_rad[3];
+    dhc_rot_mul_t(&fit->model.arm.base.rot, &input->arm.base.rot, &turned);
+    dhc_rot_log(&turned, w_rad);
+    return w_rad[axis] * 180.0 / DHC_PI;
 }
 
 int dhcal_implausible(const dhc_model *nominal, const dhcal_fit *fit, char *why, size_t cap)

@@ -109,6 +109,17 @@ const char *dhcal_effect_signature(dhc_effect effect);
 /* A parameter value in file units: angles and compliances in degrees, the rest as is. */
 double dhcal_param_display(const dhc_param_set *set, size_t k, double value);
 
+/* The unit of dhcal_param_display's value: "deg", "deg/mm", "mm", "mm/s", "1/K", "1/s",
+ * or "" for a scale. */
+const char *dhcal_param_unit(const dhc_param_set *set, size_t k);
+
+/* The fitted value of parameter k as reported, in file units. base_rx, base_ry, base_rz
+ * have no value in the model (the fit composes them into the base's rotation, so
+ * dhc_params_value reads 0): they report the rotation the fit composed into the input's base,
+ * the rotation vector of R_fitted R_input^T in world axes (deg), the rotation their std is
+ * about. Every other parameter: dhcal_param_display of its value. */
+double dhcal_param_fitted(const dhcal_fit *fit, const dhc_model *input, size_t k);
+
 /* A link parameter far outside its physical range: a joint offset or twist moved by more
  * than DHCAL_PLAUSIBLE_ANGLE_DEG from nominal, a length by more than
  * DHCAL_PLAUSIBLE_LENGTH_SHARE of the arm's nominal reach. Such a model fits its rows but is

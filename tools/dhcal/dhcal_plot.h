@@ -28,8 +28,8 @@ typedef struct {
     const dhcal_plot_candidate *candidates; /* best first */
     size_t n_candidates;
     /* Apparent joint errors: dq = pinv(J_q) r per row, the joint error that would explain
-     * the residual (PHYSICS.md), plus the dq of the model's fitted effects (component plus
-     * residual). n_rows x n_joints each. */
+     * the residual (docs/effects.md, section 4), plus the dq of the model's fitted effects
+     * (component plus residual). n_rows x n_joints each. */
     const double *joint_err_deg;
     const double *moment_mm; /* gravity moment about each joint of unit weights at the frames
                                 beyond it: compliance shows as a line through the origin */

@@ -1,6 +1,6 @@
 /* dhcal_refine.h - choosing a model with the training data only: k-fold cross-validation,
  * the geometry level for few rows, and the loop compare -> diagnose -> add -> refit of
- * `dhcal refine` (DESIGN.md section 3b). Held-out rows are evaluated, never used to choose.
+ * `dhcal refine` (docs/cli.md, 1.5). Held-out rows are evaluated, never used to choose.
  * Host code (heap allowed). */
 #ifndef DHCAL_REFINE_H
 #define DHCAL_REFINE_H

@@ -1,5 +1,5 @@
 /* dhcal - the command line: compare a model with measurements, fit it, find the missing
- * physical effect, plot it. Contract: DESIGN.md section 3 (flags, exit codes, JSON keys). */
+ * physical effect, plot it. Contract: docs/cli.md, section 1 (flags, exit codes, JSON keys). */
 #ifndef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 200809L
 #endif
@@ -36,7 +36,7 @@ typedef struct {
 } options;
 
 static const char *const common_help =
-    "  --model M.json     nominal model (DESIGN.md section 3)\n"
+    "  --model M.json     nominal model (docs/formats.md, section 2)\n"
     "  --data D.csv       measurements: q1..qN in deg; x,y,z in mm or raw wire lengths\n"
     "                     L1,L2,L3 (fitted in wire-length space when the model has a\n"
     "                     measurer); optional dir1..dirN, temp_c, t_s, qw,qx,qy,qz\n"
@@ -334,7 +334,7 @@ static int cmd_compare(const options *o, session *s)
 
 /* ---------------------------------------------------------------- fit reporting */
 
-/* The contract's name of an outlier's reason (DESIGN.md 3b). */
+/* The contract's name of an outlier's reason (docs/cli.md, 1.4, `fit`). */
 static const char *outlier_reason(uint8_t flag)
 {
     switch (flag) {
@@ -546,7 +546,7 @@ static void json_fit(cJSON *obj, const dhcal_fit *f, const session *s, const dou
         if (f->rep.identifiable[k]) {
             cJSON *p = cJSON_CreateObject();
             cJSON_AddStringToObject(p, "name", name);
-            cJSON_AddNumberToObject(p, "value", dhcal_param_display(&f->set, k, f->rep.value[k]));
+            cJSON_AddNumberToObject(p, "value", dhcal_param_fitted(f, &s->model, k));
             cJSON_AddNumberToObject(p, "std", dhcal_param_display(&f->set, k, f->rep.std_err[k]));
             cJSON_AddItemToArray(params, p);
             continue;
@@ -609,14 +609,8 @@ static void text_fit(const dhcal_fit *f, const session *s, const options *o, con
             continue;
         }
         (void)dhc_params_name(&f->set, k, name, sizeof name);
-        const int degrees = dhc_params_is_angle(&f->set, k);
-        const int compliance = f->set.id[k].kind == (uint8_t)DHC_P_COMPLIANCE;
-        printf("%-18s %16.8g %12.3g %s\n", name, dhcal_param_display(&f->set, k, rep->value[k]),
-               dhcal_param_display(&f->set, k, rep->std_err[k]),
-               degrees ? "deg" : compliance ? "deg/mm" : f->set.id[k].kind == (uint8_t)DHC_P_JOINT_SCALE ||
-                                                           f->set.id[k].kind == (uint8_t)DHC_P_MEAS_SCALE
-                                                       ? ""
-                                                       : f->set.id[k].kind == (uint8_t)DHC_P_THERMAL ? "1/K" : "mm");
+        printf("%-18s %16.8g %12.3g %s\n", name, dhcal_param_fitted(f, &s->model, k),
+               dhcal_param_display(&f->set, k, rep->std_err[k]), dhcal_param_unit(&f->set, k));
     }
     for (size_t k = 0U; k < f->set.count; ++k) {
         if (rep->identifiable[k]) {
@@ -730,8 +724,11 @@ static int cmd_fit(const options *o, session *s)
             memset(&err, 0, sizeof err);
             extras.have_cv = dhcal_cross_validate(&fit.model, &fit.set, &s->noise, &s->samples,
                                                   &extras.cv, &err) == DHCAL_IO_OK;
+            /* asked for and not computable: a failed computation, as for diagnose --cv; a
+             * script must not take a report without cv_rms_mm for a success */
             if (!extras.have_cv) {
                 fprintf(stderr, "dhcal: %s\n", err.msg);
+                rc = EXIT_COMPUTE;
             }
         }
     }

@@ -120,7 +120,7 @@ typedef struct {
     double min_anchor_plane_mm;  /* ... and this far in front of the measurer's anchor plane */
 } dhs_scenario;
 
-/* Defaults of PHYSICS.md's plant table for every joint (motor, amplifier, N = 100,
+/* The plant defaults of docs/formats.md, 6.5, for every joint (motor, amplifier, N = 100,
  * 500-line encoder, tacho), rigid joints, no imperfection, massless links, truth =
  * nominal = nominal_arm (copied), gravity -z 9.81, 10 kHz, +-10 V DAC and ADC, no measurer,
  * no noise, pose limits 150 mm. DHC_ERR_ARGUMENT for NULL, DHC_ERR_CAPACITY for a bad joint
@@ -128,7 +128,7 @@ typedef struct {
 dhc_status dhs_scenario_defaults(dhs_scenario *sc, const dhc_arm *nominal_arm);
 
 /* A measurer on the model's nominal geometry (anchors in its frame, T_Meas), built exactly
- * and counted with PHYSICS.md's wheel (r = 10 mm, 1000 lines x4, 16-bit counter, zero at
+ * and counted with the default wheel (r = 10 mm, 1000 lines x4, 16-bit counter, zero at
  * length 0), no noise. */
 void dhs_scenario_set_measurer(dhs_scenario *sc, const double anchors_mm[3][3],
                                const dhc_frame *frame);

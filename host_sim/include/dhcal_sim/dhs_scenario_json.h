@@ -1,12 +1,12 @@
 /* dhs_scenario_json.h - scenario files (JSON) for dhcal-sim. Host only (stdio, heap, cJSON).
  *
- * A scenario file, every key but the marked ones optional (defaults: PHYSICS.md's plant
- * table; units in the key names; a key that is not listed here is an error):
+ * A scenario file, every key but the marked ones optional (docs/formats.md, section 6;
+ * defaults in 6.5; units in the key names; a key that is not listed here is an error):
  * {
  *   "name": "joint_compliance_2",          label for comments in outputs
  *   "comment": "...",                       free text, ignored
  *   "seed": 7,                              REQUIRED integer 0..2^53: fixes random errors
- *   "model": "paper-3dof-model.json",       REQUIRED nominal model file (DESIGN.md sec. 3),
+ *   "model": "paper-3dof-model.json",       REQUIRED nominal model file (formats.md 2),
  *                                           relative to this file's directory
  *   "truth": {                              the arm as built = nominal + these errors
  *     "joints": [{"theta_offset_deg", "d_mm", "a_mm", "alpha_deg", "beta_deg"}, ...],
@@ -32,7 +32,8 @@
  *     "controller": {"gear_ratio": 100, "encoder_lines": 500}   what the controller
  *                                           believes (default: the gear's ratio, lines)
  *   }, ...],
- *   "payload": {"mass_kg": 0, "com_mm": nominal tool point, "inertia_kgm2": [0,0,0]},
+ *   "payload": {"mass_kg": 0, "com_mm": the true tool point (nominal + truth.tool_mm),
+ *               "inertia_kgm2": [0,0,0]},
  *   "drive": {"dac_range_v": 10, "adc_range_v": 10},
  *   "measurer": {                           needs the model's measurer; without this key
  *     "anchor_errors_mm": [[3],[3],[3]],    the measurer is built exactly, noise-free

@@ -5,7 +5,7 @@
  * Standard DH has beta_i = 0. Where axes i and i+1 are nominally parallel (alpha_i = 0 or
  * 180 deg, i not the last joint) standard DH cannot represent a small tilt between them and
  * its d_i is not identifiable; such joints use Hayati's convention: d_i is held at its
- * nominal value and beta_i is a parameter instead (DESIGN.md section 3).
+ * nominal value and beta_i is a parameter instead (docs/effects.md, section 2).
  *
  * The tool point in the world (measurement) frame is
  *     p = base * A_1 ... A_N * tool_mm

@@ -87,7 +87,7 @@ void dhc_rot_column(const dhc_mat3 *r, size_t c, double out[3]);
 void dhc_rot_exp(const double w_rad[3], dhc_mat3 *r);
 /* Rotation vector of r (inverse of dhc_rot_exp, angle in [0, pi]); accurate near 0 and pi. */
 void dhc_rot_log(const dhc_mat3 *r, double w_rad[3]);
-/* R = Rz(yaw) Ry(pitch) Rx(roll), rpy_rad = {roll, pitch, yaw} (DESIGN.md section 2). */
+/* R = Rz(yaw) Ry(pitch) Rx(roll), rpy_rad = {roll, pitch, yaw} (docs/formats.md, section 1). */
 void dhc_rot_from_rpy(const double rpy_rad[3], dhc_mat3 *r);
 /* Inverse of dhc_rot_from_rpy, pitch in [-pi/2, pi/2]. */
 void dhc_rot_to_rpy(const dhc_mat3 *r, double rpy_rad[3]);

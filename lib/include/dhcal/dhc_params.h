@@ -2,7 +2,7 @@
  *
  * A parameter set is an ordered list of (kind, joint, aux) triples; the fit's Jacobian has
  * one column per entry, in that order. Parameters are grouped into the effects of
- * DESIGN.md section 3 ("joint_compliance:2" adds c_2j for every j >= 2, ...).
+ * docs/effects.md, section 3 ("joint_compliance:2" adds c_2j for every j >= 2, ...).
  * The base frame is perturbed about its own origin with world-frame axes.
  * Units of parameter values: mm for lengths, rad for angles, 1 for scales, rad/mm for
  * compliances, 1/K for thermal expansion.
@@ -50,7 +50,7 @@ typedef enum {
     DHC_P_KIND_COUNT
 } dhc_param_kind;
 
-/* The effects of DESIGN.md section 3 that a fit can add to the base model. */
+/* The effects of docs/effects.md, section 3, that a fit can add to the base model. */
 typedef enum {
     DHC_EFFECT_BASE_FRAME = 0,
     DHC_EFFECT_TOOL_OFFSET,
@@ -99,7 +99,7 @@ dhc_status dhc_params_base_model(dhc_param_set *set, const dhc_model *model);
 dhc_status dhc_params_add_effect(dhc_param_set *set, const dhc_model *model, dhc_effect effect,
                                  size_t joint);
 
-/* "joint_compliance" etc. (DESIGN.md names); NULL for an unknown value. */
+/* "joint_compliance" etc. (the names of docs/effects.md); NULL for an unknown value. */
 const char *dhc_effect_name(dhc_effect effect);
 /* 1 when the effect is written "name:i" (per joint). */
 int dhc_effect_is_per_joint(dhc_effect effect);
