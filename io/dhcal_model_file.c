@@ -351,7 +351,7 @@ static int load_measurer(const jctx *c, const cJSON *m, dhcal_model *model)
     return load_frame(c, m, "measurer", "frame", &model->measurer_frame);
 }
 
-/* The effect catalogue is the library's (dhc_params): one list of names for every program. */
+/* The effect catalogue is the library's (dhc_effects): one list of names for every program. */
 static int effect_name_ok(const char *name, size_t n_joints)
 {
     dhc_effect effect;
@@ -362,13 +362,22 @@ static int effect_name_ok(const char *name, size_t n_joints)
 size_t dhcal_effect_catalogue(char *buf, size_t cap)
 {
     size_t pos = 0U;
-    for (unsigned e = 0U; e < (unsigned)DHC_EFFECT_COUNT; ++e) {
+    for (size_t i = 0U; i < (size_t)DHC_EFFECT_COUNT; ++i) {
+        const dhc_effect_info *fx = dhc_effect_at(i);
         const int n = snprintf(buf + (pos < cap ? pos : cap), pos < cap ? cap - pos : 0U,
-                               "%s%s%s", e == 0U ? "" : ", ", dhc_effect_name((dhc_effect)e),
-                               dhc_effect_is_per_joint((dhc_effect)e) ? ":i" : "");
+                               "%s%s%s", i == 0U ? "" : ", ", fx->name, fx->per_joint ? ":i" : "");
         pos += n > 0 ? (size_t)n : 0U;
     }
     return pos;
+}
+
+void dhcal_effect_label(dhc_effect effect, size_t joint, char *buf, size_t cap)
+{
+    if (dhc_effect_is_per_joint(effect)) {
+        snprintf(buf, cap, "%s:%zu", dhc_effect_name(effect), joint + 1U);
+    } else {
+        snprintf(buf, cap, "%s", dhc_effect_name(effect));
+    }
 }
 
 static int load_effects(const jctx *c, const cJSON *fx, dhcal_model *model)
