@@ -805,19 +805,9 @@ static void format_model(strbuf *sb, const dhcal_model *m)
     sb_printf(sb, "\n}\n");
 }
 
-static int all_finite(const double *v, size_t n)
-{
-    for (size_t i = 0U; i < n; ++i) {
-        if (!isfinite(v[i])) {
-            return 0;
-        }
-    }
-    return 1;
-}
-
 static int frame_finite(const dhc_frame *f)
 {
-    return all_finite(&f->rot.m[0][0], 9U) && all_finite(f->pos, 3U);
+    return dhc_all_finite(&f->rot.m[0][0], 9U) && dhc_all_finite(f->pos, 3U);
 }
 
 /* Everything save needs before it touches the disk; where names the first bad value. */
@@ -842,13 +832,13 @@ static int model_writable(const dhcal_model *m, char *where, size_t cap)
         }
     }
     const char *bad = NULL;
-    if (!all_finite(m->arm.tool_mm, 3U)) {
+    if (!dhc_all_finite(m->arm.tool_mm, 3U)) {
         bad = "tool_mm";
     } else if (!frame_finite(&m->arm.base)) {
         bad = "base";
-    } else if (!all_finite(m->gravity, 3U)) {
+    } else if (!dhc_all_finite(m->gravity, 3U)) {
         bad = "gravity";
-    } else if (m->has_measurer && !all_finite(&m->anchors_mm[0][0], 9U)) {
+    } else if (m->has_measurer && !dhc_all_finite(&m->anchors_mm[0][0], 9U)) {
         bad = "measurer.anchors_mm";
     } else if (m->has_measurer && !frame_finite(&m->measurer_frame)) {
         bad = "measurer.frame";
@@ -870,7 +860,7 @@ static int model_writable(const dhcal_model *m, char *where, size_t cap)
                            i, e->n_values);
             return 0;
         }
-        if (!all_finite(e->values, e->n_values)) {
+        if (!dhc_all_finite(e->values, e->n_values)) {
             (void)snprintf(where, cap, "effects.%s: not a finite number", e->name);
             return 0;
         }

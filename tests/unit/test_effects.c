@@ -50,12 +50,7 @@ static dhc_model catalogue_model(void)
     const double g[3] = {0.28, -0.19, -0.94};
     const double norm = dhc_vec3_norm(g);
     dhc_vec3_scale(g, 1.0 / norm, m.gravity);
-    m.measurer.present = 1;
-    const double anchors[3][3] = {{0.0, 0.0, 1200.0}, {0.0, 600.0, 300.0}, {0.0, -600.0, 300.0}};
-    memcpy(m.measurer.anchor_mm, anchors, sizeof anchors);
-    const double xyz[3] = {1300.0, 0.0, 0.0};
-    const double rpy[3] = {0.0, 0.0, DHC_PI};
-    dhc_frame_from_xyz_rpy(xyz, rpy, &m.measurer.frame);
+    test_put_paper_measurer(&m);
     return m;
 }
 
