@@ -183,33 +183,9 @@ static void copy_vec(const double *src, double *dst, size_t n)
     }
 }
 
-dhc_status dhc_tri_lower_solve(const dhc_mat *l, size_t k, const double *b, double *y,
-                               size_t len)
-{
-    const dhc_status st = check_solve(l, k, b, y, len);
-    if (st != DHC_OK) {
-        return st;
-    }
-    const dhc_tri t = dhc_tri_of_mat(l);
-    copy_vec(b, y, k);
-    dhc_tri_forward(&t, k, y);
-    return DHC_OK;
-}
-
-dhc_status dhc_tri_lower_t_solve(const dhc_mat *l, size_t k, const double *y, double *x,
-                                 size_t len)
-{
-    const dhc_status st = check_solve(l, k, y, x, len);
-    if (st != DHC_OK) {
-        return st;
-    }
-    const dhc_tri t = dhc_tri_of_mat(l);
-    copy_vec(y, x, k);
-    dhc_tri_backward(&t, k, x);
-    return DHC_OK;
-}
-
-dhc_status dhc_chol_solve(const dhc_mat *l, size_t k, const double *b, double *x, size_t len)
+/* The checked solves: L y = b (forward), then L^T x = y (backward), as asked. */
+static dhc_status checked_solve(const dhc_mat *l, size_t k, const double *b, double *x,
+                                size_t len, int forward, int backward)
 {
     const dhc_status st = check_solve(l, k, b, x, len);
     if (st != DHC_OK) {
@@ -217,9 +193,30 @@ dhc_status dhc_chol_solve(const dhc_mat *l, size_t k, const double *b, double *x
     }
     const dhc_tri t = dhc_tri_of_mat(l);
     copy_vec(b, x, k);
-    dhc_tri_forward(&t, k, x);
-    dhc_tri_backward(&t, k, x);
+    if (forward) {
+        dhc_tri_forward(&t, k, x);
+    }
+    if (backward) {
+        dhc_tri_backward(&t, k, x);
+    }
     return DHC_OK;
+}
+
+dhc_status dhc_tri_lower_solve(const dhc_mat *l, size_t k, const double *b, double *y,
+                               size_t len)
+{
+    return checked_solve(l, k, b, y, len, 1, 0);
+}
+
+dhc_status dhc_tri_lower_t_solve(const dhc_mat *l, size_t k, const double *y, double *x,
+                                 size_t len)
+{
+    return checked_solve(l, k, y, x, len, 0, 1);
+}
+
+dhc_status dhc_chol_solve(const dhc_mat *l, size_t k, const double *b, double *x, size_t len)
+{
+    return checked_solve(l, k, b, x, len, 1, 1);
 }
 
 double dhc_chol_condition_estimate(const dhc_mat *l, size_t k)

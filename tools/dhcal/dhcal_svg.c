@@ -234,6 +234,27 @@ void dhcal_svg_dot(dhcal_text *b, double x, double y, double r)
                       dhcal_svg_num(y), dhcal_svg_num(r));
 }
 
+/* The tick labels of one axis of the frame, in a group that holds nothing else. */
+static void tick_labels(dhcal_text *b, const dhcal_svg_frame *f, int horizontal)
+{
+    const dhcal_svg_axis *const a = horizontal ? &f->ax : &f->ay;
+    if (a->n_ticks == 0U) {
+        return;
+    }
+    dhcal_text_printf(b,
+                      "<g class=\"axis-%s\" font-size=\"11\" text-anchor=\"%s\" "
+                      "fill=\"" DHCAL_COLOR_TEXT "\">\n",
+                      horizontal ? "x" : "y", horizontal ? "middle" : "end");
+    for (size_t i = 0U; i < a->n_ticks; ++i) {
+        const double v = dhcal_svg_tick_value(a, i);
+        const double x = horizontal ? dhcal_svg_px_x(f, v) : f->x - 6.0;
+        const double y = horizontal ? f->y + f->h + 15.0 : dhcal_svg_px_y(f, v) + 4.0;
+        dhcal_text_printf(b, "<text x=\"%.6g\" y=\"%.6g\">%.6g</text>\n", dhcal_svg_num(x),
+                          dhcal_svg_num(y), dhcal_svg_num(v));
+    }
+    dhcal_text_str(b, "</g>\n");
+}
+
 void dhcal_svg_draw_frame(dhcal_text *b, const dhcal_svg_frame *f, int x_grid)
 {
     dhcal_text_printf(b,
@@ -251,28 +272,8 @@ void dhcal_svg_draw_frame(dhcal_text *b, const dhcal_svg_frame *f, int x_grid)
         dhcal_svg_line(b, x, f->y, x, f->y + f->h, "");
     }
     dhcal_text_str(b, "</g>\n");
-    if (f->ay.n_ticks > 0U) {
-        dhcal_text_str(b, "<g class=\"axis-y\" font-size=\"11\" text-anchor=\"end\" "
-                          "fill=\"" DHCAL_COLOR_TEXT "\">\n");
-        for (size_t i = 0U; i < f->ay.n_ticks; ++i) {
-            const double v = dhcal_svg_tick_value(&f->ay, i);
-            dhcal_text_printf(b, "<text x=\"%.6g\" y=\"%.6g\">%.6g</text>\n",
-                              dhcal_svg_num(f->x - 6.0), dhcal_svg_num(dhcal_svg_px_y(f, v) + 4.0),
-                              dhcal_svg_num(v));
-        }
-        dhcal_text_str(b, "</g>\n");
-    }
-    if (f->ax.n_ticks > 0U) {
-        dhcal_text_str(b, "<g class=\"axis-x\" font-size=\"11\" text-anchor=\"middle\" "
-                          "fill=\"" DHCAL_COLOR_TEXT "\">\n");
-        for (size_t i = 0U; i < f->ax.n_ticks; ++i) {
-            const double v = dhcal_svg_tick_value(&f->ax, i);
-            dhcal_text_printf(b, "<text x=\"%.6g\" y=\"%.6g\">%.6g</text>\n",
-                              dhcal_svg_num(dhcal_svg_px_x(f, v)),
-                              dhcal_svg_num(f->y + f->h + 15.0), dhcal_svg_num(v));
-        }
-        dhcal_text_str(b, "</g>\n");
-    }
+    tick_labels(b, f, 0);
+    tick_labels(b, f, 1);
 }
 
 void dhcal_svg_axis_titles(dhcal_text *b, const dhcal_svg_frame *f, const char *x_title,
