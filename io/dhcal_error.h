@@ -14,4 +14,13 @@ typedef struct {
     char msg[1024];
 } dhcal_error;
 
+#if defined(__GNUC__)
+#define DHCAL_PRINTF(fmt_index, first_arg) __attribute__((format(printf, fmt_index, first_arg)))
+#else
+#define DHCAL_PRINTF(fmt_index, first_arg)
+#endif
+
+/* Writes the message into err (when err is not NULL) and returns code. */
+int dhcal_error_set(dhcal_error *err, int code, const char *fmt, ...) DHCAL_PRINTF(3, 4);
+
 #endif /* DHCAL_ERROR_H */

@@ -7,10 +7,12 @@
 
 int dhcal_error_set(dhcal_error *err, int code, const char *fmt, ...)
 {
-    va_list ap;
-    va_start(ap, fmt);
-    (void)vsnprintf(err->msg, sizeof err->msg, fmt, ap);
-    va_end(ap);
+    if (err != NULL) {
+        va_list ap;
+        va_start(ap, fmt);
+        (void)vsnprintf(err->msg, sizeof err->msg, fmt, ap);
+        va_end(ap);
+    }
     return code;
 }
 

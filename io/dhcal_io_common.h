@@ -11,15 +11,6 @@
 #define LEN_MAX_MM 1e5
 #define UNIT_NORM_TOL 1e-3
 
-#if defined(__GNUC__)
-#define IO_PRINTF(fmt_index, first_arg) __attribute__((format(printf, fmt_index, first_arg)))
-#else
-#define IO_PRINTF(fmt_index, first_arg)
-#endif
-
-/* Writes the message into err and returns code. */
-int dhcal_error_set(dhcal_error *err, int code, const char *fmt, ...) IO_PRINTF(3, 4);
-
 /* Quoted text from a file, for a message: at most DHCAL_QUOTE_MAX bytes, bytes outside
  * printable ASCII as \xNN, so that garbage and megabyte fields cannot flood or corrupt a
  * terminal. Returns out. */

@@ -18,6 +18,7 @@
 #include "dhcal/dhc_params.h"
 #include "dhcal_file.h"
 #include "dhcal_io_common.h"
+#include "dhcal_text.h"
 
 /* Value ranges of the model file (docs/formats.md). */
 #define MODEL_ANGLE_MAX_DEG 360.0
@@ -37,7 +38,7 @@ typedef struct {
 
 #define JPATH_CAP 160U
 
-static int jfail(const jctx *c, const char *jpath, const char *fmt, ...) IO_PRINTF(3, 4);
+static int jfail(const jctx *c, const char *jpath, const char *fmt, ...) DHCAL_PRINTF(3, 4);
 static int jfail(const jctx *c, const char *jpath, const char *fmt, ...)
 {
     const int head = snprintf(c->err->msg, sizeof c->err->msg, "%s: %s: ", c->file, jpath);
@@ -351,7 +352,7 @@ static int load_measurer(const jctx *c, const cJSON *m, dhcal_model *model)
     return load_frame(c, m, "measurer", "frame", &model->measurer_frame);
 }
 
-/* The effect catalogue is the library's (dhc_params): one list of names for every program. */
+/* The effect catalogue is the library's (dhc_effects): one list of names for every program. */
 static int effect_name_ok(const char *name, size_t n_joints)
 {
     dhc_effect effect;
@@ -362,13 +363,22 @@ static int effect_name_ok(const char *name, size_t n_joints)
 size_t dhcal_effect_catalogue(char *buf, size_t cap)
 {
     size_t pos = 0U;
-    for (unsigned e = 0U; e < (unsigned)DHC_EFFECT_COUNT; ++e) {
+    for (size_t i = 0U; i < (size_t)DHC_EFFECT_COUNT; ++i) {
+        const dhc_effect_info *fx = dhc_effect_at(i);
         const int n = snprintf(buf + (pos < cap ? pos : cap), pos < cap ? cap - pos : 0U,
-                               "%s%s%s", e == 0U ? "" : ", ", dhc_effect_name((dhc_effect)e),
-                               dhc_effect_is_per_joint((dhc_effect)e) ? ":i" : "");
+                               "%s%s%s", i == 0U ? "" : ", ", fx->name, fx->per_joint ? ":i" : "");
         pos += n > 0 ? (size_t)n : 0U;
     }
     return pos;
+}
+
+void dhcal_effect_label(dhc_effect effect, size_t joint, char *buf, size_t cap)
+{
+    if (dhc_effect_is_per_joint(effect)) {
+        snprintf(buf, cap, "%s:%zu", dhc_effect_name(effect), joint + 1U);
+    } else {
+        snprintf(buf, cap, "%s", dhc_effect_name(effect));
+    }
 }
 
 static int load_effects(const jctx *c, const cJSON *fx, dhcal_model *model)
@@ -619,51 +629,8 @@ int dhcal_model_load(const char *path, dhcal_model *model, dhcal_error *err)
 
 /* ------------------------------------------------------------------ model: writing */
 
-typedef struct {
-    char *p;
-    size_t len;
-    size_t cap;
-    int oom;
-} strbuf;
-
-static void sb_printf(strbuf *sb, const char *fmt, ...) IO_PRINTF(2, 3);
-static void sb_printf(strbuf *sb, const char *fmt, ...)
-{
-    if (sb->oom) {
-        return;
-    }
-    va_list ap;
-    va_start(ap, fmt);
-    va_list ap2;
-    va_copy(ap2, ap);
-    const int need = vsnprintf(NULL, 0U, fmt, ap);
-    va_end(ap);
-    if (need < 0) {
-        sb->oom = 1;
-        va_end(ap2);
-        return;
-    }
-    if (sb->len + (size_t)need + 1U > sb->cap) {
-        size_t cap = sb->cap == 0U ? 4096U : sb->cap;
-        while (cap < sb->len + (size_t)need + 1U) {
-            cap *= 2U;
-        }
-        char *const grown = realloc(sb->p, cap);
-        if (grown == NULL) {
-            sb->oom = 1;
-            va_end(ap2);
-            return;
-        }
-        sb->p = grown;
-        sb->cap = cap;
-    }
-    (void)vsnprintf(sb->p + sb->len, sb->cap - sb->len, fmt, ap2);
-    va_end(ap2);
-    sb->len += (size_t)need;
-}
-
 /* The shortest of %.15g, %.16g, %.17g that reads back to v (%.17g always does). */
-static void put_exact(strbuf *sb, double v)
+static void put_exact(dhcal_text *sb, double v)
 {
     char num[40];
     v = v + 0.0; /* -0 becomes +0 */
@@ -673,12 +640,12 @@ static void put_exact(strbuf *sb, double v)
             break;
         }
     }
-    sb_printf(sb, "%s", num);
+    dhcal_text_printf(sb, "%s", num);
 }
 
 /* Angles in degrees: the fewest digits (15 to 17) that load back to the same radians, so
  * 90 deg stays "90" and two limits 1e-15 apart do not collapse into one on saving. */
-static void put_deg(strbuf *sb, double rad)
+static void put_deg(dhcal_text *sb, double rad)
 {
     char num[40];
     const double deg = rad * (1.0 / DHC_DEG) + 0.0; /* -0 becomes +0 */
@@ -688,47 +655,47 @@ static void put_deg(strbuf *sb, double rad)
             break;
         }
     }
-    sb_printf(sb, "%s", num);
+    dhcal_text_printf(sb, "%s", num);
 }
 
-static void put_vec_mm(strbuf *sb, const double *v, size_t n)
+static void put_vec_mm(dhcal_text *sb, const double *v, size_t n)
 {
-    sb_printf(sb, "[");
+    dhcal_text_printf(sb, "[");
     for (size_t i = 0U; i < n; ++i) {
-        sb_printf(sb, "%s", i > 0U ? ", " : "");
+        dhcal_text_printf(sb, "%s", i > 0U ? ", " : "");
         put_exact(sb, v[i]);
     }
-    sb_printf(sb, "]");
+    dhcal_text_printf(sb, "]");
 }
 
-static void put_string(strbuf *sb, const char *s)
+static void put_string(dhcal_text *sb, const char *s)
 {
-    sb_printf(sb, "\"");
+    dhcal_text_printf(sb, "\"");
     for (; *s != '\0'; ++s) {
         const unsigned char ch = (unsigned char)*s;
         if (ch == '"' || ch == '\\') {
-            sb_printf(sb, "\\%c", (char)ch);
+            dhcal_text_printf(sb, "\\%c", (char)ch);
         } else if (ch < 0x20U || ch == 0x7fU) {
-            sb_printf(sb, "\\u%04x", (unsigned)ch);
+            dhcal_text_printf(sb, "\\u%04x", (unsigned)ch);
         } else {
-            sb_printf(sb, "%c", (char)ch);
+            dhcal_text_printf(sb, "%c", (char)ch);
         }
     }
-    sb_printf(sb, "\"");
+    dhcal_text_printf(sb, "\"");
 }
 
-static void put_frame(strbuf *sb, const dhc_frame *f)
+static void put_frame(dhcal_text *sb, const dhc_frame *f)
 {
     double rpy[3];
     dhc_rot_to_rpy(&f->rot, rpy);
-    sb_printf(sb, "{\"xyz_mm\": ");
+    dhcal_text_printf(sb, "{\"xyz_mm\": ");
     put_vec_mm(sb, f->pos, 3U);
-    sb_printf(sb, ", \"rpy_deg\": [");
+    dhcal_text_printf(sb, ", \"rpy_deg\": [");
     for (size_t i = 0U; i < 3U; ++i) {
-        sb_printf(sb, "%s", i > 0U ? ", " : "");
+        dhcal_text_printf(sb, "%s", i > 0U ? ", " : "");
         put_deg(sb, rpy[i]);
     }
-    sb_printf(sb, "]}");
+    dhcal_text_printf(sb, "]}");
 }
 
 static int joint_writes_beta(const dhcal_model *m, size_t i)
@@ -737,78 +704,68 @@ static int joint_writes_beta(const dhcal_model *m, size_t i)
     return j->convention == DHC_CONV_HAYATI || m->has_beta[i] || fabs(j->beta_rad) > 0.0;
 }
 
-static void format_model(strbuf *sb, const dhcal_model *m)
+static void format_model(dhcal_text *sb, const dhcal_model *m)
 {
-    sb_printf(sb, "{\n");
+    dhcal_text_printf(sb, "{\n");
     if (m->name[0] != '\0') {
-        sb_printf(sb, "  \"name\": ");
+        dhcal_text_printf(sb, "  \"name\": ");
         put_string(sb, m->name);
-        sb_printf(sb, ",\n");
+        dhcal_text_printf(sb, ",\n");
     }
-    sb_printf(sb, "  \"joints\": [\n");
+    dhcal_text_printf(sb, "  \"joints\": [\n");
     for (size_t i = 0U; i < m->arm.n_joints; ++i) {
         const dhc_joint *const j = &m->arm.joint[i];
-        sb_printf(sb, "    {\"alpha_deg\": ");
+        dhcal_text_printf(sb, "    {\"alpha_deg\": ");
         put_deg(sb, j->alpha_rad);
-        sb_printf(sb, ", \"a_mm\": ");
+        dhcal_text_printf(sb, ", \"a_mm\": ");
         put_exact(sb, j->a_mm);
-        sb_printf(sb, ", \"d_mm\": ");
+        dhcal_text_printf(sb, ", \"d_mm\": ");
         put_exact(sb, j->d_mm);
-        sb_printf(sb, ", \"theta_offset_deg\": ");
+        dhcal_text_printf(sb, ", \"theta_offset_deg\": ");
         put_deg(sb, j->theta_offset_rad);
         if (joint_writes_beta(m, i)) {
-            sb_printf(sb, ", \"beta_deg\": ");
+            dhcal_text_printf(sb, ", \"beta_deg\": ");
             put_deg(sb, j->beta_rad);
         }
-        sb_printf(sb, ",\n     \"min_deg\": ");
+        dhcal_text_printf(sb, ",\n     \"min_deg\": ");
         put_deg(sb, j->min_rad);
-        sb_printf(sb, ", \"max_deg\": ");
+        dhcal_text_printf(sb, ", \"max_deg\": ");
         put_deg(sb, j->max_rad);
-        sb_printf(sb, "}%s\n", i + 1U < m->arm.n_joints ? "," : "");
+        dhcal_text_printf(sb, "}%s\n", i + 1U < m->arm.n_joints ? "," : "");
     }
-    sb_printf(sb, "  ],\n  \"tool_mm\": ");
+    dhcal_text_printf(sb, "  ],\n  \"tool_mm\": ");
     put_vec_mm(sb, m->arm.tool_mm, 3U);
-    sb_printf(sb, ",\n  \"base\": ");
+    dhcal_text_printf(sb, ",\n  \"base\": ");
     put_frame(sb, &m->arm.base);
-    sb_printf(sb, ",\n  \"gravity\": ");
+    dhcal_text_printf(sb, ",\n  \"gravity\": ");
     put_vec_mm(sb, m->gravity, 3U);
     if (m->has_measurer) {
-        sb_printf(sb, ",\n  \"measurer\": {\n    \"anchors_mm\": [");
+        dhcal_text_printf(sb, ",\n  \"measurer\": {\n    \"anchors_mm\": [");
         for (size_t i = 0U; i < 3U; ++i) {
-            sb_printf(sb, "%s", i > 0U ? ", " : "");
+            dhcal_text_printf(sb, "%s", i > 0U ? ", " : "");
             put_vec_mm(sb, m->anchors_mm[i], 3U);
         }
-        sb_printf(sb, "],\n    \"frame\": ");
+        dhcal_text_printf(sb, "],\n    \"frame\": ");
         put_frame(sb, &m->measurer_frame);
-        sb_printf(sb, "\n  }");
+        dhcal_text_printf(sb, "\n  }");
     }
     if (m->n_effects > 0U) {
-        sb_printf(sb, ",\n  \"effects\": {\n");
+        dhcal_text_printf(sb, ",\n  \"effects\": {\n");
         for (size_t i = 0U; i < m->n_effects; ++i) {
-            sb_printf(sb, "    ");
+            dhcal_text_printf(sb, "    ");
             put_string(sb, m->effects[i].name);
-            sb_printf(sb, ": ");
+            dhcal_text_printf(sb, ": ");
             put_vec_mm(sb, m->effects[i].values, m->effects[i].n_values);
-            sb_printf(sb, "%s\n", i + 1U < m->n_effects ? "," : "");
+            dhcal_text_printf(sb, "%s\n", i + 1U < m->n_effects ? "," : "");
         }
-        sb_printf(sb, "  }");
+        dhcal_text_printf(sb, "  }");
     }
-    sb_printf(sb, "\n}\n");
-}
-
-static int all_finite(const double *v, size_t n)
-{
-    for (size_t i = 0U; i < n; ++i) {
-        if (!isfinite(v[i])) {
-            return 0;
-        }
-    }
-    return 1;
+    dhcal_text_printf(sb, "\n}\n");
 }
 
 static int frame_finite(const dhc_frame *f)
 {
-    return all_finite(&f->rot.m[0][0], 9U) && all_finite(f->pos, 3U);
+    return dhc_all_finite(&f->rot.m[0][0], 9U) && dhc_all_finite(f->pos, 3U);
 }
 
 /* Everything save needs before it touches the disk; where names the first bad value. */
@@ -833,13 +790,13 @@ static int model_writable(const dhcal_model *m, char *where, size_t cap)
         }
     }
     const char *bad = NULL;
-    if (!all_finite(m->arm.tool_mm, 3U)) {
+    if (!dhc_all_finite(m->arm.tool_mm, 3U)) {
         bad = "tool_mm";
     } else if (!frame_finite(&m->arm.base)) {
         bad = "base";
-    } else if (!all_finite(m->gravity, 3U)) {
+    } else if (!dhc_all_finite(m->gravity, 3U)) {
         bad = "gravity";
-    } else if (m->has_measurer && !all_finite(&m->anchors_mm[0][0], 9U)) {
+    } else if (m->has_measurer && !dhc_all_finite(&m->anchors_mm[0][0], 9U)) {
         bad = "measurer.anchors_mm";
     } else if (m->has_measurer && !frame_finite(&m->measurer_frame)) {
         bad = "measurer.frame";
@@ -861,7 +818,7 @@ static int model_writable(const dhcal_model *m, char *where, size_t cap)
                            i, e->n_values);
             return 0;
         }
-        if (!all_finite(e->values, e->n_values)) {
+        if (!dhc_all_finite(e->values, e->n_values)) {
             (void)snprintf(where, cap, "effects.%s: not a finite number", e->name);
             return 0;
         }
@@ -879,9 +836,9 @@ int dhcal_model_save(const char *path, const dhcal_model *model, dhcal_error *er
     if (!model_writable(model, where, sizeof where)) {
         return dhcal_error_set(err, DHCAL_IO_FAILED, "%s: not written: %s", path, where);
     }
-    strbuf sb = {NULL, 0U, 0U, 0};
+    dhcal_text sb = {NULL, 0U, 0U, 0};
     format_model(&sb, model);
-    if (sb.oom) {
+    if (sb.failed) {
         free(sb.p);
         return dhcal_error_set(err, DHCAL_IO_FAILED, "%s: not written: out of memory", path);
     }

@@ -11,6 +11,7 @@
 
 #include <stddef.h>
 
+#include "dhcal/dhc_effects.h"
 #include "dhcal/dhc_kinematics.h"
 #include "dhcal_error.h"
 
@@ -73,5 +74,9 @@ int dhcal_model_save(const char *path, const dhcal_model *model, dhcal_error *er
  * ("base_frame, tool_offset, joint_scale:i, ..."), into buf (snprintf rules); returns the
  * full length. */
 size_t dhcal_effect_catalogue(char *buf, size_t cap);
+
+/* "joint_compliance:2" / "measurer_scale": an effect as the CLI, model files and JSON write it
+ * (joint 0-based in, 1-based out; ignored when the effect is not per joint). */
+void dhcal_effect_label(dhc_effect effect, size_t joint, char *buf, size_t cap);
 
 #endif /* DHCAL_MODEL_FILE_H */

@@ -16,6 +16,78 @@ static int bad(dhcal_error *err, const char *path, const char *name, const char 
     return DHCAL_IO_BAD_INPUT;
 }
 
+/* "expected [harmonic_sin2_deg, harmonic_cos2_deg]": the parameters' report names in the
+ * file's units, then the reference value a file gives after them. */
+static void expected_values(const dhc_param_set *set, const dhc_effect_info *fx, char *buf,
+                            size_t cap)
+{
+    char list[192];
+    size_t pos = 0U;
+    list[0] = '\0';
+    for (size_t k = 0U; k < set->count && pos < sizeof list; ++k) {
+        char name[32];
+        (void)dhc_params_name(set, k, name, sizeof name);
+        pos += (size_t)snprintf(list + pos, sizeof list - pos, "%s%s%s", k == 0U ? "" : ", ",
+                                name, dhc_params_in_degrees(set, k) ? "_deg" : "");
+    }
+    if (fx->reference == DHC_EFFECT_REF_TIME) {
+        (void)snprintf(buf, cap, "expected [%s, t0_s]", list);
+    } else if (fx->reference == DHC_EFFECT_REF_TEMPERATURE) {
+        (void)snprintf(buf, cap, "expected [%s] or [%s, T0_C]", list, list);
+    } else {
+        (void)snprintf(buf, cap, "expected [%s]", list);
+    }
+}
+
+/* One entry of the file's "effects" object into the library's model. */
+static int effect_to_lib(const dhcal_model *file, const dhcal_effect_value *ev, const char *path,
+                         dhc_model *out, dhcal_error *err)
+{
+    dhc_effect effect;
+    size_t j;
+    if (dhc_effect_parse(ev->name, strlen(ev->name), file->arm.n_joints, &effect, &j) !=
+        DHC_OK) {
+        return bad(err, path, ev->name, "unknown effect", ev->n_values);
+    }
+    const dhc_effect_info *fx = dhc_effect_info_of(effect);
+    const size_t k = ev->n_values;
+    if (fx->in_frames) {
+        return bad(err, path, ev->name,
+                   "is stored in the model itself ('base', 'tool_mm', "
+                   "'measurer.anchors_mm'), not under 'effects'",
+                   k);
+    }
+    if ((fx->needs & DHC_NEEDS_WIRES) != 0U && !file->has_measurer) {
+        return bad(err, path, ev->name, "needs a 'measurer' block", k);
+    }
+    dhc_param_set set;
+    dhc_params_clear(&set);
+    if (dhc_params_add_effect(&set, out, effect, j) != DHC_OK) {
+        return bad(err, path, ev->name, "does not fit this model", k);
+    }
+    const size_t p = set.count;
+    const int ref_ok = fx->reference == DHC_EFFECT_REF_NONE   ? k == p
+                       : fx->reference == DHC_EFFECT_REF_TIME ? k == p + 1U
+                                                              : k == p || k == p + 1U;
+    if (!ref_ok) {
+        char what[448];
+        expected_values(&set, fx, what, sizeof what);
+        return bad(err, path, ev->name, what, k);
+    }
+    for (size_t m = 0U; m < p; ++m) {
+        const double v = dhc_params_in_degrees(&set, m) ? ev->values[m] * DHC_DEG : ev->values[m];
+        if (dhc_params_set_value(&set, out, m, v) != DHC_OK) {
+            return bad(err, path, ev->name, "not a finite value", k);
+        }
+    }
+    if (fx->reference == DHC_EFFECT_REF_TIME) {
+        out->drift_ref_s = ev->values[p];
+    } else if (fx->reference == DHC_EFFECT_REF_TEMPERATURE) {
+        out->thermal_ref_c = k > p ? ev->values[p] : 20.0;
+    }
+    return DHCAL_IO_OK;
+}
+
 int dhcal_model_to_lib(const dhcal_model *file, const char *path, dhc_model *out,
                        dhcal_error *err)
 {
@@ -29,123 +101,44 @@ int dhcal_model_to_lib(const dhcal_model *file, const char *path, dhc_model *out
     out->measurer.present = file->has_measurer;
     memcpy(out->measurer.anchor_mm, file->anchors_mm, sizeof out->measurer.anchor_mm);
     out->measurer.frame = file->measurer_frame;
-    const size_t n = file->arm.n_joints;
     for (size_t e = 0U; e < file->n_effects; ++e) {
-        const dhcal_effect_value *ev = &file->effects[e];
-        dhc_effect effect;
-        size_t j;
-        if (dhc_effect_parse(ev->name, strlen(ev->name), n, &effect, &j) != DHC_OK) {
-            return bad(err, path, ev->name, "unknown effect", ev->n_values);
-        }
-        const double *v = ev->values;
-        const size_t k = ev->n_values;
-        dhc_joint_effects *fx = &out->effect[j];
-        switch (effect) {
-        case DHC_EFFECT_JOINT_SCALE:
-            if (k != 1U) {
-                return bad(err, path, ev->name, "expected [s]", k);
-            }
-            fx->scale = v[0];
-            break;
-        case DHC_EFFECT_JOINT_HARMONIC:
-            if (k != 2U) {
-                return bad(err, path, ev->name, "expected [A_deg, B_deg]", k);
-            }
-            fx->harmonic_sin_rad = v[0] * DHC_DEG;
-            fx->harmonic_cos_rad = v[1] * DHC_DEG;
-            break;
-        case DHC_EFFECT_JOINT_HARMONIC2:
-        case DHC_EFFECT_JOINT_HARMONIC3:
-        case DHC_EFFECT_JOINT_HARMONIC4: {
-            if (k != 2U) {
-                return bad(err, path, ev->name, "expected [A_deg, B_deg]", k);
-            }
-            const size_t order = (size_t)((unsigned)effect - (unsigned)DHC_EFFECT_JOINT_HARMONIC2);
-            fx->harmonic_hi_sin_rad[order] = v[0] * DHC_DEG;
-            fx->harmonic_hi_cos_rad[order] = v[1] * DHC_DEG;
-            break;
-        }
-        case DHC_EFFECT_DRIFT_SCALE:
-            if (k != 2U) {
-                return bad(err, path, ev->name, "expected [k_per_s, t0_s]", k);
-            }
-            out->drift_scale_per_s = v[0];
-            out->drift_ref_s = v[1];
-            break;
-        case DHC_EFFECT_DRIFT_OFFSET:
-            if (k != 4U) {
-                return bad(err, path, ev->name, "expected [vx_mm_per_s, vy, vz, t0_s]", k);
-            }
-            memcpy(out->drift_mm_per_s, v, 3U * sizeof v[0]);
-            out->drift_ref_s = v[3];
-            break;
-        case DHC_EFFECT_JOINT_BACKLASH:
-            if (k != 1U) {
-                return bad(err, path, ev->name, "expected [b_deg]", k);
-            }
-            fx->backlash_rad = v[0] * DHC_DEG;
-            break;
-        case DHC_EFFECT_JOINT_COMPLIANCE:
-            if (k != n - j) {
-                return bad(err, path, ev->name,
-                           "expected one value per joint from this one to the last", k);
-            }
-            for (size_t m = 0U; m < k; ++m) {
-                fx->compliance[j + m] = v[m] * DHC_DEG;
-            }
-            break;
-        case DHC_EFFECT_MEASURER_SCALE:
-        case DHC_EFFECT_MEASURER_OFFSET:
-            if (!file->has_measurer) {
-                return bad(err, path, ev->name, "needs a 'measurer' block", k);
-            }
-            if (effect == DHC_EFFECT_MEASURER_SCALE) {
-                if (k != 1U) {
-                    return bad(err, path, ev->name, "expected [s]", k);
-                }
-                out->measurer.scale = v[0];
-            } else {
-                if (k != 3U) {
-                    return bad(err, path, ev->name, "expected [o1_mm, o2_mm, o3_mm]", k);
-                }
-                memcpy(out->measurer.offset_mm, v, 3U * sizeof v[0]);
-            }
-            break;
-        case DHC_EFFECT_THERMAL_SCALE:
-            if (k != 1U && k != 2U) {
-                return bad(err, path, ev->name, "expected [k_per_K] or [k_per_K, T0_C]", k);
-            }
-            out->thermal_per_k = v[0];
-            out->thermal_ref_c = k == 2U ? v[1] : 20.0;
-            break;
-        case DHC_EFFECT_BASE_FRAME:
-        case DHC_EFFECT_TOOL_OFFSET:
-        case DHC_EFFECT_MEASURER_ANCHORS:
-        case DHC_EFFECT_COUNT:
-        default:
-            return bad(err, path, ev->name,
-                       "is stored in the model itself ('base', 'tool_mm', "
-                       "'measurer.anchors_mm'), not under 'effects'",
-                       k);
+        const int rc = effect_to_lib(file, &file->effects[e], path, out, err);
+        if (rc != DHCAL_IO_OK) {
+            return rc;
         }
     }
     return DHCAL_IO_OK;
 }
 
-static void put_effect(dhcal_model *out, dhc_effect effect, size_t joint, const double *v,
-                       size_t k)
+/* The file entry of one effect of m at joint, when any of its values is not zero. */
+static void effect_from_lib(const dhc_model *m, const dhc_effect_info *fx, size_t joint,
+                            dhcal_model *out)
 {
-    if (out->n_effects >= DHCAL_MAX_EFFECTS) {
+    dhc_param_set set;
+    dhc_params_clear(&set);
+    if (out->n_effects >= DHCAL_MAX_EFFECTS ||
+        dhc_params_add_effect(&set, m, (dhc_effect)fx->effect, joint) != DHC_OK ||
+        set.count + 1U > DHCAL_MAX_EFFECT_VALUES) {
         return;
     }
-    dhcal_effect_value *ev = &out->effects[out->n_effects++];
-    if (dhc_effect_is_per_joint(effect)) {
-        snprintf(ev->name, sizeof ev->name, "%s:%zu", dhc_effect_name(effect), joint + 1U);
-    } else {
-        snprintf(ev->name, sizeof ev->name, "%s", dhc_effect_name(effect));
+    dhcal_effect_value *ev = &out->effects[out->n_effects];
+    int any = 0;
+    for (size_t k = 0U; k < set.count; ++k) {
+        const double v = dhc_params_value(&set, m, k);
+        ev->values[k] = dhc_params_in_degrees(&set, k) ? v / DHC_DEG : v;
+        any |= fabs(ev->values[k]) > 0.0;
     }
-    ev->n_values = k;
-    memcpy(ev->values, v, k * sizeof v[0]);
+    if (!any) {
+        return;
+    }
+    ev->n_values = set.count;
+    if (fx->reference == DHC_EFFECT_REF_TIME) {
+        ev->values[ev->n_values++] = m->drift_ref_s;
+    } else if (fx->reference == DHC_EFFECT_REF_TEMPERATURE) {
+        ev->values[ev->n_values++] = m->thermal_ref_c;
+    }
+    dhcal_effect_label((dhc_effect)fx->effect, joint, ev->name, sizeof ev->name);
+    out->n_effects++;
 }
 
 void dhcal_model_from_lib(const dhc_model *m, const dhcal_model *template_model,
@@ -155,58 +148,19 @@ void dhcal_model_from_lib(const dhc_model *m, const dhcal_model *template_model,
     out->arm = m->arm;
     memcpy(out->anchors_mm, m->measurer.anchor_mm, sizeof out->anchors_mm);
     out->n_effects = 0U;
-    const size_t n = m->arm.n_joints;
-    for (size_t j = 0U; j < n; ++j) {
-        const dhc_joint_effects *fx = &m->effect[j];
-        if (fabs(fx->scale) > 0.0) {
-            put_effect(out, DHC_EFFECT_JOINT_SCALE, j, &fx->scale, 1U);
-        }
-        if (fabs(fx->harmonic_sin_rad) > 0.0 || fabs(fx->harmonic_cos_rad) > 0.0) {
-            const double v[2] = {fx->harmonic_sin_rad / DHC_DEG, fx->harmonic_cos_rad / DHC_DEG};
-            put_effect(out, DHC_EFFECT_JOINT_HARMONIC, j, v, 2U);
-        }
-        for (size_t order = 0U; order + 1U < DHC_HARMONIC_MAX_ORDER; ++order) {
-            if (fabs(fx->harmonic_hi_sin_rad[order]) > 0.0 ||
-                fabs(fx->harmonic_hi_cos_rad[order]) > 0.0) {
-                const double v[2] = {fx->harmonic_hi_sin_rad[order] / DHC_DEG,
-                                     fx->harmonic_hi_cos_rad[order] / DHC_DEG};
-                put_effect(out,
-                           (dhc_effect)((unsigned)DHC_EFFECT_JOINT_HARMONIC2 + (unsigned)order),
-                           j, v, 2U);
+    /* joint by joint, then the others: each in the catalogue's order */
+    for (size_t j = 0U; j < m->arm.n_joints; ++j) {
+        for (size_t i = 0U; i < (size_t)DHC_EFFECT_COUNT; ++i) {
+            const dhc_effect_info *fx = dhc_effect_at(i);
+            if (fx->per_joint) {
+                effect_from_lib(m, fx, j, out);
             }
         }
-        if (fabs(fx->backlash_rad) > 0.0) {
-            const double v = fx->backlash_rad / DHC_DEG;
-            put_effect(out, DHC_EFFECT_JOINT_BACKLASH, j, &v, 1U);
+    }
+    for (size_t i = 0U; i < (size_t)DHC_EFFECT_COUNT; ++i) {
+        const dhc_effect_info *fx = dhc_effect_at(i);
+        if (!fx->per_joint && !fx->in_frames) {
+            effect_from_lib(m, fx, 0U, out);
         }
-        double c[DHC_MAX_JOINTS];
-        int any = 0;
-        for (size_t i = j; i < n; ++i) {
-            c[i - j] = fx->compliance[i] / DHC_DEG;
-            any |= fabs(c[i - j]) > 0.0;
-        }
-        if (any) {
-            put_effect(out, DHC_EFFECT_JOINT_COMPLIANCE, j, c, n - j);
-        }
-    }
-    if (m->measurer.present && fabs(m->measurer.scale) > 0.0) {
-        put_effect(out, DHC_EFFECT_MEASURER_SCALE, 0U, &m->measurer.scale, 1U);
-    }
-    const double *o = m->measurer.offset_mm;
-    if (m->measurer.present && (fabs(o[0]) > 0.0 || fabs(o[1]) > 0.0 || fabs(o[2]) > 0.0)) {
-        put_effect(out, DHC_EFFECT_MEASURER_OFFSET, 0U, o, 3U);
-    }
-    if (fabs(m->thermal_per_k) > 0.0) {
-        const double v[2] = {m->thermal_per_k, m->thermal_ref_c};
-        put_effect(out, DHC_EFFECT_THERMAL_SCALE, 0U, v, 2U);
-    }
-    if (fabs(m->drift_scale_per_s) > 0.0) {
-        const double v[2] = {m->drift_scale_per_s, m->drift_ref_s};
-        put_effect(out, DHC_EFFECT_DRIFT_SCALE, 0U, v, 2U);
-    }
-    const double *dv = m->drift_mm_per_s;
-    if (fabs(dv[0]) > 0.0 || fabs(dv[1]) > 0.0 || fabs(dv[2]) > 0.0) {
-        const double v[4] = {dv[0], dv[1], dv[2], m->drift_ref_s};
-        put_effect(out, DHC_EFFECT_DRIFT_OFFSET, 0U, v, 4U);
     }
 }

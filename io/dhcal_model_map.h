@@ -1,21 +1,12 @@
 /* dhcal_model_map.h - the model file's representation (dhcal_model) to and from the
  * library's measurement model (dhc_model).
  *
- * Effects in the file's "effects" object (units as in every file: mm and degrees):
- *   "joint_scale:i":      [s]                              (unitless)
- *   "joint_harmonic:i":   [A_deg, B_deg]                   dq = A sin q + B cos q
- *   "joint_harmonic<k>:i", k = 2, 3, 4: [A_deg, B_deg]     dq = A sin(k q) + B cos(k q)
- *   "joint_backlash:i":   [b_deg]                          full play
- *   "joint_compliance:i": [c_ii, c_i(i+1), ..., c_iN]      deg per mm of gravity moment arm
- *   "measurer_scale":     [s]
- *   "measurer_offset":    [o1_mm, o2_mm, o3_mm]
- *   "thermal_scale":      [k_per_K] or [k_per_K, T0_C]     (T0 default 20 C)
- *   "drift_scale":        [k_per_s, t0_s]                  offset from the base origin
- *                                                          scales by 1 + k (t - t0)
- *   "drift_offset":       [vx, vy, vz (mm/s, world), t0_s] the point moves by v (t - t0)
- * The two drifts share one t0: where both are given, the last one read sets it.
- * base_frame, tool_offset and measurer_anchors have no entry here: they are the model's
- * "base", "tool_mm" and "measurer.anchors_mm".
+ * The keys of the file's "effects" object, how many values each takes and in which units come
+ * from the library's effect catalogue (dhc_effects.h) and parameter names (dhc_params.h): the
+ * effect's parameters in report order and units (degrees for angles and compliances), then
+ * T0_C (thermal_scale, optional, default 20) or t0_s (the drift effects). Effects whose values
+ * are the model's own frames (base_frame, tool_offset, measurer_anchors) have no entry there:
+ * they are the model's "base", "tool_mm" and "measurer.anchors_mm" (docs/formats.md, 2.5).
  */
 #ifndef DHCAL_MODEL_MAP_H
 #define DHCAL_MODEL_MAP_H

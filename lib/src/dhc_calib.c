@@ -82,19 +82,6 @@ dhc_status dhc_noise_model_check(const double *joint_noise_rad, double meas_nois
     return DHC_OK;
 }
 
-/* x = L^-1 x for the lower triangle of l (rows x rows, row stride DHC_MAX_ROWS_PER_SAMPLE);
- * x's entries are stride apart (a residual: 1; a Jacobian column: its column count). */
-static void lower_solve(const double *l, size_t rows, double *x, size_t stride)
-{
-    for (size_t i = 0U; i < rows; ++i) {
-        double v = x[i * stride];
-        for (size_t m = 0U; m < i; ++m) {
-            v -= l[i * DHC_MAX_ROWS_PER_SAMPLE + m] * x[m * stride];
-        }
-        x[i * stride] = v / l[i * DHC_MAX_ROWS_PER_SAMPLE + i];
-    }
-}
-
 /* dhc_sample_whiten with the covariance of the sample at `model`, whose residual there is
  * r_model (for the orientation rows' slope; may alias r, read first), applied to r and jac
  * (which may belong to another estimate: a trial step judged with its start's weights). */
@@ -179,26 +166,13 @@ static dhc_status whiten_at(const dhc_model *model, const dhc_sample *s,
     }
     /* Cholesky in place (lower triangle): every eigenvalue is at least meas_noise_mm^2 > 0,
      * so only an overflowing covariance can fail. */
-    for (size_t k = 0U; k < rows; ++k) {
-        double d = c[k * DHC_MAX_ROWS_PER_SAMPLE + k];
-        for (size_t m = 0U; m < k; ++m) {
-            d -= sq(c[k * DHC_MAX_ROWS_PER_SAMPLE + m]);
-        }
-        if (!(d > 0.0) || !dhc_is_finite(d)) {
-            return DHC_ERR_NONFINITE;
-        }
-        c[k * DHC_MAX_ROWS_PER_SAMPLE + k] = sqrt(d);
-        for (size_t i = k + 1U; i < rows; ++i) {
-            double v = c[i * DHC_MAX_ROWS_PER_SAMPLE + k];
-            for (size_t m = 0U; m < k; ++m) {
-                v -= c[i * DHC_MAX_ROWS_PER_SAMPLE + m] * c[k * DHC_MAX_ROWS_PER_SAMPLE + m];
-            }
-            c[i * DHC_MAX_ROWS_PER_SAMPLE + k] = v / c[k * DHC_MAX_ROWS_PER_SAMPLE + k];
-        }
+    const dhc_tri l = {c, DHC_MAX_ROWS_PER_SAMPLE, 1U, c, DHC_MAX_ROWS_PER_SAMPLE + 1U};
+    if (dhc_chol_in_place(&l, rows, 0.0, 0.0) != DHC_OK) {
+        return DHC_ERR_NONFINITE;
     }
-    lower_solve(c, rows, r, 1U);
-    for (size_t col = 0U; jac != NULL && col < jac->cols; ++col) {
-        lower_solve(c, rows, jac->data + col, jac->cols);
+    dhc_tri_forward(&l, rows, r);
+    if (jac != NULL) {
+        dhc_tri_forward_cols(&l, rows, jac);
     }
     return DHC_OK;
 }

@@ -255,16 +255,13 @@ size_t dhc_diagnose_candidates(const dhc_model *model, const dhc_param_set *base
     size_t n = 0U;
     for (unsigned e = 0U; e < (unsigned)DHC_EFFECT_COUNT; ++e) {
         const dhc_effect effect = (dhc_effect)e;
-        const int measurer = effect == DHC_EFFECT_MEASURER_SCALE ||
-                             effect == DHC_EFFECT_MEASURER_OFFSET ||
-                             effect == DHC_EFFECT_MEASURER_ANCHORS;
-        const int drift = effect == DHC_EFFECT_DRIFT_SCALE || effect == DHC_EFFECT_DRIFT_OFFSET;
-        if ((measurer && !(scope->wires && model->measurer.present)) ||
-            (effect == DHC_EFFECT_THERMAL_SCALE && !scope->temperature) ||
-            (drift && !scope->time)) {
+        const dhc_effect_info *fx = dhc_effect_info_of(effect);
+        if (((fx->needs & DHC_NEEDS_WIRES) != 0U && !(scope->wires && model->measurer.present)) ||
+            ((fx->needs & DHC_NEEDS_TEMPERATURE) != 0U && !scope->temperature) ||
+            ((fx->needs & DHC_NEEDS_TIME) != 0U && !scope->time)) {
             continue;
         }
-        const size_t joints = dhc_effect_is_per_joint(effect) ? model->arm.n_joints : 1U;
+        const size_t joints = fx->per_joint ? model->arm.n_joints : 1U;
         for (size_t j = 0U; j < joints && n < cap; ++j) {
             if (!base_has_effect(base, effect, j)) {
                 out[n].effect = effect;

@@ -113,13 +113,7 @@ static dhc_status check_arm(const dhc_arm *arm)
 
 static int jac_finite(const dhc_mat *jac)
 {
-    const size_t entries = jac->rows * jac->cols;
-    for (size_t i = 0U; i < entries; ++i) {
-        if (!dhc_is_finite(jac->data[i])) {
-            return 0;
-        }
-    }
-    return 1;
+    return dhc_all_finite(jac->data, jac->rows * jac->cols);
 }
 
 static dhc_status check_jac(const dhc_mat *jac, size_t rows, size_t cols)

@@ -8,16 +8,6 @@
  * parameter a partner of j; below it the coupling is rounding noise. */
 #define CONFOUND_COEF_MIN 1e-4
 
-static int finite_all(const double *x, size_t n)
-{
-    for (size_t i = 0U; i < n; ++i) {
-        if (!dhc_is_finite(x[i])) {
-            return 0;
-        }
-    }
-    return 1;
-}
-
 static int ne_valid(const dhc_normal_eq *ne)
 {
     return ne != NULL && ne->n >= 1U && ne->n <= DHC_MAX_PARAMS;
@@ -28,49 +18,15 @@ static int fac_valid(const dhc_lsq_factor *fac)
     return fac != NULL && fac->n >= 1U && fac->n <= DHC_MAX_PARAMS && fac->rank <= fac->n;
 }
 
-/* A lower-triangular T of order k over borrowed storage: T(i, m) = off[i * rs + m * cs] for
- * m < i and T(i, i) = diag[i * ds]. The analysed factor and the damped factor (kept transposed
- * in the factor's free upper triangle) are both read through this. */
-typedef struct {
-    const double *off;
-    size_t rs;
-    size_t cs;
-    const double *diag;
-    size_t ds;
-} tri_view;
-
-static double tri_at(const tri_view *t, size_t i, size_t m)
+/* The analysed factor L (L L^T = S N11 S, pivoted order) in the factor's lower triangle. The
+ * damped factor lives transposed in its free upper triangle (dhc_lsq_step); only the step
+ * writes there, so a read-only view of a const factor is sound: the cast through uintptr_t
+ * drops const without -Wcast-qual's objection. */
+static dhc_tri analysed_factor(const dhc_lsq_factor *fac)
 {
-    return t->off[i * t->rs + m * t->cs];
-}
-
-/* T x = b in place. */
-static void tri_forward(const tri_view *t, size_t k, double *x)
-{
-    for (size_t i = 0U; i < k; ++i) {
-        double s = x[i];
-        for (size_t m = 0U; m < i; ++m) {
-            s -= tri_at(t, i, m) * x[m];
-        }
-        x[i] = s / t->diag[i * t->ds];
-    }
-}
-
-/* T^T x = b in place. */
-static void tri_backward(const tri_view *t, size_t k, double *x)
-{
-    for (size_t i = k; i-- > 0U;) {
-        double s = x[i];
-        for (size_t m = i + 1U; m < k; ++m) {
-            s -= tri_at(t, m, i) * x[m];
-        }
-        x[i] = s / t->diag[i * t->ds];
-    }
-}
-
-static tri_view analysed_factor(const dhc_lsq_factor *fac)
-{
-    const tri_view t = {fac->factor, fac->n, 1U, fac->factor, fac->n + 1U};
+    /* NOLINTNEXTLINE(performance-no-int-to-ptr): a round trip of a valid pointer. */
+    double *const f = (double *)(uintptr_t)fac->factor;
+    const dhc_tri t = {f, fac->n, 1U, f, fac->n + 1U};
     return t;
 }
 
@@ -104,7 +60,7 @@ dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double
     if (jac->rows != k || jac->cols != n) {
         return DHC_ERR_DIMENSION;
     }
-    if (!finite_all(jac->data, k * n) || !finite_all(r, k)) {
+    if (!dhc_all_finite(jac->data, k * n) || !dhc_all_finite(r, k)) {
         return DHC_ERR_NONFINITE;
     }
     if (w != NULL) {
@@ -166,7 +122,7 @@ dhc_status dhc_lsq_analyse(const dhc_normal_eq *ne, double rel_tol, dhc_lsq_fact
     if (ne->rows == 0U) {
         return DHC_ERR_NO_DATA;
     }
-    if (!finite_all(ne->jtj, n * n) || !finite_all(ne->jtr, n) || !dhc_is_finite(ne->ssr)) {
+    if (!dhc_all_finite(ne->jtj, n * n) || !dhc_all_finite(ne->jtr, n) || !dhc_is_finite(ne->ssr)) {
         return DHC_ERR_NONFINITE;
     }
     for (size_t i = 0U; i < n; ++i) {
@@ -238,42 +194,36 @@ dhc_status dhc_lsq_step(const dhc_normal_eq *ne, dhc_lsq_factor *fac, double lam
     double dmax = 0.0;
     for (size_t i = 0U; i < r; ++i) {
         dmax = fmax(dmax, ne->jtj[p[i] * n + p[i]] * s[p[i]] * s[p[i]] + lambda);
-    }
-    const double piv_min = DBL_EPSILON * dmax;
-    for (size_t i = 0U; i < r; ++i) {
         for (size_t m = 0U; m <= i; ++m) {
-            double sum = ne->jtj[p[i] * n + p[m]] * s[p[i]] * s[p[m]];
-            for (size_t t = 0U; t < m; ++t) {
-                sum -= up[t * n + i] * up[t * n + m];
-            }
+            const double a = ne->jtj[p[i] * n + p[m]] * s[p[i]] * s[p[m]];
             if (m < i) {
-                up[m * n + i] = sum / dd[m];
-                continue;
+                up[m * n + i] = a;
+            } else {
+                dd[i] = a;
             }
-            sum += lambda;
-            if (!(sum > piv_min)) {
-                for (size_t k = 0U; k < n; ++k) {
-                    delta[k] = 0.0;
-                }
-                return DHC_ERR_NOT_SPD;
-            }
-            dd[i] = sqrt(sum);
         }
+    }
+    const dhc_tri damped = {up, 1U, n, dd, 1U};
+    const dhc_status st = dhc_chol_in_place(&damped, r, lambda, DBL_EPSILON * dmax);
+    if (st != DHC_OK) {
+        for (size_t k = 0U; k < n; ++k) {
+            delta[k] = 0.0;
+        }
+        return st;
     }
     double y[DHC_MAX_PARAMS]; /* pivoted, scaled step: the one n-sized local of this module */
     for (size_t i = 0U; i < r; ++i) {
         y[i] = ne->jtr[p[i]] * s[p[i]];
     }
-    const tri_view damped = {up, 1U, n, dd, 1U};
-    tri_forward(&damped, r, y);
-    tri_backward(&damped, r, y);
+    dhc_tri_forward(&damped, r, y);
+    dhc_tri_backward(&damped, r, y);
     for (size_t k = 0U; k < n; ++k) {
         delta[k] = 0.0;
     }
     for (size_t i = 0U; i < r; ++i) {
         delta[p[i]] = y[i] * s[p[i]];
     }
-    if (!finite_all(delta, n)) {
+    if (!dhc_all_finite(delta, n)) {
         for (size_t k = 0U; k < n; ++k) {
             delta[k] = 0.0;
         }
@@ -297,8 +247,8 @@ dhc_status dhc_lsq_decrement(const dhc_normal_eq *ne, const dhc_lsq_factor *fac,
     for (size_t i = 0U; i < fac->rank; ++i) {
         y[i] = ne->jtr[fac->perm[i]] * fac->scale[fac->perm[i]];
     }
-    const tri_view l = analysed_factor(fac);
-    tri_forward(&l, fac->rank, y);
+    const dhc_tri l = analysed_factor(fac);
+    dhc_tri_forward(&l, fac->rank, y);
     double sum = 0.0;
     for (size_t i = 0U; i < fac->rank; ++i) {
         sum += y[i] * y[i];
@@ -323,27 +273,17 @@ dhc_status dhc_lsq_std_errors(const dhc_lsq_factor *fac, double sigma2, double *
         return DHC_ERR_ARGUMENT;
     }
     const size_t r = fac->rank;
-    const tri_view l = analysed_factor(fac);
+    const dhc_tri l = analysed_factor(fac);
     for (size_t k = 0U; k < n; ++k) {
         std[k] = 0.0;
     }
-    /* diag((L L^T)^-1)_i = |L^-1 e_i|^2; the column L^-1 e_i is zero above row i. */
-    double x[DHC_MAX_PARAMS];
+    double scratch[DHC_MAX_PARAMS];
     for (size_t i = 0U; i < r; ++i) {
-        double sum = 0.0;
-        for (size_t m = i; m < r; ++m) {
-            double v = m == i ? 1.0 : 0.0;
-            for (size_t t = i; t < m; ++t) {
-                v -= tri_at(&l, m, t) * x[t];
-            }
-            x[m] = v / l.diag[m * l.ds];
-            sum += x[m] * x[m];
-        }
         const size_t k = fac->perm[i];
-        std[k] = fac->scale[k] * sqrt(sigma2 * sum);
+        std[k] = fac->scale[k] * sqrt(sigma2 * dhc_chol_inverse_diagonal(&l, r, i, scratch));
     }
     /* A pivot barely above rel_tol can make |L^-1 e_i|^2 overflow (found by fuzzing). */
-    if (!finite_all(std, n)) {
+    if (!dhc_all_finite(std, n)) {
         for (size_t k = 0U; k < n; ++k) {
             std[k] = 0.0;
         }
@@ -362,7 +302,7 @@ dhc_status dhc_lsq_prediction_variance(const dhc_lsq_factor *fac, double sigma2,
     if (len < n) {
         return DHC_ERR_DIMENSION;
     }
-    if (!dhc_is_finite(sigma2) || !finite_all(row, n)) {
+    if (!dhc_is_finite(sigma2) || !dhc_all_finite(row, n)) {
         return DHC_ERR_NONFINITE;
     }
     if (!(sigma2 >= 0.0)) {
@@ -373,8 +313,8 @@ dhc_status dhc_lsq_prediction_variance(const dhc_lsq_factor *fac, double sigma2,
     for (size_t i = 0U; i < fac->rank; ++i) {
         y[i] = row[fac->perm[i]] * fac->scale[fac->perm[i]];
     }
-    const tri_view l = analysed_factor(fac);
-    tri_forward(&l, fac->rank, y);
+    const dhc_tri l = analysed_factor(fac);
+    dhc_tri_forward(&l, fac->rank, y);
     double sum = 0.0;
     for (size_t i = 0U; i < fac->rank; ++i) {
         sum += y[i] * y[i];
@@ -403,9 +343,9 @@ dhc_status dhc_lsq_confounded(const dhc_normal_eq *ne, const dhc_lsq_factor *fac
     for (size_t i = 0U; i < r; ++i) {
         v[i] = -ne->jtj[p[i] * n + j] * fac->scale[p[i]] * fac->scale[j];
     }
-    const tri_view l = analysed_factor(fac);
-    tri_forward(&l, r, v);
-    tri_backward(&l, r, v);
+    const dhc_tri l = analysed_factor(fac);
+    dhc_tri_forward(&l, r, v);
+    dhc_tri_backward(&l, r, v);
     for (size_t k = 0U; k < n; ++k) {
         partner[k] = 0U;
     }

@@ -104,171 +104,42 @@ dhc_status dhc_params_base_model(dhc_param_set *set, const dhc_model *model)
     return DHC_OK;
 }
 
-static dhc_status add_run(dhc_param_set *set, const dhc_model *model, dhc_param_kind kind,
-                          size_t joint, size_t aux_first, size_t aux_end)
-{
-    for (size_t aux = aux_first; aux < aux_end; ++aux) {
-        const dhc_status st = dhc_params_add(set, model, kind, joint, aux);
-        if (st != DHC_OK) {
-            return st;
-        }
-    }
-    return DHC_OK;
-}
-
-/* A_ik and B_ik of one harmonic order (aux = order - 1). */
-static dhc_status add_harmonic(dhc_param_set *set, const dhc_model *model, size_t joint,
-                               size_t order)
-{
-    dhc_status st = dhc_params_add(set, model, DHC_P_HARMONIC_SIN, joint, order - 1U);
-    return st == DHC_OK ? dhc_params_add(set, model, DHC_P_HARMONIC_COS, joint, order - 1U) : st;
-}
-
-static dhc_status add_kinds(dhc_param_set *set, const dhc_model *model, dhc_param_kind first,
-                            dhc_param_kind last, size_t joint)
-{
-    for (unsigned k = (unsigned)first; k <= (unsigned)last; ++k) {
-        const dhc_status st = dhc_params_add(set, model, (dhc_param_kind)k, joint, 0U);
-        if (st != DHC_OK) {
-            return st;
-        }
-    }
-    return DHC_OK;
-}
-
 dhc_status dhc_params_add_effect(dhc_param_set *set, const dhc_model *model, dhc_effect effect,
                                  size_t joint)
 {
-    if (set == NULL || model == NULL) {
-        return DHC_ERR_ARGUMENT;
-    }
-    if (dhc_effect_is_per_joint(effect) && joint >= model->arm.n_joints) {
+    const dhc_effect_info *fx = dhc_effect_info_of(effect);
+    if (set == NULL || model == NULL || fx == NULL ||
+        (fx->per_joint && joint >= model->arm.n_joints)) {
         return DHC_ERR_ARGUMENT;
     }
     const size_t before = set->count;
-    const size_t j = dhc_effect_is_per_joint(effect) ? joint : 0U;
-    dhc_status st;
-    switch (effect) {
-    case DHC_EFFECT_BASE_FRAME: st = add_kinds(set, model, DHC_P_BASE_X, DHC_P_BASE_RZ, 0U); break;
-    case DHC_EFFECT_TOOL_OFFSET: st = add_kinds(set, model, DHC_P_TOOL_X, DHC_P_TOOL_Z, 0U); break;
-    case DHC_EFFECT_JOINT_SCALE: st = dhc_params_add(set, model, DHC_P_JOINT_SCALE, j, 0U); break;
-    case DHC_EFFECT_JOINT_HARMONIC: st = add_harmonic(set, model, j, 1U); break;
-    case DHC_EFFECT_JOINT_HARMONIC2:
-    case DHC_EFFECT_JOINT_HARMONIC3:
-    case DHC_EFFECT_JOINT_HARMONIC4:
-        st = add_harmonic(set, model, j,
-                          2U + (size_t)((unsigned)effect - (unsigned)DHC_EFFECT_JOINT_HARMONIC2));
-        break;
-    case DHC_EFFECT_DRIFT_SCALE: st = dhc_params_add(set, model, DHC_P_DRIFT_SCALE, 0U, 0U); break;
-    case DHC_EFFECT_DRIFT_OFFSET: st = add_run(set, model, DHC_P_DRIFT_OFFSET, 0U, 0U, 3U); break;
-    case DHC_EFFECT_JOINT_BACKLASH: st = dhc_params_add(set, model, DHC_P_BACKLASH, j, 0U); break;
-    case DHC_EFFECT_JOINT_COMPLIANCE:
-        st = add_run(set, model, DHC_P_COMPLIANCE, j, j, model->arm.n_joints);
-        break;
-    case DHC_EFFECT_MEASURER_SCALE: st = dhc_params_add(set, model, DHC_P_MEAS_SCALE, 0U, 0U); break;
-    case DHC_EFFECT_MEASURER_OFFSET: st = add_run(set, model, DHC_P_MEAS_OFFSET, 0U, 0U, 3U); break;
-    case DHC_EFFECT_MEASURER_ANCHORS: st = add_run(set, model, DHC_P_MEAS_ANCHOR, 0U, 0U, 9U); break;
-    case DHC_EFFECT_THERMAL_SCALE: st = dhc_params_add(set, model, DHC_P_THERMAL, 0U, 0U); break;
-    case DHC_EFFECT_COUNT:
-    default: st = DHC_ERR_ARGUMENT; break;
-    }
-    if (st != DHC_OK) {
-        set->count = before;
-    }
-    return st;
-}
-
-static const char *const effect_names[DHC_EFFECT_COUNT] = {
-    "base_frame",       "tool_offset",     "joint_scale",     "joint_harmonic",
-    "joint_backlash",   "joint_compliance", "measurer_scale", "measurer_offset",
-    "measurer_anchors", "thermal_scale",   "joint_harmonic2", "joint_harmonic3",
-    "joint_harmonic4",  "drift_scale",     "drift_offset"};
-
-const char *dhc_effect_name(dhc_effect effect)
-{
-    return (unsigned)effect < (unsigned)DHC_EFFECT_COUNT ? effect_names[effect] : NULL;
-}
-
-int dhc_effect_is_per_joint(dhc_effect effect)
-{
-    return effect == DHC_EFFECT_JOINT_SCALE || effect == DHC_EFFECT_JOINT_HARMONIC ||
-           effect == DHC_EFFECT_JOINT_BACKLASH || effect == DHC_EFFECT_JOINT_COMPLIANCE ||
-           effect == DHC_EFFECT_JOINT_HARMONIC2 || effect == DHC_EFFECT_JOINT_HARMONIC3 ||
-           effect == DHC_EFFECT_JOINT_HARMONIC4;
-}
-
-dhc_status dhc_effect_parse(const char *text, size_t len, size_t n_joints, dhc_effect *effect,
-                            size_t *joint)
-{
-    if (text == NULL || effect == NULL || joint == NULL) {
-        return DHC_ERR_ARGUMENT;
-    }
-    size_t name_len = 0U;
-    while (name_len < len && text[name_len] != ':') {
-        ++name_len;
-    }
-    for (unsigned e = 0U; e < (unsigned)DHC_EFFECT_COUNT; ++e) {
-        const char *name = effect_names[e];
-        if (strlen(name) != name_len || memcmp(name, text, name_len) != 0) {
-            continue;
-        }
-        const int per_joint = dhc_effect_is_per_joint((dhc_effect)e);
-        if (!per_joint) {
-            if (name_len != len) {
-                return DHC_ERR_ARGUMENT;
+    const size_t j = fx->per_joint ? joint : 0U;
+    const size_t aux_first = fx->aux_count != 0U ? fx->aux_first : j;
+    const size_t aux_end = fx->aux_count != 0U ? aux_first + fx->aux_count : model->arm.n_joints;
+    for (unsigned k = fx->first_kind; k < (unsigned)fx->first_kind + fx->kinds; ++k) {
+        for (size_t aux = aux_first; aux < aux_end; ++aux) {
+            const dhc_status st = dhc_params_add(set, model, (dhc_param_kind)k, j, aux);
+            if (st != DHC_OK) {
+                set->count = before;
+                return st;
             }
-            *effect = (dhc_effect)e;
-            *joint = 0U;
-            return DHC_OK;
         }
-        /* ":i" with a 1-based decimal joint number, no sign, no leading zero */
-        if (name_len + 1U >= len || text[name_len + 1U] == '0') {
-            return DHC_ERR_ARGUMENT;
-        }
-        size_t number = 0U;
-        for (size_t k = name_len + 1U; k < len; ++k) {
-            if (text[k] < '0' || text[k] > '9' || number > 1000U) {
-                return DHC_ERR_ARGUMENT;
-            }
-            number = number * 10U + (size_t)(text[k] - '0');
-        }
-        if (number < 1U || number > n_joints) {
-            return DHC_ERR_ARGUMENT;
-        }
-        *effect = (dhc_effect)e;
-        *joint = number - 1U;
-        return DHC_OK;
     }
-    return DHC_ERR_ARGUMENT;
+    return DHC_OK;
 }
 
 dhc_effect dhc_params_effect_of(const dhc_param_id *id)
 {
-    switch ((dhc_param_kind)id->kind) {
-    case DHC_P_BASE_X:
-    case DHC_P_BASE_Y:
-    case DHC_P_BASE_Z:
-    case DHC_P_BASE_RX:
-    case DHC_P_BASE_RY:
-    case DHC_P_BASE_RZ: return DHC_EFFECT_BASE_FRAME;
-    case DHC_P_TOOL_X:
-    case DHC_P_TOOL_Y:
-    case DHC_P_TOOL_Z: return DHC_EFFECT_TOOL_OFFSET;
-    case DHC_P_JOINT_SCALE: return DHC_EFFECT_JOINT_SCALE;
-    case DHC_P_HARMONIC_SIN:
-    case DHC_P_HARMONIC_COS:
-        return id->aux == 0U ? DHC_EFFECT_JOINT_HARMONIC
-                             : (dhc_effect)((unsigned)DHC_EFFECT_JOINT_HARMONIC2 + id->aux - 1U);
-    case DHC_P_BACKLASH: return DHC_EFFECT_JOINT_BACKLASH;
-    case DHC_P_COMPLIANCE: return DHC_EFFECT_JOINT_COMPLIANCE;
-    case DHC_P_MEAS_SCALE: return DHC_EFFECT_MEASURER_SCALE;
-    case DHC_P_MEAS_OFFSET: return DHC_EFFECT_MEASURER_OFFSET;
-    case DHC_P_MEAS_ANCHOR: return DHC_EFFECT_MEASURER_ANCHORS;
-    case DHC_P_THERMAL: return DHC_EFFECT_THERMAL_SCALE;
-    case DHC_P_DRIFT_SCALE: return DHC_EFFECT_DRIFT_SCALE;
-    case DHC_P_DRIFT_OFFSET: return DHC_EFFECT_DRIFT_OFFSET;
-    default: return DHC_EFFECT_COUNT;
+    for (size_t i = 0U; i < (size_t)DHC_EFFECT_COUNT; ++i) {
+        const dhc_effect_info *fx = dhc_effect_at(i);
+        const int kind_in = id->kind >= fx->first_kind && id->kind < fx->first_kind + fx->kinds;
+        const int aux_in = fx->aux_count == 0U ||
+                           (id->aux >= fx->aux_first && id->aux < fx->aux_first + fx->aux_count);
+        if (kind_in && aux_in) {
+            return (dhc_effect)fx->effect;
+        }
     }
+    return DHC_EFFECT_COUNT;
 }
 
 /* The model quantity a parameter stands for; NULL for the base rotations, which are
@@ -319,6 +190,24 @@ double dhc_params_value(const dhc_param_set *set, const dhc_model *model, size_t
      * NOLINTNEXTLINE(performance-no-int-to-ptr): a round trip of a valid pointer. */
     const double *slot = param_slot((dhc_model *)(uintptr_t)model, &set->id[k]);
     return slot != NULL ? *slot : 0.0;
+}
+
+dhc_status dhc_params_set_value(const dhc_param_set *set, dhc_model *model, size_t k,
+                                double value)
+{
+    if (set == NULL || model == NULL || k >= set->count ||
+        set->id[k].kind >= (uint8_t)DHC_P_KIND_COUNT) {
+        return DHC_ERR_ARGUMENT;
+    }
+    double *slot = param_slot(model, &set->id[k]);
+    if (slot == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    if (!dhc_is_finite(value)) {
+        return DHC_ERR_NONFINITE;
+    }
+    *slot = value;
+    return DHC_OK;
 }
 
 dhc_status dhc_params_apply(const dhc_param_set *set, dhc_model *model, const double *delta,
@@ -456,4 +345,9 @@ int dhc_params_is_angle(const dhc_param_set *set, size_t k)
     case DHC_P_BACKLASH: return 1;
     default: return 0;
     }
+}
+
+int dhc_params_in_degrees(const dhc_param_set *set, size_t k)
+{
+    return dhc_params_is_angle(set, k) || set->id[k].kind == (uint8_t)DHC_P_COMPLIANCE;
 }

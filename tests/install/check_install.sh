@@ -23,6 +23,7 @@ for h in "$prefix"/include/dhcal/*.h; do
   grep -q "#include \"$name\"" "$prefix/include/dhcal/dhcal.h" ||
     { echo "FAIL: dhcal.h does not include $name"; exit 1; }
   case $name in dhc_config.h | dhc_version.h) continue ;; esac
+  grep -q ';' "$h" || continue # includes and macros only
   grep -q 'extern "C"' "$h" || { echo "FAIL: $name has no extern \"C\" block"; exit 1; }
 done
 lib=$(find "$prefix" -name libdhcal.a | head -1)

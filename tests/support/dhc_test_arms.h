@@ -5,6 +5,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #include "dhcal/dhc_model.h"
 
@@ -68,6 +69,18 @@ static inline dhc_model test_model_of(const dhc_arm *arm)
     (void)dhc_model_init(&m, arm->n_joints);
     m.arm = *arm;
     return m;
+}
+
+/* The paper's draw-wire measurer (examples/models/paper-3dof.json): three anchors in its
+ * frame, the frame 1.3 m along world x, turned half a turn about z. */
+static inline void test_put_paper_measurer(dhc_model *m)
+{
+    m->measurer.present = 1;
+    const double anchors[3][3] = {{0.0, 0.0, 1200.0}, {0.0, 600.0, 300.0}, {0.0, -600.0, 300.0}};
+    memcpy(m->measurer.anchor_mm, anchors, sizeof anchors);
+    const double xyz[3] = {1300.0, 0.0, 0.0};
+    const double rpy[3] = {0.0, 0.0, TEST_PI};
+    dhc_frame_from_xyz_rpy(xyz, rpy, &m->measurer.frame);
 }
 
 /* The built arm of Table 3 with the joint ranges the acceptance data use: the base turns

@@ -1,6 +1,7 @@
-/* test_linalg.c - vectors, rotations, frames and dense matrices against closed forms,
- * hand-derived values, reconstructions and round trips; every documented error status, with
- * guard zones past the outputs. */
+/* test_linalg.c - the linear algebra of dhc_linalg.h (dhc_geometry: vectors, rotations,
+ * frames; dhc_matrix: dense matrices; dhc_factor: Cholesky factorizations, triangular solves,
+ * inverses) against closed forms, hand-derived values, reconstructions, a second method and
+ * round trips; every documented error status, with guard zones past the outputs. */
 #include <float.h>
 #include <math.h>
 #include <stdint.h>
@@ -1149,6 +1150,195 @@ static void test_is_finite_classifies_special_values(void)
     TEST_ASSERT_FALSE(dhc_is_finite(-nan_value()));
 }
 
+/* ---------------------------------------------------------------- kernels on a strided triangle */
+
+/* The lower triangle of the n x n a into the layout dhc_lsq keeps its damped factor in: T(i, m)
+ * transposed in the strict upper triangle of a MAXN x MAXN block, the diagonal apart. */
+static dhc_tri transposed_layout(const dhc_mat *a, size_t n, double *block, double *diag)
+{
+    for (size_t i = 0U; i < n; ++i) {
+        for (size_t m = 0U; m < i; ++m) {
+            block[m * MAXN + i] = DHC_MAT_AT(a, i, m);
+        }
+        diag[i] = DHC_MAT_AT(a, i, i);
+    }
+    const dhc_tri t = {block, 1U, MAXN, diag, 1U};
+    return t;
+}
+
+static double tri_entry(const dhc_tri *t, size_t i, size_t m)
+{
+    return m == i ? t->diag[i * t->diag_stride]
+                  : t->off[i * t->row_stride + m * t->col_stride];
+}
+
+static void test_chol_in_place_reconstructs_the_shifted_matrix_in_strided_storage(void)
+{
+    static double block[MAXN * MAXN];
+    static double diag[MAXN];
+    const size_t n = 7U;
+    const double shift = 0.375;
+    dhc_mat a;
+    TEST_ASSERT_EQUAL_INT(DHC_OK, dhc_mat_init(&a, n, n, buf_a, n * n));
+    random_psd(&a, n, n);
+    fill_sentinel(block, MAXN * MAXN);
+    fill_sentinel(diag, MAXN);
+    const dhc_tri t = transposed_layout(&a, n, block, diag);
+    TEST_ASSERT_EQUAL_INT(DHC_OK, dhc_chol_in_place(&t, n, shift, 1e-12));
+    const double tol = 1e-13 * (max_abs(&a) + shift);
+    for (size_t i = 0U; i < n; ++i) {
+        for (size_t j = 0U; j <= i; ++j) {
+            double s = 0.0;
+            for (size_t m = 0U; m <= j; ++m) {
+                s += tri_entry(&t, i, m) * tri_entry(&t, j, m);
+            }
+            TEST_ASSERT_DOUBLE_WITHIN(tol, DHC_MAT_AT(&a, i, j) + (i == j ? shift : 0.0), s);
+        }
+        /* the lower triangle of the block, and what lies beyond n, untouched */
+        for (size_t m = 0U; m <= i; ++m) {
+            TEST_ASSERT_TRUE(same_bits(SENTINEL, block[i * MAXN + m]));
+        }
+    }
+    assert_sentinel(diag + n, MAXN - n);
+}
+
+static void test_chol_in_place_refuses_what_is_not_positive_definite(void)
+{
+    double m2[4] = {1.0, 0.0, 2.0, 1.0}; /* [[1, 2], [2, 1]]: eigenvalues 3 and -1 */
+    dhc_mat a;
+    TEST_ASSERT_EQUAL_INT(DHC_OK, dhc_mat_init(&a, 2U, 2U, m2, 4U));
+    dhc_tri t = dhc_tri_of_mat(&a);
+    TEST_ASSERT_EQUAL_INT(DHC_ERR_NOT_SPD, dhc_chol_in_place(&t, 2U, 0.0, 0.0));
+    /* a shift that makes it definite: [[4, 2], [2, 4]] = L L^T, L = [[2, 0], [1, sqrt 3]] */
+    double m3[4] = {1.0, 0.0, 2.0, 1.0};
+    TEST_ASSERT_EQUAL_INT(DHC_OK, dhc_mat_init(&a, 2U, 2U, m3, 4U));
+    t = dhc_tri_of_mat(&a);
+    TEST_ASSERT_EQUAL_INT(DHC_OK, dhc_chol_in_place(&t, 2U, 3.0, 0.0));
+    TEST_ASSERT_DOUBLE_WITHIN(1e-15, 2.0, m3[0]);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-15, 1.0, m3[2]);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-15, sqrt(3.0), m3[3]);
+    /* a pivot at or below the floor, a NaN, an infinity */
+    double small[4] = {1.0, 0.0, 0.0, 1e-20};
+    TEST_ASSERT_EQUAL_INT(DHC_OK, dhc_mat_init(&a, 2U, 2U, small, 4U));
+    t = dhc_tri_of_mat(&a);
+    TEST_ASSERT_EQUAL_INT(DHC_ERR_NOT_SPD, dhc_chol_in_place(&t, 2U, 0.0, 1e-16));
+    double bad[4] = {nan_value(), 0.0, 0.0, 1.0};
+    TEST_ASSERT_EQUAL_INT(DHC_OK, dhc_mat_init(&a, 2U, 2U, bad, 4U));
+    t = dhc_tri_of_mat(&a);
+    TEST_ASSERT_EQUAL_INT(DHC_ERR_NOT_SPD, dhc_chol_in_place(&t, 2U, 0.0, 0.0));
+    bad[0] = (double)INFINITY;
+    TEST_ASSERT_EQUAL_INT(DHC_ERR_NONFINITE, dhc_chol_in_place(&t, 2U, 0.0, 0.0));
+}
+
+static void test_strided_triangular_solves_satisfy_their_systems(void)
+{
+    static double block[MAXN * MAXN];
+    static double diag[MAXN];
+    const size_t n = 6U;
+    dhc_mat a;
+    TEST_ASSERT_EQUAL_INT(DHC_OK, dhc_mat_init(&a, n, n, buf_a, n * n));
+    for (size_t i = 0U; i < n; ++i) {
+        for (size_t m = 0U; m < n; ++m) {
+            DHC_MAT_AT(&a, i, m) = m == i ? uniform(0.5, 2.0) : uniform(-1.0, 1.0);
+        }
+    }
+    const dhc_tri t = transposed_layout(&a, n, block, diag);
+    double b[MAXN];
+    double x[MAXN];
+    for (size_t i = 0U; i < n; ++i) {
+        b[i] = uniform(-3.0, 3.0);
+        x[i] = b[i];
+    }
+    dhc_tri_forward(&t, n, x);
+    for (size_t i = 0U; i < n; ++i) { /* T x = b */
+        double s = 0.0;
+        for (size_t m = 0U; m <= i; ++m) {
+            s += DHC_MAT_AT(&a, i, m) * x[m];
+        }
+        TEST_ASSERT_DOUBLE_WITHIN(1e-12, b[i], s);
+    }
+    /* every column of a matrix at once: the same as each column alone */
+    double cols_buf[MAXN * 3U];
+    dhc_mat bm;
+    TEST_ASSERT_EQUAL_INT(DHC_OK, dhc_mat_init(&bm, n, 3U, cols_buf, MAXN * 3U));
+    for (size_t i = 0U; i < n; ++i) {
+        for (size_t c = 0U; c < 3U; ++c) {
+            DHC_MAT_AT(&bm, i, c) = c == 1U ? b[i] : uniform(-3.0, 3.0);
+        }
+    }
+    dhc_tri_forward_cols(&t, n, &bm);
+    for (size_t i = 0U; i < n; ++i) {
+        TEST_ASSERT_TRUE(same_bits(x[i], DHC_MAT_AT(&bm, i, 1U)));
+    }
+    for (size_t i = 0U; i < n; ++i) {
+        x[i] = b[i];
+    }
+    dhc_tri_backward(&t, n, x);
+    for (size_t i = 0U; i < n; ++i) { /* T^T x = b */
+        double s = 0.0;
+        for (size_t m = i; m < n; ++m) {
+            s += DHC_MAT_AT(&a, m, i) * x[m];
+        }
+        TEST_ASSERT_DOUBLE_WITHIN(1e-12, b[i], s);
+    }
+}
+
+/* The diagonal of A^-1 by Gauss-Jordan elimination with partial pivoting on [A | I]. */
+static void gauss_jordan_inverse_diagonal(const dhc_mat *a, size_t n, double *out)
+{
+    static double w[MAXN][2U * MAXN];
+    for (size_t i = 0U; i < n; ++i) {
+        for (size_t j = 0U; j < n; ++j) {
+            w[i][j] = DHC_MAT_AT(a, i, j);
+            w[i][n + j] = i == j ? 1.0 : 0.0;
+        }
+    }
+    for (size_t c = 0U; c < n; ++c) {
+        size_t p = c;
+        for (size_t i = c + 1U; i < n; ++i) {
+            p = fabs(w[i][c]) > fabs(w[p][c]) ? i : p;
+        }
+        for (size_t j = 0U; j < 2U * n; ++j) {
+            const double tmp = w[c][j];
+            w[c][j] = w[p][j];
+            w[p][j] = tmp;
+        }
+        const double piv = w[c][c];
+        for (size_t j = 0U; j < 2U * n; ++j) {
+            w[c][j] /= piv;
+        }
+        for (size_t i = 0U; i < n; ++i) {
+            const double f = w[i][c];
+            for (size_t j = 0U; i != c && j < 2U * n; ++j) {
+                w[i][j] -= f * w[c][j];
+            }
+        }
+    }
+    for (size_t i = 0U; i < n; ++i) {
+        out[i] = w[i][n + i];
+    }
+}
+
+static void test_chol_inverse_diagonal_matches_gauss_jordan(void)
+{
+    const size_t n = 6U;
+    dhc_mat a;
+    dhc_mat l;
+    TEST_ASSERT_EQUAL_INT(DHC_OK, dhc_mat_init(&a, n, n, buf_a, n * n));
+    TEST_ASSERT_EQUAL_INT(DHC_OK, dhc_mat_init(&l, n, n, buf_b, n * n));
+    random_psd(&a, n, n + 2U);
+    copy_mat(&a, &l);
+    const dhc_tri t = dhc_tri_of_mat(&l);
+    TEST_ASSERT_EQUAL_INT(DHC_OK, dhc_chol_in_place(&t, n, 0.0, 0.0));
+    double expected[MAXN];
+    gauss_jordan_inverse_diagonal(&a, n, expected);
+    double scratch[MAXN];
+    for (size_t i = 0U; i < n; ++i) {
+        const double got = dhc_chol_inverse_diagonal(&t, n, i, scratch);
+        TEST_ASSERT_DOUBLE_WITHIN(1e-10 * expected[i], expected[i], got);
+    }
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -1192,5 +1382,9 @@ int main(void)
     RUN_TEST(test_triangular_solves_report_every_error);
     RUN_TEST(test_condition_estimate_is_squared_diagonal_ratio);
     RUN_TEST(test_is_finite_classifies_special_values);
+    RUN_TEST(test_chol_in_place_reconstructs_the_shifted_matrix_in_strided_storage);
+    RUN_TEST(test_chol_in_place_refuses_what_is_not_positive_definite);
+    RUN_TEST(test_strided_triangular_solves_satisfy_their_systems);
+    RUN_TEST(test_chol_inverse_diagonal_matches_gauss_jordan);
     return UNITY_END();
 }

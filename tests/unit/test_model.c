@@ -21,12 +21,7 @@ static dhc_model paper_model(void)
     test_arm_from_table(&arm, TEST_TABLE3, 3U, 0.0);
     dhc_arm_choose_conventions(&arm, 1e-3);
     dhc_model m = test_model_of(&arm);
-    m.measurer.present = 1;
-    const double anchors[3][3] = {{0.0, 0.0, 1200.0}, {0.0, 600.0, 300.0}, {0.0, -600.0, 300.0}};
-    memcpy(m.measurer.anchor_mm, anchors, sizeof anchors);
-    const double xyz[3] = {1300.0, 0.0, 0.0};
-    const double rpy[3] = {0.0, 0.0, TEST_PI};
-    dhc_frame_from_xyz_rpy(xyz, rpy, &m.measurer.frame);
+    test_put_paper_measurer(&m);
     return m;
 }
 

@@ -418,42 +418,9 @@ int dhcal_apparent_joint_errors(const dhc_model *model, const dhcal_samples *s, 
     return DHCAL_IO_OK;
 }
 
-void dhcal_effect_label(dhc_effect effect, size_t joint, char *buf, size_t cap)
-{
-    if (dhc_effect_is_per_joint(effect)) {
-        snprintf(buf, cap, "%s:%zu", dhc_effect_name(effect), joint + 1U);
-    } else {
-        snprintf(buf, cap, "%s", dhc_effect_name(effect));
-    }
-}
-
-const char *dhcal_effect_signature(dhc_effect effect)
-{
-    switch (effect) {
-    case DHC_EFFECT_BASE_FRAME: return "a constant shift and a rotation growing with distance (robot or measurer placement)";
-    case DHC_EFFECT_TOOL_OFFSET: return "an error vector that turns with the last link (tool point unknown)";
-    case DHC_EFFECT_JOINT_SCALE: return "a joint error growing in proportion to the joint angle (gear ratio or encoder resolution)";
-    case DHC_EFFECT_JOINT_HARMONIC: return "a joint error periodic in the joint angle (encoder or gear eccentricity)";
-    case DHC_EFFECT_JOINT_BACKLASH: return "a joint error that splits by approach direction (gear backlash)";
-    case DHC_EFFECT_JOINT_COMPLIANCE: return "a joint error that follows the gravity torque (joint stiffness)";
-    case DHC_EFFECT_MEASURER_SCALE: return "wire errors growing with wire length (friction-wheel radius)";
-    case DHC_EFFECT_MEASURER_OFFSET: return "a constant error on each wire (wire zero reference)";
-    case DHC_EFFECT_MEASURER_ANCHORS: return "errors pointing at the measurer's anchors (measurer built off its drawing)";
-    case DHC_EFFECT_THERMAL_SCALE: return "lengths growing with temperature (thermal expansion)";
-    case DHC_EFFECT_JOINT_HARMONIC2: return "a joint error repeating twice per turn (encoder ellipticity, gear harmonic)";
-    case DHC_EFFECT_JOINT_HARMONIC3: return "a joint error repeating three times per turn (gear harmonic)";
-    case DHC_EFFECT_JOINT_HARMONIC4: return "a joint error repeating four times per turn (gear harmonic)";
-    case DHC_EFFECT_DRIFT_SCALE: return "errors growing over the session in proportion to the distance from the base (warming arm)";
-    case DHC_EFFECT_DRIFT_OFFSET: return "a constant error growing over the session (measurer or base moving)";
-    case DHC_EFFECT_COUNT:
-    default: return "an unknown pattern";
-    }
-}
-
 double dhcal_param_display(const dhc_param_set *set, size_t k, double value)
 {
-    const int degrees = dhc_params_is_angle(set, k) || set->id[k].kind == (uint8_t)DHC_P_COMPLIANCE;
-    return degrees ? value * 180.0 / DHC_PI : value;
+    return dhc_params_in_degrees(set, k) ? value * 180.0 / DHC_PI : value;
 }
 
 const char *dhcal_param_unit(const dhc_param_set *set, size_t k)

@@ -100,12 +100,6 @@ int dhcal_run_diagnose(const dhcal_fit *fit, const dhcal_samples *s, dhc_diagnos
 int dhcal_apparent_joint_errors(const dhc_model *model, const dhcal_samples *s, int with_effects,
                                 double *dq_deg, double *moment_mm);
 
-/* "joint_compliance:2" / "measurer_scale" for a candidate (joint 0-based in, 1-based out). */
-void dhcal_effect_label(dhc_effect effect, size_t joint, char *buf, size_t cap);
-
-/* What the effect looks like in the residual, in plain words. */
-const char *dhcal_effect_signature(dhc_effect effect);
-
 /* A parameter value in file units: angles and compliances in degrees, the rest as is. */
 double dhcal_param_display(const dhc_param_set *set, size_t k, double value);
 

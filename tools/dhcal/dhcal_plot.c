@@ -1,13 +1,10 @@
-/* dhcal_plot.c - the pictures of a fit as hand-written SVG 1.1: residuals against each joint
- * angle, the apparent joint errors against angle and gravity moment, the per-row error
- * before and after an effect, the diagnosis' candidate shares.
+/* dhcal_plot.c - the pictures of a fit: residuals against each joint angle, the apparent
+ * joint errors against angle and gravity moment, the per-row error before and after an
+ * effect, the diagnosis' candidate shares; drawn with the SVG writer (dhcal_svg.h).
  *
  * Every input is checked before anything touches the disk. Each document is built whole in
  * a heap buffer, then written through dhcal_file_write_atomic() (a temporary file beside
- * its target, renamed over it), so a reader never sees half a picture. Numbers go out as
- * %.6g through fin(), text through put_text() (escaped, valid UTF-8 only), so every file
- * parses as XML whatever the labels.
- * Layout uses an estimated glyph advance (PLOT_CHAR_EM): no font metrics are available.
+ * its target, renamed over it), so a reader never sees half a picture.
  */
 /* POSIX.1-2008: mkdir, stat. */
 #ifndef _POSIX_C_SOURCE
@@ -17,7 +14,6 @@
 
 #include <errno.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -25,24 +21,11 @@
 #include <sys/stat.h>
 
 #include "dhcal_file.h"
-
-#if defined(__GNUC__)
-#define PLOT_PRINTF(fmt_index, first_arg) __attribute__((format(printf, fmt_index, first_arg)))
-#else
-#define PLOT_PRINTF(fmt_index, first_arg)
-#endif
+#include "dhcal_svg.h"
 
 /* |value| beyond this (mm or degrees) is no measurement; refusing it also keeps every range,
  * span and pixel coordinate below finite (no overflow to inf in hi - lo). */
 #define PLOT_MAX_ABS 1e12
-/* Advance of an average glyph of a sans-serif font, in ems (DejaVu Sans ~0.55-0.63), and of
- * the bold title's. */
-#define PLOT_CHAR_EM 0.62
-#define PLOT_BOLD_EM 0.78
-#define PLOT_MAX_TICKS 64U
-/* Characters of the <title> element (tooltip, accessible name) before it is cut with "...";
- * the drawn title is cut to the picture's width. */
-#define PLOT_TITLE_ATTR_MAX 1000U
 /* A joint whose gravity moment stays below this (mm) in every row has none: a vertical axis,
  * where the computed moment is rounding noise (~1e-13 mm for metre-long links). */
 #define PLOT_NO_MOMENT_MM 1e-6
@@ -51,479 +34,17 @@
 /* Files dhcal_plot_write() writes. */
 #define PLOT_DOCS 4U
 
-#define COLOR_X "#1f77b4"
-#define COLOR_Y "#ff7f0e"
-#define COLOR_Z "#2ca02c"
-#define COLOR_BEFORE "#9e9e9e"
-#define COLOR_BEFORE_LINE "#555555"
-#define COLOR_AFTER "#1f77b4"
-#define COLOR_SIGNIFICANT "#c62828"
-#define COLOR_OTHER "#bdbdbd"
-#define COLOR_GRID "#e6e6e6"
-#define COLOR_FRAME "#999999"
-#define COLOR_TEXT "#222222"
-#define COLOR_MUTED "#666666"
-#define COLOR_DIR_PLUS "#1f77b4"
-#define COLOR_DIR_MINUS "#ff7f0e"
-#define COLOR_DIR_UNKNOWN "#9e9e9e"
-#define COLOR_ZERO "#444444"
+static const char *const component_color[3] = {DHCAL_COLOR_X, DHCAL_COLOR_Y, DHCAL_COLOR_Z};
 
-static const char *const component_color[3] = {COLOR_X, COLOR_Y, COLOR_Z};
-
-/* ------------------------------------------------------------------ messages */
-
-static int set_error(dhcal_error *err, int code, const char *fmt, ...) PLOT_PRINTF(3, 4);
-static int set_error(dhcal_error *err, int code, const char *fmt, ...)
+/* "<prefix><model name>" into t (the name may be anything: dhcal_svg_put_text() escapes it
+ * later). */
+static void title_text(dhcal_text *t, const char *prefix, const dhcal_plot_data *d)
 {
-    if (err != NULL) {
-        va_list ap;
-        va_start(ap, fmt);
-        (void)vsnprintf(err->msg, sizeof err->msg, fmt, ap);
-        va_end(ap);
-    }
-    return code;
+    dhcal_text_str(t, prefix);
+    dhcal_text_str(t, d->title[0] != '\0' ? d->title : "(unnamed model)");
 }
 
-/* ------------------------------------------------------------------ growing text buffer */
-
-typedef struct {
-    char *p;
-    size_t len;
-    size_t cap;
-    int failed; /* out of memory (or a printf failure): the document is lost */
-} svgbuf;
-
-static void sb_reserve(svgbuf *b, size_t extra)
-{
-    if (b->failed) {
-        return;
-    }
-    if (extra > SIZE_MAX - b->len - 1U) {
-        b->failed = 1;
-        return;
-    }
-    const size_t want = b->len + extra + 1U;
-    if (want <= b->cap) {
-        return;
-    }
-    size_t cap = b->cap == 0U ? 4096U : b->cap;
-    while (cap < want) {
-        cap = cap > SIZE_MAX / 2U ? want : cap * 2U;
-    }
-    char *const p = realloc(b->p, cap);
-    if (p == NULL) {
-        b->failed = 1;
-        return;
-    }
-    b->p = p;
-    b->cap = cap;
-}
-
-static void sb_put(svgbuf *b, const char *s, size_t n)
-{
-    sb_reserve(b, n);
-    if (!b->failed) {
-        memcpy(b->p + b->len, s, n);
-        b->len += n;
-        b->p[b->len] = '\0';
-    }
-}
-
-static void sb_str(svgbuf *b, const char *s)
-{
-    sb_put(b, s, strlen(s));
-}
-
-static void sb_printf(svgbuf *b, const char *fmt, ...) PLOT_PRINTF(2, 3);
-static void sb_printf(svgbuf *b, const char *fmt, ...)
-{
-    char small[256];
-    va_list ap;
-    va_start(ap, fmt);
-    const int n = vsnprintf(small, sizeof small, fmt, ap);
-    va_end(ap);
-    if (n < 0) {
-        b->failed = 1;
-        return;
-    }
-    if ((size_t)n < sizeof small) {
-        sb_put(b, small, (size_t)n);
-        return;
-    }
-    sb_reserve(b, (size_t)n);
-    if (b->failed) {
-        return;
-    }
-    va_start(ap, fmt);
-    (void)vsnprintf(b->p + b->len, (size_t)n + 1U, fmt, ap);
-    va_end(ap);
-    b->len += (size_t)n;
-}
-
-/* Every number printed goes through here: inputs are checked finite, so a non-finite value
- * would be a bug in the layout arithmetic; 0 keeps the file valid all the same. */
-static double fin(double v)
-{
-    return isfinite(v) ? v : 0.0;
-}
-
-/* ------------------------------------------------------------------ text */
-
-/* Bytes of the character at s (n > 0 bytes left) if it is well-formed UTF-8 and a character
- * XML 1.0 allows; 0 otherwise (C0 controls, overlong forms, surrogates, U+FFFE/U+FFFF). */
-static size_t xml_char_len(const unsigned char *s, size_t n)
-{
-    const unsigned c = s[0];
-    if (c < 0x80U) {
-        return c >= 0x20U || c == 0x09U || c == 0x0AU || c == 0x0DU ? 1U : 0U;
-    }
-    size_t len;
-    unsigned long cp;
-    if (c >= 0xC2U && c <= 0xDFU) {
-        len = 2U;
-        cp = c & 0x1FU;
-    } else if (c >= 0xE0U && c <= 0xEFU) {
-        len = 3U;
-        cp = c & 0x0FU;
-    } else if (c >= 0xF0U && c <= 0xF4U) {
-        len = 4U;
-        cp = c & 0x07U;
-    } else {
-        return 0U;
-    }
-    if (n < len) {
-        return 0U;
-    }
-    for (size_t i = 1U; i < len; ++i) {
-        if ((s[i] & 0xC0U) != 0x80U) {
-            return 0U;
-        }
-        cp = (cp << 6U) | (s[i] & 0x3FUL);
-    }
-    if ((len == 3U && cp < 0x800UL) || (len == 4U && (cp < 0x10000UL || cp > 0x10FFFFUL))) {
-        return 0U;
-    }
-    if ((cp >= 0xD800UL && cp <= 0xDFFFUL) || cp == 0xFFFEUL || cp == 0xFFFFUL) {
-        return 0U;
-    }
-    return len;
-}
-
-/* Characters put_text() draws for s[0..n): what the layout measures. */
-static size_t text_chars(const char *s, size_t n)
-{
-    const unsigned char *const u = (const unsigned char *)s;
-    size_t chars = 0U;
-    for (size_t i = 0U; i < n; ++chars) {
-        const size_t k = xml_char_len(u + i, n - i);
-        i += k > 0U ? k : 1U;
-    }
-    return chars;
-}
-
-/* s[0..n) as XML character data: & < > " ' escaped; tab and line breaks become a space (one
- * line of text), anything else XML cannot carry becomes '?'. At most max_chars characters:
- * a longer text is cut and ends in "...". */
-static void put_text(svgbuf *b, const char *s, size_t n, size_t max_chars)
-{
-    const unsigned char *const u = (const unsigned char *)s;
-    const size_t total = text_chars(s, n);
-    const size_t keep = total <= max_chars ? total : (max_chars > 3U ? max_chars - 3U : 0U);
-    size_t i = 0U;
-    for (size_t c = 0U; c < keep && i < n; ++c) {
-        const size_t k = xml_char_len(u + i, n - i);
-        if (k == 0U) {
-            sb_put(b, "?", 1U);
-            i++;
-            continue;
-        }
-        switch (u[i]) {
-        case '&': sb_str(b, "&amp;"); break;
-        case '<': sb_str(b, "&lt;"); break;
-        case '>': sb_str(b, "&gt;"); break;
-        case '"': sb_str(b, "&quot;"); break;
-        case '\'': sb_str(b, "&apos;"); break;
-        case '\t':
-        case '\n':
-        case '\r': sb_put(b, " ", 1U); break;
-        default: sb_put(b, s + i, k); break;
-        }
-        i += k;
-    }
-    if (keep < total) {
-        sb_str(b, "...");
-    }
-}
-
-/* <text x y attrs>s</text>, s cut to max_chars. attrs: literal attribute text, no user data. */
-static void text_el(svgbuf *b, double x, double y, const char *attrs, const char *s, size_t n,
-                    size_t max_chars)
-{
-    sb_printf(b, "<text x=\"%.6g\" y=\"%.6g\"%s%s>", fin(x), fin(y), attrs[0] != '\0' ? " " : "",
-              attrs);
-    put_text(b, s, n, max_chars);
-    sb_str(b, "</text>\n");
-}
-
-static void text_str(svgbuf *b, double x, double y, const char *attrs, const char *s)
-{
-    text_el(b, x, y, attrs, s, strlen(s), SIZE_MAX);
-}
-
-/* Estimated width in px of `chars` characters at font size `size_px`. */
-static double text_w(size_t chars, double size_px)
-{
-    return (double)chars * size_px * PLOT_CHAR_EM;
-}
-
-/* How many characters fit into width_px at size_px (at least 4, room for "x..."). */
-static size_t chars_fit(double width_px, double size_px)
-{
-    const double c = floor(width_px / (size_px * PLOT_CHAR_EM));
-    return c < 4.0 ? 4U : (c > 1e6 ? 1000000U : (size_t)c);
-}
-
-/* ------------------------------------------------------------------ axes */
-
-typedef struct {
-    double lo, hi; /* drawn range: the data range widened to multiples of step */
-    double step;
-    size_t n_ticks;
-} axis;
-
-/* 1, 2 or 5 times a power of ten, the smallest not below raw (> 0). */
-static double nice_step(double raw)
-{
-    const double p = pow(10.0, floor(log10(raw)));
-    const double f = raw / p;
-    const double m = f <= 1.0 ? 1.0 : (f <= 2.0 ? 2.0 : (f <= 5.0 ? 5.0 : 10.0));
-    return m * p;
-}
-
-/* Widens [lo, hi] by a fraction of its span on each side, so points do not sit on the frame. */
-static void pad_range(double *lo, double *hi, double frac_lo, double frac_hi)
-{
-    const double span = *hi - *lo;
-    *lo -= span * frac_lo;
-    *hi += span * frac_hi;
-}
-
-/* An axis over [lo, hi] (finite, lo <= hi, |.| <= PLOT_MAX_ABS) with about `target`
- * intervals. Constant data (a span below 1e-9 of the magnitude, or below 1e-12 absolute)
- * gets a window around the value instead of a zero range. `integer`: steps of at least 1. */
-static axis make_axis(double lo, double hi, double target, int integer)
-{
-    const double mag = fmax(fabs(lo), fabs(hi));
-    if (!(hi - lo > fmax(mag * 1e-9, 1e-12))) {
-        const double c = 0.5 * (lo + hi);
-        const double half = fabs(c) > 1e-9 ? fabs(c) * 0.1 : 1.0;
-        lo = c - half;
-        hi = c + half;
-    }
-    double step = nice_step((hi - lo) / (target >= 1.0 ? target : 1.0));
-    if (integer && step < 1.0) {
-        step = 1.0;
-    }
-    axis a;
-    a.step = step;
-    a.lo = floor(lo / step) * step;
-    a.hi = ceil(hi / step) * step;
-    const double intervals = floor((a.hi - a.lo) / step + 0.5);
-    if (!(intervals >= 1.0 && intervals < (double)PLOT_MAX_TICKS)) {
-        /* unreachable with the span guaranteed above; never a zero or NaN step */
-        a.lo = lo;
-        a.hi = lo + 1.0;
-        a.step = 1.0;
-        a.n_ticks = 2U;
-        return a;
-    }
-    a.n_ticks = (size_t)intervals + 1U;
-    return a;
-}
-
-static double tick_value(const axis *a, size_t i)
-{
-    const double t = a->lo + (double)i * a->step;
-    return fabs(t) < a->step * 1e-6 ? 0.0 : t; /* 0, not 1.4e-17 or -0 */
-}
-
-/* Characters of the widest tick label. */
-static size_t tick_label_chars(const axis *a)
-{
-    size_t w = 1U;
-    for (size_t i = 0U; i < a->n_ticks; ++i) {
-        char s[40];
-        const int n = snprintf(s, sizeof s, "%.6g", tick_value(a, i));
-        if (n > 0 && (size_t)n > w) {
-            w = (size_t)n;
-        }
-    }
-    return w;
-}
-
-/* The axis with the most ticks (about 5 intervals at most) whose labels do not collide
- * along length_px: horizontal, labels side by side (their estimated width counts); else
- * stacked (their height counts). */
-static axis fit_axis(double lo, double hi, double length_px, double font_px, int horizontal,
-                     int integer)
-{
-    axis a = make_axis(lo, hi, 5.0, integer);
-    for (unsigned target = 4U; target >= 1U; --target) {
-        const double need =
-            horizontal ? text_w(tick_label_chars(&a), font_px) + 10.0 : font_px * 1.8;
-        if (a.n_ticks < 2U || length_px / (double)(a.n_ticks - 1U) >= need) {
-            break;
-        }
-        a = make_axis(lo, hi, (double)target, integer);
-    }
-    return a;
-}
-
-/* A plot area in px and the data ranges it shows. */
-typedef struct {
-    double x, y, w, h;
-    axis ax, ay;
-} frame;
-
-static double px_x(const frame *f, double v)
-{
-    return f->x + (v - f->ax.lo) / (f->ax.hi - f->ax.lo) * f->w;
-}
-
-static double px_y(const frame *f, double v)
-{
-    return f->y + f->h - (v - f->ay.lo) / (f->ay.hi - f->ay.lo) * f->h;
-}
-
-/* White plot area, grid lines at the ticks, tick labels (groups "axis-x"/"axis-y" hold
- * nothing but the numeric labels: tests/tools/check_svg.py checks they are round numbers). */
-static void draw_frame(svgbuf *b, const frame *f, int x_grid)
-{
-    sb_printf(b, "<rect x=\"%.6g\" y=\"%.6g\" width=\"%.6g\" height=\"%.6g\" fill=\"#ffffff\" "
-                 "stroke=\"" COLOR_FRAME "\"/>\n",
-              fin(f->x), fin(f->y), fin(f->w), fin(f->h));
-    sb_str(b, "<g stroke=\"" COLOR_GRID "\" stroke-width=\"1\">\n");
-    for (size_t i = 0U; i < f->ay.n_ticks; ++i) {
-        const double y = px_y(f, tick_value(&f->ay, i));
-        sb_printf(b, "<line x1=\"%.6g\" y1=\"%.6g\" x2=\"%.6g\" y2=\"%.6g\"/>\n", fin(f->x),
-                  fin(y), fin(f->x + f->w), fin(y));
-    }
-    for (size_t i = 0U; x_grid && i < f->ax.n_ticks; ++i) {
-        const double x = px_x(f, tick_value(&f->ax, i));
-        sb_printf(b, "<line x1=\"%.6g\" y1=\"%.6g\" x2=\"%.6g\" y2=\"%.6g\"/>\n", fin(x),
-                  fin(f->y), fin(x), fin(f->y + f->h));
-    }
-    sb_str(b, "</g>\n");
-    if (f->ay.n_ticks > 0U) {
-        sb_str(b, "<g class=\"axis-y\" font-size=\"11\" text-anchor=\"end\" fill=\"" COLOR_TEXT
-                  "\">\n");
-        for (size_t i = 0U; i < f->ay.n_ticks; ++i) {
-            const double v = tick_value(&f->ay, i);
-            sb_printf(b, "<text x=\"%.6g\" y=\"%.6g\">%.6g</text>\n", fin(f->x - 6.0),
-                      fin(px_y(f, v) + 4.0), fin(v));
-        }
-        sb_str(b, "</g>\n");
-    }
-    if (f->ax.n_ticks > 0U) {
-        sb_str(b, "<g class=\"axis-x\" font-size=\"11\" text-anchor=\"middle\" fill=\"" COLOR_TEXT
-                  "\">\n");
-        for (size_t i = 0U; i < f->ax.n_ticks; ++i) {
-            const double v = tick_value(&f->ax, i);
-            sb_printf(b, "<text x=\"%.6g\" y=\"%.6g\">%.6g</text>\n", fin(px_x(f, v)),
-                      fin(f->y + f->h + 15.0), fin(v));
-        }
-        sb_str(b, "</g>\n");
-    }
-}
-
-/* Axis titles: below the plot area, and rotated along its left side at x_left. */
-static void draw_axis_titles(svgbuf *b, const frame *f, const char *x_title, double x_left,
-                             const char *y_title)
-{
-    text_str(b, f->x + 0.5 * f->w, f->y + f->h + 33.0,
-             "font-size=\"12\" text-anchor=\"middle\" fill=\"" COLOR_TEXT "\"", x_title);
-    const double yc = f->y + 0.5 * f->h;
-    sb_printf(b,
-              "<text x=\"%.6g\" y=\"%.6g\" transform=\"rotate(-90 %.6g %.6g)\" font-size=\"12\" "
-              "text-anchor=\"middle\" fill=\"" COLOR_TEXT "\">",
-              fin(x_left), fin(yc), fin(x_left), fin(yc));
-    put_text(b, y_title, strlen(y_title), SIZE_MAX);
-    sb_str(b, "</text>\n");
-}
-
-/* In the upper part of the plot area: the middle is where the zero line runs. */
-static void no_data_note(svgbuf *b, const frame *f, const char *what)
-{
-    text_str(b, f->x + 0.5 * f->w, f->y + fmax(0.3 * f->h, 16.0),
-             "font-size=\"13\" text-anchor=\"middle\" fill=\"" COLOR_MUTED "\"", what);
-}
-
-/* ------------------------------------------------------------------ documents */
-
-static void doc_begin(svgbuf *b, double w, double h, const char *title, size_t title_len)
-{
-    sb_printf(b,
-              "<?xml version=\"1.0\" encoding=\"UTF-8\" standalone=\"no\"?>\n"
-              "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"%.6g\" "
-              "height=\"%.6g\" viewBox=\"0 0 %.6g %.6g\" "
-              "font-family=\"DejaVu Sans, Helvetica, Arial, sans-serif\">\n<title>",
-              fin(w), fin(h), fin(w), fin(h));
-    put_text(b, title, title_len, PLOT_TITLE_ATTR_MAX);
-    sb_printf(b, "</title>\n<rect x=\"0\" y=\"0\" width=\"%.6g\" height=\"%.6g\" fill=\"#ffffff\"/>\n",
-              fin(w), fin(h));
-    text_el(b, 20.0, 28.0, "font-size=\"16\" font-weight=\"bold\" fill=\"" COLOR_TEXT "\"", title,
-            title_len, chars_fit(w - 40.0, 16.0 * PLOT_BOLD_EM / PLOT_CHAR_EM));
-}
-
-static void doc_end(svgbuf *b)
-{
-    sb_str(b, "</svg>\n");
-}
-
-/* "<prefix><model name>" into t (the name may be anything: put_text() escapes it later). */
-static void title_text(svgbuf *t, const char *prefix, const dhcal_plot_data *d)
-{
-    sb_str(t, prefix);
-    sb_str(t, d->title[0] != '\0' ? d->title : "(unnamed model)");
-}
-
-/* A legend entry: a colour swatch (a square, or a circle of class "legend" so that data points
- * stay countable) and its text, cut to max_chars; returns the x after it. */
-static double legend_item(svgbuf *b, double x, double y, const char *color, int round,
-                          const char *label, size_t max_chars)
-{
-    if (round) {
-        sb_printf(b, "<circle class=\"legend\" cx=\"%.6g\" cy=\"%.6g\" r=\"4\" fill=\"%s\"/>\n",
-                  fin(x + 5.0), fin(y - 4.0), color);
-    } else {
-        sb_printf(b, "<rect x=\"%.6g\" y=\"%.6g\" width=\"10\" height=\"10\" fill=\"%s\"/>\n",
-                  fin(x), fin(y - 9.0), color);
-    }
-    const size_t n = strlen(label);
-    text_el(b, x + 15.0, y, "font-size=\"12\" fill=\"" COLOR_TEXT "\"", label, n, max_chars);
-    const size_t chars = text_chars(label, n);
-    return x + 15.0 + text_w(chars < max_chars ? chars : max_chars, 12.0) + 18.0;
-}
-
-/* Zero lines through the plot area: horizontal at y = 0, vertical at x = 0 (`vertical`),
- * each only when 0 is inside the drawn range. */
-static void zero_lines(svgbuf *b, const frame *f, int vertical)
-{
-    if (f->ay.lo < 0.0 && f->ay.hi > 0.0) {
-        const double y0 = px_y(f, 0.0);
-        sb_printf(b, "<line x1=\"%.6g\" y1=\"%.6g\" x2=\"%.6g\" y2=\"%.6g\" stroke=\"" COLOR_ZERO
-                     "\" stroke-width=\"1\"/>\n",
-                  fin(f->x), fin(y0), fin(f->x + f->w), fin(y0));
-    }
-    if (vertical && f->ax.n_ticks > 0U && f->ax.lo < 0.0 && f->ax.hi > 0.0) {
-        const double x0 = px_x(f, 0.0);
-        sb_printf(b, "<line x1=\"%.6g\" y1=\"%.6g\" x2=\"%.6g\" y2=\"%.6g\" stroke=\"" COLOR_ZERO
-                     "\" stroke-width=\"1\"/>\n",
-                  fin(x0), fin(f->y), fin(x0), fin(f->y + f->h));
-    }
-}
-
-static void residuals_svg(svgbuf *b, const dhcal_plot_data *d)
+static void residuals_svg(dhcal_text *b, const dhcal_plot_data *d)
 {
     const size_t n = d->n_rows;
     const size_t nj = d->n_joints;
@@ -535,11 +56,11 @@ static void residuals_svg(svgbuf *b, const dhcal_plot_data *d)
         ylo = fmin(ylo, d->resid_before[i]);
         yhi = fmax(yhi, d->resid_before[i]);
     }
-    pad_range(&ylo, &yhi, 0.05, 0.05);
+    dhcal_svg_pad_range(&ylo, &yhi, 0.05, 0.05);
     const double plot_w = 380.0;
     const double plot_h = 190.0;
-    const axis ay = fit_axis(ylo, yhi, plot_h, 11.0, 0, 0);
-    const double left = 24.0 + text_w(tick_label_chars(&ay), 11.0) + 12.0;
+    const dhcal_svg_axis ay = dhcal_svg_fit_axis(ylo, yhi, plot_h, 11.0, 0, 0);
+    const double left = 24.0 + dhcal_svg_text_width(dhcal_svg_tick_label_chars(&ay), 11.0) + 12.0;
     const double cell_w = left + plot_w + 24.0;
     const double cell_h = 30.0 + plot_h + 50.0;
     const size_t cols = nj >= 2U ? 2U : 1U;
@@ -549,9 +70,9 @@ static void residuals_svg(svgbuf *b, const dhcal_plot_data *d)
     const double width = fmax(640.0, 20.0 + (double)cols * cell_w);
     const double height = top + (double)rows * cell_h + 6.0;
 
-    svgbuf t = {NULL, 0U, 0U, 0};
+    dhcal_text t = {NULL, 0U, 0U, 0};
     title_text(&t, "Residuals vs joint angle: ", d);
-    doc_begin(b, width, height, t.failed ? "" : t.p, t.failed ? 0U : t.len);
+    dhcal_svg_begin(b, width, height, t.failed ? "" : t.p, t.failed ? 0U : t.len);
     b->failed |= t.failed;
     free(t.p);
 
@@ -560,13 +81,13 @@ static void residuals_svg(svgbuf *b, const dhcal_plot_data *d)
     const char *const *const names = d->wires ? wires : xyz;
     double lx = 20.0;
     for (size_t k = 0U; k < 3U; ++k) {
-        lx = legend_item(b, lx, 52.0, component_color[k], 0, names[k], SIZE_MAX);
+        lx = dhcal_svg_legend_item(b, lx, 52.0, component_color[k], 0, names[k], SIZE_MAX);
     }
     char note[160];
     (void)snprintf(note, sizeof note, "%zu rows; residual in mm (%s), the same in every panel",
                    n, d->wires ? "wire lengths" : "position");
-    if (lx + text_w(strlen(note), 12.0) <= width - 10.0) {
-        text_str(b, lx, 52.0, "font-size=\"12\" fill=\"" COLOR_MUTED "\"", note);
+    if (lx + dhcal_svg_text_width(strlen(note), 12.0) <= width - 10.0) {
+        dhcal_svg_text(b, lx, 52.0, "font-size=\"12\" fill=\"" DHCAL_COLOR_MUTED "\"", note);
     }
 
     for (size_t j = 0U; j < nj; ++j) {
@@ -582,47 +103,47 @@ static void residuals_svg(svgbuf *b, const dhcal_plot_data *d)
                 xlo = fmin(xlo, d->q_deg[i * nj + j]);
                 xhi = fmax(xhi, d->q_deg[i * nj + j]);
             }
-            pad_range(&xlo, &xhi, 0.03, 0.03);
+            dhcal_svg_pad_range(&xlo, &xhi, 0.03, 0.03);
         }
-        const frame f = {cx + left, cy + 30.0, plot_w, plot_h,
-                         fit_axis(xlo, xhi, plot_w, 11.0, 1, 0), ay};
-        sb_printf(b, "<g class=\"panel\" id=\"joint%zu\">\n", j + 1U);
-        draw_frame(b, &f, 1);
-        zero_lines(b, &f, 0);
+        const dhcal_svg_frame f = {cx + left, cy + 30.0, plot_w, plot_h,
+                                   dhcal_svg_fit_axis(xlo, xhi, plot_w, 11.0, 1, 0), ay};
+        dhcal_text_printf(b, "<g class=\"panel\" id=\"joint%zu\">\n", j + 1U);
+        dhcal_svg_draw_frame(b, &f, 1);
+        dhcal_svg_zero_lines(b, &f, 0);
         for (size_t k = 0U; k < 3U; ++k) {
-            sb_printf(b, "<g class=\"series-%s\" fill=\"%s\" fill-opacity=\"0.7\">\n", names[k],
-                      component_color[k]);
+            dhcal_text_printf(b, "<g class=\"series-%s\" fill=\"%s\" fill-opacity=\"0.7\">\n",
+                              names[k], component_color[k]);
             for (size_t i = 0U; i < n; ++i) {
-                sb_printf(b, "<circle cx=\"%.6g\" cy=\"%.6g\" r=\"2.2\"/>\n",
-                          fin(px_x(&f, d->q_deg[i * nj + j])),
-                          fin(px_y(&f, d->resid_before[3U * i + k])));
+                dhcal_svg_dot(b, dhcal_svg_px_x(&f, d->q_deg[i * nj + j]),
+                              dhcal_svg_px_y(&f, d->resid_before[3U * i + k]), 2.2);
             }
-            sb_str(b, "</g>\n");
+            dhcal_text_str(b, "</g>\n");
         }
         if (n == 0U) {
-            no_data_note(b, &f, "no rows");
+            dhcal_svg_note(b, &f, "no rows");
         }
         char s[48];
         (void)snprintf(s, sizeof s, "joint %zu", j + 1U);
-        text_str(b, f.x, f.y - 8.0, "font-size=\"13\" font-weight=\"bold\" fill=\"" COLOR_TEXT "\"",
-                 s);
+        dhcal_svg_text(b, f.x, f.y - 8.0,
+                       "font-size=\"13\" font-weight=\"bold\" fill=\"" DHCAL_COLOR_TEXT "\"", s);
         (void)snprintf(s, sizeof s, "q%zu [deg]", j + 1U);
-        draw_axis_titles(b, &f, s, cx + 16.0, "residual [mm]");
-        sb_str(b, "</g>\n");
+        dhcal_svg_axis_titles(b, &f, s, cx + 16.0, "residual [mm]");
+        dhcal_text_str(b, "</g>\n");
     }
-    doc_end(b);
+    dhcal_svg_end(b);
 }
 
 /* Approach directions in drawing order: unknown underneath, the two bands on top. */
 static const signed char dir_value[3] = {0, 1, -1};
 static const char *const dir_class[3] = {"dir-unknown", "dir-plus", "dir-minus"};
-static const char *const dir_color[3] = {COLOR_DIR_UNKNOWN, COLOR_DIR_PLUS, COLOR_DIR_MINUS};
+static const char *const dir_color[3] = {DHCAL_COLOR_DIR_UNKNOWN, DHCAL_COLOR_DIR_PLUS,
+                                         DHCAL_COLOR_DIR_MINUS};
 
 /* Joint j's apparent errors (times y_scale) against x[i * nj + j], one group per approach
  * direction that occurs. A value beyond the y axis is drawn hollow on the frame's edge (class
  * "clipped"); returns how many were. */
-static size_t joint_points(svgbuf *b, const frame *f, const dhcal_plot_data *d, size_t j,
-                           const double *x, double y_scale)
+static size_t joint_points(dhcal_text *b, const dhcal_svg_frame *f, const dhcal_plot_data *d,
+                           size_t j, const double *x, double y_scale)
 {
     const size_t n = d->n_rows;
     const size_t nj = d->n_joints;
@@ -635,26 +156,27 @@ static size_t joint_points(svgbuf *b, const frame *f, const dhcal_plot_data *d, 
         if (count == 0U) {
             continue;
         }
-        sb_printf(b, "<g class=\"%s\" fill=\"%s\" fill-opacity=\"0.75\">\n", dir_class[k],
-                  dir_color[k]);
+        dhcal_text_printf(b, "<g class=\"%s\" fill=\"%s\" fill-opacity=\"0.75\">\n", dir_class[k],
+                          dir_color[k]);
         for (size_t i = 0U; i < n; ++i) {
             if (d->dir[i * nj + j] != dir_value[k]) {
                 continue;
             }
-            const double px = px_x(f, x[i * nj + j]);
+            const double px = dhcal_svg_px_x(f, x[i * nj + j]);
             const double y = d->joint_err_deg[i * nj + j] * y_scale;
             if (y >= f->ay.lo && y <= f->ay.hi) {
-                sb_printf(b, "<circle cx=\"%.6g\" cy=\"%.6g\" r=\"2.2\"/>\n", fin(px),
-                          fin(px_y(f, y)));
+                dhcal_svg_dot(b, px, dhcal_svg_px_y(f, y), 2.2);
             } else {
-                sb_printf(b, "<circle cx=\"%.6g\" cy=\"%.6g\" r=\"2.6\" class=\"clipped\" "
-                             "fill=\"#ffffff\" fill-opacity=\"1\" stroke=\"%s\" "
-                             "stroke-width=\"1.3\"/>\n",
-                          fin(px), fin(y < f->ay.lo ? f->y + f->h : f->y), dir_color[k]);
+                dhcal_text_printf(b,
+                                  "<circle cx=\"%.6g\" cy=\"%.6g\" r=\"2.6\" class=\"clipped\" "
+                                  "fill=\"#ffffff\" fill-opacity=\"1\" stroke=\"%s\" "
+                                  "stroke-width=\"1.3\"/>\n",
+                                  dhcal_svg_num(px),
+                                  dhcal_svg_num(y < f->ay.lo ? f->y + f->h : f->y), dir_color[k]);
                 clipped++;
             }
         }
-        sb_str(b, "</g>\n");
+        dhcal_text_str(b, "</g>\n");
     }
     return clipped;
 }
@@ -724,13 +246,13 @@ static void dq_range(const dhcal_plot_data *d, size_t j, double scale, double *l
  * bands by approach direction) and against its gravity moment (compliance: a line through
  * the origin). Both panels of a row share the y axis; each row has its own, in degrees or,
  * when every value is small, in millidegrees. */
-static void joints_svg(svgbuf *b, const dhcal_plot_data *d)
+static void joints_svg(dhcal_text *b, const dhcal_plot_data *d)
 {
     const size_t n = d->n_rows;
     const size_t nj = d->n_joints;
     const double plot_w = 360.0;
     const double plot_h = 170.0;
-    axis ay[DHC_MAX_JOINTS];
+    dhcal_svg_axis ay[DHC_MAX_JOINTS];
     double y_scale[DHC_MAX_JOINTS];
     int no_moment[DHC_MAX_JOINTS];
     size_t tick_chars = 1U;
@@ -748,21 +270,21 @@ static void joints_svg(svgbuf *b, const dhcal_plot_data *d)
         int ok;
         dq_range(d, j, y_scale[j], &lo, &hi, &ok);
         b->failed |= !ok;
-        pad_range(&lo, &hi, 0.05, 0.05);
-        ay[j] = fit_axis(lo, hi, plot_h, 11.0, 0, 0);
-        const size_t c = tick_label_chars(&ay[j]);
+        dhcal_svg_pad_range(&lo, &hi, 0.05, 0.05);
+        ay[j] = dhcal_svg_fit_axis(lo, hi, plot_h, 11.0, 0, 0);
+        const size_t c = dhcal_svg_tick_label_chars(&ay[j]);
         tick_chars = c > tick_chars ? c : tick_chars;
     }
-    const double left = 24.0 + text_w(tick_chars, 11.0) + 12.0;
+    const double left = 24.0 + dhcal_svg_text_width(tick_chars, 11.0) + 12.0;
     const double cell_w = left + plot_w + 24.0;
     const double cell_h = 30.0 + plot_h + 50.0;
     const double top = 72.0;
     const double width = 20.0 + 2.0 * cell_w;
     const double height = top + (double)nj * cell_h + 6.0;
 
-    svgbuf t = {NULL, 0U, 0U, 0};
+    dhcal_text t = {NULL, 0U, 0U, 0};
     title_text(&t, "Apparent joint error: ", d);
-    doc_begin(b, width, height, t.failed ? "" : t.p, t.failed ? 0U : t.len);
+    dhcal_svg_begin(b, width, height, t.failed ? "" : t.p, t.failed ? 0U : t.len);
     b->failed |= t.failed;
     free(t.p);
 
@@ -777,13 +299,13 @@ static void joints_svg(svgbuf *b, const dhcal_plot_data *d)
             seen = d->dir[i] == dir_value[o];
         }
         if (seen) {
-            lx = legend_item(b, lx, 52.0, dir_color[o], 1, dir_label[o], SIZE_MAX);
+            lx = dhcal_svg_legend_item(b, lx, 52.0, dir_color[o], 1, dir_label[o], SIZE_MAX);
         }
     }
     char note[160];
     (void)snprintf(note, sizeof note, "%zu rows; dq = pinv(J_q) r + the fitted effects' own dq", n);
-    if (lx + text_w(strlen(note), 12.0) <= width - 10.0) {
-        text_str(b, lx, 52.0, "font-size=\"12\" fill=\"" COLOR_MUTED "\"", note);
+    if (lx + dhcal_svg_text_width(strlen(note), 12.0) <= width - 10.0) {
+        dhcal_svg_text(b, lx, 52.0, "font-size=\"12\" fill=\"" DHCAL_COLOR_MUTED "\"", note);
     }
 
     for (size_t j = 0U; j < nj; ++j) {
@@ -792,7 +314,7 @@ static void joints_svg(svgbuf *b, const dhcal_plot_data *d)
         char y_title[48];
         (void)snprintf(y_title, sizeof y_title, "dq%zu [%s]", j + 1U, unit);
         char s[64];
-        sb_printf(b, "<g class=\"panel\" id=\"joint%zu-angle\">\n", j + 1U);
+        dhcal_text_printf(b, "<g class=\"panel\" id=\"joint%zu-angle\">\n", j + 1U);
         {
             double xlo = -180.0;
             double xhi = 180.0;
@@ -802,33 +324,34 @@ static void joints_svg(svgbuf *b, const dhcal_plot_data *d)
                     xlo = fmin(xlo, d->q_deg[i * nj + j]);
                     xhi = fmax(xhi, d->q_deg[i * nj + j]);
                 }
-                pad_range(&xlo, &xhi, 0.03, 0.03);
+                dhcal_svg_pad_range(&xlo, &xhi, 0.03, 0.03);
             }
             const double cx = 10.0;
-            const frame f = {cx + left, cy + 30.0, plot_w, plot_h,
-                             fit_axis(xlo, xhi, plot_w, 11.0, 1, 0), ay[j]};
-            draw_frame(b, &f, 1);
-            zero_lines(b, &f, 0);
+            const dhcal_svg_frame f = {cx + left, cy + 30.0, plot_w, plot_h,
+                                       dhcal_svg_fit_axis(xlo, xhi, plot_w, 11.0, 1, 0), ay[j]};
+            dhcal_svg_draw_frame(b, &f, 1);
+            dhcal_svg_zero_lines(b, &f, 0);
             const size_t clipped = joint_points(b, &f, d, j, d->q_deg, y_scale[j]);
             if (n == 0U) {
-                no_data_note(b, &f, "no rows");
+                dhcal_svg_note(b, &f, "no rows");
             }
             (void)snprintf(s, sizeof s, "joint %zu vs angle", j + 1U);
-            text_str(b, f.x, f.y - 8.0,
-                     "font-size=\"13\" font-weight=\"bold\" fill=\"" COLOR_TEXT "\"", s);
+            dhcal_svg_text(b, f.x, f.y - 8.0,
+                           "font-size=\"13\" font-weight=\"bold\" fill=\"" DHCAL_COLOR_TEXT "\"",
+                           s);
             if (clipped > 0U) { /* the same points are off scale in both panels */
                 (void)snprintf(s, sizeof s, "%zu point%s off scale (hollow)", clipped,
                                clipped == 1U ? "" : "s");
-                text_str(b, f.x + f.w, f.y - 8.0,
-                         "class=\"clipped-note\" font-size=\"11\" text-anchor=\"end\" "
-                         "fill=\"" COLOR_MUTED "\"",
-                         s);
+                dhcal_svg_text(b, f.x + f.w, f.y - 8.0,
+                               "class=\"clipped-note\" font-size=\"11\" text-anchor=\"end\" "
+                               "fill=\"" DHCAL_COLOR_MUTED "\"",
+                               s);
             }
             (void)snprintf(s, sizeof s, "q%zu [deg]", j + 1U);
-            draw_axis_titles(b, &f, s, cx + 16.0, y_title);
+            dhcal_svg_axis_titles(b, &f, s, cx + 16.0, y_title);
         }
-        sb_str(b, "</g>\n");
-        sb_printf(b, "<g class=\"panel\" id=\"joint%zu-moment\">\n", j + 1U);
+        dhcal_text_str(b, "</g>\n");
+        dhcal_text_printf(b, "<g class=\"panel\" id=\"joint%zu-moment\">\n", j + 1U);
         {
             /* zero in range: compliance is a line through the origin */
             double xlo = 0.0;
@@ -837,38 +360,39 @@ static void joints_svg(svgbuf *b, const dhcal_plot_data *d)
                 xlo = fmin(xlo, d->moment_mm[i * nj + j]);
                 xhi = fmax(xhi, d->moment_mm[i * nj + j]);
             }
-            pad_range(&xlo, &xhi, xlo < 0.0 ? 0.05 : 0.0, xhi > 0.0 ? 0.05 : 0.0);
-            axis ax = fit_axis(xlo, xhi, plot_w, 11.0, 1, 0);
+            dhcal_svg_pad_range(&xlo, &xhi, xlo < 0.0 ? 0.05 : 0.0, xhi > 0.0 ? 0.05 : 0.0);
+            dhcal_svg_axis ax = dhcal_svg_fit_axis(xlo, xhi, plot_w, 11.0, 1, 0);
             if (no_moment[j]) {
                 ax.n_ticks = 0U; /* the moment is no quantity here: no numbers on its axis */
             }
             const double cx = 10.0 + cell_w;
-            const frame f = {cx + left, cy + 30.0, plot_w, plot_h, ax, ay[j]};
-            draw_frame(b, &f, 1);
-            zero_lines(b, &f, 1);
+            const dhcal_svg_frame f = {cx + left, cy + 30.0, plot_w, plot_h, ax, ay[j]};
+            dhcal_svg_draw_frame(b, &f, 1);
+            dhcal_svg_zero_lines(b, &f, 1);
             if (no_moment[j]) {
-                no_data_note(b, &f, "no gravity moment about this joint");
+                dhcal_svg_note(b, &f, "no gravity moment about this joint");
             } else {
                 (void)joint_points(b, &f, d, j, d->moment_mm, y_scale[j]);
             }
             if (n == 0U) {
-                no_data_note(b, &f, "no rows");
+                dhcal_svg_note(b, &f, "no rows");
             }
             (void)snprintf(s, sizeof s, "joint %zu vs gravity moment", j + 1U);
-            text_str(b, f.x, f.y - 8.0,
-                     "font-size=\"13\" font-weight=\"bold\" fill=\"" COLOR_TEXT "\"", s);
-            draw_axis_titles(b, &f, "gravity moment [mm]", cx + 16.0, y_title);
+            dhcal_svg_text(b, f.x, f.y - 8.0,
+                           "font-size=\"13\" font-weight=\"bold\" fill=\"" DHCAL_COLOR_TEXT "\"",
+                           s);
+            dhcal_svg_axis_titles(b, &f, "gravity moment [mm]", cx + 16.0, y_title);
         }
-        sb_str(b, "</g>\n");
+        dhcal_text_str(b, "</g>\n");
     }
-    doc_end(b);
+    dhcal_svg_end(b);
 }
 
 /* An RMS value for a label: 3 decimals in the usual range, 3 significant digits outside. */
 static void fmt_mm(char *s, size_t cap, double v)
 {
     const double a = fabs(v);
-    (void)snprintf(s, cap, a >= 0.01 && a < 1e5 ? "%.3f" : "%.3g", fin(v));
+    (void)snprintf(s, cap, a >= 0.01 && a < 1e5 ? "%.3f" : "%.3g", dhcal_svg_num(v));
 }
 
 /* Places two labels by their lines' pixel heights (upper = smaller y), each just above
@@ -899,21 +423,24 @@ static void place_labels(double py_up, double py_low, double y_min, double y_max
 
 /* A label over a translucent white box, right-aligned at x_right (the box is an estimate
  * of the text's extent: no font metrics). */
-static void boxed_label(svgbuf *b, double x_right, double y, const char *color, const char *s,
+static void boxed_label(dhcal_text *b, double x_right, double y, const char *color, const char *s,
                         size_t max_chars)
 {
-    const size_t chars = text_chars(s, strlen(s));
-    const double w = text_w(chars < max_chars ? chars : max_chars, 12.0) + 6.0;
-    sb_printf(b, "<rect x=\"%.6g\" y=\"%.6g\" width=\"%.6g\" height=\"15\" fill=\"#ffffff\" "
-                 "fill-opacity=\"0.85\"/>\n",
-              fin(x_right - w + 3.0), fin(y - 11.5), fin(w));
-    sb_printf(b, "<text x=\"%.6g\" y=\"%.6g\" font-size=\"12\" text-anchor=\"end\" fill=\"%s\">",
-              fin(x_right), fin(y), color);
-    put_text(b, s, strlen(s), max_chars);
-    sb_str(b, "</text>\n");
+    const size_t chars = dhcal_svg_text_chars(s, strlen(s));
+    const double w = dhcal_svg_text_width(chars < max_chars ? chars : max_chars, 12.0) + 6.0;
+    dhcal_text_printf(b,
+                      "<rect x=\"%.6g\" y=\"%.6g\" width=\"%.6g\" height=\"15\" "
+                      "fill=\"#ffffff\" fill-opacity=\"0.85\"/>\n",
+                      dhcal_svg_num(x_right - w + 3.0), dhcal_svg_num(y - 11.5), dhcal_svg_num(w));
+    dhcal_text_printf(b,
+                      "<text x=\"%.6g\" y=\"%.6g\" font-size=\"12\" text-anchor=\"end\" "
+                      "fill=\"%s\">",
+                      dhcal_svg_num(x_right), dhcal_svg_num(y), color);
+    dhcal_svg_put_text(b, s, strlen(s), max_chars);
+    dhcal_text_str(b, "</text>\n");
 }
 
-static void errors_svg(svgbuf *b, const dhcal_plot_data *d)
+static void errors_svg(dhcal_text *b, const dhcal_plot_data *d)
 {
     const size_t n = d->n_rows;
     const int named = d->effect[0] != '\0';
@@ -923,77 +450,86 @@ static void errors_svg(svgbuf *b, const dhcal_plot_data *d)
         yhi = fmax(yhi, fmax(d->err_before[i], d->err_after[i]));
         ylo = fmin(ylo, fmin(d->err_before[i], d->err_after[i]));
     }
-    pad_range(&ylo, &yhi, ylo < 0.0 ? 0.05 : 0.0, 0.05);
+    dhcal_svg_pad_range(&ylo, &yhi, ylo < 0.0 ? 0.05 : 0.0, 0.05);
     if (!(yhi > ylo)) {
-        yhi = ylo + 1.0; /* all zero: [0, 1], not the window around 0 make_axis() would choose */
+        yhi = ylo + 1.0; /* all zero: [0, 1], not the window around 0 a constant axis gets */
     }
     const double width = 960.0;
     const double plot_h = 300.0;
-    const axis ay = fit_axis(ylo, yhi, plot_h, 11.0, 0, 0);
-    const double left = 24.0 + text_w(tick_label_chars(&ay), 11.0) + 12.0;
+    const dhcal_svg_axis ay = dhcal_svg_fit_axis(ylo, yhi, plot_h, 11.0, 0, 0);
+    const double left = 24.0 + dhcal_svg_text_width(dhcal_svg_tick_label_chars(&ay), 11.0) + 12.0;
     const double xhi = n > 1U ? (double)(n - 1U) : 1.0;
     const double plot_w = width - left - 24.0;
-    const frame f = {left, 72.0, plot_w, plot_h, fit_axis(0.0, xhi, plot_w, 11.0, 1, 1), ay};
+    const dhcal_svg_frame f = {left, 72.0, plot_w, plot_h,
+                               dhcal_svg_fit_axis(0.0, xhi, plot_w, 11.0, 1, 1), ay};
     const double height = f.y + f.h + 48.0;
 
-    svgbuf t = {NULL, 0U, 0U, 0};
+    dhcal_text t = {NULL, 0U, 0U, 0};
     title_text(&t, "Error per row, before and after: ", d);
-    doc_begin(b, width, height, t.failed ? "" : t.p, t.failed ? 0U : t.len);
+    dhcal_svg_begin(b, width, height, t.failed ? "" : t.p, t.failed ? 0U : t.len);
     b->failed |= t.failed;
     free(t.p);
 
     /* The labels, built once: the legend and the RMS lines say the same thing. */
-    svgbuf after = {NULL, 0U, 0U, 0};
-    sb_str(&after, "after (");
+    dhcal_text after = {NULL, 0U, 0U, 0};
+    dhcal_text_str(&after, "after (");
     if (named) {
-        sb_str(&after, "+");
-        sb_str(&after, d->effect);
+        dhcal_text_str(&after, "+");
+        dhcal_text_str(&after, d->effect);
     } else {
-        sb_str(&after, "no effect named");
+        dhcal_text_str(&after, "no effect named");
     }
-    sb_str(&after, ")");
+    dhcal_text_str(&after, ")");
     char num[48];
     char before_rms[80];
     fmt_mm(num, sizeof num, d->rms_before_mm);
     (void)snprintf(before_rms, sizeof before_rms, "before RMS %s mm", num);
-    svgbuf after_rms = {NULL, 0U, 0U, 0};
+    dhcal_text after_rms = {NULL, 0U, 0U, 0};
     fmt_mm(num, sizeof num, d->rms_after_mm);
     if (!after.failed) {
-        sb_put(&after_rms, after.p, after.len);
+        dhcal_text_put(&after_rms, after.p, after.len);
     }
-    sb_printf(&after_rms, " RMS %s mm", num);
+    dhcal_text_printf(&after_rms, " RMS %s mm", num);
     b->failed |= after.failed | after_rms.failed;
     const char *const after_label = after.failed ? "after" : after.p;
     const char *const after_rms_label = after_rms.failed ? "after" : after_rms.p;
 
     /* Legend: round swatches, like the points they stand for. */
-    const double lx = legend_item(b, 20.0, 52.0, COLOR_BEFORE, 1, "before (base fit)", SIZE_MAX);
-    (void)legend_item(b, lx, 52.0, COLOR_AFTER, 1, after_label, chars_fit(width - lx - 40.0, 12.0));
+    const double lx = dhcal_svg_legend_item(b, 20.0, 52.0, DHCAL_COLOR_BEFORE, 1,
+                                            "before (base fit)", SIZE_MAX);
+    (void)dhcal_svg_legend_item(b, lx, 52.0, DHCAL_COLOR_AFTER, 1, after_label,
+                                dhcal_svg_chars_fit(width - lx - 40.0, 12.0));
 
-    draw_frame(b, &f, 0);
-    sb_str(b, "<g class=\"series-before\" fill=\"" COLOR_BEFORE "\" fill-opacity=\"0.8\">\n");
+    dhcal_svg_draw_frame(b, &f, 0);
+    dhcal_text_str(b, "<g class=\"series-before\" fill=\"" DHCAL_COLOR_BEFORE "\" "
+                      "fill-opacity=\"0.8\">\n");
     for (size_t i = 0U; i < n; ++i) {
-        sb_printf(b, "<circle cx=\"%.6g\" cy=\"%.6g\" r=\"2\"/>\n", fin(px_x(&f, (double)i)),
-                  fin(px_y(&f, d->err_before[i])));
+        dhcal_svg_dot(b, dhcal_svg_px_x(&f, (double)i), dhcal_svg_px_y(&f, d->err_before[i]), 2.0);
     }
-    sb_str(b, "</g>\n<g class=\"series-after\" fill=\"" COLOR_AFTER "\" fill-opacity=\"0.8\">\n");
+    dhcal_text_str(b, "</g>\n<g class=\"series-after\" fill=\"" DHCAL_COLOR_AFTER "\" "
+                      "fill-opacity=\"0.8\">\n");
     for (size_t i = 0U; i < n; ++i) {
-        sb_printf(b, "<circle cx=\"%.6g\" cy=\"%.6g\" r=\"2\"/>\n", fin(px_x(&f, (double)i)),
-                  fin(px_y(&f, d->err_after[i])));
+        dhcal_svg_dot(b, dhcal_svg_px_x(&f, (double)i), dhcal_svg_px_y(&f, d->err_after[i]), 2.0);
     }
-    sb_str(b, "</g>\n");
+    dhcal_text_str(b, "</g>\n");
     if (n == 0U) {
-        no_data_note(b, &f, "no rows");
+        dhcal_svg_note(b, &f, "no rows");
     }
 
-    const double py_b = px_y(&f, d->rms_before_mm);
-    const double py_a = px_y(&f, d->rms_after_mm);
-    sb_printf(b, "<line class=\"rms-before\" x1=\"%.6g\" y1=\"%.6g\" x2=\"%.6g\" y2=\"%.6g\" "
-                 "stroke=\"" COLOR_BEFORE_LINE "\" stroke-width=\"1.5\" stroke-dasharray=\"6 4\"/>\n",
-              fin(f.x), fin(py_b), fin(f.x + f.w), fin(py_b));
-    sb_printf(b, "<line class=\"rms-after\" x1=\"%.6g\" y1=\"%.6g\" x2=\"%.6g\" y2=\"%.6g\" "
-                 "stroke=\"" COLOR_AFTER "\" stroke-width=\"1.5\" stroke-dasharray=\"6 4\"/>\n",
-              fin(f.x), fin(py_a), fin(f.x + f.w), fin(py_a));
+    const double py_b = dhcal_svg_px_y(&f, d->rms_before_mm);
+    const double py_a = dhcal_svg_px_y(&f, d->rms_after_mm);
+    dhcal_text_printf(b,
+                      "<line class=\"rms-before\" x1=\"%.6g\" y1=\"%.6g\" x2=\"%.6g\" "
+                      "y2=\"%.6g\" stroke=\"" DHCAL_COLOR_BEFORE_LINE "\" stroke-width=\"1.5\" "
+                      "stroke-dasharray=\"6 4\"/>\n",
+                      dhcal_svg_num(f.x), dhcal_svg_num(py_b), dhcal_svg_num(f.x + f.w),
+                      dhcal_svg_num(py_b));
+    dhcal_text_printf(b,
+                      "<line class=\"rms-after\" x1=\"%.6g\" y1=\"%.6g\" x2=\"%.6g\" "
+                      "y2=\"%.6g\" stroke=\"" DHCAL_COLOR_AFTER "\" stroke-width=\"1.5\" "
+                      "stroke-dasharray=\"6 4\"/>\n",
+                      dhcal_svg_num(f.x), dhcal_svg_num(py_a), dhcal_svg_num(f.x + f.w),
+                      dhcal_svg_num(py_a));
     double ty_b;
     double ty_a;
     if (py_b <= py_a) {
@@ -1001,14 +537,14 @@ static void errors_svg(svgbuf *b, const dhcal_plot_data *d)
     } else {
         place_labels(py_a, py_b, f.y + 2.0, f.y + f.h - 3.0, &ty_a, &ty_b);
     }
-    const size_t max_chars = chars_fit(f.w - 12.0, 12.0);
-    boxed_label(b, f.x + f.w - 6.0, ty_b, COLOR_BEFORE_LINE, before_rms, max_chars);
-    boxed_label(b, f.x + f.w - 6.0, ty_a, COLOR_AFTER, after_rms_label, max_chars);
+    const size_t max_chars = dhcal_svg_chars_fit(f.w - 12.0, 12.0);
+    boxed_label(b, f.x + f.w - 6.0, ty_b, DHCAL_COLOR_BEFORE_LINE, before_rms, max_chars);
+    boxed_label(b, f.x + f.w - 6.0, ty_a, DHCAL_COLOR_AFTER, after_rms_label, max_chars);
     free(after.p);
     free(after_rms.p);
 
-    draw_axis_titles(b, &f, "row (data order)", 18.0, "error [mm]");
-    doc_end(b);
+    dhcal_svg_axis_titles(b, &f, "row (data order)", 18.0, "error [mm]");
+    dhcal_svg_end(b);
 }
 
 static size_t label_len(const dhcal_plot_candidate *c)
@@ -1017,58 +553,62 @@ static size_t label_len(const dhcal_plot_candidate *c)
     return nul != NULL ? (size_t)((const char *)nul - c->label) : sizeof c->label;
 }
 
-static void candidates_svg(svgbuf *b, const dhcal_plot_data *d)
+static void candidates_svg(dhcal_text *b, const dhcal_plot_data *d)
 {
     const size_t nc = d->n_candidates;
     size_t label_chars = 10U;
     for (size_t i = 0U; i < nc; ++i) {
-        const size_t c = text_chars(d->candidates[i].label, label_len(&d->candidates[i]));
+        const size_t c = dhcal_svg_text_chars(d->candidates[i].label, label_len(&d->candidates[i]));
         label_chars = c > label_chars ? c : label_chars;
     }
-    const double label_w = text_w(label_chars, 12.0) + 14.0;
+    const double label_w = dhcal_svg_text_width(label_chars, 12.0) + 14.0;
     const double row_h = 24.0;
-    axis categories = make_axis(0.0, 1.0, 1.0, 0);
+    dhcal_svg_axis categories = dhcal_svg_make_axis(0.0, 1.0, 1.0, 0);
     categories.n_ticks = 0U; /* the y axis holds names, not numbers: no ticks */
-    const frame f = {20.0 + label_w, 72.0, 480.0, row_h * (double)(nc > 0U ? nc : 1U),
-                     make_axis(0.0, 100.0, 5.0, 0), categories};
+    const dhcal_svg_frame f = {20.0 + label_w, 72.0, 480.0, row_h * (double)(nc > 0U ? nc : 1U),
+                               dhcal_svg_make_axis(0.0, 100.0, 5.0, 0), categories};
     const double width = f.x + f.w + 170.0;
     const double height = f.y + f.h + 48.0;
 
-    svgbuf t = {NULL, 0U, 0U, 0};
+    dhcal_text t = {NULL, 0U, 0U, 0};
     title_text(&t, "Candidate effects: ", d);
-    doc_begin(b, width, height, t.failed ? "" : t.p, t.failed ? 0U : t.len);
+    dhcal_svg_begin(b, width, height, t.failed ? "" : t.p, t.failed ? 0U : t.len);
     b->failed |= t.failed;
     free(t.p);
-    const double lx = legend_item(b, 20.0, 52.0, COLOR_SIGNIFICANT, 0, "significant", SIZE_MAX);
-    (void)legend_item(b, lx, 52.0, COLOR_OTHER, 0, "not significant", SIZE_MAX);
+    const double lx = dhcal_svg_legend_item(b, 20.0, 52.0, DHCAL_COLOR_SIGNIFICANT, 0,
+                                            "significant", SIZE_MAX);
+    (void)dhcal_svg_legend_item(b, lx, 52.0, DHCAL_COLOR_OTHER, 0, "not significant", SIZE_MAX);
 
-    draw_frame(b, &f, 1);
+    dhcal_svg_draw_frame(b, &f, 1);
     for (size_t i = 0U; i < nc; ++i) {
         const dhcal_plot_candidate *const c = &d->candidates[i];
         const double share = fmin(1.0, fmax(0.0, c->explained));
         const double y = f.y + row_h * (double)i;
-        const char *const color = c->significant ? COLOR_SIGNIFICANT : COLOR_OTHER;
-        text_el(b, f.x - 8.0, y + 16.0, "font-size=\"12\" text-anchor=\"end\" fill=\"" COLOR_TEXT "\"",
-                c->label, label_len(c), SIZE_MAX);
-        sb_printf(b, "<rect class=\"bar\" x=\"%.6g\" y=\"%.6g\" width=\"%.6g\" height=\"16\" "
-                     "fill=\"%s\"/>\n",
-                  fin(f.x), fin(y + 4.0), fin(share * f.w), color);
+        const char *const color = c->significant ? DHCAL_COLOR_SIGNIFICANT : DHCAL_COLOR_OTHER;
+        dhcal_svg_text_el(b, f.x - 8.0, y + 16.0,
+                          "font-size=\"12\" text-anchor=\"end\" fill=\"" DHCAL_COLOR_TEXT "\"",
+                          c->label, label_len(c), SIZE_MAX);
+        dhcal_text_printf(b,
+                          "<rect class=\"bar\" x=\"%.6g\" y=\"%.6g\" width=\"%.6g\" "
+                          "height=\"16\" fill=\"%s\"/>\n",
+                          dhcal_svg_num(f.x), dhcal_svg_num(y + 4.0), dhcal_svg_num(share * f.w),
+                          color);
         char pct[80];
-        (void)snprintf(pct, sizeof pct, "%.1f %%%s", fin(100.0 * c->explained),
+        (void)snprintf(pct, sizeof pct, "%.1f %%%s", dhcal_svg_num(100.0 * c->explained),
                        c->significant ? " significant" : "");
-        text_str(b, f.x + share * f.w + 6.0, y + 16.0,
-                 c->significant ? "font-size=\"12\" font-weight=\"bold\" fill=\"" COLOR_SIGNIFICANT
-                                  "\""
-                                : "font-size=\"12\" fill=\"" COLOR_MUTED "\"",
-                 pct);
+        dhcal_svg_text(b, f.x + share * f.w + 6.0, y + 16.0,
+                       c->significant ? "font-size=\"12\" font-weight=\"bold\" "
+                                        "fill=\"" DHCAL_COLOR_SIGNIFICANT "\""
+                                      : "font-size=\"12\" fill=\"" DHCAL_COLOR_MUTED "\"",
+                       pct);
     }
     if (nc == 0U) {
-        no_data_note(b, &f, "no candidates");
+        dhcal_svg_note(b, &f, "no candidates");
     }
-    text_str(b, f.x + 0.5 * f.w, f.y + f.h + 33.0,
-             "font-size=\"12\" text-anchor=\"middle\" fill=\"" COLOR_TEXT "\"",
-             "share of the residual explained [%]");
-    doc_end(b);
+    dhcal_svg_text(b, f.x + 0.5 * f.w, f.y + f.h + 33.0,
+                   "font-size=\"12\" text-anchor=\"middle\" fill=\"" DHCAL_COLOR_TEXT "\"",
+                   "share of the residual explained [%]");
+    dhcal_svg_end(b);
 }
 
 /* ------------------------------------------------------------------ checks */
@@ -1089,11 +629,11 @@ static int check_values(const double *v, size_t n, size_t cols, const char *name
             (void)snprintf(where, sizeof where, "%s[%zu]", name, i);
         }
         if (!isfinite(v[i])) {
-            return set_error(err, DHCAL_IO_BAD_INPUT, "plot: %s is %s, not a finite number", where,
-                             isnan(v[i]) ? "NaN" : "infinite");
+            return dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "plot: %s is %s, not a finite number",
+                                   where, isnan(v[i]) ? "NaN" : "infinite");
         }
-        return set_error(err, DHCAL_IO_BAD_INPUT, "plot: %s = %g %s is beyond +-%g", where, v[i],
-                         unit, PLOT_MAX_ABS);
+        return dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "plot: %s = %g %s is beyond +-%g", where,
+                               v[i], unit, PLOT_MAX_ABS);
     }
     return DHCAL_IO_OK;
 }
@@ -1101,20 +641,20 @@ static int check_values(const double *v, size_t n, size_t cols, const char *name
 static int check_data(const dhcal_plot_data *d, dhcal_error *err)
 {
     if (d->title == NULL || d->effect == NULL || (d->n_candidates > 0U && d->candidates == NULL)) {
-        return set_error(err, DHCAL_IO_FAILED, "plot: title, effect or candidates missing");
+        return dhcal_error_set(err, DHCAL_IO_FAILED, "plot: title, effect or candidates missing");
     }
     if (d->n_joints < 1U || d->n_joints > DHC_MAX_JOINTS) {
-        return set_error(err, DHCAL_IO_FAILED, "plot: %zu joints (1..%u)", d->n_joints,
-                         (unsigned)DHC_MAX_JOINTS);
+        return dhcal_error_set(err, DHCAL_IO_FAILED, "plot: %zu joints (1..%u)", d->n_joints,
+                               (unsigned)DHC_MAX_JOINTS);
     }
     const size_t n = d->n_rows;
     if (n > SIZE_MAX / 64U / DHC_MAX_JOINTS) {
-        return set_error(err, DHCAL_IO_FAILED, "plot: %zu rows: too many", n);
+        return dhcal_error_set(err, DHCAL_IO_FAILED, "plot: %zu rows: too many", n);
     }
     if (n > 0U && (d->q_deg == NULL || d->resid_before == NULL || d->resid_after == NULL ||
                    d->err_before == NULL || d->err_after == NULL || d->joint_err_deg == NULL ||
                    d->moment_mm == NULL || d->dir == NULL)) {
-        return set_error(err, DHCAL_IO_FAILED, "plot: data arrays missing");
+        return dhcal_error_set(err, DHCAL_IO_FAILED, "plot: data arrays missing");
     }
     int rc = DHCAL_IO_OK;
     if (n > 0U) {
@@ -1132,8 +672,9 @@ static int check_data(const dhcal_plot_data *d, dhcal_error *err)
                                               err);
         for (size_t i = 0U; rc == DHCAL_IO_OK && i < nq; ++i) {
             if (d->dir[i] < -1 || d->dir[i] > 1) {
-                rc = set_error(err, DHCAL_IO_BAD_INPUT, "plot: dir[%zu][%zu] = %d, not -1, 0 or +1",
-                               i / d->n_joints, i % d->n_joints, (int)d->dir[i]);
+                rc = dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
+                                     "plot: dir[%zu][%zu] = %d, not -1, 0 or +1", i / d->n_joints,
+                                     i % d->n_joints, (int)d->dir[i]);
             }
         }
     }
@@ -1141,8 +682,8 @@ static int check_data(const dhcal_plot_data *d, dhcal_error *err)
     rc = rc != DHCAL_IO_OK ? rc : check_values(&d->rms_after_mm, 1U, 0U, "rms_after_mm", "mm", err);
     for (size_t i = 0U; rc == DHCAL_IO_OK && i < d->n_candidates; ++i) {
         if (!isfinite(d->candidates[i].explained)) {
-            rc = set_error(err, DHCAL_IO_BAD_INPUT,
-                           "plot: candidates[%zu].explained is not a finite number", i);
+            rc = dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
+                                 "plot: candidates[%zu].explained is not a finite number", i);
         }
     }
     return rc;
@@ -1156,13 +697,14 @@ static int make_dir(const char *dir, dhcal_error *err)
     struct stat st;
     if (stat(dir, &st) == 0) {
         return S_ISDIR(st.st_mode) ? DHCAL_IO_OK
-                                   : set_error(err, DHCAL_IO_FAILED,
-                                               "%s: exists and is not a directory", dir);
+                                   : dhcal_error_set(err, DHCAL_IO_FAILED,
+                                                     "%s: exists and is not a directory", dir);
     }
     const size_t len = strlen(dir);
     char *const p = malloc(len + 1U);
     if (p == NULL) {
-        return set_error(err, DHCAL_IO_FAILED, "%s: cannot create directory: out of memory", dir);
+        return dhcal_error_set(err, DHCAL_IO_FAILED, "%s: cannot create directory: out of memory",
+                               dir);
     }
     memcpy(p, dir, len + 1U);
     int rc = DHCAL_IO_OK;
@@ -1173,27 +715,28 @@ static int make_dir(const char *dir, dhcal_error *err)
         const char c = p[i];
         p[i] = '\0';
         if (mkdir(p, 0777) != 0 && errno != EEXIST) {
-            rc = set_error(err, DHCAL_IO_FAILED, "%s: cannot create directory '%s': %s", dir, p,
-                           strerror(errno));
+            rc = dhcal_error_set(err, DHCAL_IO_FAILED, "%s: cannot create directory '%s': %s", dir,
+                                 p, strerror(errno));
         }
         p[i] = c;
     }
     free(p);
     if (rc == DHCAL_IO_OK && (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))) {
-        rc = set_error(err, DHCAL_IO_FAILED, "%s: exists and is not a directory", dir);
+        rc = dhcal_error_set(err, DHCAL_IO_FAILED, "%s: exists and is not a directory", dir);
     }
     return rc;
 }
 
 /* dir/name := b, atomically (dhcal_file.h). */
-static int write_file(const char *dir, const char *name, const svgbuf *b, dhcal_error *err)
+static int write_file(const char *dir, const char *name, const dhcal_text *b, dhcal_error *err)
 {
     const size_t dlen = strlen(dir);
     const int slash = dlen > 0U && dir[dlen - 1U] == '/';
     const size_t cap = dlen + strlen(name) + 2U;
     char *const path = malloc(cap);
     if (path == NULL) {
-        return set_error(err, DHCAL_IO_FAILED, "%s/%s: not written: out of memory", dir, name);
+        return dhcal_error_set(err, DHCAL_IO_FAILED, "%s/%s: not written: out of memory", dir,
+                               name);
     }
     (void)snprintf(path, cap, "%s%s%s", dir, slash ? "" : "/", name);
     const int rc = dhcal_file_write_atomic(path, b->p, b->len, err);
@@ -1207,10 +750,10 @@ int dhcal_plot_write(const char *dir, const dhcal_plot_data *d, dhcal_error *err
         err->msg[0] = '\0';
     }
     if (dir == NULL || d == NULL) {
-        return set_error(err, DHCAL_IO_FAILED, "plot: no directory or no data");
+        return dhcal_error_set(err, DHCAL_IO_FAILED, "plot: no directory or no data");
     }
     if (dir[0] == '\0') {
-        return set_error(err, DHCAL_IO_FAILED, "plot: empty directory name");
+        return dhcal_error_set(err, DHCAL_IO_FAILED, "plot: empty directory name");
     }
     int rc = check_data(d, err);
     if (rc != DHCAL_IO_OK) {
@@ -1218,7 +761,7 @@ int dhcal_plot_write(const char *dir, const dhcal_plot_data *d, dhcal_error *err
     }
     static const char *const names[PLOT_DOCS] = {"residuals.svg", "joints.svg", "errors.svg",
                                               "candidates.svg"};
-    svgbuf doc[PLOT_DOCS] = {{NULL, 0U, 0U, 0}, {NULL, 0U, 0U, 0}, {NULL, 0U, 0U, 0},
+    dhcal_text doc[PLOT_DOCS] = {{NULL, 0U, 0U, 0}, {NULL, 0U, 0U, 0}, {NULL, 0U, 0U, 0},
                           {NULL, 0U, 0U, 0}};
     residuals_svg(&doc[0], d);
     joints_svg(&doc[1], d);
@@ -1226,8 +769,8 @@ int dhcal_plot_write(const char *dir, const dhcal_plot_data *d, dhcal_error *err
     candidates_svg(&doc[3], d);
     for (size_t k = 0U; k < PLOT_DOCS && rc == DHCAL_IO_OK; ++k) {
         if (doc[k].failed) {
-            rc = set_error(err, DHCAL_IO_FAILED, "%s/%s: not written: out of memory", dir,
-                           names[k]);
+            rc = dhcal_error_set(err, DHCAL_IO_FAILED, "%s/%s: not written: out of memory", dir,
+                                 names[k]);
         }
     }
     rc = rc != DHCAL_IO_OK ? rc : make_dir(dir, err);

@@ -35,18 +35,16 @@ typedef struct {
     int cv; /* fit: report the cross-validated RMS too */
 } options;
 
-static const char *const common_help =
+static const char *const model_data_help =
     "  --model M.json     nominal model (docs/formats.md, section 2)\n"
     "  --data D.csv       measurements: q1..qN in deg; x,y,z in mm or raw wire lengths\n"
     "                     L1,L2,L3 (fitted in wire-length space when the model has a\n"
     "                     measurer); optional dir1..dirN, temp_c, t_s, qw,qx,qy,qz\n"
     "  --effects LIST     effects to fit besides joint offsets and link geometry, comma\n"
-    "                     separated: base_frame, tool_offset, joint_scale:i,\n"
-    "                     joint_harmonic:i, joint_harmonic2:i .. joint_harmonic4:i,\n"
-    "                     joint_backlash:i, joint_compliance:i, measurer_scale,\n"
-    "                     measurer_offset, measurer_anchors, thermal_scale, drift_scale,\n"
-    "                     drift_offset (drift over the session: time from t_s, else the\n"
-    "                     row number)\n"
+    "                     separated (i: a joint number; drift: time from t_s, else the\n"
+    "                     row number):\n";
+
+static const char *const common_help =
     "  --heldout H.csv    rows not used in the fit; their RMS error is reported\n"
     "  --noise J,M        the samples' noise: each joint angle's sd J (deg) and each\n"
     "                     measured coordinate's sd M (mm); every row is then weighted by\n"
@@ -66,6 +64,27 @@ static const char *const usage_text =
     "  plot       residual and error plots (SVG) of a fit and its diagnosis\n"
     "'dhcal <command> --help' describes each; 'dhcal --version' prints the version.\n"
     "exit codes: 0 success, 1 computation failed, 2 bad input or usage\n";
+
+/* The catalogue's names, wrapped under the option's description. */
+static void print_effect_names(void)
+{
+    enum { INDENT = 21, WIDTH = 88 };
+    size_t column = INDENT;
+    printf("%*s", INDENT, "");
+    for (size_t i = 0U; i < (size_t)DHC_EFFECT_COUNT; ++i) {
+        const dhc_effect_info *fx = dhc_effect_at(i);
+        const size_t len = strlen(fx->name) + (fx->per_joint ? 2U : 0U) + 2U; /* ", " */
+        if (i > 0U && column + len > WIDTH) {
+            printf(",\n%*s", INDENT, "");
+            column = INDENT;
+        } else if (i > 0U) {
+            fputs(", ", stdout);
+        }
+        printf("%s%s", fx->name, fx->per_joint ? ":i" : "");
+        column += len;
+    }
+    putchar('\n');
+}
 
 static void print_command_help(const char *command)
 {
@@ -110,7 +129,9 @@ static void print_command_help(const char *command)
         fputs(usage_text, stdout);
         return;
     }
-    printf("options:\n%s", common_help);
+    printf("options:\n%s", model_data_help);
+    print_effect_names();
+    fputs(common_help, stdout);
     if (strcmp(command, "plot") == 0) {
         printf("  --out DIR          directory for the SVG files (created if missing)\n");
     }
@@ -840,7 +861,7 @@ static void text_diagnosis(const dhcal_fit *fit, const dhc_diagnosis *d, const c
     } else {
         dhcal_effect_label(top->effect, top->joint, label, sizeof label);
         printf("found %s: add '%s' (explains %.0f%% of the residual, significant)\n",
-               dhcal_effect_signature(top->effect), label, 100.0 * top->explained);
+               dhc_effect_info_of(top->effect)->summary, label, 100.0 * top->explained);
         if (top->lookalike < d->count) {
             char other[64];
             const dhc_candidate_result *l = &d->c[top->lookalike];

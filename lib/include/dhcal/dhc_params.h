@@ -1,8 +1,8 @@
 /* dhc_params.h - the identification parameter vector: which model quantities a fit adjusts.
  *
  * A parameter set is an ordered list of (kind, joint, aux) triples; the fit's Jacobian has
- * one column per entry, in that order. Parameters are grouped into the effects of
- * docs/effects.md, section 3 ("joint_compliance:2" adds c_2j for every j >= 2, ...).
+ * one column per entry, in that order. Parameters are grouped into the effects of the
+ * catalogue (dhc_effects.h: "joint_compliance:2" adds c_2j for every j >= 2, ...).
  * The base frame is perturbed about its own origin with world-frame axes.
  * Units of parameter values: mm for lengths, rad for angles, 1 for scales, rad/mm for
  * compliances, 1/K for thermal expansion.
@@ -14,6 +14,7 @@
 #include <stdint.h>
 
 #include "dhc_config.h"
+#include "dhc_effects.h"
 #include "dhc_model.h"
 #include "dhc_status.h"
 
@@ -50,26 +51,6 @@ typedef enum {
     DHC_P_KIND_COUNT
 } dhc_param_kind;
 
-/* The effects of docs/effects.md, section 3, that a fit can add to the base model. */
-typedef enum {
-    DHC_EFFECT_BASE_FRAME = 0,
-    DHC_EFFECT_TOOL_OFFSET,
-    DHC_EFFECT_JOINT_SCALE,
-    DHC_EFFECT_JOINT_HARMONIC,
-    DHC_EFFECT_JOINT_BACKLASH,
-    DHC_EFFECT_JOINT_COMPLIANCE,
-    DHC_EFFECT_MEASURER_SCALE,
-    DHC_EFFECT_MEASURER_OFFSET,
-    DHC_EFFECT_MEASURER_ANCHORS,
-    DHC_EFFECT_THERMAL_SCALE,
-    DHC_EFFECT_JOINT_HARMONIC2, /* orders 2..4 of joint_harmonic, in order */
-    DHC_EFFECT_JOINT_HARMONIC3,
-    DHC_EFFECT_JOINT_HARMONIC4,
-    DHC_EFFECT_DRIFT_SCALE,
-    DHC_EFFECT_DRIFT_OFFSET,
-    DHC_EFFECT_COUNT
-} dhc_effect;
-
 typedef struct {
     uint8_t kind;  /* dhc_param_kind */
     uint8_t joint; /* 0-based joint index for per-joint kinds, 0 otherwise */
@@ -99,19 +80,17 @@ dhc_status dhc_params_base_model(dhc_param_set *set, const dhc_model *model);
 dhc_status dhc_params_add_effect(dhc_param_set *set, const dhc_model *model, dhc_effect effect,
                                  size_t joint);
 
-/* "joint_compliance" etc. (the names of docs/effects.md); NULL for an unknown value. */
-const char *dhc_effect_name(dhc_effect effect);
-/* 1 when the effect is written "name:i" (per joint). */
-int dhc_effect_is_per_joint(dhc_effect effect);
-/* Parses "name" or "name:i" (i 1-based) of length len. DHC_ERR_ARGUMENT for an unknown
- * name, a missing or extra ":i", or i outside 1..n_joints. joint is 0-based. */
-dhc_status dhc_effect_parse(const char *text, size_t len, size_t n_joints, dhc_effect *effect,
-                            size_t *joint);
 /* The effect a parameter belongs to; base-model kinds (theta..beta) give DHC_EFFECT_COUNT. */
 dhc_effect dhc_params_effect_of(const dhc_param_id *id);
 
 /* Current value of parameter k (base-frame rotations read 0: they are perturbations). */
 double dhc_params_value(const dhc_param_set *set, const dhc_model *model, size_t k);
+
+/* Sets parameter k to value. DHC_ERR_ARGUMENT for a base-frame rotation (a perturbation,
+ * not a quantity of the model) or k outside the set; DHC_ERR_NONFINITE for a non-finite
+ * value (model untouched then). */
+dhc_status dhc_params_set_value(const dhc_param_set *set, dhc_model *model, size_t k,
+                                double value);
 
 /* Adds delta[k] to every parameter of the set in the model. Base-frame rotations compose
  * exactly (Rodrigues) about the base origin. DHC_ERR_DIMENSION when len != set->count,
@@ -129,6 +108,9 @@ size_t dhc_params_name(const dhc_param_set *set, size_t k, char *buf, size_t cap
 /* 1 when the parameter is an angle (front ends show degrees), 0 otherwise. */
 int dhc_params_is_angle(const dhc_param_set *set, size_t k);
 
+/* 1 when reports and model files give the parameter in degrees: the angles, and compliances
+ * (degrees per mm of moment arm); 0 for the others (mm, 1, 1/K, 1/s, mm/s). */
+int dhc_params_in_degrees(const dhc_param_set *set, size_t k);
 #ifdef __cplusplus
 }
 #endif
