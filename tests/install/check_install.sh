@@ -23,7 +23,8 @@ for h in "$prefix"/include/dhcal/*.h; do
   grep -q "#include \"$name\"" "$prefix/include/dhcal/dhcal.h" ||
     { echo "FAIL: dhcal.h does not include $name"; exit 1; }
   case $name in dhc_config.h | dhc_version.h) continue ;; esac
-  grep -q ';' "$h" || continue # includes and macros only
+  # no function declared (a line opening with a return type and a name): includes, macros
+  grep -qE '^[A-Za-z_][A-Za-z_0-9 *]* \**[a-z_0-9]+\(' "$h" || continue
   grep -q 'extern "C"' "$h" || { echo "FAIL: $name has no extern \"C\" block"; exit 1; }
 done
 lib=$(find "$prefix" -name libdhcal.a | head -1)
