@@ -18,6 +18,7 @@
 
 #include "dhcal/dhc_params.h"
 #include "dhcal_fw/fw_acquire.h"
+#include "dhcal_fw/fw_job.h"
 #include "dhcal_fw/fw_can.h"
 #include "dhcal_fw/fw_can_link.h"
 #include "dhcal_fw/fw_can_offset.h"
@@ -354,13 +355,8 @@ static fw_can_offset id_offset_wrap;
 static fw_linux_nv nv_file;
 static fw_port port;
 static fw_io_config io;
-static fw_ctrl ctrl;
-static fw_pose plan[FW_ACQ_MAX_SAMPLES];
-static dhc_sample samples[FW_ACQ_MAX_SAMPLES];
+static fw_job job;
 static dhc_model nominal;
-static dhc_model final_model;
-static dhc_model geometric;
-static fw_autocal_result res;
 
 static int open_linux_port(const options *o)
 {
@@ -429,36 +425,33 @@ static void print_result(const options *o, fw_fault fault, size_t n_done, int ca
     const int is_linux = strcmp(o->port, "linux") == 0;
     printf("{\"mode\": \"calibrate\", \"port\": \"%s\", \"fault\": \"%s\", \"fault_index\": %zu, "
            "\"ticks\": %llu, \"samples\": %zu",
-           o->port, fw_fault_name(fault), fault != FW_FAULT_NONE ? ctrl.fault_index : 0U,
-           (unsigned long long)ctrl.ticks, n_done);
+           o->port, fw_fault_name(fault), fault != FW_FAULT_NONE ? job.ctrl.fault_index : 0U,
+           (unsigned long long)job.ctrl.ticks, n_done);
     if (fault != FW_FAULT_NONE) {
         /* What the controller last commanded: 0 V once the fault latched. */
-        printf(", \"drive_v_after_fault\": [%.6f, %.6f, %.6f]", ctrl.u_v[0], ctrl.u_v[1],
-               ctrl.u_v[2]);
+        printf(", \"drive_v_after_fault\": [%.6f, %.6f, %.6f]", job.ctrl.u_v[0],
+               job.ctrl.u_v[1], job.ctrl.u_v[2]);
     }
     if (calibrated) {
         char effect[64];
-        if (!res.found) {
+        if (!job.result.found) {
             snprintf(effect, sizeof effect, "none");
-        } else if (dhc_effect_is_per_joint(res.effect)) {
-            snprintf(effect, sizeof effect, "%s:%zu", dhc_effect_name(res.effect),
-                     res.effect_joint + 1U);
+        } else if (dhc_effect_is_per_joint(job.result.effect)) {
+            snprintf(effect, sizeof effect, "%s:%zu", dhc_effect_name(job.result.effect),
+                     job.result.effect_joint + 1U);
         } else {
-            snprintf(effect, sizeof effect, "%s", dhc_effect_name(res.effect));
+            snprintf(effect, sizeof effect, "%s", dhc_effect_name(job.result.effect));
         }
         printf(", \"effect\": \"%s\", \"geometric_rms_mm\": %.9f, \"wire_rms_mm\": %.9f, "
                "\"saved\": %d, \"seq\": %u, \"params\": {",
-               effect, res.geo.rms_mm, res.new_rms_mm, res.saved, (unsigned)res.seq);
+               effect, job.result.geo.rms_mm, job.result.new_rms_mm, job.result.saved, (unsigned)job.result.seq);
         dhc_param_set set;
-        (void)dhc_params_base_model(&set, &final_model);
-        if (res.found) {
-            (void)dhc_params_add_effect(&set, &final_model, res.effect, res.effect_joint);
-        }
+        (void)fw_job_param_set(&job, &set);
         FILE *pf = o->params_out != NULL ? fopen(o->params_out, "w") : NULL;
         for (size_t k = 0U; k < set.count; ++k) {
             char name[64];
             (void)dhc_params_name(&set, k, name, sizeof name);
-            const double v = dhc_params_value(&set, &final_model, k);
+            const double v = dhc_params_value(&set, &job.calibrated, k);
             printf("%s\"%s\": %.17g", k > 0U ? ", " : "", name, v);
             if (pf != NULL) {
                 fprintf(pf, "%s %.17g\n", name, v);
@@ -521,20 +514,12 @@ static int run_calibration(const options *o)
         fw_linux_can_close(&can_bus);
         return rc;
     }
-    fw_ctrl_config cfg;
-    fw_ctrl_default_config(&cfg, 3U);
-    fw_ctrl_config_limits(&cfg, &nominal.arm);
-    dhc_sample s0;
-    memset(&s0, 0, sizeof s0);
-    s0.kind = (uint8_t)DHC_MEAS_WIRES;
-    memcpy(s0.q_rad, q_start, sizeof q_start);
-    s0.dir[0] = s0.dir[1] = s0.dir[2] = 1;
-    s0.temp_c = nominal.thermal_ref_c;
-    dhc_prediction pr;
-    if (dhc_model_predict(&nominal, &s0, &pr) != DHC_OK) {
-        fprintf(stderr, "dhcal-fw: the nominal model cannot predict the start pose\n");
-        return EXIT_FAULT;
-    }
+    fw_job_config jc;
+    fw_job_default_config(&jc, &nominal);
+    memcpy(jc.q_start_rad, q_start, sizeof q_start);
+    jc.n_samples = (size_t)o->samples;
+    jc.plan_seed = (uint32_t)o->plan_seed;
+    jc.hold_ticks = (uint32_t)o->hold_ticks;
     fw_fault fault = FW_FAULT_NONE;
     if (strcmp(o->port, "linux") == 0) {
         /* The drives may come up after us: repeat SYNC 0 until they answer. */
@@ -549,24 +534,13 @@ static int run_calibration(const options *o)
         }
     }
     if (fault == FW_FAULT_NONE) {
-        fault = fw_ctrl_init(&ctrl, &port, &io, &cfg, q_start, pr.wire_mm);
+        fault = fw_job_run(&job, &jc, &nominal, &port, &io, &port.nv);
     }
-    size_t n_done = 0U;
-    if (fault == FW_FAULT_NONE) {
-        const size_t n_plan = fw_plan_poses(&nominal, (size_t)o->samples,
-                                            (uint32_t)o->plan_seed, 0, plan);
-        fault = fw_acquire(&ctrl, &nominal, plan, n_plan, (uint32_t)o->hold_ticks, samples,
-                           &n_done);
-    }
-    int calibrated = 0;
-    if (fault == FW_FAULT_NONE) {
-        final_model = nominal;
-        fault = fw_autocal(&final_model, samples, n_done, &port.nv, &geometric, &res);
-        calibrated = fault == FW_FAULT_NONE || fault == FW_FAULT_STORAGE;
-    }
+    const size_t n_done = job.n_samples;
+    const int calibrated = job.calibrated_ok;
     if (fault != FW_FAULT_NONE) {
         fprintf(stderr, "dhcal-fw: fault %s (index %zu) after %zu samples\n",
-                fw_fault_name(fault), ctrl.fault_index, n_done);
+                fw_fault_name(fault), job.ctrl.fault_index, n_done);
     }
     print_result(o, fault, n_done, calibrated, &t0);
     fw_linux_nv_close(&nv_file);

@@ -20,10 +20,10 @@
 #include <string.h>
 
 #include "dhcal/dhc_params.h"
-#include "dhcal_fw/fw_acquire.h"
 #include "dhcal_fw/fw_calstore.h"
 #include "dhcal_fw/fw_controller.h"
 #include "dhcal_fw/fw_ik.h"
+#include "dhcal_fw/fw_job.h"
 #include "dhcal_io.h"
 #include "dhcal_model_map.h"
 #include "dhcal_sim/dhs_scenario_json.h"
@@ -35,12 +35,9 @@ static dhs_scenario_file sf;
 static fw_sim sim;
 static fw_port port;
 static fw_io_config io;
-static fw_ctrl ctrl;
-static dhc_sample samples[FW_ACQ_MAX_SAMPLES];
-static fw_pose plan[FW_ACQ_MAX_SAMPLES];
+static fw_job job;
 static fw_pose targets_pose[MAX_TARGETS];
 static dhc_model nominal;
-static dhc_model geometric;
 static dhc_model final_model;
 
 typedef struct {
@@ -85,10 +82,10 @@ static int run_targets(const dhc_model *model, size_t n, uint32_t seed, phase_re
             ++r->failed;
             continue;
         }
-        if (fw_ctrl_move_to(&ctrl, q, NULL) != FW_FAULT_NONE ||
-            fw_ctrl_hold(&ctrl, 100U, NULL) != FW_FAULT_NONE) {
-            fprintf(stderr, "dhcal-demo: fault %s (index %zu)\n", fw_fault_name(ctrl.fault),
-                    ctrl.fault_index);
+        if (fw_ctrl_move_to(&job.ctrl, q, NULL) != FW_FAULT_NONE ||
+            fw_ctrl_hold(&job.ctrl, 100U, NULL) != FW_FAULT_NONE) {
+            fprintf(stderr, "dhcal-demo: fault %s (index %zu)\n",
+                    fw_fault_name(job.ctrl.fault), job.ctrl.fault_index);
             return -1;
         }
         dhs_plant_truth t;
@@ -222,7 +219,7 @@ static double noise_floor(const dhc_model *m, const dhc_param_set *set, const ui
         }
         for (size_t k = 0U; k < p; ++k) {
             double d[3] = {0.0, 0.0, 0.0};
-            if (use[k] && sens(m, set, &samples[i], 1, k, d) != 0) {
+            if (use[k] && sens(m, set, &job.samples[i], 1, k, d) != 0) {
                 return (double)NAN;
             }
             for (size_t row = 0U; row < 3U; ++row) {
@@ -231,7 +228,7 @@ static double noise_floor(const dhc_model *m, const dhc_param_set *set, const ui
         }
         /* the fit's weighting (nothing when its noise model was off) */
         double dummy_r[DHC_MAX_ROWS_PER_SAMPLE] = {0.0};
-        if (dhc_sample_whiten(m, &samples[i], res->joint_noise_rad, res->meas_noise_mm, 1000.0,
+        if (dhc_sample_whiten(m, &job.samples[i], res->joint_noise_rad, res->meas_noise_mm, 1000.0,
                               dummy_r, &rows) != DHC_OK) {
             return (double)NAN;
         }
@@ -307,7 +304,7 @@ static void where_it_fails(const dhc_model *m, size_t n, FILE *log)
     for (size_t i = 0U; i < n; ++i) {
         double r[DHC_MAX_ROWS_PER_SAMPLE];
         size_t rows = 0U;
-        if (dhc_model_residual(m, &samples[i], 1000.0, r, &rows) != DHC_OK) {
+        if (dhc_model_residual(m, &job.samples[i], 1000.0, r, &rows) != DHC_OK) {
             continue;
         }
         double e = 0.0;
@@ -329,7 +326,7 @@ static void where_it_fails(const dhc_model *m, size_t n, FILE *log)
     }
     fprintf(log, "    the geometric model fails most at (q deg -> |wire residual| mm):\n");
     for (size_t k = 0U; k < 3U && wv[k] >= 0.0; ++k) {
-        const dhc_sample *s = &samples[worst[k]];
+        const dhc_sample *s = &job.samples[worst[k]];
         fprintf(log, "      (%7.1f %7.1f %7.1f) -> %.4f\n", s->q_rad[0] * 180.0 / DHC_PI,
                 s->q_rad[1] * 180.0 / DHC_PI, s->q_rad[2] * 180.0 / DHC_PI, wv[k]);
     }
@@ -356,10 +353,10 @@ static int write_outputs(const char *dir, size_t n, const char *effect)
     }
     fprintf(f, "q1,q2,q3,dir1,dir2,dir3,L1,L2,L3\n");
     for (size_t i = 0U; i < n; ++i) {
-        fprintf(f, "%.9f,%.9f,%.9f,%d,%d,%d,%.6f,%.6f,%.6f\n", samples[i].q_rad[0] * 180.0 / DHC_PI,
-                samples[i].q_rad[1] * 180.0 / DHC_PI, samples[i].q_rad[2] * 180.0 / DHC_PI,
-                samples[i].dir[0], samples[i].dir[1], samples[i].dir[2], samples[i].wire_mm[0],
-                samples[i].wire_mm[1], samples[i].wire_mm[2]);
+        fprintf(f, "%.9f,%.9f,%.9f,%d,%d,%d,%.6f,%.6f,%.6f\n", job.samples[i].q_rad[0] * 180.0 / DHC_PI,
+                job.samples[i].q_rad[1] * 180.0 / DHC_PI, job.samples[i].q_rad[2] * 180.0 / DHC_PI,
+                job.samples[i].dir[0], job.samples[i].dir[1], job.samples[i].dir[2], job.samples[i].wire_mm[0],
+                job.samples[i].wire_mm[1], job.samples[i].wire_mm[2]);
     }
     fclose(f);
     snprintf(path, sizeof path, "%s/positioning.csv", dir);
@@ -457,22 +454,20 @@ int main(int argc, char **argv)
         return 1;
     }
     fw_sim_io_config(&sf.sc, &io);
+    fw_job_config jc;
+    fw_job_default_config(&jc, &nominal);
+    memcpy(jc.q_start_rad, q_start, sizeof q_start);
+    jc.n_samples = n_samples;
+    jc.plan_seed = 4242U;
+    jc.mixed_dirs = mixed_dirs;
+    jc.hold_ticks = 200U;
     /* the calibration's noise model: encoder quantisation from the io configuration, the
-     * wires' noise measured over the holds (fw_acquire_wire_noise_mm) */
-    autocal.io = weighted ? &io : NULL;
-    fw_ctrl_config cfg;
-    fw_ctrl_default_config(&cfg, 3U);
-    fw_ctrl_config_limits(&cfg, &nominal.arm);
-    /* wire counters: homed near the lengths the nominal model expects at the start pose */
-    dhc_sample s0;
-    memset(&s0, 0, sizeof s0);
-    memcpy(s0.q_rad, q_start, sizeof q_start);
-    s0.dir[0] = s0.dir[1] = s0.dir[2] = 1;
-    s0.temp_c = nominal.thermal_ref_c;
-    double w0[3];
-    if (prediction(&nominal, &s0, w0, 1) != 0 ||
-        fw_ctrl_init(&ctrl, &port, &io, &cfg, q_start, w0) != FW_FAULT_NONE) {
-        fprintf(stderr, "dhcal-demo: controller init failed: %s\n", fw_fault_name(ctrl.fault));
+     * wires' noise measured over the holds (fw_acq_wire_noise_mm) */
+    jc.noise_model = weighted;
+    jc.autocal = autocal;
+    if (fw_job_boot(&job, &jc, &nominal, &port, &io) != FW_FAULT_NONE) {
+        fprintf(stderr, "dhcal-demo: controller init failed: %s\n",
+                fw_fault_name(job.ctrl.fault));
         return 1;
     }
     FILE *log = json ? stderr : stdout;
@@ -485,64 +480,60 @@ int main(int argc, char **argv)
             ph[0].n, ph[0].rms_mm, ph[0].max_mm);
 
     /* (b) samples */
-    const size_t n_plan = fw_plan_poses(&nominal, n_samples, 4242U, mixed_dirs, plan);
-    dhc_param_set base;
-    (void)dhc_params_base_model(&base, &nominal);
-    double o1 = 0.0;
-    size_t rank = 0U;
-    (void)fw_plan_observability(&nominal, &base, plan, n_plan, &o1, &rank);
-    size_t n_done = 0U;
-    const fw_fault fa = fw_acquire(&ctrl, &nominal, plan, n_plan, 200U, samples, &n_done);
+    fw_fault fa = fw_job_plan(&job);
+    if (fa == FW_FAULT_NONE) {
+        fa = fw_job_acquire(&job);
+    }
+    const size_t n_done = job.n_samples;
+    const double o1 = job.o1;
     fprintf(log, "(b) %zu samples (plan of %zu poses, observability O1 %.4g over %zu of %zu "
-                 "parameters)\n", n_done, n_plan, o1, rank, base.count);
+                 "parameters)\n", n_done, job.n_plan, o1, job.o1_rank, job.o1_params);
     if (fa != FW_FAULT_NONE) {
         fprintf(stderr, "dhcal-demo: fault %s (index %zu) during acquisition\n",
-                fw_fault_name(fa), ctrl.fault_index);
-        for (size_t j = 0U; j < 3U; ++j) {
+                fw_fault_name(fa), job.ctrl.fault_index);
+        for (size_t j = 0U; j < nominal.arm.n_joints; ++j) {
             fprintf(stderr, "  joint %zu: error %.2f counts, velocity %.4f rad/s\n", j + 1U,
-                    (ctrl.q_ref_rad[j] - ctrl.q_rad[j]) * io.counts_per_rad[j],
-                    ctrl.qd_enc_rad_s[j]);
+                    (job.ctrl.q_ref_rad[j] - job.ctrl.q_rad[j]) * io.counts_per_rad[j],
+                    job.ctrl.qd_enc_rad_s[j]);
         }
         return 1;
     }
 
     /* (c)-(e) calibrate, diagnose, refit, store */
-    static fw_autocal_result res;
-    final_model = nominal;
-    const fw_fault fc = fw_autocal_configured(&autocal, &final_model, samples, n_done, &port.nv,
-                                              &geometric, &res);
+    const fw_fault fc = fw_job_calibrate(&job, &port.nv);
     if (fc != FW_FAULT_NONE) {
         fprintf(stderr, "dhcal-demo: calibration fault %s\n", fw_fault_name(fc));
         return 1;
     }
+    const fw_autocal_result *res = &job.result;
     char effect[64];
-    effect_label(&res, effect, sizeof effect);
-    if (res.meas_noise_mm > 0.0) {
+    effect_label(res, effect, sizeof effect);
+    if (res->meas_noise_mm > 0.0) {
         fprintf(log, "    noise model: joint angles %.3g %.3g %.3g urad (1 count / sqrt 12 with the "
                      "holds' dither), wires %.4f mm (measured over the holds)\n",
-                res.joint_noise_rad[0] * 1e6, res.joint_noise_rad[1] * 1e6,
-                res.joint_noise_rad[2] * 1e6, res.meas_noise_mm);
+                res->joint_noise_rad[0] * 1e6, res->joint_noise_rad[1] * 1e6,
+                res->joint_noise_rad[2] * 1e6, res->meas_noise_mm);
     }
     fprintf(log, "(c) geometric fit%s%s: wire residual RMS %.4f mm, max %.4f mm (%zu params, "
                  "rank %zu)\n", effects != NULL ? " with the configured " : "",
-            effects != NULL ? effects : "", res.geo.rms_mm, res.geo.max_mm, res.geo.n_params,
-            res.geo.rank);
-    if (res.meas_noise_mm > 0.0) {
+            effects != NULL ? effects : "", res->geo.rms_mm, res->geo.max_mm, res->geo.n_params,
+            res->geo.rank);
+    if (res->meas_noise_mm > 0.0) {
         fprintf(log, "    whitened residual sd %.3f (1: as the noise model predicts)\n",
-                res.geo.sigma);
+                res->geo.sigma);
     }
     if (autocal.diagnose != 0) {
-        fprintf(log, "(d) diagnosis: %s (log10 p %.1f)\n", effect, res.effect_log10_p);
+        fprintf(log, "(d) diagnosis: %s (log10 p %.1f)\n", effect, res->effect_log10_p);
     } else {
         fprintf(log, "(d) diagnosis: off (--no-diagnose)\n");
     }
     fprintf(log, "(e) with %s: wire residual RMS %.4f mm; stored: %s (seq %u)\n", effect,
-            res.found ? res.eff.rms_mm : res.geo.rms_mm, res.saved ? "yes" : "no",
-            (unsigned)res.seq);
-    where_it_fails(&geometric, n_done, log);
+            res->found ? res->eff.rms_mm : res->geo.rms_mm, res->saved ? "yes" : "no",
+            (unsigned)res->seq);
+    where_it_fails(&job.geometric, n_done, log);
 
     /* geometric model on fresh targets */
-    if (run_targets(&geometric, n_targets, 2002U, &ph[1]) != 0) {
+    if (run_targets(&job.geometric, n_targets, 2002U, &ph[1]) != 0) {
         return 1;
     }
     /* boot path: the controller uses what the store holds */
@@ -555,13 +546,10 @@ int main(int argc, char **argv)
         return 1;
     }
     dhc_param_set fset;
-    (void)dhc_params_base_model(&fset, &final_model);
-    if (res.found) {
-        (void)dhc_params_add_effect(&fset, &final_model, res.effect, res.effect_joint);
-    }
-    const dhc_calib_report *fr = res.found ? &res.eff : &res.geo;
+    (void)fw_job_param_set(&job, &fset);
+    const dhc_calib_report *fr = res->found ? &res->eff : &res->geo;
     const double floor_mm = noise_floor(&final_model, &fset, fr->identifiable, fr->sigma, n_done,
-                                        &ph[2], &res);
+                                        &ph[2], res);
 
     fprintf(log, "\n%-28s %10s %10s\n", "model (fresh targets)", "RMS mm", "max mm");
     char label[96];
@@ -591,10 +579,10 @@ int main(int argc, char **argv)
          * takes at the desk (largest joint sd, in degrees) */
         double joint_sd_deg = 0.0;
         for (size_t j = 0U; j < 3U; ++j) {
-            joint_sd_deg = fmax(joint_sd_deg, res.joint_noise_rad[j] * 180.0 / DHC_PI);
+            joint_sd_deg = fmax(joint_sd_deg, res->joint_noise_rad[j] * 180.0 / DHC_PI);
         }
         printf("\"noise_model\": {\"joint_deg\": %.6g, \"meas_mm\": %.6g}}\n", joint_sd_deg,
-               res.meas_noise_mm);
+               res->meas_noise_mm);
     }
     return 0;
 }
