@@ -13,13 +13,14 @@
  * encoder quantisation and the measured wire noise, fw_autocal_config), the fit is
  * generalized least squares: J^T J becomes J^T W J, each sample's rows whitened like the
  * fit's (dhc_sample_whiten), and s is the fit's unit-free sigma, so C is again the
- * covariance of the parameters the fit identified. */
+ * covariance of the parameters the fit identified. lib computes it (dhc_uncertainty.h). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "dhcal/dhc_params.h"
+#include "dhcal/dhc_uncertainty.h"
 #include "dhcal_fw/fw_calstore.h"
 #include "dhcal_fw/fw_controller.h"
 #include "dhcal_fw/fw_ik.h"
@@ -107,189 +108,41 @@ static int run_targets(const dhc_model *model, size_t n, uint32_t seed, phase_re
 
 /* ---------------------------------------------------------------- noise floor */
 
-static double jw[FW_ACQ_MAX_SAMPLES * 3U][DHC_MAX_PARAMS];
-static double nmat[DHC_MAX_PARAMS][DHC_MAX_PARAMS];
-static double cov[DHC_MAX_PARAMS][DHC_MAX_PARAMS];
-
-static int prediction(const dhc_model *m, const dhc_sample *s, double out[3], int wires)
+static dhc_status read_job_sample(void *ctx, size_t index, dhc_sample *out)
 {
-    dhc_sample t = *s;
-    t.kind = (uint8_t)(wires ? DHC_MEAS_WIRES : DHC_MEAS_POSITION);
-    dhc_prediction pr;
-    if (dhc_model_predict(m, &t, &pr) != DHC_OK) {
-        return -1;
+    const fw_job *j = ctx;
+    if (index >= j->n_samples) {
+        return DHC_ERR_ARGUMENT;
     }
-    memcpy(out, wires ? pr.wire_mm : pr.p_mm, 3U * sizeof(double));
-    return 0;
+    *out = j->samples[index];
+    return DHC_OK;
 }
 
-/* d(out)/d(param k) by central differences, for the parameters flagged in use. */
-static int sens(const dhc_model *m, const dhc_param_set *set, const dhc_sample *s, int wires,
-                size_t k, double d[3])
-{
-    static dhc_model tmp;
-    double delta[DHC_MAX_PARAMS] = {0.0};
-    const double h = dhc_params_is_angle(set, k) ? 1e-6 : 1e-4;
-    double a[3];
-    double b[3];
-    delta[k] = h;
-    tmp = *m;
-    if (dhc_params_apply(set, &tmp, delta, set->count) != DHC_OK || prediction(&tmp, s, a, wires)) {
-        return -1;
-    }
-    delta[k] = -h;
-    tmp = *m;
-    if (dhc_params_apply(set, &tmp, delta, set->count) != DHC_OK || prediction(&tmp, s, b, wires)) {
-        return -1;
-    }
-    for (size_t r = 0U; r < 3U; ++r) {
-        d[r] = (a[r] - b[r]) / (2.0 * h);
-    }
-    return 0;
-}
-
-/* Inverse of the identifiable block of the normal matrix (Gauss-Jordan, scaled). */
-static int invert(size_t p, const uint8_t *use)
-{
-    static double a[DHC_MAX_PARAMS][2U * DHC_MAX_PARAMS];
-    size_t idx[DHC_MAX_PARAMS];
-    size_t q = 0U;
-    for (size_t k = 0U; k < p; ++k) {
-        if (use[k]) {
-            idx[q++] = k;
-        }
-    }
-    double sc[DHC_MAX_PARAMS];
-    for (size_t i = 0U; i < q; ++i) {
-        sc[i] = 1.0 / sqrt(nmat[idx[i]][idx[i]]);
-    }
-    for (size_t i = 0U; i < q; ++i) {
-        for (size_t j = 0U; j < q; ++j) {
-            a[i][j] = nmat[idx[i]][idx[j]] * sc[i] * sc[j];
-            a[i][q + j] = i == j ? 1.0 : 0.0;
-        }
-    }
-    for (size_t c = 0U; c < q; ++c) {
-        size_t piv = c;
-        for (size_t r = c + 1U; r < q; ++r) {
-            if (fabs(a[r][c]) > fabs(a[piv][c])) {
-                piv = r;
-            }
-        }
-        if (!(fabs(a[piv][c]) > 1e-14)) {
-            return -1;
-        }
-        for (size_t j = 0U; j < 2U * q; ++j) {
-            const double t = a[c][j];
-            a[c][j] = a[piv][j];
-            a[piv][j] = t;
-        }
-        const double f = 1.0 / a[c][c];
-        for (size_t j = 0U; j < 2U * q; ++j) {
-            a[c][j] *= f;
-        }
-        for (size_t r = 0U; r < q; ++r) {
-            if (r != c) {
-                const double g = a[r][c];
-                for (size_t j = 0U; j < 2U * q; ++j) {
-                    a[r][j] -= g * a[c][j];
-                }
-            }
-        }
-    }
-    memset(cov, 0, sizeof cov);
-    for (size_t i = 0U; i < q; ++i) {
-        for (size_t j = 0U; j < q; ++j) {
-            cov[idx[i]][idx[j]] = a[i][q + j] * sc[i] * sc[j];
-        }
-    }
-    return 0;
-}
-
-static double noise_floor(const dhc_model *m, const dhc_param_set *set, const uint8_t *use,
-                          double sigma, size_t n, const phase_result *r,
+/* The noise floor (see the top of this file): lib's positioning uncertainty of the final
+ * fit at each target of phase r, with one encoder count per joint (uniform: sd = count /
+ * sqrt(12)) for the servo's resolution. */
+static double noise_floor(const dhc_model *m, const dhc_param_set *set,
+                          const dhc_calib_report *fit, const phase_result *r,
                           const fw_autocal_result *res)
 {
-    const size_t p = set->count;
-    static double rows_buf[3U * DHC_MAX_PARAMS];
-    for (size_t i = 0U; i < n; ++i) {
-        dhc_mat rows;
-        if (dhc_mat_init(&rows, 3U, p, rows_buf, sizeof rows_buf / sizeof rows_buf[0]) != DHC_OK) {
-            return (double)NAN;
-        }
-        for (size_t k = 0U; k < p; ++k) {
-            double d[3] = {0.0, 0.0, 0.0};
-            if (use[k] && sens(m, set, &job.samples[i], 1, k, d) != 0) {
-                return (double)NAN;
-            }
-            for (size_t row = 0U; row < 3U; ++row) {
-                DHC_MAT_AT(&rows, row, k) = d[row];
-            }
-        }
-        /* the fit's weighting (nothing when its noise model was off) */
-        double dummy_r[DHC_MAX_ROWS_PER_SAMPLE] = {0.0};
-        if (dhc_sample_whiten(m, &job.samples[i], res->joint_noise_rad, res->meas_noise_mm, 1000.0,
-                              dummy_r, &rows) != DHC_OK) {
-            return (double)NAN;
-        }
-        for (size_t row = 0U; row < 3U; ++row) {
-            for (size_t k = 0U; k < p; ++k) {
-                jw[3U * i + row][k] = DHC_MAT_AT(&rows, row, k);
-            }
-        }
-    }
-    memset(nmat, 0, sizeof nmat);
-    for (size_t row = 0U; row < 3U * n; ++row) {
-        for (size_t a = 0U; a < p; ++a) {
-            for (size_t b = 0U; b < p; ++b) {
-                nmat[a][b] += jw[row][a] * jw[row][b];
-            }
-        }
-    }
-    if (invert(p, use) != 0) {
+    static dhc_uncertainty unc;
+    if (dhc_uncertainty_from_samples(&unc, m, set, fit->identifiable, read_job_sample, &job,
+                                     job.n_samples, res->joint_noise_rad, res->meas_noise_mm,
+                                     1000.0, fit->sigma) != DHC_OK) {
         return (double)NAN;
+    }
+    double encoder_sd[DHC_MAX_JOINTS] = {0.0};
+    for (size_t j = 0U; j < m->arm.n_joints; ++j) {
+        encoder_sd[j] = 1.0 / (io.counts_per_rad[j] * sqrt(12.0));
     }
     double ss = 0.0;
     for (size_t t = 0U; t < r->n; ++t) {
-        dhc_sample s;
-        memset(&s, 0, sizeof s);
-        s.temp_c = m->thermal_ref_c;
-        memcpy(s.q_rad, r->q[t], sizeof s.q_rad);
-        for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
-            s.dir[j] = 1;
-        }
-        double jp[DHC_MAX_PARAMS][3];
-        for (size_t k = 0U; k < p; ++k) {
-            jp[k][0] = jp[k][1] = jp[k][2] = 0.0;
-            if (use[k] && sens(m, set, &s, 0, k, jp[k]) != 0) {
-                return (double)NAN;
-            }
-        }
         double var = 0.0;
-        for (size_t c = 0U; c < 3U; ++c) {
-            for (size_t a = 0U; a < p; ++a) {
-                for (size_t b = 0U; b < p; ++b) {
-                    var += jp[a][c] * cov[a][b] * jp[b][c];
-                }
-            }
+        if (dhc_uncertainty_tool_point(&unc, m, set, r->q[t], NULL, encoder_sd, &var) !=
+            DHC_OK) {
+            return (double)NAN;
         }
-        /* encoder resolution: one count per joint, uniform (variance 1/12 count^2) */
-        double enc = 0.0;
-        for (size_t j = 0U; j < m->arm.n_joints; ++j) {
-            double qp[DHC_MAX_JOINTS];
-            double pa[3];
-            double pb[3];
-            const double h = 1.0 / io.counts_per_rad[j];
-            memcpy(qp, r->q[t], sizeof qp);
-            qp[j] += 0.5 * h;
-            predict_point(m, qp, pa);
-            qp[j] -= h;
-            predict_point(m, qp, pb);
-            for (size_t c = 0U; c < 3U; ++c) {
-                enc += (pa[c] - pb[c]) * (pa[c] - pb[c]) / 12.0;
-            }
-        }
-        ss += sigma * sigma * var + enc;
+        ss += var;
     }
     return r->n > 0U ? sqrt(ss / (double)r->n) : (double)NAN;
 }
@@ -548,8 +401,7 @@ int main(int argc, char **argv)
     dhc_param_set fset;
     (void)fw_job_param_set(&job, &fset);
     const dhc_calib_report *fr = res->found ? &res->eff : &res->geo;
-    const double floor_mm = noise_floor(&final_model, &fset, fr->identifiable, fr->sigma, n_done,
-                                        &ph[2], res);
+    const double floor_mm = noise_floor(&final_model, &fset, fr, &ph[2], res);
 
     fprintf(log, "\n%-28s %10s %10s\n", "model (fresh targets)", "RMS mm", "max mm");
     char label[96];
