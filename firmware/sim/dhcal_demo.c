@@ -14,6 +14,10 @@
  * generalized least squares: J^T J becomes J^T W J, each sample's rows whitened like the
  * fit's (dhc_sample_whiten), and s is the fit's unit-free sigma, so C is again the
  * covariance of the parameters the fit identified. lib computes it (dhc_uncertainty.h). */
+#ifndef _POSIX_C_SOURCE
+#define _POSIX_C_SOURCE 200809L /* open_memstream */
+#endif
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -25,6 +29,7 @@
 #include "dhcal_fw/fw_controller.h"
 #include "dhcal_fw/fw_ik.h"
 #include "dhcal_fw/fw_job.h"
+#include "dhcal_file.h"
 #include "dhcal_io.h"
 #include "dhcal_model_map.h"
 #include "dhcal_sim/dhs_scenario_json.h"
@@ -196,24 +201,61 @@ static void effect_label(const fw_autocal_result *res, char *buf, size_t cap)
     }
 }
 
+/* path := the text f received (an open_memstream), replaced whole (io's atomic write). */
+static int finish_file(const char *path, FILE *f, char **text, size_t *len)
+{
+    const int bad = ferror(f);
+    if (fclose(f) != 0 || bad || *text == NULL) {
+        free(*text);
+        *text = NULL;
+        fprintf(stderr, "dhcal-demo: %s: out of memory\n", path);
+        return -1;
+    }
+    dhcal_error err;
+    memset(&err, 0, sizeof err);
+    const int rc = dhcal_file_write_atomic(path, *text, *len, &err);
+    free(*text);
+    *text = NULL;
+    if (rc != DHCAL_IO_OK) {
+        fprintf(stderr, "dhcal-demo: %s\n", err.msg);
+        return -1;
+    }
+    return 0;
+}
+
 static int write_outputs(const char *dir, size_t n, const char *effect)
 {
+    const size_t nj = nominal.arm.n_joints;
     char path[4200];
+    char *text = NULL;
+    size_t len = 0U;
     snprintf(path, sizeof path, "%s/samples.csv", dir);
-    FILE *f = fopen(path, "w");
+    FILE *f = open_memstream(&text, &len);
     if (f == NULL) {
         return -1;
     }
-    fprintf(f, "q1,q2,q3,dir1,dir2,dir3,L1,L2,L3\n");
-    for (size_t i = 0U; i < n; ++i) {
-        fprintf(f, "%.9f,%.9f,%.9f,%d,%d,%d,%.6f,%.6f,%.6f\n", job.samples[i].q_rad[0] * 180.0 / DHC_PI,
-                job.samples[i].q_rad[1] * 180.0 / DHC_PI, job.samples[i].q_rad[2] * 180.0 / DHC_PI,
-                job.samples[i].dir[0], job.samples[i].dir[1], job.samples[i].dir[2], job.samples[i].wire_mm[0],
-                job.samples[i].wire_mm[1], job.samples[i].wire_mm[2]);
+    for (size_t j = 0U; j < nj; ++j) {
+        fprintf(f, "q%zu,", j + 1U);
     }
-    fclose(f);
+    for (size_t j = 0U; j < nj; ++j) {
+        fprintf(f, "dir%zu,", j + 1U);
+    }
+    fprintf(f, "L1,L2,L3\n");
+    for (size_t i = 0U; i < n; ++i) {
+        const dhc_sample *s = &job.samples[i];
+        for (size_t j = 0U; j < nj; ++j) {
+            fprintf(f, "%.9f,", s->q_rad[j] * 180.0 / DHC_PI);
+        }
+        for (size_t j = 0U; j < nj; ++j) {
+            fprintf(f, "%d,", s->dir[j]);
+        }
+        fprintf(f, "%.6f,%.6f,%.6f\n", s->wire_mm[0], s->wire_mm[1], s->wire_mm[2]);
+    }
+    if (finish_file(path, f, &text, &len) != 0) {
+        return -1;
+    }
     snprintf(path, sizeof path, "%s/positioning.csv", dir);
-    f = fopen(path, "w");
+    f = open_memstream(&text, &len);
     if (f == NULL) {
         return -1;
     }
@@ -225,8 +267,7 @@ static int write_outputs(const char *dir, size_t n, const char *effect)
                     ph[k].target[i][1], ph[k].target[i][2], ph[k].err[i]);
         }
     }
-    fclose(f);
-    return 0;
+    return finish_file(path, f, &text, &len);
 }
 
 int main(int argc, char **argv)
@@ -273,7 +314,7 @@ int main(int argc, char **argv)
             return 2;
         }
     }
-    /* The configured effects, comma separated, in DESIGN.md's names. */
+    /* The configured effects, comma separated, by their names in docs/effects.md. */
     for (const char *e = effects; e != NULL && *e != '\0';) {
         const char *comma = strchr(e, ',');
         const size_t len = comma != NULL ? (size_t)(comma - e) : strlen(e);
@@ -298,13 +339,14 @@ int main(int argc, char **argv)
     if (dhs_scenario_load(scenario, &sf, &err) != DHCAL_IO_OK ||
         dhcal_model_to_lib(&sf.model, sf.model_path, &nominal, &err) != DHCAL_IO_OK) {
         fprintf(stderr, "dhcal-demo: %s\n", err.msg);
-        return 1;
+        return 2;
     }
     const double q_start[3] = {0.0, 60.0 * DHC_PI / 180.0, -60.0 * DHC_PI / 180.0};
     if (sf.sc.n_joints != 3U || !nominal.measurer.present ||
         fw_sim_init(&sim, &sf.sc, 7U, q_start, &port) != DHC_OK) {
-        fprintf(stderr, "dhcal-demo: the scenario must be a 3-joint arm with a measurer\n");
-        return 1;
+        fprintf(stderr, "dhcal-demo: %s: the scenario must be a 3-joint arm with a measurer\n",
+                scenario);
+        return 2;
     }
     fw_sim_io_config(&sf.sc, &io);
     fw_job_config jc;
@@ -415,7 +457,6 @@ int main(int argc, char **argv)
             ph[2].rms_mm / floor_mm);
     if (out_dir != NULL) {
         if (write_outputs(out_dir, n_done, effect) != 0) {
-            fprintf(stderr, "dhcal-demo: cannot write into %s\n", out_dir);
             return 1;
         }
         fprintf(log, "wrote %s/samples.csv and %s/positioning.csv\n", out_dir, out_dir);

@@ -6,6 +6,8 @@
 
 #include "dhcal_fw/fw_calstore.h"
 
+const dhc_candidate_scope fw_autocal_scope = {1, 0, 0};
+
 typedef struct {
     const dhc_sample *s;
     size_t n;
@@ -170,10 +172,8 @@ fw_fault fw_autocal_configured(const fw_autocal_config *cfg, dhc_model *model,
     if (geo_out != NULL) {
         *geo_out = ws->geo;
     }
-    /* the controller measures wires at one temperature and keeps no time */
-    static const dhc_candidate_scope wires_only = {1, 0, 0};
     const size_t nc = cfg->diagnose != 0
-                          ? dhc_diagnose_candidates(&ws->geo, &set, &wires_only, ws->cands,
+                          ? dhc_diagnose_candidates(&ws->geo, &set, &fw_autocal_scope, ws->cands,
                                                     DHC_MAX_CANDIDATES)
                           : 0U;
     if (nc > 0U &&

@@ -36,6 +36,11 @@
 /* one-sided normal quantile of fw_autocal's "clearly better" test (95 %) */
 #define FW_AUTOCAL_Z 1.645
 
+/* What the controller's samples can show beyond the pose, i.e. the candidates its diagnosis
+ * offers: wires, at one temperature, with no clock (no thermal or drift candidates). Every
+ * effect it can offer is kept by the calibration store (fw_calstore.h). */
+extern const dhc_candidate_scope fw_autocal_scope;
+
 typedef struct {
     dhc_calib_report geo;    /* base model fit */
     int found;               /* the diagnosis named a significant effect */

@@ -103,7 +103,8 @@ typedef struct {
     size_t fault_index;                  /* joint or wire the fault concerns */
 } fw_ctrl;
 
-/* Gains and limits for the paper's drive (PHYSICS.md: 100:1 gear, ~10 Hz position loop). */
+/* Gains and limits for the paper's drive (100:1 gear, ~10 Hz position loop; the plant of
+ * host_sim, docs/architecture.md section 5). */
 void fw_ctrl_default_config(fw_ctrl_config *cfg, size_t n_joints);
 
 /* The joint ranges of the model's arm (each joint's min_rad..max_rad): the controller then
