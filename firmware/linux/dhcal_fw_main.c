@@ -1,7 +1,9 @@
 /* dhcal-fw - the controller's main job on an embedded Linux controller: the calibration run
- * (plan, acquire, calibrate with fw_autocal, store) over the Linux port (drives and measurer
- * on SocketCAN through fw_can_link, storage in a file), or, with --port sim, over the
- * simulation port: the same run, deterministic, so both can be compared number by number.
+ * (fw_job: plan, acquire, calibrate, diagnose, store) over the Linux port (drives and
+ * measurer on SocketCAN through fw_can_link, storage in a file), or, with --port sim, over
+ * the simulation port: the same run, deterministic, so both can be compared number by
+ * number. The controller is configured by a machine file (--machine, docs/formats.md
+ * section 8.1); the sim port's simulated arm comes from a host_sim scenario (--scenario).
  * --gpio-watch checks the GPIO quadrature input of an encoder instead (libgpiod).
  *
  * Exit codes: 0 the run completed, 1 it ended in a fault or failed (the JSON says which),
@@ -23,8 +25,7 @@
 #include "dhcal_fw/fw_can_link.h"
 #include "dhcal_fw/fw_can_offset.h"
 #include "dhcal_fw/fw_controller.h"
-#include "dhcal_io.h"
-#include "dhcal_model_map.h"
+#include "dhcal_machine.h"
 #include "dhcal_sim/dhs_scenario_json.h"
 #include "fw_linux_can.h"
 #include "fw_linux_gpio.h"
@@ -33,7 +34,6 @@
 
 #define EXIT_FAULT 1
 #define EXIT_USAGE 2
-#define FW_PI 3.14159265358979323846
 #define NV_SIZE 8192U
 #define MAX_CONFIG_BYTES 65536U
 
@@ -44,26 +44,28 @@ static const char *const help_text =
     "result; prints one JSON object. Options (each also a 'key = value' line of --config,\n"
     "without the dashes; the command line wins):\n"
     "  --config FILE         key = value lines, '#' comments\n"
+    "  --machine FILE        the machine file: nominal model, joints, encoder and gear\n"
+    "                        scaling, drive limits, CAN, GPIO, store (required for a run)\n"
     "  --port linux|sim      linux (default): drives and measurer over SocketCAN;\n"
     "                        sim: the simulated arm in-process (the reference run)\n"
-    "  --scenario FILE       the machine: its nominal model and the nominal drive and\n"
-    "                        measurer data (gear ratios, encoder lines, converter ranges,\n"
-    "                        wheel); the sim port also builds the simulated arm from it\n"
-    "  --can IFNAME          CAN interface (default vcan0)\n"
+    "  --scenario FILE       sim port: the host_sim scenario of the simulated arm\n"
+    "  --can IFNAME          CAN interface (default: the machine's, else vcan0)\n"
     "  --can-id-offset N     the DBC's identifiers moved by N on the bus, for a bus shared\n"
-    "                        with other devices or arms (0..1535, default 0)\n"
+    "                        with other devices or arms (0..1535, default: the machine's,\n"
+    "                        else 0)\n"
     "  --reply-timeout-us N  all feedback of a tick within this after SYNC (default 20000;\n"
     "                        longer than the 800 us of a real drive: a shared, emulated CPU)\n"
     "  --start-timeout-ms N  wait this long for the drives to answer the first SYNC\n"
     "                        (default 5000)\n"
-    "  --nv FILE             calibration store file (linux default dhcal-fw.nv; sim: RAM\n"
-    "                        unless given)\n"
+    "  --nv FILE             calibration store file (linux default: the machine's store,\n"
+    "                        else dhcal-fw.nv; sim: RAM unless given)\n"
     "  --samples N           poses in the plan (10..128, default 30)\n"
     "  --plan-seed N         seed of the pose plan (default 4242)\n"
     "  --run-seed N          sim port: the plant's run seed (default 7, as dhcal-sim bus)\n"
     "  --hold-ticks N        ticks averaged per sample (default 200)\n"
     "  --params-out FILE     the calibrated parameters, one 'name value' line each\n"
-    "  --gpio-chip NAME      GPIO chip of an encoder's A/B lines (e.g. gpiochip0)\n"
+    "  --gpio-chip NAME      GPIO chip of an encoder's A/B lines (e.g. gpiochip0; default:\n"
+    "                        the machine's)\n"
     "  --enc-lines A,B       their line offsets\n"
     "  --gpio-watch N        instead of the run: decode N quadrature steps from the GPIO\n"
     "                        lines (or stop at the first missed edge) and report\n"
@@ -74,6 +76,7 @@ static const char *const help_text =
 
 typedef struct {
     const char *port;
+    const char *machine;
     const char *scenario;
     const char *can;
     const char *nv;
@@ -91,6 +94,7 @@ typedef struct {
     unsigned long long gpio_stall_ms;
     unsigned enc_line[2];
     int have_lines;
+    int have_can_id_offset;
 } options;
 
 /* Config file values live here: options point into it. */
@@ -145,13 +149,15 @@ static int set_option(options *o, const char *key, const char *val)
                         val != NULL ? val : "", nums[i].max);
                 return EXIT_USAGE;
             }
+            o->have_can_id_offset |= nums[i].dst == &o->can_id_offset;
             return 0;
         }
     }
     struct {
         const char *name;
         const char **dst;
-    } strs[] = {{"port", &o->port},           {"scenario", &o->scenario},
+    } strs[] = {{"port", &o->port},           {"machine", &o->machine},
+                {"scenario", &o->scenario},
                 {"can", &o->can},             {"nv", &o->nv},
                 {"params-out", &o->params_out}, {"gpio-chip", &o->gpio_chip}};
     for (size_t i = 0U; i < sizeof strs / sizeof strs[0]; ++i) {
@@ -248,7 +254,6 @@ static int parse_args(int argc, char **argv, options *o)
 {
     memset(o, 0, sizeof *o);
     o->port = "linux";
-    o->can = "vcan0";
     o->reply_timeout_us = 20000U;
     o->start_timeout_ms = 5000U;
     o->samples = 30U;
@@ -290,8 +295,15 @@ static int parse_args(int argc, char **argv, options *o)
     if (strcmp(o->port, "linux") != 0 && strcmp(o->port, "sim") != 0) {
         return usage("--port: '%s' is neither linux nor sim", o->port);
     }
-    if (o->gpio_watch == 0U && o->scenario == NULL) {
-        return usage("%s", "--scenario is required (the machine's nominal data)");
+    if (o->gpio_watch == 0U && o->machine == NULL) {
+        return usage("%s", "--machine is required (the controller's machine file)");
+    }
+    if (o->gpio_watch == 0U && strcmp(o->port, "sim") == 0 && o->scenario == NULL) {
+        return usage("%s", "--port sim needs --scenario (the simulated arm)");
+    }
+    if (strcmp(o->port, "linux") == 0 && o->scenario != NULL) {
+        return usage("%s", "--scenario is the simulated arm of --port sim; the controller "
+                           "is configured by --machine");
     }
     if (o->gpio_watch == 0U && o->samples < 10U) {
         return usage("%s", "--samples: 10..128");
@@ -305,10 +317,44 @@ static int parse_args(int argc, char **argv, options *o)
     if (o->reply_timeout_us == 0U) {
         return usage("%s", "--reply-timeout-us must be > 0");
     }
-    if (o->nv == NULL && strcmp(o->port, "linux") == 0) {
-        o->nv = "dhcal-fw.nv";
-    }
     return 0;
+}
+
+/* What the command line and the config file leave open, the machine file gives: CAN
+ * interface and identifier offset, encoder lines, the store; then the defaults. */
+static void apply_machine(options *o, const dhcal_machine *m)
+{
+    if (o->can == NULL) {
+        o->can = m->can_interface[0] != '\0' ? m->can_interface : "vcan0";
+    }
+    if (!o->have_can_id_offset && m->has_can_id_offset) {
+        o->can_id_offset = m->can_id_offset;
+    }
+    if (o->gpio_chip == NULL && m->gpio_chip[0] != '\0') {
+        o->gpio_chip = m->gpio_chip;
+        o->enc_line[0] = m->gpio_lines[0];
+        o->enc_line[1] = m->gpio_lines[1];
+        o->have_lines = 1;
+    }
+    if (o->nv == NULL && strcmp(o->port, "linux") == 0) {
+        o->nv = m->store_path[0] != '\0' ? m->store_path : "dhcal-fw.nv";
+    }
+}
+
+/* The machine's raw-code conversions (fw_port.h): encoder counts per joint radian through
+ * the gear, the tacho at the joint, the wheel's mm per count. */
+static void machine_io_config(const dhcal_machine *m, fw_io_config *out)
+{
+    memset(out, 0, sizeof *out);
+    const double two_pi = 2.0 * DHC_PI;
+    for (size_t j = 0U; j < m->n_joints; ++j) {
+        out->counts_per_rad[j] = m->encoder_counts_per_rev[j] * m->gear_ratio[j] / two_pi;
+        out->tacho_v_per_rad_s[j] = m->tacho_v_s_per_rad[j] * m->gear_ratio[j];
+    }
+    out->adc_v_full_scale = m->adc_range_v;
+    out->dac_v_full_scale = m->dac_range_v;
+    out->wire_mm_per_count = two_pi * m->wire_wheel_radius_mm / m->wire_counts_per_rev;
+    memcpy(out->wire_ref_mm, m->wire_zero_mm, sizeof out->wire_ref_mm);
 }
 
 static double elapsed_s(const struct timespec *t0)
@@ -347,6 +393,7 @@ static int run_gpio_watch(const options *o)
 
 /* ---------------------------------------------------------------- the calibration run */
 
+static dhcal_machine machine;
 static dhs_scenario_file sf;
 static fw_sim sim;
 static fw_linux_can can_bus;
@@ -356,7 +403,6 @@ static fw_linux_nv nv_file;
 static fw_port port;
 static fw_io_config io;
 static fw_job job;
-static dhc_model nominal;
 
 static int open_linux_port(const options *o)
 {
@@ -365,7 +411,7 @@ static int open_linux_port(const options *o)
     const uint32_t offset = (uint32_t)o->can_id_offset;
     uint32_t rx[FW_CAN_MAX_DRIVES + 1U];
     size_t n_rx = 0U;
-    for (size_t j = 0U; j < sf.sc.n_joints && j < FW_CAN_MAX_DRIVES; ++j) {
+    for (size_t j = 0U; j < machine.n_joints && j < FW_CAN_MAX_DRIVES; ++j) {
         rx[n_rx++] = fw_can_offset_bus_id(offset, FW_CAN_ID_DRIVE_FB_BASE + (uint32_t)j);
     }
     rx[n_rx++] = fw_can_offset_bus_id(offset, FW_CAN_ID_WIRES);
@@ -385,10 +431,11 @@ static int open_linux_port(const options *o)
         return EXIT_USAGE;
     }
     fw_can_link_config lc;
-    fw_can_link_default_config(&lc, sf.sc.n_joints);
+    fw_can_link_default_config(&lc, machine.n_joints);
     lc.reply_timeout_us = (uint32_t)o->reply_timeout_us;
     if (fw_can_link_init(&link_, &tr, &lc, &port) != FW_PORT_OK) {
-        fprintf(stderr, "dhcal-fw: the CAN link rejected %zu joints\n", sf.sc.n_joints);
+        fprintf(stderr, "dhcal-fw: %s: the CAN link rejected %zu joints (at most %u drives)\n",
+                o->machine, machine.n_joints, (unsigned)FW_CAN_MAX_DRIVES);
         return EXIT_USAGE;
     }
     return 0;
@@ -429,8 +476,11 @@ static void print_result(const options *o, fw_fault fault, size_t n_done, int ca
            (unsigned long long)job.ctrl.ticks, n_done);
     if (fault != FW_FAULT_NONE) {
         /* What the controller last commanded: 0 V once the fault latched. */
-        printf(", \"drive_v_after_fault\": [%.6f, %.6f, %.6f]", job.ctrl.u_v[0],
-               job.ctrl.u_v[1], job.ctrl.u_v[2]);
+        printf(", \"drive_v_after_fault\": [");
+        for (size_t j = 0U; j < machine.n_joints; ++j) {
+            printf("%s%.6f", j > 0U ? ", " : "", job.ctrl.u_v[j]);
+        }
+        printf("]");
     }
     if (calibrated) {
         char effect[64];
@@ -469,25 +519,29 @@ static void print_result(const options *o, fw_fault fault, size_t n_done, int ca
     fflush(stdout);
 }
 
-static int run_calibration(const options *o)
+static int run_calibration(options *o)
 {
     struct timespec t0;
     (void)clock_gettime(CLOCK_MONOTONIC, &t0);
     dhcal_error err;
     memset(&err, 0, sizeof err);
-    if (dhs_scenario_load(o->scenario, &sf, &err) != DHCAL_IO_OK ||
-        dhcal_model_to_lib(&sf.model, sf.model_path, &nominal, &err) != DHCAL_IO_OK) {
+    if (dhcal_machine_load(o->machine, &machine, &err) != DHCAL_IO_OK) {
         fprintf(stderr, "dhcal-fw: %s\n", err.msg);
         return EXIT_USAGE;
     }
-    if (sf.sc.n_joints != 3U || !nominal.measurer.present) {
-        fprintf(stderr, "dhcal-fw: %s: the machine must be a 3-joint arm with a measurer\n",
-                o->scenario);
-        return EXIT_USAGE;
+    apply_machine(o, &machine);
+    machine_io_config(&machine, &io);
+    if (strcmp(o->port, "sim") == 0) {
+        if (dhs_scenario_load(o->scenario, &sf, &err) != DHCAL_IO_OK) {
+            fprintf(stderr, "dhcal-fw: %s\n", err.msg);
+            return EXIT_USAGE;
+        }
+        if (sf.sc.n_joints != machine.n_joints) {
+            fprintf(stderr, "dhcal-fw: %s: a %zu-joint arm for the %zu-joint machine %s\n",
+                    o->scenario, sf.sc.n_joints, machine.n_joints, o->machine);
+            return EXIT_USAGE;
+        }
     }
-    /* The start pose and the counters' homing are the sim run's (dhcal-demo's). */
-    const double q_start[3] = {0.0, 60.0 * FW_PI / 180.0, -60.0 * FW_PI / 180.0};
-    fw_sim_io_config(&sf.sc, &io);
     int rc = 0;
     if (o->gpio_chip != NULL) {
         /* Encoder lines configured: a missing chip or line is a configuration error now,
@@ -503,7 +557,7 @@ static int run_calibration(const options *o)
         fw_linux_gpio_close(&enc);
     }
     if (strcmp(o->port, "sim") == 0) {
-        if (fw_sim_init(&sim, &sf.sc, o->run_seed, q_start, &port) != DHC_OK) {
+        if (fw_sim_init(&sim, &sf.sc, o->run_seed, machine.start_pose_rad, &port) != DHC_OK) {
             fprintf(stderr, "dhcal-fw: the scenario was rejected by the plant\n");
             return EXIT_USAGE;
         }
@@ -515,8 +569,14 @@ static int run_calibration(const options *o)
         return rc;
     }
     fw_job_config jc;
-    fw_job_default_config(&jc, &nominal);
-    memcpy(jc.q_start_rad, q_start, sizeof q_start);
+    fw_job_default_config(&jc, &machine.model);
+    memcpy(jc.q_start_rad, machine.start_pose_rad, sizeof jc.q_start_rad);
+    if (machine.has_speed_limit) {
+        jc.ctrl.v_max_rad_s = machine.max_speed_rad_s;
+    }
+    if (machine.has_accel_limit) {
+        jc.ctrl.a_max_rad_s2 = machine.max_accel_rad_s2;
+    }
     jc.n_samples = (size_t)o->samples;
     jc.plan_seed = (uint32_t)o->plan_seed;
     jc.hold_ticks = (uint32_t)o->hold_ticks;
@@ -534,7 +594,7 @@ static int run_calibration(const options *o)
         }
     }
     if (fault == FW_FAULT_NONE) {
-        fault = fw_job_run(&job, &jc, &nominal, &port, &io, &port.nv);
+        fault = fw_job_run(&job, &jc, &machine.model, &port, &io, &port.nv);
     }
     const size_t n_done = job.n_samples;
     const int calibrated = job.calibrated_ok;

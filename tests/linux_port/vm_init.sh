@@ -67,8 +67,8 @@ t1=$(cut -d' ' -f1 /proc/uptime)
 show "OUT fw-a" fw-a.json; show "ERR fw-a" fw-a.err; show "OUT sim-a" sim-a.json
 show "ERR sim-a" sim-a.err
 # The reference: the same run through the sim port, in this VM (same CPU, same libm).
-dhcal-fw --port sim --scenario "$SCENARIO" --samples "$SAMPLES" --params-out params-s.txt \
-    >fw-s.json 2>fw-s.err
+dhcal-fw --port sim --machine "$MACHINE" --scenario "$SCENARIO" --samples "$SAMPLES" \
+    --params-out params-s.txt >fw-s.json 2>fw-s.err
 show "OUT fw-s" fw-s.json; show "ERR fw-s" fw-s.err
 # Same parameter names in the same order; prints "ok|names COUNT MAX|difference|".
 compare() {
