@@ -13,6 +13,8 @@
 #endif
 
 #include <errno.h>
+#include <getopt.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -250,6 +252,22 @@ static int load_config(options *o, const char *path)
     return 0;
 }
 
+/* The long options, each with a value except --help; the same names are the keys of the
+ * config file (set_option). */
+static const struct option long_options[] = {
+    {"config", required_argument, NULL, 0},          {"machine", required_argument, NULL, 0},
+    {"port", required_argument, NULL, 0},            {"scenario", required_argument, NULL, 0},
+    {"can", required_argument, NULL, 0},             {"can-id-offset", required_argument, NULL, 0},
+    {"reply-timeout-us", required_argument, NULL, 0},
+    {"start-timeout-ms", required_argument, NULL, 0},
+    {"nv", required_argument, NULL, 0},              {"samples", required_argument, NULL, 0},
+    {"plan-seed", required_argument, NULL, 0},       {"run-seed", required_argument, NULL, 0},
+    {"hold-ticks", required_argument, NULL, 0},      {"params-out", required_argument, NULL, 0},
+    {"gpio-chip", required_argument, NULL, 0},       {"enc-lines", required_argument, NULL, 0},
+    {"gpio-watch", required_argument, NULL, 0},      {"gpio-timeout-ms", required_argument, NULL, 0},
+    {"gpio-stall-ms", required_argument, NULL, 0},   {"help", no_argument, NULL, 'h'},
+    {NULL, 0, NULL, 0}};
+
 static int parse_args(int argc, char **argv, options *o)
 {
     memset(o, 0, sizeof *o);
@@ -261,36 +279,50 @@ static int parse_args(int argc, char **argv, options *o)
     o->run_seed = 7U;
     o->hold_ticks = 200U;
     o->gpio_timeout_ms = 3000U;
-    /* The config file first, whatever its place: the command line overrides it. */
-    for (int i = 1; i < argc; ++i) {
-        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+    /* The options in their order; the config file is applied first, wherever it stands,
+     * so that the command line overrides it. */
+    const char *names[64];
+    const char *values[64];
+    size_t n = 0U;
+    const char *config = NULL;
+    opterr = 0; /* our own messages, in our words */
+    int index = -1;
+    int c;
+    while ((c = getopt_long(argc, argv, ":h", long_options, &index)) != -1) {
+        if (c == 'h') {
             fputs(help_text, stdout);
             return -1;
         }
-        if (strcmp(argv[i], "--config") == 0) {
-            if (i + 1 >= argc) {
-                return usage("%s needs a value", "--config");
-            }
-            const int rc = load_config(o, argv[i + 1]);
-            if (rc != 0) {
-                return rc;
-            }
+        if (c == ':') {
+            return usage("%s needs a value", argv[optind - 1]);
+        }
+        if (c == '?') {
+            const char *const bad = argv[optind - 1];
+            return usage("unknown option '%s'", bad + strspn(bad, "-"));
+        }
+        if (strcmp(long_options[index].name, "config") == 0) {
+            config = optarg;
+        } else if (n < sizeof names / sizeof names[0]) {
+            names[n] = long_options[index].name;
+            values[n++] = optarg;
+        } else {
+            return usage("%s", "too many options");
         }
     }
-    for (int i = 1; i < argc; ++i) {
-        if (strncmp(argv[i], "--", 2U) != 0) {
-            return usage("unexpected argument '%s'", argv[i]);
+    if (optind < argc) {
+        return usage("unexpected argument '%s'", argv[optind]);
+    }
+    if (config != NULL) {
+        const int rc = load_config(o, config);
+        if (rc != 0) {
+            return rc;
         }
-        if (i + 1 >= argc) {
-            return usage("%s needs a value", argv[i]);
+    }
+    for (size_t k = 0U; k < n; ++k) {
+        const int rc = set_option(o, names[k], values[k]);
+        if (rc != 0) {
+            return rc;
         }
-        if (strcmp(argv[i], "--config") != 0) {
-            const int rc = set_option(o, argv[i] + 2, argv[i + 1]);
-            if (rc != 0) {
-                return rc;
-            }
-        }
-        ++i;
     }
     if (strcmp(o->port, "linux") != 0 && strcmp(o->port, "sim") != 0) {
         return usage("--port: '%s' is neither linux nor sim", o->port);
@@ -393,6 +425,23 @@ static int run_gpio_watch(const options *o)
 
 /* ---------------------------------------------------------------- the calibration run */
 
+/* SIGINT or SIGTERM received (its number): the run stops at the next tick. */
+static volatile sig_atomic_t stop_signal;
+
+static void on_stop_signal(int sig)
+{
+    stop_signal = sig;
+}
+
+static int install_stop_handlers(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_stop_signal;
+    (void)sigemptyset(&sa.sa_mask);
+    return sigaction(SIGINT, &sa, NULL) == 0 && sigaction(SIGTERM, &sa, NULL) == 0 ? 0 : -1;
+}
+
 static dhcal_machine machine;
 static dhs_scenario_file sf;
 static fw_sim sim;
@@ -403,6 +452,36 @@ static fw_linux_nv nv_file;
 static fw_port port;
 static fw_io_config io;
 static fw_job job;
+static fw_port device_port; /* the port's own table; `port` checks for a stop first */
+
+/* A stop request ends the run at a tick boundary: the controller latches FW_FAULT_STOPPED,
+ * which commands 0 V to every drive, and the tick fails so that every step returns. */
+static fw_port_status stoppable_wait_tick(void *ctx, uint64_t *t_us)
+{
+    if (stop_signal != 0) {
+        if (job.ctrl.port != NULL) {
+            fw_ctrl_fault(&job.ctrl, FW_FAULT_STOPPED, 0U);
+        }
+        return FW_PORT_ERR_IO;
+    }
+    return device_port.wait_tick(ctx, t_us);
+}
+
+/* After a stop: every drive commanded to 0 V and disabled (the Enable bit of the CAN
+ * commands); the simulated drives of the sim port take the 0 V. */
+static void stop_drives(const options *o)
+{
+    uint16_t zero[DHC_MAX_JOINTS];
+    for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
+        zero[j] = fw_dac_code(&io, 0.0);
+    }
+    if (strcmp(o->port, "linux") == 0) {
+        link_.drive_enable = 0U;
+    }
+    if (device_port.write_dacs != NULL) {
+        (void)device_port.write_dacs(device_port.ctx, zero);
+    }
+}
 
 static int open_linux_port(const options *o)
 {
@@ -514,6 +593,13 @@ static void print_result(const options *o, fw_fault fault, size_t n_done, int ca
     }
     if (is_linux) {
         print_counters();
+    } else {
+        /* the simulated drives' last commands, as codes (2048: 0 V) */
+        printf(", \"plant_dac\": [");
+        for (size_t j = 0U; j < machine.n_joints; ++j) {
+            printf("%s%u", j > 0U ? ", " : "", (unsigned)sim.plant.dac[j]);
+        }
+        printf("]");
     }
     printf(", \"elapsed_s\": %.3f}\n", elapsed_s(t0));
     fflush(stdout);
@@ -568,6 +654,8 @@ static int run_calibration(options *o)
         fw_linux_can_close(&can_bus);
         return rc;
     }
+    device_port = port;
+    port.wait_tick = stoppable_wait_tick;
     fw_job_config jc;
     fw_job_default_config(&jc, &machine.model);
     memcpy(jc.q_start_rad, machine.start_pose_rad, sizeof jc.q_start_rad);
@@ -585,16 +673,24 @@ static int run_calibration(options *o)
         /* The drives may come up after us: repeat SYNC 0 until they answer. */
         const uint64_t tries = o->start_timeout_ms * 1000U / o->reply_timeout_us + 1U;
         fw_port_status ps = FW_PORT_ERR_TIMEOUT;
-        for (uint64_t k = 0U; k < tries && ps == FW_PORT_ERR_TIMEOUT; ++k) {
+        for (uint64_t k = 0U; k < tries && ps == FW_PORT_ERR_TIMEOUT && stop_signal == 0; ++k) {
             ps = fw_can_link_start(&link_);
         }
-        if (ps != FW_PORT_OK) {
+        if (stop_signal != 0) {
+            fault = FW_FAULT_STOPPED;
+        } else if (ps != FW_PORT_OK) {
             fault = ps == FW_PORT_ERR_TIMEOUT ? FW_FAULT_PORT_TIMEOUT : FW_FAULT_PORT_IO;
             fprintf(stderr, "dhcal-fw: no answer from the drives on %s\n", o->can);
         }
     }
     if (fault == FW_FAULT_NONE) {
         fault = fw_job_run(&job, &jc, &machine.model, &port, &io, &port.nv);
+    }
+    if (stop_signal != 0) {
+        fault = FW_FAULT_STOPPED;
+        stop_drives(o);
+        fprintf(stderr, "dhcal-fw: %s: drives commanded to 0 V and disabled\n",
+                stop_signal == SIGINT ? "SIGINT" : "SIGTERM");
     }
     const size_t n_done = job.n_samples;
     const int calibrated = job.calibrated_ok;
@@ -617,5 +713,10 @@ int main(int argc, char **argv)
     }
     nv_file.fd = -1;
     can_bus.fd = -1;
+    if (install_stop_handlers() != 0) {
+        fprintf(stderr, "dhcal-fw: cannot install the SIGINT/SIGTERM handlers: %s\n",
+                strerror(errno));
+        return EXIT_FAULT;
+    }
     return o.gpio_watch > 0U ? run_gpio_watch(&o) : run_calibration(&o);
 }

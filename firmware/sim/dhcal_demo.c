@@ -18,6 +18,7 @@
 #define _POSIX_C_SOURCE 200809L /* open_memstream */
 #endif
 
+#include <getopt.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -270,8 +271,56 @@ static int write_outputs(const char *dir, size_t n, const char *effect)
     return finish_file(path, f, &text, &len);
 }
 
+static const char *const usage_text =
+    "usage: dhcal-demo --scenario S.json [--json] [--out DIR] [--samples N] [--targets N]\n"
+    "                  [--mixed-directions] [--effects LIST] [--no-diagnose] [--unweighted]\n"
+    "  --effects LIST   the controller's configured effects, fitted in every calibration\n"
+    "                   (e.g. joint_compliance:2,measurer_scale)\n"
+    "  --no-diagnose    fit only those; do not look for a missing one\n"
+    "  --unweighted     no noise model (encoder quantisation, wire noise): plain least "
+    "squares\n";
+
+/* A count in 0..max, digits only. */
+static int parse_count(const char *s, size_t max, size_t *out)
+{
+    if (s == NULL || *s < '0' || *s > '9') {
+        return -1;
+    }
+    char *end = NULL;
+    const unsigned long long v = strtoull(s, &end, 10);
+    if (*end != '\0' || v > max) {
+        return -1;
+    }
+    *out = (size_t)v;
+    return 0;
+}
+
+enum {
+    OPT_JSON = 256,
+    OPT_SCENARIO,
+    OPT_MIXED,
+    OPT_OUT,
+    OPT_SAMPLES,
+    OPT_TARGETS,
+    OPT_EFFECTS,
+    OPT_NO_DIAGNOSE,
+    OPT_UNWEIGHTED
+};
+
 int main(int argc, char **argv)
 {
+    static const struct option long_options[] = {
+        {"json", no_argument, NULL, OPT_JSON},
+        {"scenario", required_argument, NULL, OPT_SCENARIO},
+        {"mixed-directions", no_argument, NULL, OPT_MIXED},
+        {"out", required_argument, NULL, OPT_OUT},
+        {"samples", required_argument, NULL, OPT_SAMPLES},
+        {"targets", required_argument, NULL, OPT_TARGETS},
+        {"effects", required_argument, NULL, OPT_EFFECTS},
+        {"no-diagnose", no_argument, NULL, OPT_NO_DIAGNOSE},
+        {"unweighted", no_argument, NULL, OPT_UNWEIGHTED},
+        {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0}};
     const char *scenario = NULL;
     const char *out_dir = NULL;
     int json = 0;
@@ -282,37 +331,63 @@ int main(int argc, char **argv)
     fw_autocal_default_config(&autocal);
     const char *effects = NULL;
     int weighted = 1;
-    for (int i = 1; i < argc; ++i) {
-        if (strcmp(argv[i], "--json") == 0) {
+    opterr = 0;
+    int c;
+    while ((c = getopt_long(argc, argv, ":h", long_options, NULL)) != -1) {
+        int bad = 0;
+        switch (c) {
+        case OPT_JSON:
             json = 1;
-        } else if (strcmp(argv[i], "--scenario") == 0 && i + 1 < argc) {
-            scenario = argv[++i];
-        } else if (strcmp(argv[i], "--mixed-directions") == 0) {
+            break;
+        case OPT_SCENARIO:
+            scenario = optarg;
+            break;
+        case OPT_MIXED:
             mixed_dirs = 1;
-        } else if (strcmp(argv[i], "--out") == 0 && i + 1 < argc) {
-            out_dir = argv[++i];
-        } else if (strcmp(argv[i], "--samples") == 0 && i + 1 < argc) {
-            n_samples = (size_t)strtoul(argv[++i], NULL, 10);
-        } else if (strcmp(argv[i], "--targets") == 0 && i + 1 < argc) {
-            n_targets = (size_t)strtoul(argv[++i], NULL, 10);
-        } else if (strcmp(argv[i], "--effects") == 0 && i + 1 < argc) {
-            effects = argv[++i];
-        } else if (strcmp(argv[i], "--no-diagnose") == 0) {
+            break;
+        case OPT_OUT:
+            out_dir = optarg;
+            break;
+        case OPT_SAMPLES:
+            bad = parse_count(optarg, FW_ACQ_MAX_SAMPLES, &n_samples);
+            break;
+        case OPT_TARGETS:
+            bad = parse_count(optarg, MAX_TARGETS, &n_targets);
+            break;
+        case OPT_EFFECTS:
+            effects = optarg;
+            break;
+        case OPT_NO_DIAGNOSE:
             autocal.diagnose = 0;
-        } else if (strcmp(argv[i], "--unweighted") == 0) {
+            break;
+        case OPT_UNWEIGHTED:
             weighted = 0;
-        } else {
-            fprintf(stderr,
-                    "usage: dhcal-demo --scenario S.json [--json] [--out DIR] [--samples N] "
-                    "[--targets N] [--mixed-directions] [--effects LIST] [--no-diagnose]\n"
-                    "       [--unweighted]\n"
-                    "  --effects LIST   the controller's configured effects, fitted in every "
-                    "calibration\n                   (e.g. joint_compliance:2,measurer_scale)\n"
-                    "  --no-diagnose    fit only those; do not look for a missing one\n"
-                    "  --unweighted     no noise model (encoder quantisation, wire noise): "
-                    "plain least squares\n");
+            break;
+        case 'h':
+            fputs(usage_text, stdout);
+            return 0;
+        case ':':
+            fprintf(stderr, "dhcal-demo: %s needs a value\n", argv[optind - 1]);
+            bad = 1;
+            break;
+        default:
+            fprintf(stderr, "dhcal-demo: unknown option '%s'\n", argv[optind - 1]);
+            bad = 1;
+            break;
+        }
+        if (bad) {
+            if (c == OPT_SAMPLES || c == OPT_TARGETS) {
+                fprintf(stderr, "dhcal-demo: %s: '%s' is not a count in 0..%u\n",
+                        c == OPT_SAMPLES ? "--samples" : "--targets", optarg,
+                        c == OPT_SAMPLES ? FW_ACQ_MAX_SAMPLES : MAX_TARGETS);
+            }
+            fputs(usage_text, stderr);
             return 2;
         }
+    }
+    if (optind < argc) {
+        fprintf(stderr, "dhcal-demo: unexpected argument '%s'\n%s", argv[optind], usage_text);
+        return 2;
     }
     /* The configured effects, comma separated, by their names in docs/effects.md. */
     for (const char *e = effects; e != NULL && *e != '\0';) {

@@ -115,6 +115,31 @@ fault_case() { # name "dhcal-fw options" dhcal-sim-options...
 fault_case lost-frame "--can-id-offset 32" --can-id-offset 32 --drop-frame 0x181@$FAULT_TICK
 fault_case bus-timeout "" --stop-at $FAULT_TICK
 
+# ---------------------------------------------------------------- (c') a stop request
+# SIGTERM in the middle of the run: the controller must command 0 V to every drive and
+# disable it (Enable 0), report fault "stopped" and exit 1; the simulated drives report the
+# last command and enable bit they received.
+dhcal-sim bus --scenario "$SCENARIO" --can vcan0 --idle-exit-ms 1000 >sim-stop.json \
+    2>sim-stop.err &
+SIM=$!
+settle
+dhcal-fw --config $CONF --nv nv-stop.bin >fw-stop.json 2>fw-stop.err &
+FW=$!
+sleep 3
+kill -TERM $FW
+wait $FW
+RC=$?
+wait $SIM
+show "OUT fw-stop" fw-stop.json; show "ERR fw-stop" fw-stop.err; show "OUT sim-stop" sim-stop.json
+F=$(field fw-stop.json fault)
+DAC=$(sed -n 's/.*"last_dac": \[\([^]]*\)\].*/\1/p' sim-stop.json)
+EN=$(sed -n 's/.*"last_enable": \[\([^]]*\)\].*/\1/p' sim-stop.json)
+if [ "$RC" = 1 ] && [ "$F" = stopped ] && [ "$DAC" = "2048, 2048, 2048" ] && [ "$EN" = "0, 0, 0" ]; then
+    result sigterm PASS "fault $F after $(field fw-stop.json ticks) ticks, drives commanded to 0 V (codes $DAC) and disabled (enable $EN)"
+else
+    result sigterm FAIL "exit $RC, fault '$F', last drive codes '$DAC', enable '$EN'"
+fi
+
 # ---------------------------------------------------------------- (d) encoder on GPIO
 if [ -n "$CHIP" ]; then
     # Clean motion first: every edge seen, the count exact.

@@ -125,7 +125,7 @@ echo "vm_run: prepare $((T1 - T0)) s, reference + initramfs $((T2 - T1)) s, VM $
 fail=0
 cases="calibration lost-frame"
 [ -n "$CAN_CHECK" ] && cases="can-transport $cases"
-for c in $cases bus-timeout encoder-count missed-edge missing-interface \
+for c in $cases bus-timeout sigterm encoder-count missed-edge missing-interface \
          missing-chip missing-line; do
     line=$(grep "^CASE $c " "$WORK/console.log" | head -n1 || true)
     case $line in

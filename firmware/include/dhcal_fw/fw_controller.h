@@ -46,6 +46,7 @@ typedef enum {
     FW_FAULT_UNDERDETERMINED,   /* too few or too poor samples for the parameters */
     FW_FAULT_NUMERIC,           /* samples or model that break the arithmetic (non-finite,
                                    singular) */
+    FW_FAULT_STOPPED,           /* stopped on request (an operator, a signal) */
     FW_FAULT_COUNT
 } fw_fault;
 
