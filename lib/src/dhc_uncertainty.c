@@ -89,7 +89,10 @@ dhc_status dhc_uncertainty_tool_point(const dhc_uncertainty *u, const dhc_model 
     s.temp_c = model->thermal_ref_c;
     for (size_t j = 0U; j < nj && j < DHC_MAX_JOINTS; ++j) {
         s.q_rad[j] = q_rad[j];
-        s.dir[j] = dir != NULL ? dir[j] : (int8_t)1;
+        s.dir[j] = 1;
+        if (dir != NULL) {
+            s.dir[j] = dir[j];
+        }
     }
     const size_t p = set->count;
     double jac_buf[3U * DHC_MAX_PARAMS];
