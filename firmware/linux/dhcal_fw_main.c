@@ -378,15 +378,13 @@ static void apply_machine(options *o, const dhcal_machine *m)
 static void machine_io_config(const dhcal_machine *m, fw_io_config *out)
 {
     memset(out, 0, sizeof *out);
-    const double two_pi = 2.0 * DHC_PI;
     for (size_t j = 0U; j < m->n_joints; ++j) {
-        out->counts_per_rad[j] = m->encoder_counts_per_rev[j] * m->gear_ratio[j] / two_pi;
-        out->tacho_v_per_rad_s[j] = m->tacho_v_s_per_rad[j] * m->gear_ratio[j];
+        fw_io_set_joint(out, j, m->encoder_counts_per_rev[j], m->gear_ratio[j],
+                        m->tacho_v_s_per_rad[j]);
     }
     out->adc_v_full_scale = m->adc_range_v;
     out->dac_v_full_scale = m->dac_range_v;
-    out->wire_mm_per_count = two_pi * m->wire_wheel_radius_mm / m->wire_counts_per_rev;
-    memcpy(out->wire_ref_mm, m->wire_zero_mm, sizeof out->wire_ref_mm);
+    fw_io_set_wires(out, m->wire_wheel_radius_mm, m->wire_counts_per_rev, m->wire_zero_mm);
 }
 
 static double elapsed_s(const struct timespec *t0)
