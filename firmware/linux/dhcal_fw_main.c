@@ -561,14 +561,7 @@ static void print_result(const options *o, fw_fault fault, size_t n_done, int ca
     }
     if (calibrated) {
         char effect[64];
-        if (!job.result.found) {
-            snprintf(effect, sizeof effect, "none");
-        } else if (dhc_effect_is_per_joint(job.result.effect)) {
-            snprintf(effect, sizeof effect, "%s:%zu", dhc_effect_name(job.result.effect),
-                     job.result.effect_joint + 1U);
-        } else {
-            snprintf(effect, sizeof effect, "%s", dhc_effect_name(job.result.effect));
-        }
+        (void)fw_autocal_effect_label(&job.result, effect, sizeof effect);
         printf(", \"effect\": \"%s\", \"geometric_rms_mm\": %.9f, \"wire_rms_mm\": %.9f, "
                "\"saved\": %d, \"seq\": %u, \"params\": {",
                effect, job.result.geo.rms_mm, job.result.new_rms_mm, job.result.saved, (unsigned)job.result.seq);

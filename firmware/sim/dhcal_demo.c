@@ -191,17 +191,6 @@ static void where_it_fails(const dhc_model *m, size_t n, FILE *log)
     }
 }
 
-static void effect_label(const fw_autocal_result *res, char *buf, size_t cap)
-{
-    if (!res->found) {
-        snprintf(buf, cap, "none");
-    } else if (dhc_effect_is_per_joint(res->effect)) {
-        snprintf(buf, cap, "%s:%zu", dhc_effect_name(res->effect), res->effect_joint + 1U);
-    } else {
-        snprintf(buf, cap, "%s", dhc_effect_name(res->effect));
-    }
-}
-
 /* path := the text f received (an open_memstream), replaced whole (io's atomic write). */
 static int finish_file(const char *path, FILE *f, char **text, size_t *len)
 {
@@ -477,7 +466,7 @@ int main(int argc, char **argv)
     }
     const fw_autocal_result *res = &job.result;
     char effect[64];
-    effect_label(res, effect, sizeof effect);
+    (void)fw_autocal_effect_label(res, effect, sizeof effect);
     if (res->meas_noise_mm > 0.0) {
         fprintf(log, "    noise model: joint angles %.3g %.3g %.3g urad (1 count / sqrt 12 with the "
                      "holds' dither), wires %.4f mm (measured over the holds)\n",

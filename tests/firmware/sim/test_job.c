@@ -149,6 +149,21 @@ static void test_lib_failures_map_to_distinct_faults(void)
     TEST_ASSERT_EQUAL_STRING("numeric", fw_fault_name(FW_FAULT_NUMERIC));
 }
 
+static void test_the_effect_label_is_the_effect_table_name(void)
+{
+    fw_autocal_result r;
+    memset(&r, 0, sizeof r);
+    char buf[64];
+    TEST_ASSERT_EQUAL_STRING("none", fw_autocal_effect_label(&r, buf, sizeof buf));
+    r.found = 1;
+    r.effect = DHC_EFFECT_JOINT_COMPLIANCE;
+    r.effect_joint = 11U;
+    TEST_ASSERT_EQUAL_STRING("joint_compliance:12", fw_autocal_effect_label(&r, buf, sizeof buf));
+    TEST_ASSERT_EQUAL_STRING("joint_co", fw_autocal_effect_label(&r, buf, 9U));
+    r.effect = DHC_EFFECT_MEASURER_SCALE;
+    TEST_ASSERT_EQUAL_STRING("measurer_scale", fw_autocal_effect_label(&r, buf, sizeof buf));
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -157,5 +172,6 @@ int main(void)
     RUN_TEST(test_boot_refuses_a_configuration_the_machine_cannot_run);
     RUN_TEST(test_too_few_samples_is_not_an_argument_error);
     RUN_TEST(test_lib_failures_map_to_distinct_faults);
+    RUN_TEST(test_the_effect_label_is_the_effect_table_name);
     return UNITY_END();
 }
