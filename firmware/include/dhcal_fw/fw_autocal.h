@@ -90,8 +90,8 @@ typedef struct {
 /* No configured effects; the diagnosis on; no noise model. */
 void fw_autocal_default_config(fw_autocal_config *cfg);
 
-/* Everything a calibration needs besides the caller's samples (several hundred KiB with
- * the default DHC_MAX_PARAMS: static storage, not a stack); scratch between calls. */
+/* Everything a calibration needs besides the caller's samples (about 175 KiB with the
+ * default DHC_MAX_PARAMS of 64: static storage, not a stack); scratch between calls. */
 typedef struct {
     dhc_calib_workspace cal;
     dhc_diagnose_workspace diag_ws;

@@ -3,8 +3,8 @@
  *
  * The same sequence runs on every controller: the simulation (dhcal-demo), the Linux port
  * (dhcal-fw) and a bare-metal build. The caller owns all of the job's state in one fw_job
- * (static storage: it holds the samples and the calibration's workspaces, about 1 MiB with
- * the default DHC_MAX_PARAMS) and hands it a port, the machine's conversions (fw_io_config),
+ * (static storage: it holds the samples and the calibration's workspaces, about 290 KiB with
+ * the default DHC_MAX_PARAMS of 64; the normal matrices grow with its square) and hands it a port, the machine's conversions (fw_io_config),
  * its nominal model and a configuration; nothing is kept between jobs elsewhere, so a
  * second calibration does not depend on the first. The steps may run one by one (the demo
  * positions the arm with the nominal model between boot and plan) or all at once
