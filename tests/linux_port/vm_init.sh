@@ -90,10 +90,12 @@ fi
 
 # ---------------------------------------------------------------- (b), (c) bus faults
 # The controller must latch port_timeout and command 0 V (code 2048) to every drive; the
-# simulated drives report the last command they received.
+# simulated drives report the last command they received. They stay on the bus 3 s after
+# its last frame: the controller declares the lost frame only after its reply timeout (1 s
+# in this VM), and a drive that left at the same moment would miss the 0 V.
 fault_case() { # name "dhcal-fw options" dhcal-sim-options...
     name=$1; fw_opts=$2; shift 2
-    dhcal-sim bus --scenario "$SCENARIO" --can vcan0 --idle-exit-ms 1000 "$@" \
+    dhcal-sim bus --scenario "$SCENARIO" --can vcan0 --idle-exit-ms 3000 "$@" \
         >sim-$name.json 2>sim-$name.err &
     SIM=$!
     settle
@@ -119,7 +121,7 @@ fault_case bus-timeout "" --stop-at $FAULT_TICK
 # SIGTERM in the middle of the run: the controller must command 0 V to every drive and
 # disable it (Enable 0), report fault "stopped" and exit 1; the simulated drives report the
 # last command and enable bit they received.
-dhcal-sim bus --scenario "$SCENARIO" --can vcan0 --idle-exit-ms 1000 >sim-stop.json \
+dhcal-sim bus --scenario "$SCENARIO" --can vcan0 --idle-exit-ms 3000 >sim-stop.json \
     2>sim-stop.err &
 SIM=$!
 settle
