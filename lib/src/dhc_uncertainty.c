@@ -110,14 +110,14 @@ dhc_status dhc_uncertainty_tool_point(const dhc_uncertainty *u, const dhc_model 
     if (st == DHC_OK && joint_sd_rad != NULL) {
         /* dp/dq_eff is the joint-offset column of each joint (the same screw) */
         dhc_param_set thetas;
-        thetas.count = nj;
-        for (size_t j = 0U; j < nj; ++j) {
-            thetas.id[j].kind = (uint8_t)DHC_P_THETA;
-            thetas.id[j].joint = (uint8_t)j;
-            thetas.id[j].aux = 0U;
+        dhc_params_clear(&thetas);
+        for (size_t j = 0U; j < nj && st == DHC_OK; ++j) {
+            st = dhc_params_add(&thetas, model, DHC_P_THETA, j, 0U);
         }
         dhc_mat jq;
-        st = dhc_mat_init(&jq, 3U, nj, jac_buf, sizeof jac_buf / sizeof jac_buf[0]);
+        if (st == DHC_OK) {
+            st = dhc_mat_init(&jq, 3U, nj, jac_buf, sizeof jac_buf / sizeof jac_buf[0]);
+        }
         if (st == DHC_OK) {
             st = dhc_model_jacobian(model, &thetas, &s, 1.0, &jq, NULL);
         }
