@@ -18,6 +18,7 @@
 #include "dhcal/dhc_params.h"
 #include "dhcal_file.h"
 #include "dhcal_io_common.h"
+#include "dhcal_json.h"
 #include "dhcal_text.h"
 
 /* Value ranges of the model file (docs/formats.md). */
@@ -30,195 +31,14 @@
 
 /* ------------------------------------------------------------------ model: reading */
 
-typedef struct {
-    const char *file;
-    dhcal_error *err;
-    size_t n_joints;
-} jctx;
-
-#define JPATH_CAP 160U
-
-static int jfail(const jctx *c, const char *jpath, const char *fmt, ...) DHCAL_PRINTF(3, 4);
-static int jfail(const jctx *c, const char *jpath, const char *fmt, ...)
-{
-    const int head = snprintf(c->err->msg, sizeof c->err->msg, "%s: %s: ", c->file, jpath);
-    if (head > 0 && (size_t)head < sizeof c->err->msg) {
-        va_list ap;
-        va_start(ap, fmt);
-        (void)vsnprintf(c->err->msg + head, sizeof c->err->msg - (size_t)head, fmt, ap);
-        va_end(ap);
-    }
-    return DHCAL_IO_BAD_INPUT;
-}
-
-/* out = a b c, cut at JPATH_CAP - 1 bytes (paths nest, so their lengths have no static
- * bound that snprintf's truncation analysis would accept). */
-static void path_join(char out[JPATH_CAP], const char *a, const char *b, const char *c)
-{
-    const char *const parts[3] = {a, b, c};
-    size_t o = 0U;
-    for (size_t p = 0U; p < 3U; ++p) {
-        for (const char *s = parts[p]; *s != '\0' && o + 1U < JPATH_CAP; ++s) {
-            out[o++] = *s;
-        }
-    }
-    out[o] = '\0';
-}
-
-static void key_path(char out[JPATH_CAP], const char *parent, const char *key)
-{
-    char sb[DHCAL_QUOTE_CAP];
-    path_join(out, parent, parent[0] != '\0' ? "." : "", dhcal_quote(key, strlen(key), sb));
-}
-
-static void index_path(char out[JPATH_CAP], const char *parent, size_t i)
-{
-    char ib[32];
-    (void)snprintf(ib, sizeof ib, "[%zu]", i);
-    path_join(out, parent, ib, "");
-}
-
-static const char *jtype(const cJSON *j)
-{
-    if (cJSON_IsNumber(j)) {
-        return "a number";
-    }
-    if (cJSON_IsString(j)) {
-        return "a string";
-    }
-    if (cJSON_IsBool(j)) {
-        return "a boolean";
-    }
-    if (cJSON_IsNull(j)) {
-        return "null";
-    }
-    if (cJSON_IsArray(j)) {
-        return "an array";
-    }
-    if (cJSON_IsObject(j)) {
-        return "an object";
-    }
-    return "an unknown value";
-}
-
-static size_t jcount(const cJSON *j)
-{
-    size_t n = 0U;
-    for (const cJSON *e = j->child; e != NULL; e = e->next) {
-        ++n;
-    }
-    return n;
-}
-
-/* obj must be an object whose keys are all in allowed and none repeated. */
-static int check_object(const jctx *c, const cJSON *obj, const char *path,
-                        const char *const *allowed, size_t n_allowed, const char *allowed_text)
-{
-    if (!cJSON_IsObject(obj)) {
-        return jfail(c, path[0] != '\0' ? path : "(top level)", "expected an object, got %s",
-                     jtype(obj));
-    }
-    char kp[JPATH_CAP];
-    for (const cJSON *e = obj->child; e != NULL; e = e->next) {
-        key_path(kp, path, e->string);
-        size_t ignored = 0U;
-        if (!dhcal_find_name(e->string, allowed, n_allowed, &ignored)) {
-            return jfail(c, kp, "unknown key (allowed here: %s)", allowed_text);
-        }
-        for (const cJSON *p = obj->child; p != e; p = p->next) {
-            if (strcmp(p->string, e->string) == 0) {
-                return jfail(c, kp, "key repeated");
-            }
-        }
-    }
-    return DHCAL_IO_OK;
-}
-
-static int jnumber(const jctx *c, const cJSON *item, const char *path, double lo, double hi,
-                   const char *unit, double *out)
-{
-    if (!cJSON_IsNumber(item)) {
-        return jfail(c, path, "expected a number, got %s", jtype(item));
-    }
-    const double v = item->valuedouble;
-    if (!isfinite(v)) {
-        return jfail(c, path, "number out of range (not a finite double)");
-    }
-    if (v < lo || v > hi) {
-        return jfail(c, path, "%.15g is outside [%g, %g]%s%s", v, lo, hi,
-                     unit[0] != '\0' ? " " : "", unit);
-    }
-    *out = v;
-    return DHCAL_IO_OK;
-}
-
-/* An array of exactly n numbers within [lo, hi]. */
-static int jvector(const jctx *c, const cJSON *item, const char *path, size_t n, double lo,
-                   double hi, const char *unit, double *out)
-{
-    if (!cJSON_IsArray(item)) {
-        return jfail(c, path, "expected an array of %zu numbers, got %s", n, jtype(item));
-    }
-    const size_t have = jcount(item);
-    if (have != n) {
-        return jfail(c, path, "expected %zu numbers, got %zu", n, have);
-    }
-    char ip[JPATH_CAP];
-    size_t i = 0U;
-    for (const cJSON *e = item->child; e != NULL; e = e->next, ++i) {
-        index_path(ip, path, i);
-        const int rc = jnumber(c, e, ip, lo, hi, unit, &out[i]);
-        if (rc != DHCAL_IO_OK) {
-            return rc;
-        }
-    }
-    return DHCAL_IO_OK;
-}
-
-/* Optional member: absent leaves *out untouched. */
-static int jopt_number(const jctx *c, const cJSON *obj, const char *parent, const char *key,
-                       double lo, double hi, const char *unit, double *out)
-{
-    const cJSON *const item = cJSON_GetObjectItemCaseSensitive(obj, key);
-    if (item == NULL) {
-        return DHCAL_IO_OK;
-    }
-    char kp[JPATH_CAP];
-    key_path(kp, parent, key);
-    return jnumber(c, item, kp, lo, hi, unit, out);
-}
-
-static int jreq_number(const jctx *c, const cJSON *obj, const char *parent, const char *key,
-                       double lo, double hi, const char *unit, double *out)
-{
-    if (cJSON_GetObjectItemCaseSensitive(obj, key) == NULL) {
-        char kp[JPATH_CAP];
-        key_path(kp, parent, key);
-        return jfail(c, kp, "required key missing");
-    }
-    return jopt_number(c, obj, parent, key, lo, hi, unit, out);
-}
-
-static int jopt_vector(const jctx *c, const cJSON *obj, const char *parent, const char *key,
-                       size_t n, double lo, double hi, const char *unit, double *out)
-{
-    const cJSON *const item = cJSON_GetObjectItemCaseSensitive(obj, key);
-    if (item == NULL) {
-        return DHCAL_IO_OK;
-    }
-    char kp[JPATH_CAP];
-    key_path(kp, parent, key);
-    return jvector(c, item, kp, n, lo, hi, unit, out);
-}
-
 static const char *const JOINT_KEYS[] = {"alpha_deg", "a_mm",    "d_mm",   "theta_offset_deg",
                                          "beta_deg",  "min_deg", "max_deg"};
 #define JOINT_KEYS_TEXT "alpha_deg, a_mm, d_mm, theta_offset_deg, beta_deg, min_deg, max_deg"
 
-static int load_joint(const jctx *c, const cJSON *j, const char *path, dhc_joint *out,
+static int load_joint(const dhcal_jctx *c, const cJSON *j, const char *path, dhc_joint *out,
                       int *has_beta)
 {
-    int rc = check_object(c, j, path, JOINT_KEYS, sizeof JOINT_KEYS / sizeof JOINT_KEYS[0],
+    int rc = dhcal_jcheck_object(c, j, path, JOINT_KEYS, sizeof JOINT_KEYS / sizeof JOINT_KEYS[0],
                           JOINT_KEYS_TEXT);
     double alpha = 0.0;
     double a = 0.0;
@@ -229,30 +49,30 @@ static int load_joint(const jctx *c, const cJSON *j, const char *path, dhc_joint
     double hi = 180.0;
     const double am = MODEL_ANGLE_MAX_DEG;
     if (rc == DHCAL_IO_OK) {
-        rc = jreq_number(c, j, path, "alpha_deg", -am, am, "deg", &alpha);
+        rc = dhcal_jreq_number(c, j, path, "alpha_deg", -am, am, "deg", &alpha);
     }
     if (rc == DHCAL_IO_OK) {
-        rc = jreq_number(c, j, path, "a_mm", -LEN_MAX_MM, LEN_MAX_MM, "mm", &a);
+        rc = dhcal_jreq_number(c, j, path, "a_mm", -LEN_MAX_MM, LEN_MAX_MM, "mm", &a);
     }
     if (rc == DHCAL_IO_OK) {
-        rc = jreq_number(c, j, path, "d_mm", -LEN_MAX_MM, LEN_MAX_MM, "mm", &d);
+        rc = dhcal_jreq_number(c, j, path, "d_mm", -LEN_MAX_MM, LEN_MAX_MM, "mm", &d);
     }
     if (rc == DHCAL_IO_OK) {
-        rc = jopt_number(c, j, path, "theta_offset_deg", -am, am, "deg", &theta);
+        rc = dhcal_jopt_number(c, j, path, "theta_offset_deg", -am, am, "deg", &theta);
     }
     if (rc == DHCAL_IO_OK) {
-        rc = jopt_number(c, j, path, "beta_deg", -am, am, "deg", &beta);
+        rc = dhcal_jopt_number(c, j, path, "beta_deg", -am, am, "deg", &beta);
     }
     if (rc == DHCAL_IO_OK) {
-        rc = jopt_number(c, j, path, "min_deg", -MODEL_LIMIT_MAX_DEG, MODEL_LIMIT_MAX_DEG,
+        rc = dhcal_jopt_number(c, j, path, "min_deg", -MODEL_LIMIT_MAX_DEG, MODEL_LIMIT_MAX_DEG,
                          "deg", &lo);
     }
     if (rc == DHCAL_IO_OK) {
-        rc = jopt_number(c, j, path, "max_deg", -MODEL_LIMIT_MAX_DEG, MODEL_LIMIT_MAX_DEG,
+        rc = dhcal_jopt_number(c, j, path, "max_deg", -MODEL_LIMIT_MAX_DEG, MODEL_LIMIT_MAX_DEG,
                          "deg", &hi);
     }
     if (rc == DHCAL_IO_OK && !(lo < hi)) {
-        rc = jfail(c, path, "min_deg %.15g is not below max_deg %.15g", lo, hi);
+        rc = dhcal_jfail(c, path, "min_deg %.15g is not below max_deg %.15g", lo, hi);
     }
     if (rc == DHCAL_IO_OK) {
         out->alpha_rad = alpha * DHC_DEG;
@@ -270,7 +90,7 @@ static int load_joint(const jctx *c, const cJSON *j, const char *path, dhc_joint
 static const char *const FRAME_KEYS[] = {"xyz_mm", "rpy_deg"};
 
 /* Optional frame object: absent is the identity, absent members are 0. */
-static int load_frame(const jctx *c, const cJSON *obj, const char *parent, const char *key,
+static int load_frame(const dhcal_jctx *c, const cJSON *obj, const char *parent, const char *key,
                       dhc_frame *out)
 {
     dhc_frame_identity(out);
@@ -278,16 +98,16 @@ static int load_frame(const jctx *c, const cJSON *obj, const char *parent, const
     if (f == NULL) {
         return DHCAL_IO_OK;
     }
-    char kp[JPATH_CAP];
-    key_path(kp, parent, key);
+    char kp[DHCAL_JPATH_CAP];
+    dhcal_jpath_key(kp, parent, key);
     double xyz[3] = {0.0, 0.0, 0.0};
     double rpy[3] = {0.0, 0.0, 0.0};
-    int rc = check_object(c, f, kp, FRAME_KEYS, 2U, "xyz_mm, rpy_deg");
+    int rc = dhcal_jcheck_object(c, f, kp, FRAME_KEYS, 2U, "xyz_mm, rpy_deg");
     if (rc == DHCAL_IO_OK) {
-        rc = jopt_vector(c, f, kp, "xyz_mm", 3U, -LEN_MAX_MM, LEN_MAX_MM, "mm", xyz);
+        rc = dhcal_jopt_vector(c, f, kp, "xyz_mm", 3U, -LEN_MAX_MM, LEN_MAX_MM, "mm", xyz);
     }
     if (rc == DHCAL_IO_OK) {
-        rc = jopt_vector(c, f, kp, "rpy_deg", 3U, -MODEL_ANGLE_MAX_DEG, MODEL_ANGLE_MAX_DEG,
+        rc = dhcal_jopt_vector(c, f, kp, "rpy_deg", 3U, -MODEL_ANGLE_MAX_DEG, MODEL_ANGLE_MAX_DEG,
                          "deg", rpy);
     }
     if (rc == DHCAL_IO_OK) {
@@ -300,28 +120,28 @@ static int load_frame(const jctx *c, const cJSON *obj, const char *parent, const
 
 static const char *const MEASURER_KEYS[] = {"anchors_mm", "frame"};
 
-static int load_measurer(const jctx *c, const cJSON *m, dhcal_model *model)
+static int load_measurer(const dhcal_jctx *c, const cJSON *m, dhcal_model *model)
 {
-    int rc = check_object(c, m, "measurer", MEASURER_KEYS, 2U, "anchors_mm, frame");
+    int rc = dhcal_jcheck_object(c, m, "measurer", MEASURER_KEYS, 2U, "anchors_mm, frame");
     if (rc != DHCAL_IO_OK) {
         return rc;
     }
     const cJSON *const anchors = cJSON_GetObjectItemCaseSensitive(m, "anchors_mm");
     if (anchors == NULL) {
-        return jfail(c, "measurer.anchors_mm", "required key missing");
+        return dhcal_jfail(c, "measurer.anchors_mm", "required key missing");
     }
     if (!cJSON_IsArray(anchors)) {
-        return jfail(c, "measurer.anchors_mm", "expected an array of 3 points, got %s",
-                     jtype(anchors));
+        return dhcal_jfail(c, "measurer.anchors_mm", "expected an array of 3 points, got %s",
+                     dhcal_jtype(anchors));
     }
-    if (jcount(anchors) != 3U) {
-        return jfail(c, "measurer.anchors_mm", "expected 3 points, got %zu", jcount(anchors));
+    if (dhcal_jcount(anchors) != 3U) {
+        return dhcal_jfail(c, "measurer.anchors_mm", "expected 3 points, got %zu", dhcal_jcount(anchors));
     }
-    char ip[JPATH_CAP];
+    char ip[DHCAL_JPATH_CAP];
     size_t i = 0U;
     for (const cJSON *e = anchors->child; e != NULL; e = e->next, ++i) {
-        index_path(ip, "measurer.anchors_mm", i);
-        rc = jvector(c, e, ip, 3U, -LEN_MAX_MM, LEN_MAX_MM, "mm", model->anchors_mm[i]);
+        dhcal_jpath_index(ip, "measurer.anchors_mm", i);
+        rc = dhcal_jvector(c, e, ip, 3U, -LEN_MAX_MM, LEN_MAX_MM, "mm", model->anchors_mm[i]);
         if (rc != DHCAL_IO_OK) {
             return rc;
         }
@@ -332,7 +152,7 @@ static int load_measurer(const jctx *c, const cJSON *m, dhcal_model *model)
         double d[3];
         dhc_vec3_sub(an[PAIRS[p][1]], an[PAIRS[p][0]], d);
         if (dhc_vec3_norm(d) < ANCHOR_MIN_DIST_MM) {
-            return jfail(c, "measurer.anchors_mm",
+            return dhcal_jfail(c, "measurer.anchors_mm",
                          "anchors_mm[%zu] and anchors_mm[%zu] are the same point (need three "
                          "distinct, non-collinear anchors)",
                          PAIRS[p][0], PAIRS[p][1]);
@@ -345,7 +165,7 @@ static int load_measurer(const jctx *c, const cJSON *m, dhcal_model *model)
     dhc_vec3_sub(an[2], an[0], e2);
     dhc_vec3_cross(e1, e2, cr);
     if (dhc_vec3_norm(cr) <= ANCHOR_SIN_TOL * dhc_vec3_norm(e1) * dhc_vec3_norm(e2)) {
-        return jfail(c, "measurer.anchors_mm",
+        return dhcal_jfail(c, "measurer.anchors_mm",
                      "the three anchors are collinear (trilateration needs a triangle)");
     }
     model->has_measurer = 1;
@@ -381,38 +201,38 @@ void dhcal_effect_label(dhc_effect effect, size_t joint, char *buf, size_t cap)
     }
 }
 
-static int load_effects(const jctx *c, const cJSON *fx, dhcal_model *model)
+static int load_effects(const dhcal_jctx *c, const cJSON *fx, dhcal_model *model)
 {
     if (!cJSON_IsObject(fx)) {
-        return jfail(c, "effects", "expected an object, got %s", jtype(fx));
+        return dhcal_jfail(c, "effects", "expected an object, got %s", dhcal_jtype(fx));
     }
-    char kp[JPATH_CAP];
+    char kp[DHCAL_JPATH_CAP];
     for (const cJSON *e = fx->child; e != NULL; e = e->next) {
-        key_path(kp, "effects", e->string);
+        dhcal_jpath_key(kp, "effects", e->string);
         for (const cJSON *p = fx->child; p != e; p = p->next) {
             if (strcmp(p->string, e->string) == 0) {
-                return jfail(c, kp, "key repeated");
+                return dhcal_jfail(c, kp, "key repeated");
             }
         }
         if (strlen(e->string) >= sizeof model->effects[0].name ||
             !effect_name_ok(e->string, c->n_joints)) {
             char known[512];
             (void)dhcal_effect_catalogue(known, sizeof known);
-            return jfail(c, kp, "unknown effect (known: %s; 1 <= i <= %zu)", known,
+            return dhcal_jfail(c, kp, "unknown effect (known: %s; 1 <= i <= %zu)", known,
                          c->n_joints);
         }
         if (model->n_effects == DHCAL_MAX_EFFECTS) {
-            return jfail(c, "effects", "more than %u effects", DHCAL_MAX_EFFECTS);
+            return dhcal_jfail(c, "effects", "more than %u effects", DHCAL_MAX_EFFECTS);
         }
         if (!cJSON_IsArray(e)) {
-            return jfail(c, kp, "expected an array of numbers, got %s", jtype(e));
+            return dhcal_jfail(c, kp, "expected an array of numbers, got %s", dhcal_jtype(e));
         }
-        const size_t n = jcount(e);
+        const size_t n = dhcal_jcount(e);
         if (n == 0U || n > DHCAL_MAX_EFFECT_VALUES) {
-            return jfail(c, kp, "%zu values, expected 1..%u", n, DHCAL_MAX_EFFECT_VALUES);
+            return dhcal_jfail(c, kp, "%zu values, expected 1..%u", n, DHCAL_MAX_EFFECT_VALUES);
         }
         dhcal_effect_value *const ev = &model->effects[model->n_effects];
-        const int rc = jvector(c, e, kp, n, -HUGE_VAL, HUGE_VAL, "", ev->values);
+        const int rc = dhcal_jvector(c, e, kp, n, -HUGE_VAL, HUGE_VAL, "", ev->values);
         if (rc != DHCAL_IO_OK) {
             return rc;
         }
@@ -426,34 +246,34 @@ static int load_effects(const jctx *c, const cJSON *fx, dhcal_model *model)
 static const char *const TOP_KEYS[] = {"name",    "joints",   "tool_mm", "base",
                                        "gravity", "measurer", "effects"};
 
-static int load_root(jctx *c, const cJSON *root, dhcal_model *model)
+static int load_root(dhcal_jctx *c, const cJSON *root, dhcal_model *model)
 {
-    int rc = check_object(c, root, "", TOP_KEYS, sizeof TOP_KEYS / sizeof TOP_KEYS[0],
+    int rc = dhcal_jcheck_object(c, root, "", TOP_KEYS, sizeof TOP_KEYS / sizeof TOP_KEYS[0],
                           "name, joints, tool_mm, base, gravity, measurer, effects");
     if (rc != DHCAL_IO_OK) {
         return rc;
     }
     const cJSON *const joints = cJSON_GetObjectItemCaseSensitive(root, "joints");
     if (joints == NULL) {
-        return jfail(c, "joints", "required key missing");
+        return dhcal_jfail(c, "joints", "required key missing");
     }
     if (!cJSON_IsArray(joints)) {
-        return jfail(c, "joints", "expected an array of joint objects, got %s", jtype(joints));
+        return dhcal_jfail(c, "joints", "expected an array of joint objects, got %s", dhcal_jtype(joints));
     }
-    const size_t n = jcount(joints);
+    const size_t n = dhcal_jcount(joints);
     if (n == 0U) {
-        return jfail(c, "joints", "empty array (a model needs 1..%u joints)", DHC_MAX_JOINTS);
+        return dhcal_jfail(c, "joints", "empty array (a model needs 1..%u joints)", DHC_MAX_JOINTS);
     }
     if (n > DHC_MAX_JOINTS) {
-        return jfail(c, "joints", "%zu joints, this build supports at most %u (DHC_MAX_JOINTS)",
+        return dhcal_jfail(c, "joints", "%zu joints, this build supports at most %u (DHC_MAX_JOINTS)",
                      n, DHC_MAX_JOINTS);
     }
     c->n_joints = n;
     (void)dhc_arm_init(&model->arm, n); /* cannot fail: 1 <= n <= DHC_MAX_JOINTS */
-    char ip[JPATH_CAP];
+    char ip[DHCAL_JPATH_CAP];
     size_t i = 0U;
     for (const cJSON *j = joints->child; j != NULL; j = j->next, ++i) {
-        index_path(ip, "joints", i);
+        dhcal_jpath_index(ip, "joints", i);
         rc = load_joint(c, j, ip, &model->arm.joint[i], &model->has_beta[i]);
         if (rc != DHCAL_IO_OK) {
             return rc;
@@ -464,26 +284,26 @@ static int load_root(jctx *c, const cJSON *root, dhcal_model *model)
     const cJSON *const name = cJSON_GetObjectItemCaseSensitive(root, "name");
     if (name != NULL) {
         if (!cJSON_IsString(name)) {
-            return jfail(c, "name", "expected a string, got %s", jtype(name));
+            return dhcal_jfail(c, "name", "expected a string, got %s", dhcal_jtype(name));
         }
         const size_t len = strlen(name->valuestring);
         if (len >= sizeof model->name) {
-            return jfail(c, "name", "longer than %zu bytes", sizeof model->name - 1U);
+            return dhcal_jfail(c, "name", "longer than %zu bytes", sizeof model->name - 1U);
         }
         memcpy(model->name, name->valuestring, len + 1U);
     }
-    rc = jopt_vector(c, root, "", "tool_mm", 3U, -LEN_MAX_MM, LEN_MAX_MM, "mm",
+    rc = dhcal_jopt_vector(c, root, "", "tool_mm", 3U, -LEN_MAX_MM, LEN_MAX_MM, "mm",
                      model->arm.tool_mm);
     if (rc == DHCAL_IO_OK) {
         rc = load_frame(c, root, "", "base", &model->arm.base);
     }
     if (rc == DHCAL_IO_OK) {
-        rc = jopt_vector(c, root, "", "gravity", 3U, -2.0, 2.0, "", model->gravity);
+        rc = dhcal_jopt_vector(c, root, "", "gravity", 3U, -2.0, 2.0, "", model->gravity);
     }
     if (rc == DHCAL_IO_OK) {
         const double g = dhc_vec3_norm(model->gravity);
         if (!(fabs(g - 1.0) <= UNIT_NORM_TOL)) {
-            return jfail(c, "gravity", "norm %.6g is not 1 (tolerance 1e-3)", g);
+            return dhcal_jfail(c, "gravity", "norm %.6g is not 1 (tolerance 1e-3)", g);
         }
         dhc_vec3_scale(model->gravity, 1.0 / g, model->gravity);
     }
@@ -498,132 +318,29 @@ static int load_root(jctx *c, const cJSON *root, dhcal_model *model)
     return rc;
 }
 
-/* Reads the whole file into a NUL-terminated heap buffer. */
-static int read_whole(const char *path, char **text, size_t *len, dhcal_error *err)
+int dhcal_model_from_json(const char *file, const char *jpath, const cJSON *obj,
+                          dhcal_model *model, dhcal_error *err)
 {
-    *text = NULL;
-    *len = 0U;
-    FILE *const f = fopen(path, "rb");
-    if (f == NULL) {
-        return dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s: cannot open: %s", path, strerror(errno));
+    memset(model, 0, sizeof *model);
+    model->gravity[2] = -1.0;
+    dhc_frame_identity(&model->measurer_frame);
+    dhcal_jctx c = {file, jpath != NULL ? jpath : "", err, 0U};
+    const int rc = load_root(&c, obj, model);
+    if (rc != DHCAL_IO_OK) {
+        memset(model, 0, sizeof *model);
     }
-    size_t cap = 4096U;
-    size_t n = 0U;
-    char *buf = malloc(cap);
-    int rc = buf == NULL ? dhcal_error_set(err, DHCAL_IO_FAILED, "%s: out of memory", path)
-                         : DHCAL_IO_OK;
-    while (rc == DHCAL_IO_OK) {
-        if (n + 1U == cap) {
-            char *const grown = realloc(buf, cap * 2U);
-            if (grown == NULL) {
-                rc = dhcal_error_set(err, DHCAL_IO_FAILED, "%s: out of memory", path);
-                break;
-            }
-            buf = grown;
-            cap *= 2U;
-        }
-        const size_t got = fread(buf + n, 1U, cap - 1U - n, f);
-        n += got;
-        if (n > DHCAL_MODEL_MAX_BYTES) {
-            rc = dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s: larger than %u bytes: not a model file",
-                           path, DHCAL_MODEL_MAX_BYTES);
-        } else if (got == 0U) {
-            if (ferror(f)) {
-                rc = dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s: read error: %s", path,
-                               strerror(errno));
-            }
-            break;
-        }
-    }
-    (void)fclose(f);
-    if (rc != DHCAL_IO_OK || buf == NULL) {
-        free(buf);
-        return rc != DHCAL_IO_OK ? rc : DHCAL_IO_FAILED;
-    }
-    buf[n] = '\0';
-    *text = buf;
-    *len = n;
-    return DHCAL_IO_OK;
-}
-
-static void line_col(const char *text, size_t pos, size_t *line, size_t *col)
-{
-    *line = 1U;
-    size_t line_start = 0U;
-    for (size_t k = 0U; k < pos; ++k) {
-        if (text[k] == '\n') {
-            ++*line;
-            line_start = k + 1U;
-        }
-    }
-    *col = pos - line_start + 1U;
-}
-
-static int parse_model_text(const char *path, const char *text, size_t len, dhcal_model *model,
-                            dhcal_error *err)
-{
-    size_t line = 0U;
-    size_t col = 0U;
-    /* cJSON skips every byte <= 32 as whitespace, NUL included: reject them first. */
-    for (size_t k = 0U; k < len; ++k) {
-        const unsigned char b = (unsigned char)text[k];
-        if ((b < 0x20U && b != '\t' && b != '\n' && b != '\r') || b == 0x7fU) {
-            line_col(text, k, &line, &col);
-            return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
-                             "%s:%zu:%zu: %s byte 0x%02x (binary file?)", path, line, col,
-                             b == 0U ? "NUL" : "control", (unsigned)b);
-        }
-    }
-    size_t first = 0U;
-    while (first < len && (text[first] == ' ' || text[first] == '\t' || text[first] == '\n' ||
-                           text[first] == '\r')) {
-        ++first;
-    }
-    if (first == len) {
-        return dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s: empty file (expected a JSON object)",
-                         path);
-    }
-    const char *end = NULL;
-    /* The length includes the terminator: with require_null_terminated, cJSON 1.7 checks
-     * that the byte after the value is that NUL, and fails when the length excludes it. */
-    cJSON *const root = cJSON_ParseWithLengthOpts(text, len + 1U, &end, 1);
-    if (root == NULL) {
-        size_t pos = end != NULL && end >= text ? (size_t)(end - text) : 0U;
-        if (pos > len) {
-            pos = len;
-        }
-        line_col(text, pos, &line, &col);
-        char sb[DHCAL_QUOTE_CAP];
-        const size_t rest = len - pos;
-        if (rest == 0U) {
-            return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
-                             "%s:%zu:%zu: JSON syntax error: unexpected end of file", path,
-                             line, col);
-        }
-        return dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s:%zu:%zu: JSON syntax error near '%s'",
-                         path, line, col, dhcal_quote(text + pos, rest < 20U ? rest : 20U, sb));
-    }
-    jctx c = {path, err, 0U};
-    const int rc = load_root(&c, root, model);
-    cJSON_Delete(root);
     return rc;
 }
 
 int dhcal_model_load(const char *path, dhcal_model *model, dhcal_error *err)
 {
     memset(model, 0, sizeof *model);
-    char *text = NULL;
-    size_t len = 0U;
-    int rc = read_whole(path, &text, &len, err);
+    cJSON *root = NULL;
+    int rc = dhcal_json_load(path, DHCAL_MODEL_MAX_BYTES, "a model file", &root, err);
     if (rc == DHCAL_IO_OK) {
-        model->gravity[2] = -1.0;
-        dhc_frame_identity(&model->measurer_frame);
-        rc = parse_model_text(path, text, len, model, err);
+        rc = dhcal_model_from_json(path, "", root, model, err);
     }
-    free(text);
-    if (rc != DHCAL_IO_OK) {
-        memset(model, 0, sizeof *model);
-    }
+    cJSON_Delete(root);
     return rc;
 }
 

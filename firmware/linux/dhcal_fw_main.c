@@ -1,7 +1,9 @@
 /* dhcal-fw - the controller's main job on an embedded Linux controller: the calibration run
- * (plan, acquire, calibrate with fw_autocal, store) over the Linux port (drives and measurer
- * on SocketCAN through fw_can_link, storage in a file), or, with --port sim, over the
- * simulation port: the same run, deterministic, so both can be compared number by number.
+ * (fw_job: plan, acquire, calibrate, diagnose, store) over the Linux port (drives and
+ * measurer on SocketCAN through fw_can_link, storage in a file), or, with --port sim, over
+ * the simulation port: the same run, deterministic, so both can be compared number by
+ * number. The controller is configured by a machine file (--machine, docs/formats.md
+ * section 8.1); the sim port's simulated arm comes from a host_sim scenario (--scenario).
  * --gpio-watch checks the GPIO quadrature input of an encoder instead (libgpiod).
  *
  * Exit codes: 0 the run completed, 1 it ended in a fault or failed (the JSON says which),
@@ -11,6 +13,8 @@
 #endif
 
 #include <errno.h>
+#include <getopt.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -18,12 +22,14 @@
 
 #include "dhcal/dhc_params.h"
 #include "dhcal_fw/fw_acquire.h"
+#include "dhcal_fw/fw_job.h"
 #include "dhcal_fw/fw_can.h"
 #include "dhcal_fw/fw_can_link.h"
 #include "dhcal_fw/fw_can_offset.h"
 #include "dhcal_fw/fw_controller.h"
-#include "dhcal_io.h"
-#include "dhcal_model_map.h"
+#include "dhcal_file.h"
+#include "dhcal_machine.h"
+#include "dhcal_text.h"
 #include "dhcal_sim/dhs_scenario_json.h"
 #include "fw_linux_can.h"
 #include "fw_linux_gpio.h"
@@ -32,7 +38,6 @@
 
 #define EXIT_FAULT 1
 #define EXIT_USAGE 2
-#define FW_PI 3.14159265358979323846
 #define NV_SIZE 8192U
 #define MAX_CONFIG_BYTES 65536U
 
@@ -43,26 +48,28 @@ static const char *const help_text =
     "result; prints one JSON object. Options (each also a 'key = value' line of --config,\n"
     "without the dashes; the command line wins):\n"
     "  --config FILE         key = value lines, '#' comments\n"
+    "  --machine FILE        the machine file: nominal model, joints, encoder and gear\n"
+    "                        scaling, drive limits, CAN, GPIO, store (required for a run)\n"
     "  --port linux|sim      linux (default): drives and measurer over SocketCAN;\n"
     "                        sim: the simulated arm in-process (the reference run)\n"
-    "  --scenario FILE       the machine: its nominal model and the nominal drive and\n"
-    "                        measurer data (gear ratios, encoder lines, converter ranges,\n"
-    "                        wheel); the sim port also builds the simulated arm from it\n"
-    "  --can IFNAME          CAN interface (default vcan0)\n"
+    "  --scenario FILE       sim port: the host_sim scenario of the simulated arm\n"
+    "  --can IFNAME          CAN interface (default: the machine's, else vcan0)\n"
     "  --can-id-offset N     the DBC's identifiers moved by N on the bus, for a bus shared\n"
-    "                        with other devices or arms (0..1535, default 0)\n"
+    "                        with other devices or arms (0..1535, default: the machine's,\n"
+    "                        else 0)\n"
     "  --reply-timeout-us N  all feedback of a tick within this after SYNC (default 20000;\n"
     "                        longer than the 800 us of a real drive: a shared, emulated CPU)\n"
     "  --start-timeout-ms N  wait this long for the drives to answer the first SYNC\n"
     "                        (default 5000)\n"
-    "  --nv FILE             calibration store file (linux default dhcal-fw.nv; sim: RAM\n"
-    "                        unless given)\n"
+    "  --nv FILE             calibration store file (linux default: the machine's store,\n"
+    "                        else dhcal-fw.nv; sim: RAM unless given)\n"
     "  --samples N           poses in the plan (10..128, default 30)\n"
     "  --plan-seed N         seed of the pose plan (default 4242)\n"
     "  --run-seed N          sim port: the plant's run seed (default 7, as dhcal-sim bus)\n"
     "  --hold-ticks N        ticks averaged per sample (default 200)\n"
     "  --params-out FILE     the calibrated parameters, one 'name value' line each\n"
-    "  --gpio-chip NAME      GPIO chip of an encoder's A/B lines (e.g. gpiochip0)\n"
+    "  --gpio-chip NAME      GPIO chip of an encoder's A/B lines (e.g. gpiochip0; default:\n"
+    "                        the machine's)\n"
     "  --enc-lines A,B       their line offsets\n"
     "  --gpio-watch N        instead of the run: decode N quadrature steps from the GPIO\n"
     "                        lines (or stop at the first missed edge) and report\n"
@@ -73,6 +80,7 @@ static const char *const help_text =
 
 typedef struct {
     const char *port;
+    const char *machine;
     const char *scenario;
     const char *can;
     const char *nv;
@@ -90,6 +98,7 @@ typedef struct {
     unsigned long long gpio_stall_ms;
     unsigned enc_line[2];
     int have_lines;
+    int have_can_id_offset;
 } options;
 
 /* Config file values live here: options point into it. */
@@ -144,13 +153,15 @@ static int set_option(options *o, const char *key, const char *val)
                         val != NULL ? val : "", nums[i].max);
                 return EXIT_USAGE;
             }
+            o->have_can_id_offset |= nums[i].dst == &o->can_id_offset;
             return 0;
         }
     }
     struct {
         const char *name;
         const char **dst;
-    } strs[] = {{"port", &o->port},           {"scenario", &o->scenario},
+    } strs[] = {{"port", &o->port},           {"machine", &o->machine},
+                {"scenario", &o->scenario},
                 {"can", &o->can},             {"nv", &o->nv},
                 {"params-out", &o->params_out}, {"gpio-chip", &o->gpio_chip}};
     for (size_t i = 0U; i < sizeof strs / sizeof strs[0]; ++i) {
@@ -243,11 +254,26 @@ static int load_config(options *o, const char *path)
     return 0;
 }
 
+/* The long options, each with a value except --help; the same names are the keys of the
+ * config file (set_option). */
+static const struct option long_options[] = {
+    {"config", required_argument, NULL, 0},          {"machine", required_argument, NULL, 0},
+    {"port", required_argument, NULL, 0},            {"scenario", required_argument, NULL, 0},
+    {"can", required_argument, NULL, 0},             {"can-id-offset", required_argument, NULL, 0},
+    {"reply-timeout-us", required_argument, NULL, 0},
+    {"start-timeout-ms", required_argument, NULL, 0},
+    {"nv", required_argument, NULL, 0},              {"samples", required_argument, NULL, 0},
+    {"plan-seed", required_argument, NULL, 0},       {"run-seed", required_argument, NULL, 0},
+    {"hold-ticks", required_argument, NULL, 0},      {"params-out", required_argument, NULL, 0},
+    {"gpio-chip", required_argument, NULL, 0},       {"enc-lines", required_argument, NULL, 0},
+    {"gpio-watch", required_argument, NULL, 0},      {"gpio-timeout-ms", required_argument, NULL, 0},
+    {"gpio-stall-ms", required_argument, NULL, 0},   {"help", no_argument, NULL, 'h'},
+    {NULL, 0, NULL, 0}};
+
 static int parse_args(int argc, char **argv, options *o)
 {
     memset(o, 0, sizeof *o);
     o->port = "linux";
-    o->can = "vcan0";
     o->reply_timeout_us = 20000U;
     o->start_timeout_ms = 5000U;
     o->samples = 30U;
@@ -255,42 +281,63 @@ static int parse_args(int argc, char **argv, options *o)
     o->run_seed = 7U;
     o->hold_ticks = 200U;
     o->gpio_timeout_ms = 3000U;
-    /* The config file first, whatever its place: the command line overrides it. */
-    for (int i = 1; i < argc; ++i) {
-        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+    /* The options in their order; the config file is applied first, wherever it stands,
+     * so that the command line overrides it. */
+    const char *names[64];
+    const char *values[64];
+    size_t n = 0U;
+    const char *config = NULL;
+    opterr = 0; /* our own messages, in our words */
+    int index = -1;
+    int c;
+    while ((c = getopt_long(argc, argv, ":h", long_options, &index)) != -1) {
+        if (c == 'h') {
             fputs(help_text, stdout);
             return -1;
         }
-        if (strcmp(argv[i], "--config") == 0) {
-            if (i + 1 >= argc) {
-                return usage("%s needs a value", "--config");
-            }
-            const int rc = load_config(o, argv[i + 1]);
-            if (rc != 0) {
-                return rc;
-            }
+        if (c == ':') {
+            return usage("%s needs a value", argv[optind - 1]);
+        }
+        if (c == '?') {
+            const char *const bad = argv[optind - 1];
+            return usage("unknown option '%s'", bad + strspn(bad, "-"));
+        }
+        if (strcmp(long_options[index].name, "config") == 0) {
+            config = optarg;
+        } else if (n < sizeof names / sizeof names[0]) {
+            names[n] = long_options[index].name;
+            values[n++] = optarg;
+        } else {
+            return usage("%s", "too many options");
         }
     }
-    for (int i = 1; i < argc; ++i) {
-        if (strncmp(argv[i], "--", 2U) != 0) {
-            return usage("unexpected argument '%s'", argv[i]);
+    if (optind < argc) {
+        return usage("unexpected argument '%s'", argv[optind]);
+    }
+    if (config != NULL) {
+        const int rc = load_config(o, config);
+        if (rc != 0) {
+            return rc;
         }
-        if (i + 1 >= argc) {
-            return usage("%s needs a value", argv[i]);
+    }
+    for (size_t k = 0U; k < n; ++k) {
+        const int rc = set_option(o, names[k], values[k]);
+        if (rc != 0) {
+            return rc;
         }
-        if (strcmp(argv[i], "--config") != 0) {
-            const int rc = set_option(o, argv[i] + 2, argv[i + 1]);
-            if (rc != 0) {
-                return rc;
-            }
-        }
-        ++i;
     }
     if (strcmp(o->port, "linux") != 0 && strcmp(o->port, "sim") != 0) {
         return usage("--port: '%s' is neither linux nor sim", o->port);
     }
-    if (o->gpio_watch == 0U && o->scenario == NULL) {
-        return usage("%s", "--scenario is required (the machine's nominal data)");
+    if (o->gpio_watch == 0U && o->machine == NULL) {
+        return usage("%s", "--machine is required (the controller's machine file)");
+    }
+    if (o->gpio_watch == 0U && strcmp(o->port, "sim") == 0 && o->scenario == NULL) {
+        return usage("%s", "--port sim needs --scenario (the simulated arm)");
+    }
+    if (strcmp(o->port, "linux") == 0 && o->scenario != NULL) {
+        return usage("%s", "--scenario is the simulated arm of --port sim; the controller "
+                           "is configured by --machine");
     }
     if (o->gpio_watch == 0U && o->samples < 10U) {
         return usage("%s", "--samples: 10..128");
@@ -304,10 +351,42 @@ static int parse_args(int argc, char **argv, options *o)
     if (o->reply_timeout_us == 0U) {
         return usage("%s", "--reply-timeout-us must be > 0");
     }
-    if (o->nv == NULL && strcmp(o->port, "linux") == 0) {
-        o->nv = "dhcal-fw.nv";
-    }
     return 0;
+}
+
+/* What the command line and the config file leave open, the machine file gives: CAN
+ * interface and identifier offset, encoder lines, the store; then the defaults. */
+static void apply_machine(options *o, const dhcal_machine *m)
+{
+    if (o->can == NULL) {
+        o->can = m->can_interface[0] != '\0' ? m->can_interface : "vcan0";
+    }
+    if (!o->have_can_id_offset && m->has_can_id_offset) {
+        o->can_id_offset = m->can_id_offset;
+    }
+    if (o->gpio_chip == NULL && m->gpio_chip[0] != '\0') {
+        o->gpio_chip = m->gpio_chip;
+        o->enc_line[0] = m->gpio_lines[0];
+        o->enc_line[1] = m->gpio_lines[1];
+        o->have_lines = 1;
+    }
+    if (o->nv == NULL && strcmp(o->port, "linux") == 0) {
+        o->nv = m->store_path[0] != '\0' ? m->store_path : "dhcal-fw.nv";
+    }
+}
+
+/* The machine's raw-code conversions (fw_port.h): encoder counts per joint radian through
+ * the gear, the tacho at the joint, the wheel's mm per count. */
+static void machine_io_config(const dhcal_machine *m, fw_io_config *out)
+{
+    memset(out, 0, sizeof *out);
+    for (size_t j = 0U; j < m->n_joints; ++j) {
+        fw_io_set_joint(out, j, m->encoder_counts_per_rev[j], m->gear_ratio[j],
+                        m->tacho_v_s_per_rad[j]);
+    }
+    out->adc_v_full_scale = m->adc_range_v;
+    out->dac_v_full_scale = m->dac_range_v;
+    fw_io_set_wires(out, m->wire_wheel_radius_mm, m->wire_counts_per_rev, m->wire_zero_mm);
 }
 
 static double elapsed_s(const struct timespec *t0)
@@ -346,6 +425,24 @@ static int run_gpio_watch(const options *o)
 
 /* ---------------------------------------------------------------- the calibration run */
 
+/* SIGINT or SIGTERM received (its number): the run stops at the next tick. */
+static volatile sig_atomic_t stop_signal;
+
+static void on_stop_signal(int sig)
+{
+    stop_signal = sig;
+}
+
+static int install_stop_handlers(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_stop_signal;
+    (void)sigemptyset(&sa.sa_mask);
+    return sigaction(SIGINT, &sa, NULL) == 0 && sigaction(SIGTERM, &sa, NULL) == 0 ? 0 : -1;
+}
+
+static dhcal_machine machine;
 static dhs_scenario_file sf;
 static fw_sim sim;
 static fw_linux_can can_bus;
@@ -354,13 +451,37 @@ static fw_can_offset id_offset_wrap;
 static fw_linux_nv nv_file;
 static fw_port port;
 static fw_io_config io;
-static fw_ctrl ctrl;
-static fw_pose plan[FW_ACQ_MAX_SAMPLES];
-static dhc_sample samples[FW_ACQ_MAX_SAMPLES];
-static dhc_model nominal;
-static dhc_model final_model;
-static dhc_model geometric;
-static fw_autocal_result res;
+static fw_job job;
+static fw_port device_port; /* the port's own table; `port` checks for a stop first */
+
+/* A stop request ends the run at a tick boundary: the controller latches FW_FAULT_STOPPED,
+ * which commands 0 V to every drive, and the tick fails so that every step returns. */
+static fw_port_status stoppable_wait_tick(void *ctx, uint64_t *t_us)
+{
+    if (stop_signal != 0) {
+        if (job.ctrl.port != NULL) {
+            fw_ctrl_fault(&job.ctrl, FW_FAULT_STOPPED, 0U);
+        }
+        return FW_PORT_ERR_IO;
+    }
+    return device_port.wait_tick(ctx, t_us);
+}
+
+/* After a stop: every drive commanded to 0 V and disabled (the Enable bit of the CAN
+ * commands); the simulated drives of the sim port take the 0 V. */
+static void stop_drives(const options *o)
+{
+    uint16_t zero[DHC_MAX_JOINTS];
+    for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
+        zero[j] = fw_dac_code(&io, 0.0);
+    }
+    if (strcmp(o->port, "linux") == 0) {
+        link_.drive_enable = 0U;
+    }
+    if (device_port.write_dacs != NULL) {
+        (void)device_port.write_dacs(device_port.ctx, zero);
+    }
+}
 
 static int open_linux_port(const options *o)
 {
@@ -369,7 +490,7 @@ static int open_linux_port(const options *o)
     const uint32_t offset = (uint32_t)o->can_id_offset;
     uint32_t rx[FW_CAN_MAX_DRIVES + 1U];
     size_t n_rx = 0U;
-    for (size_t j = 0U; j < sf.sc.n_joints && j < FW_CAN_MAX_DRIVES; ++j) {
+    for (size_t j = 0U; j < machine.n_joints && j < FW_CAN_MAX_DRIVES; ++j) {
         rx[n_rx++] = fw_can_offset_bus_id(offset, FW_CAN_ID_DRIVE_FB_BASE + (uint32_t)j);
     }
     rx[n_rx++] = fw_can_offset_bus_id(offset, FW_CAN_ID_WIRES);
@@ -389,10 +510,11 @@ static int open_linux_port(const options *o)
         return EXIT_USAGE;
     }
     fw_can_link_config lc;
-    fw_can_link_default_config(&lc, sf.sc.n_joints);
+    fw_can_link_default_config(&lc, machine.n_joints);
     lc.reply_timeout_us = (uint32_t)o->reply_timeout_us;
     if (fw_can_link_init(&link_, &tr, &lc, &port) != FW_PORT_OK) {
-        fprintf(stderr, "dhcal-fw: the CAN link rejected %zu joints\n", sf.sc.n_joints);
+        fprintf(stderr, "dhcal-fw: %s: the CAN link rejected %zu joints (at most %u drives)\n",
+                o->machine, machine.n_joints, (unsigned)FW_CAN_MAX_DRIVES);
         return EXIT_USAGE;
     }
     return 0;
@@ -423,78 +545,95 @@ static void print_counters(void)
 }
 
 /* The JSON result. fault: the controller's (FW_FAULT_NONE when the run completed). */
-static void print_result(const options *o, fw_fault fault, size_t n_done, int calibrated,
-                         const struct timespec *t0)
+/* Returns 0 when --params-out (if asked for) could not be written, else 1. */
+static int print_result(const options *o, fw_fault fault, size_t n_done, int calibrated,
+                        const struct timespec *t0)
 {
+    int written = 1;
     const int is_linux = strcmp(o->port, "linux") == 0;
     printf("{\"mode\": \"calibrate\", \"port\": \"%s\", \"fault\": \"%s\", \"fault_index\": %zu, "
            "\"ticks\": %llu, \"samples\": %zu",
-           o->port, fw_fault_name(fault), fault != FW_FAULT_NONE ? ctrl.fault_index : 0U,
-           (unsigned long long)ctrl.ticks, n_done);
+           o->port, fw_fault_name(fault), fault != FW_FAULT_NONE ? job.ctrl.fault_index : 0U,
+           (unsigned long long)job.ctrl.ticks, n_done);
     if (fault != FW_FAULT_NONE) {
         /* What the controller last commanded: 0 V once the fault latched. */
-        printf(", \"drive_v_after_fault\": [%.6f, %.6f, %.6f]", ctrl.u_v[0], ctrl.u_v[1],
-               ctrl.u_v[2]);
+        printf(", \"drive_v_after_fault\": [");
+        for (size_t j = 0U; j < machine.n_joints; ++j) {
+            printf("%s%.6f", j > 0U ? ", " : "", job.ctrl.u_v[j]);
+        }
+        printf("]");
     }
     if (calibrated) {
         char effect[64];
-        if (!res.found) {
-            snprintf(effect, sizeof effect, "none");
-        } else if (dhc_effect_is_per_joint(res.effect)) {
-            snprintf(effect, sizeof effect, "%s:%zu", dhc_effect_name(res.effect),
-                     res.effect_joint + 1U);
-        } else {
-            snprintf(effect, sizeof effect, "%s", dhc_effect_name(res.effect));
-        }
+        (void)fw_autocal_effect_label(&job.result, effect, sizeof effect);
         printf(", \"effect\": \"%s\", \"geometric_rms_mm\": %.9f, \"wire_rms_mm\": %.9f, "
                "\"saved\": %d, \"seq\": %u, \"params\": {",
-               effect, res.geo.rms_mm, res.new_rms_mm, res.saved, (unsigned)res.seq);
+               effect, job.result.geo.rms_mm, job.result.new_rms_mm, job.result.saved, (unsigned)job.result.seq);
         dhc_param_set set;
-        (void)dhc_params_base_model(&set, &final_model);
-        if (res.found) {
-            (void)dhc_params_add_effect(&set, &final_model, res.effect, res.effect_joint);
-        }
-        FILE *pf = o->params_out != NULL ? fopen(o->params_out, "w") : NULL;
+        (void)fw_job_param_set(&job, &set);
+        dhcal_text params = {0};
         for (size_t k = 0U; k < set.count; ++k) {
             char name[64];
             (void)dhc_params_name(&set, k, name, sizeof name);
-            const double v = dhc_params_value(&set, &final_model, k);
+            const double v = dhc_params_value(&set, &job.calibrated, k);
             printf("%s\"%s\": %.17g", k > 0U ? ", " : "", name, v);
-            if (pf != NULL) {
-                fprintf(pf, "%s %.17g\n", name, v);
-            }
-        }
-        if (pf != NULL) {
-            (void)fclose(pf);
+            dhcal_text_printf(&params, "%s %.17g\n", name, v);
         }
         printf("}");
+        /* Replaced whole or left as it was: a reader never sees half a parameter file. */
+        if (o->params_out != NULL) {
+            dhcal_error err = {0};
+            if (params.failed) {
+                (void)snprintf(err.msg, sizeof err.msg, "%s: out of memory", o->params_out);
+                written = 0;
+            } else if (dhcal_file_write_atomic(o->params_out, params.p, params.len, &err) !=
+                       DHCAL_IO_OK) {
+                written = 0;
+            }
+            if (!written) {
+                fprintf(stderr, "dhcal-fw: --params-out: %s\n", err.msg);
+            }
+        }
+        free(params.p);
     }
     if (is_linux) {
         print_counters();
+    } else {
+        /* the simulated drives' last commands, as codes (2048: 0 V) */
+        printf(", \"plant_dac\": [");
+        for (size_t j = 0U; j < machine.n_joints; ++j) {
+            printf("%s%u", j > 0U ? ", " : "", (unsigned)sim.plant.dac[j]);
+        }
+        printf("]");
     }
     printf(", \"elapsed_s\": %.3f}\n", elapsed_s(t0));
     fflush(stdout);
+    return written;
 }
 
-static int run_calibration(const options *o)
+static int run_calibration(options *o)
 {
     struct timespec t0;
     (void)clock_gettime(CLOCK_MONOTONIC, &t0);
     dhcal_error err;
     memset(&err, 0, sizeof err);
-    if (dhs_scenario_load(o->scenario, &sf, &err) != DHCAL_IO_OK ||
-        dhcal_model_to_lib(&sf.model, sf.model_path, &nominal, &err) != DHCAL_IO_OK) {
+    if (dhcal_machine_load(o->machine, &machine, &err) != DHCAL_IO_OK) {
         fprintf(stderr, "dhcal-fw: %s\n", err.msg);
         return EXIT_USAGE;
     }
-    if (sf.sc.n_joints != 3U || !nominal.measurer.present) {
-        fprintf(stderr, "dhcal-fw: %s: the machine must be a 3-joint arm with a measurer\n",
-                o->scenario);
-        return EXIT_USAGE;
+    apply_machine(o, &machine);
+    machine_io_config(&machine, &io);
+    if (strcmp(o->port, "sim") == 0) {
+        if (dhs_scenario_load(o->scenario, &sf, &err) != DHCAL_IO_OK) {
+            fprintf(stderr, "dhcal-fw: %s\n", err.msg);
+            return EXIT_USAGE;
+        }
+        if (sf.sc.n_joints != machine.n_joints) {
+            fprintf(stderr, "dhcal-fw: %s: a %zu-joint arm for the %zu-joint machine %s\n",
+                    o->scenario, sf.sc.n_joints, machine.n_joints, o->machine);
+            return EXIT_USAGE;
+        }
     }
-    /* The start pose and the counters' homing are the sim run's (dhcal-demo's). */
-    const double q_start[3] = {0.0, 60.0 * FW_PI / 180.0, -60.0 * FW_PI / 180.0};
-    fw_sim_io_config(&sf.sc, &io);
     int rc = 0;
     if (o->gpio_chip != NULL) {
         /* Encoder lines configured: a missing chip or line is a configuration error now,
@@ -510,7 +649,7 @@ static int run_calibration(const options *o)
         fw_linux_gpio_close(&enc);
     }
     if (strcmp(o->port, "sim") == 0) {
-        if (fw_sim_init(&sim, &sf.sc, o->run_seed, q_start, &port) != DHC_OK) {
+        if (fw_sim_init(&sim, &sf.sc, o->run_seed, machine.start_pose_rad, &port) != DHC_OK) {
             fprintf(stderr, "dhcal-fw: the scenario was rejected by the plant\n");
             return EXIT_USAGE;
         }
@@ -521,57 +660,54 @@ static int run_calibration(const options *o)
         fw_linux_can_close(&can_bus);
         return rc;
     }
-    fw_ctrl_config cfg;
-    fw_ctrl_default_config(&cfg, 3U);
-    fw_ctrl_config_limits(&cfg, &nominal.arm);
-    dhc_sample s0;
-    memset(&s0, 0, sizeof s0);
-    s0.kind = (uint8_t)DHC_MEAS_WIRES;
-    memcpy(s0.q_rad, q_start, sizeof q_start);
-    s0.dir[0] = s0.dir[1] = s0.dir[2] = 1;
-    s0.temp_c = nominal.thermal_ref_c;
-    dhc_prediction pr;
-    if (dhc_model_predict(&nominal, &s0, &pr) != DHC_OK) {
-        fprintf(stderr, "dhcal-fw: the nominal model cannot predict the start pose\n");
-        return EXIT_FAULT;
+    device_port = port;
+    port.wait_tick = stoppable_wait_tick;
+    fw_job_config jc;
+    fw_job_default_config(&jc, &machine.model);
+    memcpy(jc.q_start_rad, machine.start_pose_rad, sizeof jc.q_start_rad);
+    if (machine.has_speed_limit) {
+        jc.ctrl.v_max_rad_s = machine.max_speed_rad_s;
     }
+    if (machine.has_accel_limit) {
+        jc.ctrl.a_max_rad_s2 = machine.max_accel_rad_s2;
+    }
+    jc.n_samples = (size_t)o->samples;
+    jc.plan_seed = (uint32_t)o->plan_seed;
+    jc.hold_ticks = (uint32_t)o->hold_ticks;
     fw_fault fault = FW_FAULT_NONE;
     if (strcmp(o->port, "linux") == 0) {
         /* The drives may come up after us: repeat SYNC 0 until they answer. */
         const uint64_t tries = o->start_timeout_ms * 1000U / o->reply_timeout_us + 1U;
         fw_port_status ps = FW_PORT_ERR_TIMEOUT;
-        for (uint64_t k = 0U; k < tries && ps == FW_PORT_ERR_TIMEOUT; ++k) {
+        for (uint64_t k = 0U; k < tries && ps == FW_PORT_ERR_TIMEOUT && stop_signal == 0; ++k) {
             ps = fw_can_link_start(&link_);
         }
-        if (ps != FW_PORT_OK) {
+        if (stop_signal != 0) {
+            fault = FW_FAULT_STOPPED;
+        } else if (ps != FW_PORT_OK) {
             fault = ps == FW_PORT_ERR_TIMEOUT ? FW_FAULT_PORT_TIMEOUT : FW_FAULT_PORT_IO;
             fprintf(stderr, "dhcal-fw: no answer from the drives on %s\n", o->can);
         }
     }
     if (fault == FW_FAULT_NONE) {
-        fault = fw_ctrl_init(&ctrl, &port, &io, &cfg, q_start, pr.wire_mm);
+        fault = fw_job_run(&job, &jc, &machine.model, &port, &io, &port.nv);
     }
-    size_t n_done = 0U;
-    if (fault == FW_FAULT_NONE) {
-        const size_t n_plan = fw_plan_poses(&nominal, (size_t)o->samples,
-                                            (uint32_t)o->plan_seed, 0, plan);
-        fault = fw_acquire(&ctrl, &nominal, plan, n_plan, (uint32_t)o->hold_ticks, samples,
-                           &n_done);
+    if (stop_signal != 0) {
+        fault = FW_FAULT_STOPPED;
+        stop_drives(o);
+        fprintf(stderr, "dhcal-fw: %s: drives commanded to 0 V and disabled\n",
+                stop_signal == SIGINT ? "SIGINT" : "SIGTERM");
     }
-    int calibrated = 0;
-    if (fault == FW_FAULT_NONE) {
-        final_model = nominal;
-        fault = fw_autocal(&final_model, samples, n_done, &port.nv, &geometric, &res);
-        calibrated = fault == FW_FAULT_NONE || fault == FW_FAULT_STORAGE;
-    }
+    const size_t n_done = job.n_samples;
+    const int calibrated = job.calibrated_ok;
     if (fault != FW_FAULT_NONE) {
         fprintf(stderr, "dhcal-fw: fault %s (index %zu) after %zu samples\n",
-                fw_fault_name(fault), ctrl.fault_index, n_done);
+                fw_fault_name(fault), job.ctrl.fault_index, n_done);
     }
-    print_result(o, fault, n_done, calibrated, &t0);
+    const int written = print_result(o, fault, n_done, calibrated, &t0);
     fw_linux_nv_close(&nv_file);
     fw_linux_can_close(&can_bus);
-    return fault == FW_FAULT_NONE ? 0 : EXIT_FAULT;
+    return fault == FW_FAULT_NONE && written ? 0 : EXIT_FAULT;
 }
 
 int main(int argc, char **argv)
@@ -583,5 +719,10 @@ int main(int argc, char **argv)
     }
     nv_file.fd = -1;
     can_bus.fd = -1;
+    if (install_stop_handlers() != 0) {
+        fprintf(stderr, "dhcal-fw: cannot install the SIGINT/SIGTERM handlers: %s\n",
+                strerror(errno));
+        return EXIT_FAULT;
+    }
     return o.gpio_watch > 0U ? run_gpio_watch(&o) : run_calibration(&o);
 }

@@ -13,17 +13,24 @@
  * encoder quantisation and the measured wire noise, fw_autocal_config), the fit is
  * generalized least squares: J^T J becomes J^T W J, each sample's rows whitened like the
  * fit's (dhc_sample_whiten), and s is the fit's unit-free sigma, so C is again the
- * covariance of the parameters the fit identified. */
+ * covariance of the parameters the fit identified. lib computes it (dhc_uncertainty.h). */
+#ifndef _POSIX_C_SOURCE
+#define _POSIX_C_SOURCE 200809L /* open_memstream */
+#endif
+
+#include <getopt.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "dhcal/dhc_params.h"
-#include "dhcal_fw/fw_acquire.h"
+#include "dhcal/dhc_uncertainty.h"
 #include "dhcal_fw/fw_calstore.h"
 #include "dhcal_fw/fw_controller.h"
 #include "dhcal_fw/fw_ik.h"
+#include "dhcal_fw/fw_job.h"
+#include "dhcal_file.h"
 #include "dhcal_io.h"
 #include "dhcal_model_map.h"
 #include "dhcal_sim/dhs_scenario_json.h"
@@ -35,12 +42,9 @@ static dhs_scenario_file sf;
 static fw_sim sim;
 static fw_port port;
 static fw_io_config io;
-static fw_ctrl ctrl;
-static dhc_sample samples[FW_ACQ_MAX_SAMPLES];
-static fw_pose plan[FW_ACQ_MAX_SAMPLES];
+static fw_job job;
 static fw_pose targets_pose[MAX_TARGETS];
 static dhc_model nominal;
-static dhc_model geometric;
 static dhc_model final_model;
 
 typedef struct {
@@ -85,10 +89,10 @@ static int run_targets(const dhc_model *model, size_t n, uint32_t seed, phase_re
             ++r->failed;
             continue;
         }
-        if (fw_ctrl_move_to(&ctrl, q, NULL) != FW_FAULT_NONE ||
-            fw_ctrl_hold(&ctrl, 100U, NULL) != FW_FAULT_NONE) {
-            fprintf(stderr, "dhcal-demo: fault %s (index %zu)\n", fw_fault_name(ctrl.fault),
-                    ctrl.fault_index);
+        if (fw_ctrl_move_to(&job.ctrl, q, NULL) != FW_FAULT_NONE ||
+            fw_ctrl_hold(&job.ctrl, 100U, NULL) != FW_FAULT_NONE) {
+            fprintf(stderr, "dhcal-demo: fault %s (index %zu)\n",
+                    fw_fault_name(job.ctrl.fault), job.ctrl.fault_index);
             return -1;
         }
         dhs_plant_truth t;
@@ -110,189 +114,41 @@ static int run_targets(const dhc_model *model, size_t n, uint32_t seed, phase_re
 
 /* ---------------------------------------------------------------- noise floor */
 
-static double jw[FW_ACQ_MAX_SAMPLES * 3U][DHC_MAX_PARAMS];
-static double nmat[DHC_MAX_PARAMS][DHC_MAX_PARAMS];
-static double cov[DHC_MAX_PARAMS][DHC_MAX_PARAMS];
-
-static int prediction(const dhc_model *m, const dhc_sample *s, double out[3], int wires)
+static dhc_status read_job_sample(void *ctx, size_t index, dhc_sample *out)
 {
-    dhc_sample t = *s;
-    t.kind = (uint8_t)(wires ? DHC_MEAS_WIRES : DHC_MEAS_POSITION);
-    dhc_prediction pr;
-    if (dhc_model_predict(m, &t, &pr) != DHC_OK) {
-        return -1;
+    const fw_job *j = ctx;
+    if (index >= j->n_samples) {
+        return DHC_ERR_ARGUMENT;
     }
-    memcpy(out, wires ? pr.wire_mm : pr.p_mm, 3U * sizeof(double));
-    return 0;
+    *out = j->samples[index];
+    return DHC_OK;
 }
 
-/* d(out)/d(param k) by central differences, for the parameters flagged in use. */
-static int sens(const dhc_model *m, const dhc_param_set *set, const dhc_sample *s, int wires,
-                size_t k, double d[3])
-{
-    static dhc_model tmp;
-    double delta[DHC_MAX_PARAMS] = {0.0};
-    const double h = dhc_params_is_angle(set, k) ? 1e-6 : 1e-4;
-    double a[3];
-    double b[3];
-    delta[k] = h;
-    tmp = *m;
-    if (dhc_params_apply(set, &tmp, delta, set->count) != DHC_OK || prediction(&tmp, s, a, wires)) {
-        return -1;
-    }
-    delta[k] = -h;
-    tmp = *m;
-    if (dhc_params_apply(set, &tmp, delta, set->count) != DHC_OK || prediction(&tmp, s, b, wires)) {
-        return -1;
-    }
-    for (size_t r = 0U; r < 3U; ++r) {
-        d[r] = (a[r] - b[r]) / (2.0 * h);
-    }
-    return 0;
-}
-
-/* Inverse of the identifiable block of the normal matrix (Gauss-Jordan, scaled). */
-static int invert(size_t p, const uint8_t *use)
-{
-    static double a[DHC_MAX_PARAMS][2U * DHC_MAX_PARAMS];
-    size_t idx[DHC_MAX_PARAMS];
-    size_t q = 0U;
-    for (size_t k = 0U; k < p; ++k) {
-        if (use[k]) {
-            idx[q++] = k;
-        }
-    }
-    double sc[DHC_MAX_PARAMS];
-    for (size_t i = 0U; i < q; ++i) {
-        sc[i] = 1.0 / sqrt(nmat[idx[i]][idx[i]]);
-    }
-    for (size_t i = 0U; i < q; ++i) {
-        for (size_t j = 0U; j < q; ++j) {
-            a[i][j] = nmat[idx[i]][idx[j]] * sc[i] * sc[j];
-            a[i][q + j] = i == j ? 1.0 : 0.0;
-        }
-    }
-    for (size_t c = 0U; c < q; ++c) {
-        size_t piv = c;
-        for (size_t r = c + 1U; r < q; ++r) {
-            if (fabs(a[r][c]) > fabs(a[piv][c])) {
-                piv = r;
-            }
-        }
-        if (!(fabs(a[piv][c]) > 1e-14)) {
-            return -1;
-        }
-        for (size_t j = 0U; j < 2U * q; ++j) {
-            const double t = a[c][j];
-            a[c][j] = a[piv][j];
-            a[piv][j] = t;
-        }
-        const double f = 1.0 / a[c][c];
-        for (size_t j = 0U; j < 2U * q; ++j) {
-            a[c][j] *= f;
-        }
-        for (size_t r = 0U; r < q; ++r) {
-            if (r != c) {
-                const double g = a[r][c];
-                for (size_t j = 0U; j < 2U * q; ++j) {
-                    a[r][j] -= g * a[c][j];
-                }
-            }
-        }
-    }
-    memset(cov, 0, sizeof cov);
-    for (size_t i = 0U; i < q; ++i) {
-        for (size_t j = 0U; j < q; ++j) {
-            cov[idx[i]][idx[j]] = a[i][q + j] * sc[i] * sc[j];
-        }
-    }
-    return 0;
-}
-
-static double noise_floor(const dhc_model *m, const dhc_param_set *set, const uint8_t *use,
-                          double sigma, size_t n, const phase_result *r,
+/* The noise floor (see the top of this file): lib's positioning uncertainty of the final
+ * fit at each target of phase r, with one encoder count per joint (uniform: sd = count /
+ * sqrt(12)) for the servo's resolution. */
+static double noise_floor(const dhc_model *m, const dhc_param_set *set,
+                          const dhc_calib_report *fit, const phase_result *r,
                           const fw_autocal_result *res)
 {
-    const size_t p = set->count;
-    static double rows_buf[3U * DHC_MAX_PARAMS];
-    for (size_t i = 0U; i < n; ++i) {
-        dhc_mat rows;
-        if (dhc_mat_init(&rows, 3U, p, rows_buf, sizeof rows_buf / sizeof rows_buf[0]) != DHC_OK) {
-            return (double)NAN;
-        }
-        for (size_t k = 0U; k < p; ++k) {
-            double d[3] = {0.0, 0.0, 0.0};
-            if (use[k] && sens(m, set, &samples[i], 1, k, d) != 0) {
-                return (double)NAN;
-            }
-            for (size_t row = 0U; row < 3U; ++row) {
-                DHC_MAT_AT(&rows, row, k) = d[row];
-            }
-        }
-        /* the fit's weighting (nothing when its noise model was off) */
-        double dummy_r[DHC_MAX_ROWS_PER_SAMPLE] = {0.0};
-        if (dhc_sample_whiten(m, &samples[i], res->joint_noise_rad, res->meas_noise_mm, 1000.0,
-                              dummy_r, &rows) != DHC_OK) {
-            return (double)NAN;
-        }
-        for (size_t row = 0U; row < 3U; ++row) {
-            for (size_t k = 0U; k < p; ++k) {
-                jw[3U * i + row][k] = DHC_MAT_AT(&rows, row, k);
-            }
-        }
-    }
-    memset(nmat, 0, sizeof nmat);
-    for (size_t row = 0U; row < 3U * n; ++row) {
-        for (size_t a = 0U; a < p; ++a) {
-            for (size_t b = 0U; b < p; ++b) {
-                nmat[a][b] += jw[row][a] * jw[row][b];
-            }
-        }
-    }
-    if (invert(p, use) != 0) {
+    static dhc_uncertainty unc;
+    if (dhc_uncertainty_from_samples(&unc, m, set, fit->identifiable, read_job_sample, &job,
+                                     job.n_samples, res->joint_noise_rad, res->meas_noise_mm,
+                                     1000.0, fit->sigma) != DHC_OK) {
         return (double)NAN;
+    }
+    double encoder_sd[DHC_MAX_JOINTS] = {0.0};
+    for (size_t j = 0U; j < m->arm.n_joints; ++j) {
+        encoder_sd[j] = 1.0 / (io.counts_per_rad[j] * sqrt(12.0));
     }
     double ss = 0.0;
     for (size_t t = 0U; t < r->n; ++t) {
-        dhc_sample s;
-        memset(&s, 0, sizeof s);
-        s.temp_c = m->thermal_ref_c;
-        memcpy(s.q_rad, r->q[t], sizeof s.q_rad);
-        for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
-            s.dir[j] = 1;
-        }
-        double jp[DHC_MAX_PARAMS][3];
-        for (size_t k = 0U; k < p; ++k) {
-            jp[k][0] = jp[k][1] = jp[k][2] = 0.0;
-            if (use[k] && sens(m, set, &s, 0, k, jp[k]) != 0) {
-                return (double)NAN;
-            }
-        }
         double var = 0.0;
-        for (size_t c = 0U; c < 3U; ++c) {
-            for (size_t a = 0U; a < p; ++a) {
-                for (size_t b = 0U; b < p; ++b) {
-                    var += jp[a][c] * cov[a][b] * jp[b][c];
-                }
-            }
+        if (dhc_uncertainty_tool_point(&unc, m, set, r->q[t], NULL, encoder_sd, &var) !=
+            DHC_OK) {
+            return (double)NAN;
         }
-        /* encoder resolution: one count per joint, uniform (variance 1/12 count^2) */
-        double enc = 0.0;
-        for (size_t j = 0U; j < m->arm.n_joints; ++j) {
-            double qp[DHC_MAX_JOINTS];
-            double pa[3];
-            double pb[3];
-            const double h = 1.0 / io.counts_per_rad[j];
-            memcpy(qp, r->q[t], sizeof qp);
-            qp[j] += 0.5 * h;
-            predict_point(m, qp, pa);
-            qp[j] -= h;
-            predict_point(m, qp, pb);
-            for (size_t c = 0U; c < 3U; ++c) {
-                enc += (pa[c] - pb[c]) * (pa[c] - pb[c]) / 12.0;
-            }
-        }
-        ss += sigma * sigma * var + enc;
+        ss += var;
     }
     return r->n > 0U ? sqrt(ss / (double)r->n) : (double)NAN;
 }
@@ -307,7 +163,7 @@ static void where_it_fails(const dhc_model *m, size_t n, FILE *log)
     for (size_t i = 0U; i < n; ++i) {
         double r[DHC_MAX_ROWS_PER_SAMPLE];
         size_t rows = 0U;
-        if (dhc_model_residual(m, &samples[i], 1000.0, r, &rows) != DHC_OK) {
+        if (dhc_model_residual(m, &job.samples[i], 1000.0, r, &rows) != DHC_OK) {
             continue;
         }
         double e = 0.0;
@@ -329,41 +185,67 @@ static void where_it_fails(const dhc_model *m, size_t n, FILE *log)
     }
     fprintf(log, "    the geometric model fails most at (q deg -> |wire residual| mm):\n");
     for (size_t k = 0U; k < 3U && wv[k] >= 0.0; ++k) {
-        const dhc_sample *s = &samples[worst[k]];
+        const dhc_sample *s = &job.samples[worst[k]];
         fprintf(log, "      (%7.1f %7.1f %7.1f) -> %.4f\n", s->q_rad[0] * 180.0 / DHC_PI,
                 s->q_rad[1] * 180.0 / DHC_PI, s->q_rad[2] * 180.0 / DHC_PI, wv[k]);
     }
 }
 
-static void effect_label(const fw_autocal_result *res, char *buf, size_t cap)
+/* path := the text f received (an open_memstream), replaced whole (io's atomic write). */
+static int finish_file(const char *path, FILE *f, char **text, size_t *len)
 {
-    if (!res->found) {
-        snprintf(buf, cap, "none");
-    } else if (dhc_effect_is_per_joint(res->effect)) {
-        snprintf(buf, cap, "%s:%zu", dhc_effect_name(res->effect), res->effect_joint + 1U);
-    } else {
-        snprintf(buf, cap, "%s", dhc_effect_name(res->effect));
+    const int bad = ferror(f);
+    if (fclose(f) != 0 || bad || *text == NULL) {
+        free(*text);
+        *text = NULL;
+        fprintf(stderr, "dhcal-demo: %s: out of memory\n", path);
+        return -1;
     }
+    dhcal_error err;
+    memset(&err, 0, sizeof err);
+    const int rc = dhcal_file_write_atomic(path, *text, *len, &err);
+    free(*text);
+    *text = NULL;
+    if (rc != DHCAL_IO_OK) {
+        fprintf(stderr, "dhcal-demo: %s\n", err.msg);
+        return -1;
+    }
+    return 0;
 }
 
 static int write_outputs(const char *dir, size_t n, const char *effect)
 {
+    const size_t nj = nominal.arm.n_joints;
     char path[4200];
+    char *text = NULL;
+    size_t len = 0U;
     snprintf(path, sizeof path, "%s/samples.csv", dir);
-    FILE *f = fopen(path, "w");
+    FILE *f = open_memstream(&text, &len);
     if (f == NULL) {
         return -1;
     }
-    fprintf(f, "q1,q2,q3,dir1,dir2,dir3,L1,L2,L3\n");
-    for (size_t i = 0U; i < n; ++i) {
-        fprintf(f, "%.9f,%.9f,%.9f,%d,%d,%d,%.6f,%.6f,%.6f\n", samples[i].q_rad[0] * 180.0 / DHC_PI,
-                samples[i].q_rad[1] * 180.0 / DHC_PI, samples[i].q_rad[2] * 180.0 / DHC_PI,
-                samples[i].dir[0], samples[i].dir[1], samples[i].dir[2], samples[i].wire_mm[0],
-                samples[i].wire_mm[1], samples[i].wire_mm[2]);
+    for (size_t j = 0U; j < nj; ++j) {
+        fprintf(f, "q%zu,", j + 1U);
     }
-    fclose(f);
+    for (size_t j = 0U; j < nj; ++j) {
+        fprintf(f, "dir%zu,", j + 1U);
+    }
+    fprintf(f, "L1,L2,L3\n");
+    for (size_t i = 0U; i < n; ++i) {
+        const dhc_sample *s = &job.samples[i];
+        for (size_t j = 0U; j < nj; ++j) {
+            fprintf(f, "%.9f,", s->q_rad[j] * 180.0 / DHC_PI);
+        }
+        for (size_t j = 0U; j < nj; ++j) {
+            fprintf(f, "%d,", s->dir[j]);
+        }
+        fprintf(f, "%.6f,%.6f,%.6f\n", s->wire_mm[0], s->wire_mm[1], s->wire_mm[2]);
+    }
+    if (finish_file(path, f, &text, &len) != 0) {
+        return -1;
+    }
     snprintf(path, sizeof path, "%s/positioning.csv", dir);
-    f = fopen(path, "w");
+    f = open_memstream(&text, &len);
     if (f == NULL) {
         return -1;
     }
@@ -375,12 +257,59 @@ static int write_outputs(const char *dir, size_t n, const char *effect)
                     ph[k].target[i][1], ph[k].target[i][2], ph[k].err[i]);
         }
     }
-    fclose(f);
+    return finish_file(path, f, &text, &len);
+}
+
+static const char *const usage_text =
+    "usage: dhcal-demo --scenario S.json [--json] [--out DIR] [--samples N] [--targets N]\n"
+    "                  [--mixed-directions] [--effects LIST] [--no-diagnose] [--unweighted]\n"
+    "  --effects LIST   the controller's configured effects, fitted in every calibration\n"
+    "                   (e.g. joint_compliance:2,measurer_scale)\n"
+    "  --no-diagnose    fit only those; do not look for a missing one\n"
+    "  --unweighted     no noise model (encoder quantisation, wire noise): plain least "
+    "squares\n";
+
+/* A count in 0..max, digits only. */
+static int parse_count(const char *s, size_t max, size_t *out)
+{
+    if (s == NULL || *s < '0' || *s > '9') {
+        return -1;
+    }
+    char *end = NULL;
+    const unsigned long long v = strtoull(s, &end, 10);
+    if (*end != '\0' || v > max) {
+        return -1;
+    }
+    *out = (size_t)v;
     return 0;
 }
 
+enum {
+    OPT_JSON = 256,
+    OPT_SCENARIO,
+    OPT_MIXED,
+    OPT_OUT,
+    OPT_SAMPLES,
+    OPT_TARGETS,
+    OPT_EFFECTS,
+    OPT_NO_DIAGNOSE,
+    OPT_UNWEIGHTED
+};
+
 int main(int argc, char **argv)
 {
+    static const struct option long_options[] = {
+        {"json", no_argument, NULL, OPT_JSON},
+        {"scenario", required_argument, NULL, OPT_SCENARIO},
+        {"mixed-directions", no_argument, NULL, OPT_MIXED},
+        {"out", required_argument, NULL, OPT_OUT},
+        {"samples", required_argument, NULL, OPT_SAMPLES},
+        {"targets", required_argument, NULL, OPT_TARGETS},
+        {"effects", required_argument, NULL, OPT_EFFECTS},
+        {"no-diagnose", no_argument, NULL, OPT_NO_DIAGNOSE},
+        {"unweighted", no_argument, NULL, OPT_UNWEIGHTED},
+        {"help", no_argument, NULL, 'h'},
+        {NULL, 0, NULL, 0}};
     const char *scenario = NULL;
     const char *out_dir = NULL;
     int json = 0;
@@ -391,39 +320,65 @@ int main(int argc, char **argv)
     fw_autocal_default_config(&autocal);
     const char *effects = NULL;
     int weighted = 1;
-    for (int i = 1; i < argc; ++i) {
-        if (strcmp(argv[i], "--json") == 0) {
+    opterr = 0;
+    int c;
+    while ((c = getopt_long(argc, argv, ":h", long_options, NULL)) != -1) {
+        int bad = 0;
+        switch (c) {
+        case OPT_JSON:
             json = 1;
-        } else if (strcmp(argv[i], "--scenario") == 0 && i + 1 < argc) {
-            scenario = argv[++i];
-        } else if (strcmp(argv[i], "--mixed-directions") == 0) {
+            break;
+        case OPT_SCENARIO:
+            scenario = optarg;
+            break;
+        case OPT_MIXED:
             mixed_dirs = 1;
-        } else if (strcmp(argv[i], "--out") == 0 && i + 1 < argc) {
-            out_dir = argv[++i];
-        } else if (strcmp(argv[i], "--samples") == 0 && i + 1 < argc) {
-            n_samples = (size_t)strtoul(argv[++i], NULL, 10);
-        } else if (strcmp(argv[i], "--targets") == 0 && i + 1 < argc) {
-            n_targets = (size_t)strtoul(argv[++i], NULL, 10);
-        } else if (strcmp(argv[i], "--effects") == 0 && i + 1 < argc) {
-            effects = argv[++i];
-        } else if (strcmp(argv[i], "--no-diagnose") == 0) {
+            break;
+        case OPT_OUT:
+            out_dir = optarg;
+            break;
+        case OPT_SAMPLES:
+            bad = parse_count(optarg, FW_ACQ_MAX_SAMPLES, &n_samples);
+            break;
+        case OPT_TARGETS:
+            bad = parse_count(optarg, MAX_TARGETS, &n_targets);
+            break;
+        case OPT_EFFECTS:
+            effects = optarg;
+            break;
+        case OPT_NO_DIAGNOSE:
             autocal.diagnose = 0;
-        } else if (strcmp(argv[i], "--unweighted") == 0) {
+            break;
+        case OPT_UNWEIGHTED:
             weighted = 0;
-        } else {
-            fprintf(stderr,
-                    "usage: dhcal-demo --scenario S.json [--json] [--out DIR] [--samples N] "
-                    "[--targets N] [--mixed-directions] [--effects LIST] [--no-diagnose]\n"
-                    "       [--unweighted]\n"
-                    "  --effects LIST   the controller's configured effects, fitted in every "
-                    "calibration\n                   (e.g. joint_compliance:2,measurer_scale)\n"
-                    "  --no-diagnose    fit only those; do not look for a missing one\n"
-                    "  --unweighted     no noise model (encoder quantisation, wire noise): "
-                    "plain least squares\n");
+            break;
+        case 'h':
+            fputs(usage_text, stdout);
+            return 0;
+        case ':':
+            fprintf(stderr, "dhcal-demo: %s needs a value\n", argv[optind - 1]);
+            bad = 1;
+            break;
+        default:
+            fprintf(stderr, "dhcal-demo: unknown option '%s'\n", argv[optind - 1]);
+            bad = 1;
+            break;
+        }
+        if (bad) {
+            if (c == OPT_SAMPLES || c == OPT_TARGETS) {
+                fprintf(stderr, "dhcal-demo: %s: '%s' is not a count in 0..%u\n",
+                        c == OPT_SAMPLES ? "--samples" : "--targets", optarg,
+                        c == OPT_SAMPLES ? FW_ACQ_MAX_SAMPLES : MAX_TARGETS);
+            }
+            fputs(usage_text, stderr);
             return 2;
         }
     }
-    /* The configured effects, comma separated, in DESIGN.md's names. */
+    if (optind < argc) {
+        fprintf(stderr, "dhcal-demo: unexpected argument '%s'\n%s", argv[optind], usage_text);
+        return 2;
+    }
+    /* The configured effects, comma separated, by their names in docs/effects.md. */
     for (const char *e = effects; e != NULL && *e != '\0';) {
         const char *comma = strchr(e, ',');
         const size_t len = comma != NULL ? (size_t)(comma - e) : strlen(e);
@@ -448,31 +403,30 @@ int main(int argc, char **argv)
     if (dhs_scenario_load(scenario, &sf, &err) != DHCAL_IO_OK ||
         dhcal_model_to_lib(&sf.model, sf.model_path, &nominal, &err) != DHCAL_IO_OK) {
         fprintf(stderr, "dhcal-demo: %s\n", err.msg);
-        return 1;
+        return 2;
     }
     const double q_start[3] = {0.0, 60.0 * DHC_PI / 180.0, -60.0 * DHC_PI / 180.0};
     if (sf.sc.n_joints != 3U || !nominal.measurer.present ||
         fw_sim_init(&sim, &sf.sc, 7U, q_start, &port) != DHC_OK) {
-        fprintf(stderr, "dhcal-demo: the scenario must be a 3-joint arm with a measurer\n");
-        return 1;
+        fprintf(stderr, "dhcal-demo: %s: the scenario must be a 3-joint arm with a measurer\n",
+                scenario);
+        return 2;
     }
     fw_sim_io_config(&sf.sc, &io);
+    fw_job_config jc;
+    fw_job_default_config(&jc, &nominal);
+    memcpy(jc.q_start_rad, q_start, sizeof q_start);
+    jc.n_samples = n_samples;
+    jc.plan_seed = 4242U;
+    jc.mixed_dirs = mixed_dirs;
+    jc.hold_ticks = 200U;
     /* the calibration's noise model: encoder quantisation from the io configuration, the
-     * wires' noise measured over the holds (fw_acquire_wire_noise_mm) */
-    autocal.io = weighted ? &io : NULL;
-    fw_ctrl_config cfg;
-    fw_ctrl_default_config(&cfg, 3U);
-    fw_ctrl_config_limits(&cfg, &nominal.arm);
-    /* wire counters: homed near the lengths the nominal model expects at the start pose */
-    dhc_sample s0;
-    memset(&s0, 0, sizeof s0);
-    memcpy(s0.q_rad, q_start, sizeof q_start);
-    s0.dir[0] = s0.dir[1] = s0.dir[2] = 1;
-    s0.temp_c = nominal.thermal_ref_c;
-    double w0[3];
-    if (prediction(&nominal, &s0, w0, 1) != 0 ||
-        fw_ctrl_init(&ctrl, &port, &io, &cfg, q_start, w0) != FW_FAULT_NONE) {
-        fprintf(stderr, "dhcal-demo: controller init failed: %s\n", fw_fault_name(ctrl.fault));
+     * wires' noise measured over the holds (fw_acq_wire_noise_mm) */
+    jc.noise_model = weighted;
+    jc.autocal = autocal;
+    if (fw_job_boot(&job, &jc, &nominal, &port, &io) != FW_FAULT_NONE) {
+        fprintf(stderr, "dhcal-demo: controller init failed: %s\n",
+                fw_fault_name(job.ctrl.fault));
         return 1;
     }
     FILE *log = json ? stderr : stdout;
@@ -485,64 +439,60 @@ int main(int argc, char **argv)
             ph[0].n, ph[0].rms_mm, ph[0].max_mm);
 
     /* (b) samples */
-    const size_t n_plan = fw_plan_poses(&nominal, n_samples, 4242U, mixed_dirs, plan);
-    dhc_param_set base;
-    (void)dhc_params_base_model(&base, &nominal);
-    double o1 = 0.0;
-    size_t rank = 0U;
-    (void)fw_plan_observability(&nominal, &base, plan, n_plan, &o1, &rank);
-    size_t n_done = 0U;
-    const fw_fault fa = fw_acquire(&ctrl, &nominal, plan, n_plan, 200U, samples, &n_done);
+    fw_fault fa = fw_job_plan(&job);
+    if (fa == FW_FAULT_NONE) {
+        fa = fw_job_acquire(&job);
+    }
+    const size_t n_done = job.n_samples;
+    const double o1 = job.o1;
     fprintf(log, "(b) %zu samples (plan of %zu poses, observability O1 %.4g over %zu of %zu "
-                 "parameters)\n", n_done, n_plan, o1, rank, base.count);
+                 "parameters)\n", n_done, job.n_plan, o1, job.o1_rank, job.o1_params);
     if (fa != FW_FAULT_NONE) {
         fprintf(stderr, "dhcal-demo: fault %s (index %zu) during acquisition\n",
-                fw_fault_name(fa), ctrl.fault_index);
-        for (size_t j = 0U; j < 3U; ++j) {
+                fw_fault_name(fa), job.ctrl.fault_index);
+        for (size_t j = 0U; j < nominal.arm.n_joints; ++j) {
             fprintf(stderr, "  joint %zu: error %.2f counts, velocity %.4f rad/s\n", j + 1U,
-                    (ctrl.q_ref_rad[j] - ctrl.q_rad[j]) * io.counts_per_rad[j],
-                    ctrl.qd_enc_rad_s[j]);
+                    (job.ctrl.q_ref_rad[j] - job.ctrl.q_rad[j]) * io.counts_per_rad[j],
+                    job.ctrl.qd_enc_rad_s[j]);
         }
         return 1;
     }
 
     /* (c)-(e) calibrate, diagnose, refit, store */
-    static fw_autocal_result res;
-    final_model = nominal;
-    const fw_fault fc = fw_autocal_configured(&autocal, &final_model, samples, n_done, &port.nv,
-                                              &geometric, &res);
+    const fw_fault fc = fw_job_calibrate(&job, &port.nv);
     if (fc != FW_FAULT_NONE) {
         fprintf(stderr, "dhcal-demo: calibration fault %s\n", fw_fault_name(fc));
         return 1;
     }
+    const fw_autocal_result *res = &job.result;
     char effect[64];
-    effect_label(&res, effect, sizeof effect);
-    if (res.meas_noise_mm > 0.0) {
+    (void)fw_autocal_effect_label(res, effect, sizeof effect);
+    if (res->meas_noise_mm > 0.0) {
         fprintf(log, "    noise model: joint angles %.3g %.3g %.3g urad (1 count / sqrt 12 with the "
                      "holds' dither), wires %.4f mm (measured over the holds)\n",
-                res.joint_noise_rad[0] * 1e6, res.joint_noise_rad[1] * 1e6,
-                res.joint_noise_rad[2] * 1e6, res.meas_noise_mm);
+                res->joint_noise_rad[0] * 1e6, res->joint_noise_rad[1] * 1e6,
+                res->joint_noise_rad[2] * 1e6, res->meas_noise_mm);
     }
     fprintf(log, "(c) geometric fit%s%s: wire residual RMS %.4f mm, max %.4f mm (%zu params, "
                  "rank %zu)\n", effects != NULL ? " with the configured " : "",
-            effects != NULL ? effects : "", res.geo.rms_mm, res.geo.max_mm, res.geo.n_params,
-            res.geo.rank);
-    if (res.meas_noise_mm > 0.0) {
+            effects != NULL ? effects : "", res->geo.rms_mm, res->geo.max_mm, res->geo.n_params,
+            res->geo.rank);
+    if (res->meas_noise_mm > 0.0) {
         fprintf(log, "    whitened residual sd %.3f (1: as the noise model predicts)\n",
-                res.geo.sigma);
+                res->geo.sigma);
     }
     if (autocal.diagnose != 0) {
-        fprintf(log, "(d) diagnosis: %s (log10 p %.1f)\n", effect, res.effect_log10_p);
+        fprintf(log, "(d) diagnosis: %s (log10 p %.1f)\n", effect, res->effect_log10_p);
     } else {
         fprintf(log, "(d) diagnosis: off (--no-diagnose)\n");
     }
     fprintf(log, "(e) with %s: wire residual RMS %.4f mm; stored: %s (seq %u)\n", effect,
-            res.found ? res.eff.rms_mm : res.geo.rms_mm, res.saved ? "yes" : "no",
-            (unsigned)res.seq);
-    where_it_fails(&geometric, n_done, log);
+            res->found ? res->eff.rms_mm : res->geo.rms_mm, res->saved ? "yes" : "no",
+            (unsigned)res->seq);
+    where_it_fails(&job.geometric, n_done, log);
 
     /* geometric model on fresh targets */
-    if (run_targets(&geometric, n_targets, 2002U, &ph[1]) != 0) {
+    if (run_targets(&job.geometric, n_targets, 2002U, &ph[1]) != 0) {
         return 1;
     }
     /* boot path: the controller uses what the store holds */
@@ -555,13 +505,9 @@ int main(int argc, char **argv)
         return 1;
     }
     dhc_param_set fset;
-    (void)dhc_params_base_model(&fset, &final_model);
-    if (res.found) {
-        (void)dhc_params_add_effect(&fset, &final_model, res.effect, res.effect_joint);
-    }
-    const dhc_calib_report *fr = res.found ? &res.eff : &res.geo;
-    const double floor_mm = noise_floor(&final_model, &fset, fr->identifiable, fr->sigma, n_done,
-                                        &ph[2], &res);
+    (void)fw_job_param_set(&job, &fset);
+    const dhc_calib_report *fr = res->found ? &res->eff : &res->geo;
+    const double floor_mm = noise_floor(&final_model, &fset, fr, &ph[2], res);
 
     fprintf(log, "\n%-28s %10s %10s\n", "model (fresh targets)", "RMS mm", "max mm");
     char label[96];
@@ -575,7 +521,6 @@ int main(int argc, char **argv)
             ph[2].rms_mm / floor_mm);
     if (out_dir != NULL) {
         if (write_outputs(out_dir, n_done, effect) != 0) {
-            fprintf(stderr, "dhcal-demo: cannot write into %s\n", out_dir);
             return 1;
         }
         fprintf(log, "wrote %s/samples.csv and %s/positioning.csv\n", out_dir, out_dir);
@@ -591,10 +536,10 @@ int main(int argc, char **argv)
          * takes at the desk (largest joint sd, in degrees) */
         double joint_sd_deg = 0.0;
         for (size_t j = 0U; j < 3U; ++j) {
-            joint_sd_deg = fmax(joint_sd_deg, res.joint_noise_rad[j] * 180.0 / DHC_PI);
+            joint_sd_deg = fmax(joint_sd_deg, res->joint_noise_rad[j] * 180.0 / DHC_PI);
         }
         printf("\"noise_model\": {\"joint_deg\": %.6g, \"meas_mm\": %.6g}}\n", joint_sd_deg,
-               res.meas_noise_mm);
+               res->meas_noise_mm);
     }
     return 0;
 }

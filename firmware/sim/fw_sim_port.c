@@ -181,19 +181,17 @@ dhc_status fw_sim_init(fw_sim *sim, const dhs_scenario *sc, uint64_t run_seed,
 void fw_sim_io_config(const dhs_scenario *sc, fw_io_config *io)
 {
     memset(io, 0, sizeof *io);
-    const double two_pi = 6.283185307179586;
     for (size_t j = 0U; j < sc->n_joints; ++j) {
         const dhs_joint_params *jp = &sc->joint[j];
-        io->counts_per_rad[j] = (double)jp->nominal_encoder_lines * 4.0 * jp->nominal_gear_ratio /
-                                two_pi;
-        io->tacho_v_per_rad_s[j] = jp->tacho_v_s_per_rad * jp->nominal_gear_ratio;
+        fw_io_set_joint(io, j, (double)jp->nominal_encoder_lines * 4.0, jp->nominal_gear_ratio,
+                        jp->tacho_v_s_per_rad);
     }
     io->adc_v_full_scale = sc->adc_range_v;
     io->dac_v_full_scale = sc->dac_range_v;
     const dhs_measurer_params *m = &sc->measurer;
-    io->wire_mm_per_count = m->lines > 0U ? two_pi * m->wheel_radius_mm / (4.0 * (double)m->lines)
-                                          : 1.0;
-    for (size_t k = 0U; k < 3U; ++k) {
-        io->wire_ref_mm[k] = m->zero_length_nominal_mm[k];
+    fw_io_set_wires(io, m->wheel_radius_mm, m->lines > 0U ? 4.0 * (double)m->lines : 0.0,
+                    m->zero_length_nominal_mm);
+    if (m->lines == 0U) {
+        io->wire_mm_per_count = 1.0; /* no measurer: counts pass as mm */
     }
 }

@@ -7,8 +7,18 @@
 #define MAGIC1 0x48U
 #define MAGIC2 0x43U
 #define MAGIC3 0x41U
-#define FORMAT_VERSION 1U
+/* 2: the higher joint harmonics and the drift effects, so that every effect the firmware's
+ * diagnosis may name is stored; records of version 1 still load (those fields 0). */
+#define FORMAT_VERSION 2U
+#define FORMAT_VERSION_1 1U
 #define CRC_CHUNK 64U
+#define HI_HARMONICS (DHC_HARMONIC_MAX_ORDER - 1U)
+
+/* The largest payload (DHC_MAX_JOINTS joints) fits the slot. */
+#define JOINT_BYTES(n) (7U * 8U + 1U + 4U * 8U + 2U * HI_HARMONICS * 8U + (n) * 8U)
+#define MAX_PAYLOAD_BYTES \
+    (1U + DHC_MAX_JOINTS * JOINT_BYTES(DHC_MAX_JOINTS) + 18U * 8U + 1U + 25U * 8U + 2U * 8U + 5U * 8U)
+_Static_assert(MAX_PAYLOAD_BYTES <= FW_CAL_PAYLOAD_MAX, "a full model must fit a slot");
 
 uint32_t fw_crc32(uint32_t crc, const void *data, size_t len)
 {
@@ -124,6 +134,8 @@ size_t fw_cal_encode(const dhc_model *model, uint8_t *buf, size_t cap)
                              fx->backlash_rad};
         put_f64s(&w, e, 4U);
         put_f64s(&w, fx->compliance, n);
+        put_f64s(&w, fx->harmonic_hi_sin_rad, HI_HARMONICS);
+        put_f64s(&w, fx->harmonic_hi_cos_rad, HI_HARMONICS);
     }
     encode_frame(&w, &model->arm.base);
     put_f64s(&w, model->arm.tool_mm, 3U);
@@ -135,11 +147,16 @@ size_t fw_cal_encode(const dhc_model *model, uint8_t *buf, size_t cap)
     put_f64s(&w, model->measurer.offset_mm, 3U);
     put_f64(&w, model->thermal_per_k);
     put_f64(&w, model->thermal_ref_c);
+    put_f64(&w, model->drift_scale_per_s);
+    put_f64s(&w, model->drift_mm_per_s, 3U);
+    put_f64(&w, model->drift_ref_s);
     return w.overflow ? 0U : w.len;
 }
 
-fw_cal_status fw_cal_decode(const uint8_t *buf, size_t len, dhc_model *model)
+static fw_cal_status decode_version(const uint8_t *buf, size_t len, uint32_t version,
+                                    dhc_model *model)
 {
+    const int v2 = version >= 2U;
     reader r = {buf, len, 0U, 0};
     const size_t n = get_u8(&r);
     dhc_model m;
@@ -170,6 +187,10 @@ fw_cal_status fw_cal_decode(const uint8_t *buf, size_t len, dhc_model *model)
         fx->harmonic_cos_rad = e[2];
         fx->backlash_rad = e[3];
         get_f64s(&r, fx->compliance, n);
+        if (v2) {
+            get_f64s(&r, fx->harmonic_hi_sin_rad, HI_HARMONICS);
+            get_f64s(&r, fx->harmonic_hi_cos_rad, HI_HARMONICS);
+        }
     }
     decode_frame(&r, &m.arm.base);
     get_f64s(&r, m.arm.tool_mm, 3U);
@@ -181,11 +202,21 @@ fw_cal_status fw_cal_decode(const uint8_t *buf, size_t len, dhc_model *model)
     get_f64s(&r, m.measurer.offset_mm, 3U);
     m.thermal_per_k = get_f64(&r);
     m.thermal_ref_c = get_f64(&r);
+    if (v2) {
+        m.drift_scale_per_s = get_f64(&r);
+        get_f64s(&r, m.drift_mm_per_s, 3U);
+        m.drift_ref_s = get_f64(&r);
+    }
     if (r.underflow || r.pos != len) {
         return FW_CAL_ERR_MODEL;
     }
     *model = m;
     return FW_CAL_OK;
+}
+
+fw_cal_status fw_cal_decode(const uint8_t *buf, size_t len, dhc_model *model)
+{
+    return decode_version(buf, len, FORMAT_VERSION, model);
 }
 
 /* ---------------------------------------------------------------- slots */
@@ -208,6 +239,7 @@ static uint32_t get_le32(const uint8_t *p)
 
 typedef struct {
     int valid;
+    uint32_t version;
     uint32_t seq;
     uint32_t len;
 } slot_info;
@@ -221,8 +253,9 @@ static fw_cal_status inspect_slot(const fw_nvstore *nv, size_t base, slot_info *
     if (nv->read(nv->ctx, base, h, sizeof h) != FW_NV_OK) {
         return FW_CAL_ERR_IO;
     }
+    info->version = get_le32(h + 4);
     if (h[0] != MAGIC0 || h[1] != MAGIC1 || h[2] != MAGIC2 || h[3] != MAGIC3 ||
-        get_le32(h + 4) != FORMAT_VERSION) {
+        (info->version != FORMAT_VERSION && info->version != FORMAT_VERSION_1)) {
         return FW_CAL_OK;
     }
     info->seq = get_le32(h + 8);
@@ -325,7 +358,7 @@ fw_cal_status fw_cal_load(const fw_nvstore *nv, dhc_model *model, uint32_t *seq_
     if (nv->read(nv->ctx, base + FW_CAL_HEADER_SIZE, payload, info[newest].len) != FW_NV_OK) {
         return FW_CAL_ERR_IO;
     }
-    st = fw_cal_decode(payload, info[newest].len, model);
+    st = decode_version(payload, info[newest].len, info[newest].version, model);
     if (st == FW_CAL_OK && seq_out != NULL) {
         *seq_out = info[newest].seq;
     }

@@ -5,6 +5,8 @@
 #include <string.h>
 
 #include "dhc_test_arms.h"
+#include "dhcal/dhc_diagnose.h"
+#include "dhcal_fw/fw_autocal.h"
 #include "dhcal_fw/fw_calstore.h"
 #include "unity.h"
 
@@ -81,6 +83,11 @@ static dhc_model sample_model(double seed)
     m.measurer.anchor_mm[0][2] = 1200.0 + seed;
     m.measurer.scale = 1e-3;
     m.thermal_per_k = 2.3e-5;
+    m.effect[2].harmonic_hi_sin_rad[0] = 3e-4 * seed; /* joint_harmonic2:3 */
+    m.effect[0].harmonic_hi_cos_rad[2] = -2e-4;       /* joint_harmonic4:1 */
+    m.drift_scale_per_s = 1e-7;
+    m.drift_mm_per_s[1] = 2e-4 * seed;
+    m.drift_ref_s = 12.5;
     return m;
 }
 
@@ -97,6 +104,10 @@ static void assert_same_model(const dhc_model *a, const dhc_model *b)
         TEST_ASSERT_EQUAL_MEMORY(&a->effect[i].scale, &b->effect[i].scale, 4U * sizeof(double));
         TEST_ASSERT_EQUAL_MEMORY(a->effect[i].compliance, b->effect[i].compliance,
                                  a->arm.n_joints * sizeof(double));
+        TEST_ASSERT_EQUAL_MEMORY(a->effect[i].harmonic_hi_sin_rad, b->effect[i].harmonic_hi_sin_rad,
+                                 sizeof a->effect[i].harmonic_hi_sin_rad);
+        TEST_ASSERT_EQUAL_MEMORY(a->effect[i].harmonic_hi_cos_rad, b->effect[i].harmonic_hi_cos_rad,
+                                 sizeof a->effect[i].harmonic_hi_cos_rad);
     }
     TEST_ASSERT_EQUAL_MEMORY(&a->arm.base, &b->arm.base, sizeof a->arm.base);
     TEST_ASSERT_EQUAL_MEMORY(a->arm.tool_mm, b->arm.tool_mm, sizeof a->arm.tool_mm);
@@ -107,6 +118,9 @@ static void assert_same_model(const dhc_model *a, const dhc_model *b)
     TEST_ASSERT_EQUAL_DOUBLE(a->measurer.scale, b->measurer.scale);
     TEST_ASSERT_EQUAL_DOUBLE(a->thermal_per_k, b->thermal_per_k);
     TEST_ASSERT_EQUAL_DOUBLE(a->thermal_ref_c, b->thermal_ref_c);
+    TEST_ASSERT_EQUAL_DOUBLE(a->drift_scale_per_s, b->drift_scale_per_s);
+    TEST_ASSERT_EQUAL_MEMORY(a->drift_mm_per_s, b->drift_mm_per_s, sizeof a->drift_mm_per_s);
+    TEST_ASSERT_EQUAL_DOUBLE(a->drift_ref_s, b->drift_ref_s);
 }
 
 static void test_crc32_matches_the_published_check_value(void)
@@ -131,6 +145,138 @@ static void test_model_round_trips_bit_for_bit(void)
     TEST_ASSERT_EQUAL(FW_CAL_ERR_MODEL, fw_cal_decode(buf, len - 1U, &back));
     TEST_ASSERT_EQUAL(FW_CAL_ERR_MODEL, fw_cal_decode(buf, len + 1U, &back));
     TEST_ASSERT_EQUAL(0U, fw_cal_encode(&m, buf, len - 1U));
+}
+
+/* Whatever the controller's diagnosis may add to its model, the store keeps: every
+ * candidate it offers, given values, comes back from a save and a load with the same
+ * parameter values. */
+static void test_every_effect_the_diagnosis_offers_is_stored(void)
+{
+    static dhc_model m;
+    static dhc_model back;
+    m = sample_model(0.5);
+    dhc_param_set base;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&base, &m));
+    static dhc_candidate cands[DHC_MAX_CANDIDATES];
+    const size_t nc = dhc_diagnose_candidates(&m, &base, &fw_autocal_scope, cands,
+                                              DHC_MAX_CANDIDATES);
+    TEST_ASSERT_GREATER_THAN(10U, nc);
+    for (size_t c = 0U; c < nc; ++c) {
+        dhc_param_set set;
+        dhc_params_clear(&set);
+        static dhc_model with;
+        with = m;
+        TEST_ASSERT_EQUAL(DHC_OK,
+                          dhc_params_add_effect(&set, &with, cands[c].effect, cands[c].joint));
+        double delta[DHC_MAX_PARAMS];
+        for (size_t k = 0U; k < set.count; ++k) {
+            delta[k] = 1e-3 * (double)(k + 1U);
+        }
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_params_apply(&set, &with, delta, set.count));
+        dev.powered = 1;
+        memset(dev.mem, 0xFF, sizeof dev.mem);
+        power_up(&dev, SIZE_MAX);
+        const fw_nvstore nv = store_of(&dev);
+        TEST_ASSERT_EQUAL(FW_CAL_OK, fw_cal_save(&nv, &with, NULL));
+        TEST_ASSERT_EQUAL(FW_CAL_OK, fw_cal_load(&nv, &back, NULL));
+        for (size_t k = 0U; k < set.count; ++k) {
+            const double want = dhc_params_value(&set, &with, k);
+            TEST_ASSERT_EQUAL_DOUBLE(want, dhc_params_value(&set, &back, k));
+        }
+        /* the effect really changed the model, and every field came back */
+        TEST_ASSERT_TRUE(memcmp(&with, &m, sizeof m) != 0);
+        assert_same_model(&with, &back);
+    }
+}
+
+/* A little-endian writer of the version-1 payload, after docs/formats.md section 7. */
+static size_t put_double(uint8_t *p, double v)
+{
+    uint64_t bits;
+    memcpy(&bits, &v, sizeof bits);
+    for (unsigned k = 0U; k < 8U; ++k) {
+        p[k] = (uint8_t)(bits >> (8U * k));
+    }
+    return 8U;
+}
+
+static size_t put_doubles(uint8_t *p, const double *v, size_t n)
+{
+    for (size_t i = 0U; i < n; ++i) {
+        (void)put_double(p + 8U * i, v[i]);
+    }
+    return 8U * n;
+}
+
+static void put_u32(uint8_t *p, uint32_t v)
+{
+    for (unsigned k = 0U; k < 4U; ++k) {
+        p[k] = (uint8_t)(v >> (8U * k));
+    }
+}
+
+/* A store written by the first format (no higher harmonics, no drift) still loads. */
+static void test_a_version_1_record_still_loads(void)
+{
+    const dhc_model m = sample_model(2.0);
+    static uint8_t payload[FW_CAL_PAYLOAD_MAX];
+    size_t len = 0U;
+    const size_t n = m.arm.n_joints;
+    payload[len++] = (uint8_t)n;
+    for (size_t i = 0U; i < n; ++i) {
+        const dhc_joint *j = &m.arm.joint[i];
+        const double v[7] = {j->theta_offset_rad, j->d_mm, j->a_mm, j->alpha_rad, j->beta_rad,
+                             j->min_rad, j->max_rad};
+        len += put_doubles(payload + len, v, 7U);
+        payload[len++] = (uint8_t)j->convention;
+        const dhc_joint_effects *fx = &m.effect[i];
+        const double e[4] = {fx->scale, fx->harmonic_sin_rad, fx->harmonic_cos_rad,
+                             fx->backlash_rad};
+        len += put_doubles(payload + len, e, 4U);
+        len += put_doubles(payload + len, fx->compliance, n);
+    }
+    len += put_doubles(payload + len, &m.arm.base.rot.m[0][0], 9U);
+    len += put_doubles(payload + len, m.arm.base.pos, 3U);
+    len += put_doubles(payload + len, m.arm.tool_mm, 3U);
+    len += put_doubles(payload + len, m.gravity, 3U);
+    payload[len++] = 1U;
+    len += put_doubles(payload + len, &m.measurer.anchor_mm[0][0], 9U);
+    len += put_doubles(payload + len, &m.measurer.frame.rot.m[0][0], 9U);
+    len += put_doubles(payload + len, m.measurer.frame.pos, 3U);
+    len += put_double(payload + len, m.measurer.scale);
+    len += put_doubles(payload + len, m.measurer.offset_mm, 3U);
+    len += put_double(payload + len, m.thermal_per_k);
+    len += put_double(payload + len, m.thermal_ref_c);
+    uint8_t h[FW_CAL_HEADER_SIZE] = {'D', 'H', 'C', 'A'};
+    put_u32(h + 4, 1U);
+    put_u32(h + 8, 41U);
+    put_u32(h + 12, (uint32_t)len);
+    put_u32(h + 16, fw_crc32(fw_crc32(0U, h, 16U), payload, len));
+    memset(dev.mem, 0xFF, sizeof dev.mem);
+    memcpy(dev.mem + FW_CAL_SLOT_SIZE, h, sizeof h);
+    memcpy(dev.mem + FW_CAL_SLOT_SIZE + FW_CAL_HEADER_SIZE, payload, len);
+    power_up(&dev, SIZE_MAX);
+    const fw_nvstore nv = store_of(&dev);
+    static dhc_model back;
+    uint32_t seq = 0U;
+    TEST_ASSERT_EQUAL(FW_CAL_OK, fw_cal_load(&nv, &back, &seq));
+    TEST_ASSERT_EQUAL_UINT32(41U, seq);
+    /* everything version 1 held; what it did not hold is 0 */
+    static dhc_model expect;
+    expect = m;
+    for (size_t i = 0U; i < n; ++i) {
+        memset(expect.effect[i].harmonic_hi_sin_rad, 0, sizeof expect.effect[i].harmonic_hi_sin_rad);
+        memset(expect.effect[i].harmonic_hi_cos_rad, 0, sizeof expect.effect[i].harmonic_hi_cos_rad);
+    }
+    expect.drift_scale_per_s = 0.0;
+    memset(expect.drift_mm_per_s, 0, sizeof expect.drift_mm_per_s);
+    expect.drift_ref_s = 0.0;
+    assert_same_model(&expect, &back);
+    /* the next save goes to the other slot, in the current format, with the next number */
+    TEST_ASSERT_EQUAL(FW_CAL_OK, fw_cal_save(&nv, &m, &seq));
+    TEST_ASSERT_EQUAL_UINT32(42U, seq);
+    TEST_ASSERT_EQUAL(FW_CAL_OK, fw_cal_load(&nv, &back, &seq));
+    assert_same_model(&m, &back);
 }
 
 static void test_factory_state_is_empty_and_saves_then_loads(void)
@@ -277,6 +423,8 @@ int main(void)
     UNITY_BEGIN();
     RUN_TEST(test_crc32_matches_the_published_check_value);
     RUN_TEST(test_model_round_trips_bit_for_bit);
+    RUN_TEST(test_every_effect_the_diagnosis_offers_is_stored);
+    RUN_TEST(test_a_version_1_record_still_loads);
     RUN_TEST(test_factory_state_is_empty_and_saves_then_loads);
     RUN_TEST(test_power_cut_at_every_byte_keeps_the_previous_calibration);
     RUN_TEST(test_first_save_cut_anywhere_leaves_the_store_empty_not_garbage);

@@ -225,9 +225,30 @@ static void test_joint_ranges_come_from_the_model_arm(void)
     TEST_ASSERT_EQUAL_DOUBLE(third_max, c.q_max_rad[2]);
 }
 
+/* The machine's drive data become the controller's conversions: a joint turn is
+ * counts_per_rev x gear counts, the tacho reads volts per joint rad/s through the gear, one
+ * wire count is the wheel's circumference over its counts. */
+static void test_io_scaling_from_the_drive_data(void)
+{
+    fw_io_config conv;
+    memset(&conv, 0, sizeof conv);
+    fw_io_set_joint(&conv, 1U, 2000.0, 100.0, 0.029);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 200000.0, conv.counts_per_rad[1] * 2.0 * 3.14159265358979323846);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12, 2.9, conv.tacho_v_per_rad_s[1]);
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, conv.counts_per_rad[0]);
+    const double zero[3] = {100.0, 200.0, 300.0};
+    fw_io_set_wires(&conv, 10.0, 4000.0, zero);
+    /* 62.83... mm per wheel turn */
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, 20.0 * 3.14159265358979323846, conv.wire_mm_per_count * 4000.0);
+    TEST_ASSERT_EQUAL_DOUBLE(300.0, conv.wire_ref_mm[2]);
+    fw_io_set_wires(&conv, 10.0, 4000.0, NULL);
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, conv.wire_ref_mm[2]);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
+    RUN_TEST(test_io_scaling_from_the_drive_data);
     RUN_TEST(test_move_settles_at_the_target_from_the_chosen_side);
     RUN_TEST(test_target_outside_the_range_is_refused);
     RUN_TEST(test_joint_ranges_come_from_the_model_arm);

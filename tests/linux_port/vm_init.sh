@@ -67,8 +67,8 @@ t1=$(cut -d' ' -f1 /proc/uptime)
 show "OUT fw-a" fw-a.json; show "ERR fw-a" fw-a.err; show "OUT sim-a" sim-a.json
 show "ERR sim-a" sim-a.err
 # The reference: the same run through the sim port, in this VM (same CPU, same libm).
-dhcal-fw --port sim --scenario "$SCENARIO" --samples "$SAMPLES" --params-out params-s.txt \
-    >fw-s.json 2>fw-s.err
+dhcal-fw --port sim --machine "$MACHINE" --scenario "$SCENARIO" --samples "$SAMPLES" \
+    --params-out params-s.txt >fw-s.json 2>fw-s.err
 show "OUT fw-s" fw-s.json; show "ERR fw-s" fw-s.err
 # Same parameter names in the same order; prints "ok|names COUNT MAX|difference|".
 compare() {
@@ -90,10 +90,12 @@ fi
 
 # ---------------------------------------------------------------- (b), (c) bus faults
 # The controller must latch port_timeout and command 0 V (code 2048) to every drive; the
-# simulated drives report the last command they received.
+# simulated drives report the last command they received. They stay on the bus 3 s after
+# its last frame: the controller declares the lost frame only after its reply timeout (1 s
+# in this VM), and a drive that left at the same moment would miss the 0 V.
 fault_case() { # name "dhcal-fw options" dhcal-sim-options...
     name=$1; fw_opts=$2; shift 2
-    dhcal-sim bus --scenario "$SCENARIO" --can vcan0 --idle-exit-ms 1000 "$@" \
+    dhcal-sim bus --scenario "$SCENARIO" --can vcan0 --idle-exit-ms 3000 "$@" \
         >sim-$name.json 2>sim-$name.err &
     SIM=$!
     settle
@@ -114,6 +116,31 @@ fault_case() { # name "dhcal-fw options" dhcal-sim-options...
 # kernel filters included): the ticks before the fault show the moved bus works.
 fault_case lost-frame "--can-id-offset 32" --can-id-offset 32 --drop-frame 0x181@$FAULT_TICK
 fault_case bus-timeout "" --stop-at $FAULT_TICK
+
+# ---------------------------------------------------------------- (c') a stop request
+# SIGTERM in the middle of the run: the controller must command 0 V to every drive and
+# disable it (Enable 0), report fault "stopped" and exit 1; the simulated drives report the
+# last command and enable bit they received.
+dhcal-sim bus --scenario "$SCENARIO" --can vcan0 --idle-exit-ms 3000 >sim-stop.json \
+    2>sim-stop.err &
+SIM=$!
+settle
+dhcal-fw --config $CONF --nv nv-stop.bin >fw-stop.json 2>fw-stop.err &
+FW=$!
+sleep 3
+kill -TERM $FW
+wait $FW
+RC=$?
+wait $SIM
+show "OUT fw-stop" fw-stop.json; show "ERR fw-stop" fw-stop.err; show "OUT sim-stop" sim-stop.json
+F=$(field fw-stop.json fault)
+DAC=$(sed -n 's/.*"last_dac": \[\([^]]*\)\].*/\1/p' sim-stop.json)
+EN=$(sed -n 's/.*"last_enable": \[\([^]]*\)\].*/\1/p' sim-stop.json)
+if [ "$RC" = 1 ] && [ "$F" = stopped ] && [ "$DAC" = "2048, 2048, 2048" ] && [ "$EN" = "0, 0, 0" ]; then
+    result sigterm PASS "fault $F after $(field fw-stop.json ticks) ticks, drives commanded to 0 V (codes $DAC) and disabled (enable $EN)"
+else
+    result sigterm FAIL "exit $RC, fault '$F', last drive codes '$DAC', enable '$EN'"
+fi
 
 # ---------------------------------------------------------------- (d) encoder on GPIO
 if [ -n "$CHIP" ]; then

@@ -5,15 +5,18 @@
 # the sim port's run on this host, a lost CAN frame, a bus timeout, GPIO quadrature on
 # gpio-sim with and without a missed edge, and configuration errors.
 #
-# usage: vm_run.sh --cache DIR --work DIR --fw dhcal-fw --sim dhcal-sim --scenario S.json
-#                  [--can-check linux_can_check] [--samples N] [--fault-tick T] [--timeout S]
+# usage: vm_run.sh --cache DIR --work DIR --fw dhcal-fw --sim dhcal-sim --machine M.json
+#                  --scenario S.json [--can-check linux_can_check] [--samples N]
+#                  [--fault-tick T] [--timeout S]
+# M.json: the controller's machine file (self-contained: its model inline); S.json: the
+# simulated arm dhcal-sim bus plays.
 # Environment: DHCAL_VM_ACCEL=kvm tries KVM (default tcg: on these machines /dev/kvm is a
 # software nested hypervisor on which stock kernels hang).
 # Exit status: 0 every case passed, 1 a case failed or the VM did not finish, 77 the test
 # cannot run here (reason printed; CTest reports it as skipped).
 set -eu
 HERE=$(cd "$(dirname "$0")" && pwd)
-CACHE= WORK= FW= SIM= CAN_CHECK= SCENARIO= SAMPLES=20 FAULT_TICK=1500 TIMEOUT=600
+CACHE= WORK= FW= SIM= CAN_CHECK= MACHINE= SCENARIO= SAMPLES=20 FAULT_TICK=1500 TIMEOUT=600
 while [ $# -gt 0 ]; do
     case $1 in
         --cache) CACHE=$2 ;;
@@ -21,6 +24,7 @@ while [ $# -gt 0 ]; do
         --fw) FW=$2 ;;
         --sim) SIM=$2 ;;
         --can-check) CAN_CHECK=$2 ;;
+        --machine) MACHINE=$2 ;;
         --scenario) SCENARIO=$2 ;;
         --samples) SAMPLES=$2 ;;
         --fault-tick) FAULT_TICK=$2 ;;
@@ -29,8 +33,9 @@ while [ $# -gt 0 ]; do
     esac
     shift 2
 done
-[ -n "$CACHE" ] && [ -n "$WORK" ] && [ -x "$FW" ] && [ -x "$SIM" ] && [ -f "$SCENARIO" ] ||
-    { echo "vm_run: needs --cache --work --fw --sim --scenario" >&2; exit 2; }
+[ -n "$CACHE" ] && [ -n "$WORK" ] && [ -x "$FW" ] && [ -x "$SIM" ] && [ -f "$MACHINE" ] &&
+    [ -f "$SCENARIO" ] ||
+    { echo "vm_run: needs --cache --work --fw --sim --machine --scenario" >&2; exit 2; }
 skip() { echo "vm_run: SKIP: $*"; exit 77; }
 T0=$(date +%s)
 
@@ -54,7 +59,7 @@ WORK=$(cd "$WORK" && pwd)
 rm -rf "$WORK/root"
 R=$WORK/root
 mkdir -p "$R/bin" "$R/etc" "$R/dev" "$R/proc" "$R/sys" "$R/tmp" "$R/lib/modules" "$R/scenarios"
-"$FW" --port sim --scenario "$SCENARIO" --samples "$SAMPLES" \
+"$FW" --port sim --machine "$MACHINE" --scenario "$SCENARIO" --samples "$SAMPLES" \
       --params-out "$R/etc/ref-params.txt" >"$WORK/ref.json" ||
     { echo "vm_run: the sim-port reference run failed"; cat "$WORK/ref.json"; exit 1; }
 echo "vm_run: reference (sim port, this host): $(cat "$WORK/ref.json")"
@@ -75,17 +80,19 @@ cp "$CACHE"/modules/*.ko "$R/lib/modules/"
 # The scenario names its model file relative to itself: copy its whole directory.
 cp "$(dirname "$SCENARIO")"/*.json "$R/scenarios/"
 VM_SCENARIO=/scenarios/$(basename "$SCENARIO")
+cp "$MACHINE" "$R/etc/machine.json"
 cat >"$R/etc/dhcal-fw.conf" <<EOF
 # dhcal-fw in the test VM (the same settings as the sim-port reference run)
 port = linux
 can = vcan0
-scenario = $VM_SCENARIO
+machine = /etc/machine.json
 samples = $SAMPLES
 # TCG emulates one CPU for both processes, on a host that may be busy with other tests:
 # give the drives a second to be scheduled (a lost frame still ends the run at once).
 reply-timeout-us = 1000000
 EOF
 cat >"$R/etc/dhcal-vm.env" <<EOF
+MACHINE=/etc/machine.json
 SCENARIO=$VM_SCENARIO
 FAULT_TICK=$FAULT_TICK
 SAMPLES=$SAMPLES
@@ -118,7 +125,7 @@ echo "vm_run: prepare $((T1 - T0)) s, reference + initramfs $((T2 - T1)) s, VM $
 fail=0
 cases="calibration lost-frame"
 [ -n "$CAN_CHECK" ] && cases="can-transport $cases"
-for c in $cases bus-timeout encoder-count missed-edge missing-interface \
+for c in $cases bus-timeout sigterm encoder-count missed-edge missing-interface \
          missing-chip missing-line; do
     line=$(grep "^CASE $c " "$WORK/console.log" | head -n1 || true)
     case $line in

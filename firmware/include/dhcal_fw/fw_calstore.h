@@ -9,6 +9,8 @@
  *
  * Record: magic "DHCA", format version, sequence (u32), payload length (u32), CRC-32
  * (IEEE 802.3, reflected, as zlib) over the 16 header bytes before it and the payload.
+ * Format version 2 (docs/formats.md, section 7) holds every effect of the model, so that
+ * whatever the controller's diagnosis adds is stored; version-1 records still load.
  */
 #ifndef FW_CALSTORE_H
 #define FW_CALSTORE_H
@@ -35,8 +37,9 @@ typedef enum {
  * len bytes, continuing from crc (start with 0). Bitwise: no table, small code. */
 uint32_t fw_crc32(uint32_t crc, const void *data, size_t len);
 
-/* Serialises / parses the calibrated model (geometry, base, tool, effects, measurer,
- * gravity, thermal) as little-endian doubles. Returns the payload length, 0 on error. */
+/* Serialises / parses (the current format) the calibrated model (geometry, base, tool,
+ * every joint effect, measurer, gravity, thermal, drift) as little-endian doubles. Returns
+ * the payload length, 0 on error. */
 size_t fw_cal_encode(const dhc_model *model, uint8_t *buf, size_t cap);
 fw_cal_status fw_cal_decode(const uint8_t *buf, size_t len, dhc_model *model);
 

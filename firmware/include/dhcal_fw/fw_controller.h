@@ -42,6 +42,11 @@ typedef enum {
     FW_FAULT_SETTLE_TIMEOUT,    /* a move did not settle in time */
     FW_FAULT_JOINT_LIMIT,       /* a target outside the joint range */
     FW_FAULT_ARGUMENT,          /* invalid call */
+    FW_FAULT_NOT_CONVERGED,     /* a calibration fit did not converge */
+    FW_FAULT_UNDERDETERMINED,   /* too few or too poor samples for the parameters */
+    FW_FAULT_NUMERIC,           /* samples or model that break the arithmetic (non-finite,
+                                   singular) */
+    FW_FAULT_STOPPED,           /* stopped on request (an operator, a signal) */
     FW_FAULT_COUNT
 } fw_fault;
 

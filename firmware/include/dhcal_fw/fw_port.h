@@ -49,6 +49,16 @@ typedef struct {
     double wire_ref_mm[3];     /* wire length when its counter read zero */
 } fw_io_config;
 
+/* A joint's conversions from its drive's data: encoder counts per MOTOR turn (after x4
+ * decoding), gear ratio (motor turns per joint turn), tacho volts per motor rad/s. */
+void fw_io_set_joint(fw_io_config *io, size_t joint, double counts_per_rev, double gear_ratio,
+                     double tacho_v_s_per_rad);
+
+/* The measurer's conversions: friction wheel radius, counts per wheel turn (after x4
+ * decoding), wire lengths at counter zero (may be NULL: 0). */
+void fw_io_set_wires(fw_io_config *io, double wheel_radius_mm, double counts_per_rev,
+                     const double zero_length_mm[3]);
+
 /* 12-bit code of a voltage, clamped to the converter's range; and back. */
 uint16_t fw_dac_code(const fw_io_config *io, double volts);
 double fw_adc_volts(const fw_io_config *io, uint16_t code);

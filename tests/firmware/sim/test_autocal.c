@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "dhcal_fw/fw_acquire.h"
+#include "dhcal_fw/fw_autocal.h"
 #include "dhcal_fw/fw_controller.h"
 #include "fw_sim_port.h"
 #include "sim_fixture.h"
@@ -22,6 +23,8 @@ static fw_sim sim;
 static fw_port port;
 static fw_io_config io;
 static fw_ctrl ctrl;
+static fw_acq_stats acq; /* the holds of every acquisition of the test run */
+static fw_autocal_workspace cal_ws;
 static dhc_model nominal;
 static fw_pose plan[N_TRAIN];
 static fw_pose plan_held[N_HELD];
@@ -57,11 +60,11 @@ static void acquire(double joint2_stiffness)
     TEST_ASSERT_EQUAL_size_t(N_TRAIN, fw_plan_poses(&nominal, N_TRAIN, 31U, 0, plan));
     TEST_ASSERT_EQUAL_size_t(N_HELD, fw_plan_poses(&nominal, N_HELD, 32U, 0, plan_held));
     size_t n = 0U;
-    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_acquire(&ctrl, &nominal, plan, N_TRAIN, HOLD, train, &n));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_acquire(&ctrl, &nominal, plan, N_TRAIN, HOLD, &acq, train, &n));
     TEST_ASSERT_EQUAL_size_t(N_TRAIN, n);
     n = 0U;
     TEST_ASSERT_EQUAL(FW_FAULT_NONE,
-                      fw_acquire(&ctrl, &nominal, plan_held, N_HELD, HOLD, held, &n));
+                      fw_acquire(&ctrl, &nominal, plan_held, N_HELD, HOLD, &acq, held, &n));
     TEST_ASSERT_EQUAL_size_t(N_HELD, n);
 }
 
@@ -94,7 +97,7 @@ static void test_configured_compliance_of_a_rigid_arm_fits_to_zero(void)
     config_with_compliance_2(&cfg, 0);
     dhc_model model = nominal;
     TEST_ASSERT_EQUAL(FW_FAULT_NONE,
-                      fw_autocal_configured(&cfg, &model, train, N_TRAIN, NULL, NULL, &res));
+                      fw_autocal_configured(&cfg, &model, train, N_TRAIN, NULL, &cal_ws, NULL, &res));
     TEST_ASSERT_EQUAL_INT(0, res.found); /* diagnosis off */
     dhc_param_set base;
     TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&base, &nominal));
@@ -123,8 +126,7 @@ static void test_configured_compliance_predicts_a_compliant_arm_better(void)
     fw_autocal_default_config(&geometry_only);
     geometry_only.diagnose = 0;
     dhc_model geo = nominal;
-    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_autocal_configured(&geometry_only, &geo, train, N_TRAIN,
-                                                           NULL, NULL, &res));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_autocal_configured(&geometry_only, &geo, train, N_TRAIN, NULL, &cal_ws, NULL, &res));
     TEST_ASSERT_EQUAL_INT(0, res.found);
     const double geo_held = fw_wire_rms(&geo, held, N_HELD);
 
@@ -132,7 +134,7 @@ static void test_configured_compliance_predicts_a_compliant_arm_better(void)
     config_with_compliance_2(&cfg, 0);
     dhc_model with = nominal;
     TEST_ASSERT_EQUAL(FW_FAULT_NONE,
-                      fw_autocal_configured(&cfg, &with, train, N_TRAIN, NULL, NULL, &res));
+                      fw_autocal_configured(&cfg, &with, train, N_TRAIN, NULL, &cal_ws, NULL, &res));
     const double with_held = fw_wire_rms(&with, held, N_HELD);
     TEST_ASSERT_TRUE(fabs(with.effect[1].compliance[1]) > 0.0);
     printf("held-out wire RMS: geometry %.4f mm, with joint_compliance:2 %.4f mm\n", geo_held,
@@ -150,19 +152,19 @@ static void test_an_impossible_configuration_is_refused(void)
     cfg.effect_joint[0] = 5U; /* a 3-joint arm */
     dhc_model model = nominal;
     TEST_ASSERT_EQUAL(FW_FAULT_ARGUMENT,
-                      fw_autocal_configured(&cfg, &model, train, 4U, NULL, NULL, &res));
+                      fw_autocal_configured(&cfg, &model, train, 4U, NULL, &cal_ws, NULL, &res));
     TEST_ASSERT_EQUAL_MEMORY(&nominal, &model, sizeof model);
     config_with_compliance_2(&cfg, 1);
     cfg.n_effects = FW_AUTOCAL_MAX_EFFECTS + 1U;
     TEST_ASSERT_EQUAL(FW_FAULT_ARGUMENT,
-                      fw_autocal_configured(&cfg, &model, train, 4U, NULL, NULL, &res));
+                      fw_autocal_configured(&cfg, &model, train, 4U, NULL, &cal_ws, NULL, &res));
     model.measurer.present = 0;
     const dhc_model without_measurer = model;
     fw_autocal_default_config(&cfg);
     cfg.n_effects = 1U;
     cfg.effect[0] = DHC_EFFECT_MEASURER_SCALE;
     TEST_ASSERT_EQUAL(FW_FAULT_ARGUMENT,
-                      fw_autocal_configured(&cfg, &model, train, 4U, NULL, NULL, &res));
+                      fw_autocal_configured(&cfg, &model, train, 4U, NULL, &cal_ws, NULL, &res));
     TEST_ASSERT_EQUAL_MEMORY(&without_measurer, &model, sizeof model);
 }
 

@@ -25,6 +25,7 @@
 #include <string.h>
 
 #include "dhcal_fw/fw_acquire.h"
+#include "dhcal_fw/fw_autocal.h"
 #include "dhcal_fw/fw_calstore.h"
 #include "dhcal_fw/fw_controller.h"
 #include "dhcal_fw/fw_ik.h"
@@ -43,6 +44,8 @@ static fw_port port;
 static fw_io_config io;
 static fw_ctrl_config cfg;
 static fw_ctrl ctrl;
+static fw_acq_stats acq; /* the holds of every acquisition of the test run */
+static fw_autocal_workspace cal_ws;
 static dhc_model model; /* nominal */
 
 static const double q_start[3] = {0.0, 60.0 * SIM_DEG, -60.0 * SIM_DEG};
@@ -105,19 +108,19 @@ static void ensure_clean_run(void)
     size_t n = 0U;
     for (size_t k = 0U; k < N_SNAP; ++k) {
         TEST_ASSERT_EQUAL(FW_FAULT_NONE,
-                          fw_acquire(&ctrl, &model, plan + n, snap_at[k] - n, HOLD, clean, &n));
+                          fw_acquire(&ctrl, &model, plan + n, snap_at[k] - n, HOLD, &acq, clean, &n));
         snap_sim[k] = sim;
         snap_ctrl[k] = ctrl;
     }
     TEST_ASSERT_EQUAL(FW_FAULT_NONE,
-                      fw_acquire(&ctrl, &model, plan + n, N_TRAIN - n, HOLD, clean, &n));
+                      fw_acquire(&ctrl, &model, plan + n, N_TRAIN - n, HOLD, &acq, clean, &n));
     TEST_ASSERT_EQUAL_size_t(N_TRAIN, n);
     n = 0U;
-    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_acquire(&ctrl, &model, plan_held, N_HELD, HOLD, held, &n));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_acquire(&ctrl, &model, plan_held, N_HELD, HOLD, &acq, held, &n));
     TEST_ASSERT_EQUAL_size_t(N_HELD, n);
     clean_model = model;
     TEST_ASSERT_EQUAL(FW_FAULT_NONE,
-                      fw_autocal(&clean_model, clean, N_TRAIN, NULL, NULL, &clean_res));
+                      fw_autocal(&clean_model, clean, N_TRAIN, NULL, &cal_ws, NULL, &clean_res));
     clean_held_rms = fw_wire_rms(&clean_model, held, N_HELD);
     /* the fixture's geometry errors are found: nominal ~1 mm, calibrated at the noise */
     TEST_ASSERT_TRUE(fw_wire_rms(&model, held, N_HELD) > 0.5);
@@ -160,11 +163,11 @@ static void ensure_slipped_run(void)
     sim.wire_step_wire = 1U;
     sim.wire_step_counts = -100;
     TEST_ASSERT_EQUAL(FW_FAULT_NONE,
-                      fw_acquire(&ctrl, &model, plan + 16, N_TRAIN - 16U, HOLD, slipped, &n));
+                      fw_acquire(&ctrl, &model, plan + 16, N_TRAIN - 16U, HOLD, &acq, slipped, &n));
     TEST_ASSERT_EQUAL_size_t(N_TRAIN, n);
     slipped_model = model;
     static fw_autocal_result r;
-    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_autocal(&slipped_model, slipped, n, NULL, NULL, &r));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_autocal(&slipped_model, slipped, n, NULL, &cal_ws, NULL, &r));
     slipped_held_rms = fw_wire_rms(&slipped_model, held, N_HELD);
     slipped_done = 1;
 }
@@ -212,7 +215,7 @@ static void test_encoder_spike_above_the_plausible_step_stops_and_keeps_samples(
     sim.enc_spike_counts = 3000;
     ++n_faults_injected;
     TEST_ASSERT_EQUAL(FW_FAULT_ENCODER_JUMP,
-                      fw_acquire(&ctrl, &model, plan + 3, N_TRAIN - 3U, HOLD, run, &n));
+                      fw_acquire(&ctrl, &model, plan + 3, N_TRAIN - 3U, HOLD, &acq, run, &n));
     TEST_ASSERT_EQUAL_size_t(1U, ctrl.fault_index);
     TEST_ASSERT_EQUAL_UINT64(sim.enc_spike_tick, sim.ticks); /* stopped at that very tick */
     TEST_ASSERT_EQUAL_size_t(3U, n);
@@ -228,7 +231,7 @@ static void test_encoder_spike_above_the_plausible_step_stops_and_keeps_samples(
     sim.enc_spike_joint = 2U;
     sim.enc_spike_counts = -2500;
     ++n_faults_injected;
-    TEST_ASSERT_EQUAL(FW_FAULT_ENCODER_JUMP, fw_acquire_one(&ctrl, &model, HOLD, &run[3]));
+    TEST_ASSERT_EQUAL(FW_FAULT_ENCODER_JUMP, fw_acquire_one(&ctrl, &model, HOLD, &acq, &run[3]));
     TEST_ASSERT_EQUAL_size_t(2U, ctrl.fault_index);
     TEST_ASSERT_EQUAL_MEMORY(&sentinel, &run[3], sizeof sentinel);
     assert_prefix_clean(3U);
@@ -250,9 +253,9 @@ static void test_encoder_spike_below_the_plausible_step_bounds_the_sample_error(
     sim.enc_spike_joint = 1U;
     sim.enc_spike_counts = 1500;
     ++n_faults_injected;
-    const uint32_t retakes0 = fw_acquire_retakes();
-    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_acquire_one(&ctrl, &model, HOLD, &run[n]));
-    TEST_ASSERT_EQUAL_UINT32(retakes0 + 1U, fw_acquire_retakes());
+    const uint32_t retakes0 = acq.retakes;
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_acquire_one(&ctrl, &model, HOLD, &acq, &run[n]));
+    TEST_ASSERT_EQUAL_UINT32(retakes0 + 1U, acq.retakes);
     dhs_plant_truth t;
     dhs_plant_get_truth(&sim.plant, &t);
     double e_truth = 0.0;
@@ -357,7 +360,7 @@ static void wrap_moves(dhc_sample *out)
     TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_ctrl_move_to(&ctrl, q_b, NULL));
     probe.in_move = 0;
     TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_ctrl_move_to(&ctrl, q_c, NULL));
-    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_acquire_one(&ctrl, &model, HOLD, out));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_acquire_one(&ctrl, &model, HOLD, &acq, out));
 }
 
 static void test_counter_wraps_at_top_speed_and_in_the_hold_are_exact(void)
@@ -409,7 +412,7 @@ static void test_counter_wraps_at_top_speed_and_in_the_hold_are_exact(void)
     const uint32_t wire_wraps_move[3] = {sim.wire_wraps[0], sim.wire_wraps[1], sim.wire_wraps[2]};
     TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_ctrl_move_to(&ctrl, q_c, NULL));
     const uint32_t wire3_before_hold = sim.wire_wraps[2];
-    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_acquire_one(&ctrl, &model, HOLD, &s));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_acquire_one(&ctrl, &model, HOLD, &acq, &s));
     n_faults_injected += 2U;
     printf("faults: counter wraps: encoders %u/%u/%u, wires %u/%u/%u (wire 3 in the hold: "
            "%u); slowest joint at an encoder wrap in the fast move %.3f rad/s, joint 1 at a "
@@ -450,14 +453,14 @@ static void test_wire_slip_between_poses_is_rejected_and_the_calibration_holds(v
     sim.wire_step_counts = -100;
     ++n_faults_injected;
     TEST_ASSERT_EQUAL(FW_FAULT_WIRES_INCONSISTENT,
-                      fw_acquire(&ctrl, &model, plan + 16, N_TRAIN - 16U, HOLD, run, &n));
+                      fw_acquire(&ctrl, &model, plan + 16, N_TRAIN - 16U, HOLD, &acq, run, &n));
     TEST_ASSERT_EQUAL_size_t(1U, ctrl.fault_index);
     TEST_ASSERT_EQUAL_UINT64(sim.wire_step_tick, sim.ticks); /* caught at the slip's tick */
     TEST_ASSERT_EQUAL_size_t(16U, n);
     assert_prefix_clean(16U);
     assert_drives_zero();
     dhc_model m = model;
-    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_autocal(&m, run, n, NULL, NULL, &res));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_autocal(&m, run, n, NULL, &cal_ws, NULL, &res));
     const double kept_rms = fw_wire_rms(&m, held, N_HELD);
 
     /* the same slip unseen (ensure_slipped_run): the slipped samples enter the set and the
@@ -496,7 +499,7 @@ static void test_stuck_wire_counter_is_detected_and_the_set_stays_clean(void)
     sim.wire_stuck_wire = 0U;
     ++n_faults_injected;
     TEST_ASSERT_EQUAL(FW_FAULT_WIRES_INCONSISTENT,
-                      fw_acquire(&ctrl, &model, plan + 10, N_TRAIN - 10U, HOLD, run, &n));
+                      fw_acquire(&ctrl, &model, plan + 10, N_TRAIN - 10U, HOLD, &acq, run, &n));
     TEST_ASSERT_EQUAL_size_t(0U, ctrl.fault_index);
     dhc_prediction a;
     dhc_prediction b;
@@ -576,7 +579,7 @@ static void test_power_cut_while_calibrating_or_storing_keeps_the_previous_calib
      * writes */
     dhc_model next = model;
     const size_t w0 = sim.nv_bytes_written;
-    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_autocal(&next, clean, N_TRAIN, &port.nv, NULL, &res));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_autocal(&next, clean, N_TRAIN, &port.nv, &cal_ws, NULL, &res));
     TEST_ASSERT_TRUE(res.saved);
     const size_t write_len = sim.nv_bytes_written - w0;
     reboot_and_expect(&next, 2U);
@@ -589,7 +592,7 @@ static void test_power_cut_while_calibrating_or_storing_keeps_the_previous_calib
     sim.powered_off = 0;
     dhc_model m = model;
     ++n_faults_injected;
-    TEST_ASSERT_EQUAL(FW_FAULT_STORAGE, fw_autocal(&m, clean, N_TRAIN, &port.nv, NULL, &res));
+    TEST_ASSERT_EQUAL(FW_FAULT_STORAGE, fw_autocal(&m, clean, N_TRAIN, &port.nv, &cal_ws, NULL, &res));
     TEST_ASSERT_EQUAL_MEMORY(nv_before, sim.nv, sizeof nv_before);
     reboot_and_expect(&prev, 1U);
 
@@ -601,7 +604,7 @@ static void test_power_cut_while_calibrating_or_storing_keeps_the_previous_calib
         sim.nv_cut_after = cut;
         sim.powered_off = 0;
         m = model;
-        TEST_ASSERT_EQUAL(FW_FAULT_STORAGE, fw_autocal(&m, clean, N_TRAIN, &port.nv, NULL, &res));
+        TEST_ASSERT_EQUAL(FW_FAULT_STORAGE, fw_autocal(&m, clean, N_TRAIN, &port.nv, &cal_ws, NULL, &res));
         TEST_ASSERT_TRUE(sim.powered_off);
         reboot_and_expect(&prev, 1U);
         ++cuts;
@@ -612,7 +615,7 @@ static void test_power_cut_while_calibrating_or_storing_keeps_the_previous_calib
     sim.nv_cut_after = write_len - 1U;
     sim.powered_off = 0;
     m = model;
-    TEST_ASSERT_EQUAL(FW_FAULT_STORAGE, fw_autocal(&m, clean, N_TRAIN, &port.nv, NULL, &res));
+    TEST_ASSERT_EQUAL(FW_FAULT_STORAGE, fw_autocal(&m, clean, N_TRAIN, &port.nv, &cal_ws, NULL, &res));
     reboot_and_expect(&prev, 1U);
     ++cuts;
     n_faults_injected += cuts;
@@ -650,7 +653,7 @@ static void test_a_worse_calibration_does_not_replace_the_stored_one(void)
     TEST_ASSERT_EQUAL(FW_CAL_OK, fw_cal_save(&port.nv, &model, &seq1));
     TEST_ASSERT_EQUAL_UINT32(1U, seq1);
     dhc_model good = model;
-    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_autocal(&good, clean, N_TRAIN, &port.nv, NULL, &res));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_autocal(&good, clean, N_TRAIN, &port.nv, &cal_ws, NULL, &res));
     printf("faults: better calibration (24 samples): FPE %.4f mm vs stored (drawing) %.4f mm "
            "-> %s\n",
            res.new_fpe_mm, res.stored_rms_mm, res.saved ? "stored" : "kept");
@@ -665,7 +668,7 @@ static void test_a_worse_calibration_does_not_replace_the_stored_one(void)
         dhc_model few = model;
         ++n_faults_injected;
         TEST_ASSERT_EQUAL(FW_FAULT_NONE,
-                          fw_autocal(&few, clean + firsts[r], 8U, &port.nv, NULL, &res));
+                          fw_autocal(&few, clean + firsts[r], 8U, &port.nv, &cal_ws, NULL, &res));
         const double few_held = fw_wire_rms(&few, held, N_HELD);
         const double good_held = fw_wire_rms(&good, held, N_HELD);
         printf("faults: worse calibration (8 samples from %zu): in-sample %.4f mm, FPE %.4f mm "
@@ -681,7 +684,7 @@ static void test_a_worse_calibration_does_not_replace_the_stored_one(void)
      * wire 2, scored on those same samples */
     dhc_model bad = model;
     ++n_faults_injected;
-    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_autocal(&bad, slipped, N_TRAIN, &port.nv, NULL, &res));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_autocal(&bad, slipped, N_TRAIN, &port.nv, &cal_ws, NULL, &res));
     printf("faults: worse calibration (slipped data): RMS %.4f / FPE %.4f mm vs stored %.4f mm, "
            "median %.4f vs stored %.4f mm -> %s; held-out %.4f mm\n",
            res.new_rms_mm, res.new_fpe_mm, res.stored_rms_mm, res.new_median_mm,

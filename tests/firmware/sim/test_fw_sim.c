@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "dhcal_fw/fw_acquire.h"
+#include "dhcal_fw/fw_autocal.h"
 #include "dhcal_fw/fw_controller.h"
 #include "fw_sim_port.h"
 #include "sim_fixture.h"
@@ -17,6 +18,9 @@ static fw_sim sim;
 static fw_port port;
 static fw_io_config io;
 static fw_ctrl ctrl;
+static fw_acq_stats acq; /* the holds of every acquisition of the test run */
+static fw_autocal_workspace cal_ws;
+static fw_plan_workspace plan_ws;
 static dhc_model model;
 static dhc_sample samples[8];
 
@@ -74,7 +78,7 @@ static void test_samples_keep_encoder_angles_directions_and_raw_lengths(void)
     fw_pose plan[3];
     TEST_ASSERT_EQUAL_size_t(3U, fw_plan_poses(&model, 3U, 11U, 1, plan));
     size_t n = 0U;
-    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_acquire(&ctrl, &model, plan, 3U, 50U, samples, &n));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_acquire(&ctrl, &model, plan, 3U, 50U, &acq, samples, &n));
     TEST_ASSERT_EQUAL_size_t(3U, n);
     TEST_ASSERT_EQUAL_UINT8(DHC_MEAS_WIRES, samples[2].kind);
     for (size_t j = 0U; j < 3U; ++j) {
@@ -88,7 +92,7 @@ static void test_samples_keep_encoder_angles_directions_and_raw_lengths(void)
     TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &model));
     fw_pose big[40];
     const size_t nb = fw_plan_poses(&model, 40U, 5U, 1, big);
-    TEST_ASSERT_EQUAL(DHC_OK, fw_plan_observability(&model, &set, big, nb, &o1, &rank));
+    TEST_ASSERT_EQUAL(DHC_OK, fw_plan_observability(&model, &set, big, nb, &plan_ws, &o1, &rank));
     TEST_ASSERT_TRUE(o1 > 0.0);
     TEST_ASSERT_TRUE(rank >= set.count - 2U);
 }
@@ -147,12 +151,12 @@ static void test_impossible_wire_lengths_keep_the_samples_taken(void)
     fw_pose plan[3];
     TEST_ASSERT_EQUAL_size_t(3U, fw_plan_poses(&model, 3U, 11U, 0, plan));
     size_t n = 0U;
-    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_acquire(&ctrl, &model, plan, 2U, 50U, samples, &n));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_acquire(&ctrl, &model, plan, 2U, 50U, &acq, samples, &n));
     TEST_ASSERT_EQUAL_size_t(2U, n);
     const dhc_sample kept = samples[1];
     sim.wire_offset[0] = 3900; /* 61 mm: a slipped wheel, still below the counter's jump bound */
     TEST_ASSERT_EQUAL(FW_FAULT_WIRES_INCONSISTENT,
-                      fw_acquire(&ctrl, &model, plan + 2, 1U, 50U, samples, &n));
+                      fw_acquire(&ctrl, &model, plan + 2, 1U, 50U, &acq, samples, &n));
     TEST_ASSERT_EQUAL_size_t(2U, n);
     TEST_ASSERT_EQUAL_MEMORY(&kept, &samples[1], sizeof kept);
     assert_drives_zero();
@@ -164,21 +168,21 @@ static void test_storage_failure_is_reported(void)
     fw_pose plan[24];
     const size_t np = fw_plan_poses(&model, 24U, 21U, 0, plan);
     size_t n = 0U;
-    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_acquire(&ctrl, &model, plan, np, 50U, many, &n));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_acquire(&ctrl, &model, plan, np, 50U, &acq, many, &n));
     sim.nv_fail = 1;
     static fw_autocal_result res;
     dhc_model m = model;
-    TEST_ASSERT_EQUAL(FW_FAULT_STORAGE, fw_autocal(&m, many, n, &port.nv, NULL, &res));
+    TEST_ASSERT_EQUAL(FW_FAULT_STORAGE, fw_autocal(&m, many, n, &port.nv, &cal_ws, NULL, &res));
     TEST_ASSERT_FALSE(res.saved);
     /* the calibration itself worked: the geometry errors of the fixture are found */
     TEST_ASSERT_TRUE(res.geo.rms_mm < 0.1);
     sim.nv_fail = 0;
     m = model;
-    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_autocal(&m, many, n, &port.nv, NULL, &res));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_autocal(&m, many, n, &port.nv, &cal_ws, NULL, &res));
     TEST_ASSERT_TRUE(res.saved);
     /* a second run on the same data is not better than what is stored: not saved again */
     m = model;
-    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_autocal(&m, many, n, &port.nv, NULL, &res));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_autocal(&m, many, n, &port.nv, &cal_ws, NULL, &res));
     TEST_ASSERT_FALSE(res.saved);
 }
 

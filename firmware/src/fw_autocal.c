@@ -1,0 +1,276 @@
+/* fw_autocal.c - calibration on the controller (fw_autocal.h). */
+#include "dhcal_fw/fw_autocal.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "dhcal_fw/fw_calstore.h"
+
+const dhc_candidate_scope fw_autocal_scope = {1, 0, 0};
+
+typedef struct {
+    const dhc_sample *s;
+    size_t n;
+} sample_buf;
+
+static dhc_status read_sample(void *ctx, size_t index, dhc_sample *out)
+{
+    const sample_buf *b = ctx;
+    if (index >= b->n) {
+        return DHC_ERR_ARGUMENT;
+    }
+    *out = b->s[index];
+    return DHC_OK;
+}
+
+/* RMS of the per-sample residual norms; err (may be NULL, n <= FW_ACQ_MAX_SAMPLES) receives
+ * the norms of the samples that have a residual, *used how many. */
+static double wire_errors(const dhc_model *model, const dhc_sample *samples, size_t n,
+                          double *err, size_t *used)
+{
+    double ss = 0.0;
+    size_t u = 0U;
+    for (size_t i = 0U; i < n; ++i) {
+        double r[DHC_MAX_ROWS_PER_SAMPLE];
+        size_t rows = 0U;
+        if (dhc_model_residual(model, &samples[i], 1000.0, r, &rows) != DHC_OK) {
+            continue;
+        }
+        double e2 = 0.0;
+        for (size_t k = 0U; k < rows; ++k) {
+            e2 += r[k] * r[k];
+        }
+        ss += e2;
+        if (err != NULL) {
+            err[u] = sqrt(e2);
+        }
+        ++u;
+    }
+    if (used != NULL) {
+        *used = u;
+    }
+    return u > 0U ? sqrt(ss / (double)u) : -1.0;
+}
+
+double fw_wire_rms(const dhc_model *model, const dhc_sample *samples, size_t n)
+{
+    return wire_errors(model, samples, n, NULL, NULL);
+}
+
+/* Median of v[0 .. n) (sorted in place; n <= FW_ACQ_MAX_SAMPLES, insertion sort). */
+static double median(double *v, size_t n)
+{
+    if (n == 0U) {
+        return -1.0;
+    }
+    for (size_t i = 1U; i < n; ++i) {
+        const double x = v[i];
+        size_t j = i;
+        while (j > 0U && v[j - 1U] > x) {
+            v[j] = v[j - 1U];
+            --j;
+        }
+        v[j] = x;
+    }
+    return (n % 2U) != 0U ? v[n / 2U] : 0.5 * (v[n / 2U - 1U] + v[n / 2U]);
+}
+
+void fw_autocal_default_config(fw_autocal_config *cfg)
+{
+    memset(cfg, 0, sizeof *cfg);
+    cfg->diagnose = 1;
+    cfg->io = NULL;
+    cfg->acq = NULL;
+    cfg->wire_noise_mm = 0.0;
+}
+
+fw_fault fw_autocal(dhc_model *model, const dhc_sample *samples, size_t n,
+                    const fw_nvstore *nv, fw_autocal_workspace *ws, dhc_model *geo_out,
+                    fw_autocal_result *res)
+{
+    fw_autocal_config cfg;
+    fw_autocal_default_config(&cfg);
+    return fw_autocal_configured(&cfg, model, samples, n, nv, ws, geo_out, res);
+}
+
+/* Appends text to buf[*len ..), keeping the terminator within cap. */
+static void append(char *buf, size_t cap, size_t *len, const char *text)
+{
+    for (const char *t = text; *t != '\0' && *len + 1U < cap; ++t) {
+        buf[(*len)++] = *t;
+    }
+    buf[*len] = '\0';
+}
+
+char *fw_autocal_effect_label(const fw_autocal_result *res, char *buf, size_t cap)
+{
+    if (cap == 0U) {
+        return buf;
+    }
+    size_t len = 0U;
+    buf[0] = '\0';
+    if (!res->found) {
+        append(buf, cap, &len, "none");
+        return buf;
+    }
+    append(buf, cap, &len, dhc_effect_name(res->effect));
+    if (dhc_effect_is_per_joint(res->effect)) {
+        char digits[24];
+        size_t n = 0U;
+        size_t v = res->effect_joint + 1U;
+        do {
+            digits[n++] = (char)('0' + (int)(v % 10U));
+            v /= 10U;
+        } while (v > 0U && n < sizeof digits);
+        char joint[26] = {':'};
+        for (size_t k = 0U; k < n; ++k) {
+            joint[1U + k] = digits[n - 1U - k];
+        }
+        joint[1U + n] = '\0';
+        append(buf, cap, &len, joint);
+    }
+    return buf;
+}
+
+fw_fault fw_fault_of_status(dhc_status st)
+{
+    switch (st) {
+    case DHC_OK:
+        return FW_FAULT_NONE;
+    case DHC_ERR_NOT_CONVERGED:
+        return FW_FAULT_NOT_CONVERGED;
+    case DHC_ERR_UNDERDETERMINED:
+    case DHC_ERR_NO_DATA:
+        return FW_FAULT_UNDERDETERMINED;
+    case DHC_ERR_NONFINITE:
+    case DHC_ERR_NOT_SPD:
+    case DHC_ERR_SINGULAR:
+    case DHC_ERR_INCONSISTENT:
+        return FW_FAULT_NUMERIC;
+    default:
+        return FW_FAULT_ARGUMENT;
+    }
+}
+
+fw_fault fw_autocal_configured(const fw_autocal_config *cfg, dhc_model *model,
+                               const dhc_sample *samples, size_t n, const fw_nvstore *nv,
+                               fw_autocal_workspace *ws, dhc_model *geo_out,
+                               fw_autocal_result *res)
+{
+    memset(res, 0, sizeof *res);
+    res->stored_rms_mm = -1.0;
+    res->stored_median_mm = -1.0;
+    if (n == 0U || n > FW_ACQ_MAX_SAMPLES || ws == NULL) {
+        return FW_FAULT_ARGUMENT;
+    }
+    sample_buf buf = {samples, n};
+    dhc_calib_options opt;
+    dhc_calib_default_options(&opt);
+    dhc_diagnose_options dopt;
+    dhc_diagnose_default_options(&dopt);
+    if (cfg->io != NULL) {
+        /* one encoder count, uniform (variance count^2 / 12), plus the hold's dither: the
+         * sample keeps the last reading, the wires saw the mean pose of the hold */
+        for (size_t j = 0U; j < model->arm.n_joints && j < DHC_MAX_JOINTS; ++j) {
+            const double cpr = cfg->io->counts_per_rad[j];
+            const double dither = cfg->acq != NULL ? fw_acq_angle_dither_rad(cfg->acq, j) : 0.0;
+            opt.joint_noise_rad[j] =
+                cpr > 0.0 ? sqrt(1.0 / (12.0 * cpr * cpr) + dither * dither) : 0.0;
+        }
+        opt.meas_noise_mm = cfg->wire_noise_mm > 0.0 ? cfg->wire_noise_mm
+                            : cfg->acq != NULL           ? fw_acq_wire_noise_mm(cfg->acq)
+                                                         : 0.0;
+        if (!(opt.meas_noise_mm > 0.0)) {
+            opt.meas_noise_mm = cfg->io->wire_mm_per_count / sqrt(12.0);
+        }
+        memcpy(dopt.joint_noise_rad, opt.joint_noise_rad, sizeof opt.joint_noise_rad);
+        dopt.meas_noise_mm = opt.meas_noise_mm;
+        memcpy(res->joint_noise_rad, opt.joint_noise_rad, sizeof opt.joint_noise_rad);
+        res->meas_noise_mm = opt.meas_noise_mm;
+    }
+    dhc_param_set set;
+    if (dhc_params_base_model(&set, model) != DHC_OK ||
+        cfg->n_effects > FW_AUTOCAL_MAX_EFFECTS) {
+        return FW_FAULT_ARGUMENT;
+    }
+    for (size_t e = 0U; e < cfg->n_effects; ++e) {
+        if (dhc_params_add_effect(&set, model, cfg->effect[e], cfg->effect_joint[e]) !=
+            DHC_OK) {
+            return FW_FAULT_ARGUMENT;
+        }
+    }
+    memset(ws->flags, 0, sizeof ws->flags);
+    ws->geo = *model;
+    const dhc_status fit = dhc_calib_fit(&ws->geo, &set, read_sample, &buf, n, ws->flags, &opt,
+                                         &ws->cal, &res->geo);
+    if (fit != DHC_OK) {
+        return fw_fault_of_status(fit);
+    }
+    *model = ws->geo;
+    const dhc_calib_report *final_fit = &res->geo;
+    if (geo_out != NULL) {
+        *geo_out = ws->geo;
+    }
+    const size_t nc = cfg->diagnose != 0
+                          ? dhc_diagnose_candidates(&ws->geo, &set, &fw_autocal_scope, ws->cands,
+                                                    DHC_MAX_CANDIDATES)
+                          : 0U;
+    if (nc > 0U &&
+        dhc_diagnose(&ws->geo, &set, res->geo.identifiable, res->geo.sigma * res->geo.sigma,
+                     ws->cands, nc, read_sample, &buf, n, ws->flags, &dopt, &ws->diag_ws,
+                     &ws->diag) == DHC_OK &&
+        ws->diag.count > 0U && ws->diag.c[0].significant) {
+        res->found = 1;
+        res->effect = ws->diag.c[0].effect;
+        res->effect_joint = ws->diag.c[0].joint;
+        res->effect_log10_p = ws->diag.c[0].log10_p;
+        dhc_param_set set2 = set;
+        dhc_model m2 = ws->geo;
+        if (dhc_params_add_effect(&set2, &m2, res->effect, res->effect_joint) == DHC_OK) {
+            memset(ws->flags, 0, sizeof ws->flags);
+            if (dhc_calib_fit(&m2, &set2, read_sample, &buf, n, ws->flags, &opt, &ws->cal,
+                              &res->eff) == DHC_OK) {
+                *model = m2;
+                final_fit = &res->eff;
+            }
+        }
+    }
+    size_t used_new = 0U;
+    res->new_rms_mm = wire_errors(model, samples, n, ws->err_new, &used_new);
+    res->new_median_mm = median(ws->err_new, used_new);
+    /* Akaike's final prediction error: the in-sample RMS of a fit with p parameters on m
+     * equations underestimates its error on new data by about sqrt((m - p) / (m + p)). */
+    const double m_rows = (double)final_fit->rows;
+    const double p_fit = (double)final_fit->rank;
+    res->new_fpe_mm = m_rows > p_fit ? res->new_rms_mm * sqrt((m_rows + p_fit) / (m_rows - p_fit))
+                                     : HUGE_VAL;
+    if (nv == NULL) {
+        return FW_FAULT_NONE;
+    }
+    uint32_t seq = 0U;
+    const fw_cal_status ls = fw_cal_load(nv, &ws->stored, &seq);
+    if (ls == FW_CAL_OK) {
+        size_t used_old = 0U;
+        res->stored_rms_mm = wire_errors(&ws->stored, samples, n, ws->err_old, &used_old);
+        res->stored_median_mm = median(ws->err_old, used_old);
+        /* significantly better (see fw_autocal.h): log(stored / FPE) above z standard
+         * deviations of that log-ratio, sd(log s) ~ 1 / sqrt(2 dof) per RMS estimate */
+        const double dof_new = m_rows - p_fit;
+        const double dof_old = 3.0 * (double)used_old;
+        const int better = dof_new > 0.0 && dof_old > 0.0 && res->new_fpe_mm > 0.0 &&
+                           res->stored_rms_mm > 0.0 &&
+                           log(res->stored_rms_mm / res->new_fpe_mm) >
+                               FW_AUTOCAL_Z * sqrt(0.5 / dof_new + 0.5 / dof_old) &&
+                           res->new_median_mm <= res->stored_median_mm;
+        if (!better) {
+            return FW_FAULT_NONE; /* the stored one is not clearly worse: keep it */
+        }
+    } else if (ls == FW_CAL_ERR_IO) {
+        return FW_FAULT_STORAGE;
+    }
+    if (fw_cal_save(nv, model, &res->seq) != FW_CAL_OK) {
+        return FW_FAULT_STORAGE;
+    }
+    res->saved = 1;
+    return FW_FAULT_NONE;
+}

@@ -1,0 +1,148 @@
+/* fw_job.c - the controller's job (fw_job.h). */
+#include "dhcal_fw/fw_job.h"
+
+#include <string.h>
+
+void fw_job_default_config(fw_job_config *cfg, const dhc_model *nominal)
+{
+    memset(cfg, 0, sizeof *cfg);
+    cfg->n_samples = 30U;
+    cfg->plan_seed = 4242U;
+    cfg->mixed_dirs = 0;
+    cfg->hold_ticks = 200U;
+    cfg->noise_model = 0;
+    fw_autocal_default_config(&cfg->autocal);
+    fw_ctrl_default_config(&cfg->ctrl, nominal->arm.n_joints);
+    fw_ctrl_config_limits(&cfg->ctrl, &nominal->arm);
+}
+
+/* The controller latches the fault (drives to 0 V) when it is running. */
+static fw_fault job_fault(fw_job *job, fw_fault f)
+{
+    if (f != FW_FAULT_NONE && job->ctrl.port != NULL) {
+        fw_ctrl_fault(&job->ctrl, f, 0U);
+    }
+    return f;
+}
+
+fw_fault fw_job_boot(fw_job *job, const fw_job_config *cfg, const dhc_model *nominal,
+                     const fw_port *port, const fw_io_config *io)
+{
+    memset(&job->ctrl, 0, sizeof job->ctrl);
+    /* until the controller runs, the job refuses every step */
+    job->ctrl.fault = FW_FAULT_ARGUMENT;
+    job->n_plan = 0U;
+    job->n_samples = 0U;
+    job->calibrated_ok = 0;
+    if (cfg == NULL || nominal == NULL || port == NULL || io == NULL) {
+        return FW_FAULT_ARGUMENT;
+    }
+    const size_t nj = nominal->arm.n_joints;
+    if (!nominal->measurer.present || nj == 0U || nj > DHC_MAX_JOINTS ||
+        nj > port->n_joints || cfg->n_samples == 0U || cfg->n_samples > FW_ACQ_MAX_SAMPLES) {
+        return FW_FAULT_ARGUMENT;
+    }
+    job->cfg = *cfg;
+    job->port = port;
+    job->io = io;
+    job->nominal = *nominal;
+    fw_acq_stats_reset(&job->acq);
+    fw_pose start;
+    memset(&start, 0, sizeof start);
+    for (size_t j = 0U; j < nj; ++j) {
+        start.q_rad[j] = cfg->q_start_rad[j];
+        start.dir[j] = 1;
+    }
+    double wires[3];
+    if (fw_pose_wires(&job->nominal, &start, wires) != DHC_OK) {
+        return FW_FAULT_ARGUMENT;
+    }
+    job->ctrl.fault = FW_FAULT_NONE;
+    return fw_ctrl_init(&job->ctrl, port, io, &job->cfg.ctrl, start.q_rad, wires);
+}
+
+fw_fault fw_job_plan(fw_job *job)
+{
+    if (job->ctrl.fault != FW_FAULT_NONE) {
+        return job->ctrl.fault;
+    }
+    job->n_plan = fw_plan_poses(&job->nominal, job->cfg.n_samples, job->cfg.plan_seed,
+                                job->cfg.mixed_dirs, job->plan);
+    if (job->n_plan == 0U) {
+        return job_fault(job, FW_FAULT_UNDERDETERMINED);
+    }
+    dhc_param_set base;
+    job->o1 = 0.0;
+    job->o1_rank = 0U;
+    job->o1_params = 0U;
+    if (dhc_params_base_model(&base, &job->nominal) == DHC_OK) {
+        job->o1_params = base.count;
+        /* a score, not a gate: a plan the analysis cannot score still runs */
+        (void)fw_plan_observability(&job->nominal, &base, job->plan, job->n_plan,
+                                    &job->plan_ws, &job->o1, &job->o1_rank);
+    }
+    return FW_FAULT_NONE;
+}
+
+fw_fault fw_job_acquire(fw_job *job)
+{
+    job->n_samples = 0U;
+    fw_acq_stats_reset(&job->acq);
+    if (job->ctrl.fault != FW_FAULT_NONE) {
+        return job->ctrl.fault;
+    }
+    return fw_acquire(&job->ctrl, &job->nominal, job->plan, job->n_plan, job->cfg.hold_ticks,
+                      &job->acq, job->samples, &job->n_samples);
+}
+
+fw_fault fw_job_calibrate(fw_job *job, const fw_nvstore *nv)
+{
+    job->calibrated_ok = 0;
+    if (job->ctrl.fault != FW_FAULT_NONE) {
+        return job->ctrl.fault;
+    }
+    fw_autocal_config ac = job->cfg.autocal;
+    ac.io = job->cfg.noise_model ? job->io : NULL;
+    ac.acq = &job->acq;
+    job->calibrated = job->nominal;
+    const fw_fault f = fw_autocal_configured(&ac, &job->calibrated, job->samples,
+                                             job->n_samples, nv, &job->autocal_ws,
+                                             &job->geometric, &job->result);
+    job->calibrated_ok = f == FW_FAULT_NONE || f == FW_FAULT_STORAGE;
+    /* a calibration that failed leaves the arm where it is, holding: the controller's
+     * faults are the motion's, the caller decides what a failed fit means */
+    return f;
+}
+
+fw_fault fw_job_run(fw_job *job, const fw_job_config *cfg, const dhc_model *nominal,
+                    const fw_port *port, const fw_io_config *io, const fw_nvstore *nv)
+{
+    fw_fault f = fw_job_boot(job, cfg, nominal, port, io);
+    if (f == FW_FAULT_NONE) {
+        f = fw_job_plan(job);
+    }
+    if (f == FW_FAULT_NONE) {
+        f = fw_job_acquire(job);
+    }
+    if (f == FW_FAULT_NONE) {
+        f = fw_job_calibrate(job, nv);
+    }
+    return f;
+}
+
+dhc_status fw_job_param_set(const fw_job *job, dhc_param_set *set)
+{
+    if (!job->calibrated_ok) {
+        return DHC_ERR_ARGUMENT;
+    }
+    dhc_status st = dhc_params_base_model(set, &job->calibrated);
+    const fw_autocal_config *ac = &job->cfg.autocal;
+    for (size_t e = 0U; e < ac->n_effects && st == DHC_OK; ++e) {
+        st = dhc_params_add_effect(set, &job->calibrated, ac->effect[e], ac->effect_joint[e]);
+    }
+    if (st == DHC_OK && job->result.found) {
+        st = dhc_params_add_effect(set, &job->calibrated, job->result.effect,
+                                   job->result.effect_joint);
+    }
+    return st;
+}
