@@ -32,7 +32,7 @@ int dhcal_json_load(const char *path, size_t max_bytes, const char *what, cJSON 
                     dhcal_error *err);
 
 /* "file: prefix.jpath: message": sets c->err, returns DHCAL_IO_BAD_INPUT. */
-int dhcal_jfail(const dhcal_jctx *c, const char *jpath, const char *fmt, ...) IO_PRINTF(3, 4);
+int dhcal_jfail(const dhcal_jctx *c, const char *jpath, const char *fmt, ...) DHCAL_PRINTF(3, 4);
 void dhcal_jpath_key(char out[DHCAL_JPATH_CAP], const char *parent, const char *key);
 void dhcal_jpath_index(char out[DHCAL_JPATH_CAP], const char *parent, size_t i);
 /* "a number", "a string", ... for messages. */
