@@ -89,7 +89,8 @@ int dhcal_samples_errors(const dhc_model *model, const dhcal_samples *s, double 
     for (size_t i = 0U; i < s->n; ++i) {
         double r[DHC_MAX_ROWS_PER_SAMPLE];
         size_t rows;
-        if (dhc_model_residual(model, &s->samples[i], 1000.0, r, &rows) != DHC_OK) {
+        if (dhc_model_residual(model, &s->samples[i], DHC_ORIENTATION_WEIGHT_MM_PER_RAD, r,
+                               &rows) != DHC_OK) {
             return DHCAL_IO_FAILED;
         }
         if (resid != NULL) {

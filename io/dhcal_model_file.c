@@ -192,15 +192,6 @@ size_t dhcal_effect_catalogue(char *buf, size_t cap)
     return pos;
 }
 
-void dhcal_effect_label(dhc_effect effect, size_t joint, char *buf, size_t cap)
-{
-    if (dhc_effect_is_per_joint(effect)) {
-        snprintf(buf, cap, "%s:%zu", dhc_effect_name(effect), joint + 1U);
-    } else {
-        snprintf(buf, cap, "%s", dhc_effect_name(effect));
-    }
-}
-
 static int load_effects(const dhcal_jctx *c, const cJSON *fx, dhcal_model *model)
 {
     if (!cJSON_IsObject(fx)) {

@@ -75,8 +75,4 @@ int dhcal_model_save(const char *path, const dhcal_model *model, dhcal_error *er
  * full length. */
 size_t dhcal_effect_catalogue(char *buf, size_t cap);
 
-/* "joint_compliance:2" / "measurer_scale": an effect as the CLI, model files and JSON write it
- * (joint 0-based in, 1-based out; ignored when the effect is not per joint). */
-void dhcal_effect_label(dhc_effect effect, size_t joint, char *buf, size_t cap);
-
 #endif /* DHCAL_MODEL_FILE_H */

@@ -137,7 +137,7 @@ static void effect_from_lib(const dhc_model *m, const dhc_effect_info *fx, size_
     } else if (fx->reference == DHC_EFFECT_REF_TEMPERATURE) {
         ev->values[ev->n_values++] = m->thermal_ref_c;
     }
-    dhcal_effect_label((dhc_effect)fx->effect, joint, ev->name, sizeof ev->name);
+    (void)dhc_effect_label((dhc_effect)fx->effect, joint, ev->name, sizeof ev->name);
     out->n_effects++;
 }
 

@@ -134,7 +134,7 @@ static double noise_floor(const dhc_model *m, const dhc_param_set *set,
     static dhc_uncertainty unc;
     if (dhc_uncertainty_from_samples(&unc, m, set, fit->identifiable, read_job_sample, &job,
                                      job.n_samples, res->joint_noise_rad, res->meas_noise_mm,
-                                     1000.0, fit->sigma) != DHC_OK) {
+                                     DHC_ORIENTATION_WEIGHT_MM_PER_RAD, fit->sigma) != DHC_OK) {
         return (double)NAN;
     }
     double encoder_sd[DHC_MAX_JOINTS] = {0.0};
@@ -163,7 +163,7 @@ static void where_it_fails(const dhc_model *m, size_t n, FILE *log)
     for (size_t i = 0U; i < n; ++i) {
         double r[DHC_MAX_ROWS_PER_SAMPLE];
         size_t rows = 0U;
-        if (dhc_model_residual(m, &job.samples[i], 1000.0, r, &rows) != DHC_OK) {
+        if (dhc_model_residual(m, &job.samples[i], DHC_ORIENTATION_WEIGHT_MM_PER_RAD, r, &rows) != DHC_OK) {
             continue;
         }
         double e = 0.0;

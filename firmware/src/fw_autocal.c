@@ -33,7 +33,8 @@ static double wire_errors(const dhc_model *model, const dhc_sample *samples, siz
     for (size_t i = 0U; i < n; ++i) {
         double r[DHC_MAX_ROWS_PER_SAMPLE];
         size_t rows = 0U;
-        if (dhc_model_residual(model, &samples[i], 1000.0, r, &rows) != DHC_OK) {
+        if (dhc_model_residual(model, &samples[i], DHC_ORIENTATION_WEIGHT_MM_PER_RAD, r, &rows) !=
+            DHC_OK) {
             continue;
         }
         double e2 = 0.0;
@@ -93,42 +94,17 @@ fw_fault fw_autocal(dhc_model *model, const dhc_sample *samples, size_t n,
     return fw_autocal_configured(&cfg, model, samples, n, nv, ws, geo_out, res);
 }
 
-/* Appends text to buf[*len ..), keeping the terminator within cap. */
-static void append(char *buf, size_t cap, size_t *len, const char *text)
-{
-    for (const char *t = text; *t != '\0' && *len + 1U < cap; ++t) {
-        buf[(*len)++] = *t;
-    }
-    buf[*len] = '\0';
-}
-
 char *fw_autocal_effect_label(const fw_autocal_result *res, char *buf, size_t cap)
 {
     if (cap == 0U) {
         return buf;
     }
-    size_t len = 0U;
-    buf[0] = '\0';
     if (!res->found) {
-        append(buf, cap, &len, "none");
+        buf[0] = '\0';
+        (void)strncat(buf, "none", cap - 1U);
         return buf;
     }
-    append(buf, cap, &len, dhc_effect_name(res->effect));
-    if (dhc_effect_is_per_joint(res->effect)) {
-        char digits[24];
-        size_t n = 0U;
-        size_t v = res->effect_joint + 1U;
-        do {
-            digits[n++] = (char)('0' + (int)(v % 10U));
-            v /= 10U;
-        } while (v > 0U && n < sizeof digits);
-        char joint[26] = {':'};
-        for (size_t k = 0U; k < n; ++k) {
-            joint[1U + k] = digits[n - 1U - k];
-        }
-        joint[1U + n] = '\0';
-        append(buf, cap, &len, joint);
-    }
+    (void)dhc_effect_label(res->effect, res->effect_joint, buf, cap);
     return buf;
 }
 

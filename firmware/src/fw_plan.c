@@ -100,7 +100,7 @@ dhc_status fw_plan_observability(const dhc_model *model, const dhc_param_set *se
         dhc_mat jac;
         st = dhc_mat_init(&jac, 3U, p, rows_buf, sizeof rows_buf / sizeof rows_buf[0]);
         if (st == DHC_OK) {
-            st = dhc_model_jacobian(model, set, &s, 1000.0, &jac, NULL);
+            st = dhc_model_jacobian(model, set, &s, DHC_ORIENTATION_WEIGHT_MM_PER_RAD, &jac, NULL);
         }
         if (st == DHC_OK) {
             st = dhc_normal_eq_add(&ws->ne, &jac, zero_residual, NULL, 3U);

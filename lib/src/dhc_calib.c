@@ -47,7 +47,7 @@ void dhc_calib_default_options(dhc_calib_options *opt)
     opt->max_identifiability_checks = 3U;
     opt->max_std_angle_rad = 0.0;
     opt->max_std_length_mm = 0.0;
-    opt->orientation_weight_mm_per_rad = 1000.0;
+    opt->orientation_weight_mm_per_rad = DHC_ORIENTATION_WEIGHT_MM_PER_RAD;
     opt->outlier_threshold = 6.0;
     opt->outlier_floor_mm = 1e-6;
     opt->joint_margin_rad = 0.1;

@@ -20,7 +20,7 @@ void dhc_diagnose_default_options(dhc_diagnose_options *opt)
     opt->alpha = 1e-3;
     opt->separable_tol = 1e-6;
     opt->lookalike_ratio = 1.02;
-    opt->orientation_weight_mm_per_rad = 1000.0;
+    opt->orientation_weight_mm_per_rad = DHC_ORIENTATION_WEIGHT_MM_PER_RAD;
     for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
         opt->joint_noise_rad[j] = 0.0;
     }

@@ -150,3 +150,43 @@ dhc_status dhc_effect_parse(const char *text, size_t len, size_t n_joints, dhc_e
     }
     return DHC_ERR_ARGUMENT;
 }
+
+/* Appends text to buf[*len ..), keeping the terminator within cap. */
+static void append(char *buf, size_t cap, size_t *len, const char *text)
+{
+    for (const char *t = text; *t != '\0' && *len + 1U < cap; ++t) {
+        buf[(*len)++] = *t;
+    }
+    buf[*len] = '\0';
+}
+
+size_t dhc_effect_label(dhc_effect effect, size_t joint, char *buf, size_t cap)
+{
+    if (buf == NULL || cap == 0U) {
+        return 0U;
+    }
+    size_t len = 0U;
+    buf[0] = '\0';
+    const char *const name = dhc_effect_name(effect);
+    if (name == NULL) {
+        return 0U;
+    }
+    append(buf, cap, &len, name);
+    if (dhc_effect_is_per_joint(effect)) {
+        /* ":" and the 1-based joint number, digits written backwards then reversed */
+        char digits[24];
+        size_t n = 0U;
+        size_t v = joint + 1U;
+        do {
+            digits[n++] = (char)('0' + (int)(v % 10U));
+            v /= 10U;
+        } while (v > 0U && n < sizeof digits);
+        char number[26] = {':'};
+        for (size_t k = 0U; k < n; ++k) {
+            number[1U + k] = digits[n - 1U - k];
+        }
+        number[1U + n] = '\0';
+        append(buf, cap, &len, number);
+    }
+    return len;
+}

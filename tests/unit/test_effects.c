@@ -176,6 +176,38 @@ static void test_every_name_parses_back_to_its_effect(void)
 
 /* The count the table gives, the parameters dhc_params_add_effect appends, the columns the
  * Jacobian really separates over spread data, and docs/effects.md: all the same number. */
+/* The label is what people, model files and the CLI write: parsed back it names the same
+ * effect and joint; written for a joint beyond 9 it carries every digit; cut to a small
+ * buffer it stays terminated. */
+static void test_labels_parse_back_and_fit_their_buffer(void)
+{
+    char label[40];
+    for (size_t i = 0U; i < (size_t)DHC_EFFECT_COUNT; ++i) {
+        const dhc_effect effect = (dhc_effect)i;
+        for (size_t joint = 0U; joint < DHC_MAX_JOINTS; ++joint) {
+            const size_t len = dhc_effect_label(effect, joint, label, sizeof label);
+            TEST_ASSERT_EQUAL_size_t(strlen(label), len);
+            dhc_effect parsed;
+            size_t parsed_joint;
+            TEST_ASSERT_EQUAL(DHC_OK, dhc_effect_parse(label, len, DHC_MAX_JOINTS, &parsed,
+                                                       &parsed_joint));
+            TEST_ASSERT_EQUAL(effect, parsed);
+            TEST_ASSERT_EQUAL_size_t(dhc_effect_is_per_joint(effect) ? joint : 0U, parsed_joint);
+        }
+    }
+    (void)dhc_effect_label(DHC_EFFECT_JOINT_COMPLIANCE, 1U, label, sizeof label);
+    TEST_ASSERT_EQUAL_STRING("joint_compliance:2", label);
+    (void)dhc_effect_label(DHC_EFFECT_JOINT_HARMONIC3, 11U, label, sizeof label);
+    TEST_ASSERT_EQUAL_STRING("joint_harmonic3:12", label);
+    (void)dhc_effect_label(DHC_EFFECT_MEASURER_SCALE, 4U, label, sizeof label);
+    TEST_ASSERT_EQUAL_STRING("measurer_scale", label);
+    char small[6] = "xxxxx";
+    TEST_ASSERT_EQUAL_size_t(5U, dhc_effect_label(DHC_EFFECT_JOINT_SCALE, 0U, small, sizeof small));
+    TEST_ASSERT_EQUAL_STRING("joint", small);
+    TEST_ASSERT_EQUAL_size_t(0U, dhc_effect_label(DHC_EFFECT_COUNT, 0U, label, sizeof label));
+    TEST_ASSERT_EQUAL_STRING("", label);
+}
+
 static void test_parameter_counts_are_the_independent_columns_of_the_jacobian(void)
 {
     const dhc_model m = catalogue_model();
@@ -257,6 +289,7 @@ int main(void)
     UNITY_BEGIN();
     RUN_TEST(test_the_catalogue_holds_the_documented_effects_in_order);
     RUN_TEST(test_every_name_parses_back_to_its_effect);
+    RUN_TEST(test_labels_parse_back_and_fit_their_buffer);
     RUN_TEST(test_parameter_counts_are_the_independent_columns_of_the_jacobian);
     RUN_TEST(test_without_what_an_effect_needs_its_columns_add_nothing);
     return UNITY_END();

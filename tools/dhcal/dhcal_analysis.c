@@ -357,13 +357,13 @@ static dhc_status joint_error_of_sample(const dhc_model *model, const dhc_param_
     size_t rows;
     dhc_mat jac;
     /* position (or wire) rows only: an orientation row would weigh in at 1000 mm/rad */
-    dhc_status st = dhc_model_residual(model, smp, 1000.0, r, &rows);
+    dhc_status st = dhc_model_residual(model, smp, DHC_ORIENTATION_WEIGHT_MM_PER_RAD, r, &rows);
     if (st == DHC_OK) {
         st = dhc_mat_init(&jac, dhc_sample_rows(smp), nj, jac_buf,
                           sizeof jac_buf / sizeof jac_buf[0]);
     }
     if (st == DHC_OK) {
-        st = dhc_model_jacobian(model, offsets, smp, 1000.0, &jac, pred);
+        st = dhc_model_jacobian(model, offsets, smp, DHC_ORIENTATION_WEIGHT_MM_PER_RAD, &jac, pred);
     }
     if (st == DHC_OK) {
         jac.rows = 3U;
@@ -561,7 +561,8 @@ static double predicted_row_variance(const dhcal_fit *fit, const dhc_sample *smp
     dhc_mat jq;
     const double meas2 = fit->noise.meas_mm * fit->noise.meas_mm;
     if (dhc_mat_init(&jq, dhc_sample_rows(smp), n, buf, sizeof buf / sizeof buf[0]) != DHC_OK ||
-        dhc_model_jacobian(&fit->model, &thetas, smp, 1000.0, &jq, NULL) != DHC_OK) {
+        dhc_model_jacobian(&fit->model, &thetas, smp, DHC_ORIENTATION_WEIGHT_MM_PER_RAD, &jq,
+                           NULL) != DHC_OK) {
         return meas2;
     }
     double sum = 0.0;

@@ -73,7 +73,8 @@ int dhcal_cross_validate(const dhc_model *start, const dhc_param_set *set,
             }
             double r[DHC_MAX_ROWS_PER_SAMPLE];
             size_t n_rows;
-            if (dhc_model_residual(&model, &s->samples[i], 1000.0, r, &n_rows) != DHC_OK) {
+            if (dhc_model_residual(&model, &s->samples[i], DHC_ORIENTATION_WEIGHT_MM_PER_RAD, r,
+                                   &n_rows) != DHC_OK) {
                 snprintf(err->msg, sizeof err->msg, "cross-validation: row %zu cannot be "
                          "predicted", i + 1U);
                 rc = DHCAL_IO_FAILED;
@@ -389,7 +390,7 @@ int dhcal_run_refine(const dhc_model *nominal, const char *start_effects,
         for (size_t c = 0U; c < diag.count; ++c) {
             if (trials.trial[c].unsupported) {
                 char lab[64];
-                dhcal_effect_label(diag.c[c].effect, diag.c[c].joint, lab, sizeof lab);
+                (void)dhc_effect_label(diag.c[c].effect, diag.c[c].joint, lab, sizeof lab);
                 const size_t len = strlen(out->skipped);
                 snprintf(out->skipped + len, sizeof out->skipped - len, "%s%s (%.3f -> %.3f mm)",
                          len > 0U ? ", " : "", lab, trials.workspace_std_mm,
@@ -399,7 +400,7 @@ int dhcal_run_refine(const dhc_model *nominal, const char *start_effects,
         char best_label[64] = "";
         double best_cv = out->cv.rms_mm;
         if (trials.best < diag.count) {
-            dhcal_effect_label(diag.c[trials.best].effect, diag.c[trials.best].joint,
+            (void)dhc_effect_label(diag.c[trials.best].effect, diag.c[trials.best].joint,
                                best_label, sizeof best_label);
             best_cv = trials.trial[trials.best].cv.rms_mm;
         }

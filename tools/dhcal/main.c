@@ -859,13 +859,13 @@ static void text_diagnosis(const dhcal_fit *fit, const dhc_diagnosis *d, const c
         printf("no missing effect found: no effect of the catalogue explains a significant "
                "share of the residual (whether the model fits the noise: see adequacy)\n");
     } else {
-        dhcal_effect_label(top->effect, top->joint, label, sizeof label);
+        (void)dhc_effect_label(top->effect, top->joint, label, sizeof label);
         printf("found %s: add '%s' (explains %.0f%% of the residual, significant)\n",
                dhc_effect_info_of(top->effect)->summary, label, 100.0 * top->explained);
         if (top->lookalike < d->count) {
             char other[64];
             const dhc_candidate_result *l = &d->c[top->lookalike];
-            dhcal_effect_label(l->effect, l->joint, other, sizeof other);
+            (void)dhc_effect_label(l->effect, l->joint, other, sizeof other);
             printf("caution: '%s' explains the residual about as well (%.0f%%); these data "
                    "cannot tell the two apart\n",
                    other, 100.0 * l->explained);
@@ -883,7 +883,7 @@ static void text_diagnosis(const dhcal_fit *fit, const dhc_diagnosis *d, const c
             unseen++;
             continue;
         }
-        dhcal_effect_label(c->effect, c->joint, label, sizeof label);
+        (void)dhc_effect_label(c->effect, c->joint, label, sizeof label);
         char cv[48] = "";
         if (trials != NULL && trials->trial[i].tried) {
             if (trials->trial[i].unsupported) {
@@ -899,7 +899,7 @@ static void text_diagnosis(const dhcal_fit *fit, const dhc_diagnosis *d, const c
         printf("cannot be seen in these data (looks exactly like what the fit already adjusts):");
         for (size_t i = 0U; i < d->count; ++i) {
             if (d->c[i].rank == 0U) {
-                dhcal_effect_label(d->c[i].effect, d->c[i].joint, label, sizeof label);
+                (void)dhc_effect_label(d->c[i].effect, d->c[i].joint, label, sizeof label);
                 printf(" %s", label);
             }
         }
@@ -956,7 +956,7 @@ static int cmd_diagnose(const options *o, session *s)
                 }
                 if (c->lookalike < diag.count) {
                     char label[64];
-                    dhcal_effect_label(diag.c[c->lookalike].effect, diag.c[c->lookalike].joint,
+                    (void)dhc_effect_label(diag.c[c->lookalike].effect, diag.c[c->lookalike].joint,
                                        label, sizeof label);
                     cJSON_AddStringToObject(j, "lookalike", label);
                 }
@@ -1127,7 +1127,7 @@ static int cmd_plot(const options *o, session *s)
 
     /* "after": the effect the diagnosis names, added to whatever --effects gave */
     if (rc == 0 && diag.count > 0U && diag.c[0].significant) {
-        dhcal_effect_label(diag.c[0].effect, diag.c[0].joint, label, sizeof label);
+        (void)dhc_effect_label(diag.c[0].effect, diag.c[0].joint, label, sizeof label);
         char list[600];
         snprintf(list, sizeof list, "%s%s%s", o->effects != NULL ? o->effects : "",
                  o->effects != NULL ? "," : "", label);
@@ -1162,7 +1162,7 @@ static int cmd_plot(const options *o, session *s)
         if (diag.c[i].rank == 0U) {
             continue;
         }
-        dhcal_effect_label(diag.c[i].effect, diag.c[i].joint, cands[nc].label, sizeof cands[nc].label);
+        (void)dhc_effect_label(diag.c[i].effect, diag.c[i].joint, cands[nc].label, sizeof cands[nc].label);
         cands[nc].explained = diag.c[i].explained;
         cands[nc].significant = diag.c[i].significant;
         nc++;

@@ -64,7 +64,8 @@ typedef struct {
     double max_std_angle_rad;    /* a joint offset or twist whose standard error exceeds this
                                     is held at its input value (0: no bound, the default) */
     double max_std_length_mm;    /* ... a length (a, d) likewise (0: no bound) */
-    double orientation_weight_mm_per_rad; /* rad residuals count as this many mm (1000) */
+    /* rad residuals count as this many mm (DHC_ORIENTATION_WEIGHT_MM_PER_RAD) */
+    double orientation_weight_mm_per_rad;
     double outlier_threshold;    /* |error| / robust sigma above this is an outlier (6); 0 off */
     double outlier_floor_mm;     /* robust sigma is at least this (1e-6 mm: noise-free data);
                                     with the noise model on, errors and this floor are in

@@ -73,7 +73,7 @@ typedef struct {
     double lookalike_ratio;/* two candidates are look-alikes when their union explains less
                               than this factor more than the better one (default 1.02) and
                               the better one adds nothing significant (at alpha) to the other */
-    double orientation_weight_mm_per_rad; /* as in the fit (1000) */
+    double orientation_weight_mm_per_rad; /* as in the fit (DHC_ORIENTATION_WEIGHT_MM_PER_RAD) */
     /* Noise model, as dhc_calib_options (all 0 = off): use the fit's. When on, residuals
      * and Jacobian rows (candidates' too) are whitened sample by sample (dhc_sample_whiten),
      * so the score test's i.i.d. assumption holds for joint-angle noise too; sigma2 is then

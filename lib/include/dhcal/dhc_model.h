@@ -148,6 +148,11 @@ dhc_status dhc_model_predict(const dhc_model *model, const dhc_sample *s, dhc_pr
 dhc_status dhc_model_tool_point(const dhc_model *model, const double *q_rad, const int8_t *dir,
                                 double p_mm[3]);
 
+/* How many mm one radian of orientation error counts as, unless a caller chooses otherwise:
+ * 1 mrad weighs like 1 mm, an arm's reach of about a metre, so neither half of a pose
+ * measurement drowns the other. */
+#define DHC_ORIENTATION_WEIGHT_MM_PER_RAD 1000.0
+
 /* Residual r = measured - predicted, rows as dhc_sample_rows; orientation rows are
  * weighted into mm-equivalents with weight_mm_per_rad. Errors of dhc_model_predict, and
  * DHC_ERR_NONFINITE when a residual is not finite (a non-finite or overflowing weight, a

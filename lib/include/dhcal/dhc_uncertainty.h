@@ -29,6 +29,10 @@
 #include "dhc_params.h"
 #include "dhc_status.h"
 
+#ifdef __cplusplus
+extern "C" {
+#endif
+
 typedef struct {
     dhc_normal_eq ne;   /* J^T W J of the parameters in use */
     dhc_lsq_factor fac; /* its analysis */
@@ -60,5 +64,9 @@ dhc_status dhc_uncertainty_tool_point(const dhc_uncertainty *u, const dhc_model 
                                       const dhc_param_set *set, const double *q_rad,
                                       const int8_t *dir, const double *joint_sd_rad,
                                       double *variance_mm2);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* DHC_UNCERTAINTY_H */

@@ -21,5 +21,6 @@
 #include "dhc_params.h"
 #include "dhc_status.h"
 #include "dhc_trilat.h"
+#include "dhc_uncertainty.h"
 
 #endif /* DHCAL_H */
