@@ -133,7 +133,7 @@ static double noise_floor(const dhc_model *m, const dhc_param_set *set,
 {
     static dhc_uncertainty unc;
     if (dhc_uncertainty_from_samples(&unc, m, set, fit->identifiable, read_job_sample, &job,
-                                     job.n_samples, res->joint_noise_rad, res->meas_noise_mm,
+                                     job.n_samples, &res->noise,
                                      DHC_ORIENTATION_WEIGHT_MM_PER_RAD, fit->sigma) != DHC_OK) {
         return (double)NAN;
     }
@@ -467,17 +467,17 @@ int main(int argc, char **argv)
     const fw_autocal_result *res = &job.result;
     char effect[64];
     (void)fw_autocal_effect_label(res, effect, sizeof effect);
-    if (res->meas_noise_mm > 0.0) {
+    if (res->noise.meas_mm > 0.0) {
         fprintf(log, "    noise model: joint angles %.3g %.3g %.3g urad (1 count / sqrt 12 with the "
                      "holds' dither), wires %.4f mm (measured over the holds)\n",
-                res->joint_noise_rad[0] * 1e6, res->joint_noise_rad[1] * 1e6,
-                res->joint_noise_rad[2] * 1e6, res->meas_noise_mm);
+                res->noise.joint_rad[0] * 1e6, res->noise.joint_rad[1] * 1e6,
+                res->noise.joint_rad[2] * 1e6, res->noise.meas_mm);
     }
     fprintf(log, "(c) geometric fit%s%s: wire residual RMS %.4f mm, max %.4f mm (%zu params, "
                  "rank %zu)\n", effects != NULL ? " with the configured " : "",
             effects != NULL ? effects : "", res->geo.rms_mm, res->geo.max_mm, res->geo.n_params,
             res->geo.rank);
-    if (res->meas_noise_mm > 0.0) {
+    if (res->noise.meas_mm > 0.0) {
         fprintf(log, "    whitened residual sd %.3f (1: as the noise model predicts)\n",
                 res->geo.sigma);
     }
@@ -536,10 +536,10 @@ int main(int argc, char **argv)
          * takes at the desk (largest joint sd, in degrees) */
         double joint_sd_deg = 0.0;
         for (size_t j = 0U; j < 3U; ++j) {
-            joint_sd_deg = fmax(joint_sd_deg, res->joint_noise_rad[j] * 180.0 / DHC_PI);
+            joint_sd_deg = fmax(joint_sd_deg, res->noise.joint_rad[j] * 180.0 / DHC_PI);
         }
         printf("\"noise_model\": {\"joint_deg\": %.6g, \"meas_mm\": %.6g}}\n", joint_sd_deg,
-               res->meas_noise_mm);
+               res->noise.meas_mm);
     }
     return 0;
 }

@@ -150,19 +150,17 @@ fw_fault fw_autocal_configured(const fw_autocal_config *cfg, dhc_model *model,
         for (size_t j = 0U; j < model->arm.n_joints && j < DHC_MAX_JOINTS; ++j) {
             const double cpr = cfg->io->counts_per_rad[j];
             const double dither = cfg->acq != NULL ? fw_acq_angle_dither_rad(cfg->acq, j) : 0.0;
-            opt.joint_noise_rad[j] =
+            opt.noise.joint_rad[j] =
                 cpr > 0.0 ? sqrt(1.0 / (12.0 * cpr * cpr) + dither * dither) : 0.0;
         }
-        opt.meas_noise_mm = cfg->wire_noise_mm > 0.0 ? cfg->wire_noise_mm
+        opt.noise.meas_mm = cfg->wire_noise_mm > 0.0 ? cfg->wire_noise_mm
                             : cfg->acq != NULL           ? fw_acq_wire_noise_mm(cfg->acq)
                                                          : 0.0;
-        if (!(opt.meas_noise_mm > 0.0)) {
-            opt.meas_noise_mm = cfg->io->wire_mm_per_count / sqrt(12.0);
+        if (!(opt.noise.meas_mm > 0.0)) {
+            opt.noise.meas_mm = cfg->io->wire_mm_per_count / sqrt(12.0);
         }
-        memcpy(dopt.joint_noise_rad, opt.joint_noise_rad, sizeof opt.joint_noise_rad);
-        dopt.meas_noise_mm = opt.meas_noise_mm;
-        memcpy(res->joint_noise_rad, opt.joint_noise_rad, sizeof opt.joint_noise_rad);
-        res->meas_noise_mm = opt.meas_noise_mm;
+        dopt.noise = opt.noise;
+        res->noise = opt.noise;
     }
     dhc_param_set set;
     if (dhc_params_base_model(&set, model) != DHC_OK ||

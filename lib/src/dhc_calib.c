@@ -55,18 +55,16 @@ void dhc_calib_default_options(dhc_calib_options *opt)
     opt->robust_start = 1;
     opt->max_outlier_rounds = 3U;
     opt->structural_seed = 12345U;
-    for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
-        opt->joint_noise_rad[j] = 0.0;
-    }
-    opt->meas_noise_mm = 0.0;
+    memset(&opt->noise, 0, sizeof opt->noise);
 }
 
-dhc_status dhc_noise_model_check(const double *joint_noise_rad, double meas_noise_mm,
-                                 size_t n_joints, int *on)
+dhc_status dhc_noise_model_check(const dhc_noise_model *noise, size_t n_joints, int *on)
 {
-    if (on == NULL || joint_noise_rad == NULL) {
+    if (on == NULL || noise == NULL) {
         return DHC_ERR_ARGUMENT;
     }
+    const double *const joint_noise_rad = noise->joint_rad;
+    const double meas_noise_mm = noise->meas_mm;
     *on = 0;
     int joints_on = 0;
     /* !(x >= 0) also refuses NaN; an infinite sd would whiten everything to 0 */
@@ -86,32 +84,32 @@ dhc_status dhc_noise_model_check(const double *joint_noise_rad, double meas_nois
  * r_model (for the orientation rows' slope; may alias r, read first), applied to r and jac
  * (which may belong to another estimate: a trial step judged with its start's weights). */
 static dhc_status whiten_at(const dhc_model *model, const dhc_sample *s,
-                            const double *joint_noise_rad, double meas_noise_mm,
-                            double weight_mm_per_rad, const double *r_model, double *r,
-                            dhc_mat *jac);
+                            const dhc_noise_model *noise, double weight_mm_per_rad,
+                            const double *r_model, double *r, dhc_mat *jac);
 
 dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_sample *s,
-                             const double *joint_noise_rad, double meas_noise_mm,
-                             double weight_mm_per_rad, double *r, dhc_mat *jac)
+                             const dhc_noise_model *noise, double weight_mm_per_rad, double *r,
+                             dhc_mat *jac)
 {
     /* r_model may alias r: it is read before r is whitened */
-    return whiten_at(model, s, joint_noise_rad, meas_noise_mm, weight_mm_per_rad, r, r, jac);
+    return whiten_at(model, s, noise, weight_mm_per_rad, r, r, jac);
 }
 
 static dhc_status whiten_at(const dhc_model *model, const dhc_sample *s,
-                            const double *joint_noise_rad, double meas_noise_mm,
-                            double weight_mm_per_rad, const double *r_model, double *r,
-                            dhc_mat *jac)
+                            const dhc_noise_model *noise, double weight_mm_per_rad,
+                            const double *r_model, double *r, dhc_mat *jac)
 {
-    if (model == NULL || s == NULL || r == NULL) {
+    if (model == NULL || s == NULL || r == NULL || noise == NULL) {
         return DHC_ERR_ARGUMENT;
     }
+    const double *const joint_noise_rad = noise->joint_rad;
+    const double meas_noise_mm = noise->meas_mm;
     const size_t n = model->arm.n_joints;
     if (n == 0U || n > DHC_MAX_JOINTS) {
         return DHC_ERR_CAPACITY;
     }
     int on = 0;
-    dhc_status st = dhc_noise_model_check(joint_noise_rad, meas_noise_mm, n, &on);
+    dhc_status st = dhc_noise_model_check(noise, n, &on);
     if (st != DHC_OK || !on) {
         return st;
     }
@@ -288,7 +286,7 @@ static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *mod
                 st = dhc_model_residual(weights, s, w, r_weights, &weights_rows);
             }
             if (st == DHC_OK) {
-                st = whiten_at(weights, s, fc->opt->joint_noise_rad, fc->opt->meas_noise_mm, w,
+                st = whiten_at(weights, s, &fc->opt->noise, w,
                                r_weights, rw, accumulate ? &jac : NULL);
             }
         }
@@ -407,8 +405,7 @@ static dhc_status sample_error2(const fit_context *fc, const dhc_model *model, s
     if (st == DHC_OK && fc->whiten) {
         /* screened in units of each sample's own noise: a sample at a pose where the joint
          * noise maps large is not an outlier for being larger */
-        st = dhc_sample_whiten(model, &fc->ws->sample, fc->opt->joint_noise_rad,
-                               fc->opt->meas_noise_mm, fc->opt->orientation_weight_mm_per_rad, r,
+        st = dhc_sample_whiten(model, &fc->ws->sample, &fc->opt->noise, fc->opt->orientation_weight_mm_per_rad, r,
                                NULL);
     }
     if (st != DHC_OK) {
@@ -1018,7 +1015,7 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
         return DHC_ERR_CAPACITY;
     }
     int whiten = 0;
-    if (dhc_noise_model_check(opt->joint_noise_rad, opt->meas_noise_mm, model->arm.n_joints,
+    if (dhc_noise_model_check(&opt->noise, model->arm.n_joints,
                               &whiten) != DHC_OK) {
         return DHC_ERR_ARGUMENT;
     }

@@ -21,10 +21,7 @@ void dhc_diagnose_default_options(dhc_diagnose_options *opt)
     opt->separable_tol = 1e-6;
     opt->lookalike_ratio = 1.02;
     opt->orientation_weight_mm_per_rad = DHC_ORIENTATION_WEIGHT_MM_PER_RAD;
-    for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
-        opt->joint_noise_rad[j] = 0.0;
-    }
-    opt->meas_noise_mm = 0.0;
+    memset(&opt->noise, 0, sizeof opt->noise);
 }
 
 /* ln Gamma(dof / 2), exact sums: chi-square only needs integer and half-integer arguments,
@@ -445,7 +442,7 @@ static dhc_status accumulate(const dhc_model *model, dhc_sample_reader read, voi
         }
         if (st == DHC_OK) {
             /* off: returns at once, r and jac untouched */
-            st = dhc_sample_whiten(model, &ws->sample, opt->joint_noise_rad, opt->meas_noise_mm,
+            st = dhc_sample_whiten(model, &ws->sample, &opt->noise,
                                    opt->orientation_weight_mm_per_rad, r, &jac);
         }
         if (st == DHC_OK) {
@@ -604,7 +601,7 @@ dhc_status dhc_diagnose(const dhc_model *model, const dhc_param_set *base,
         return DHC_ERR_CAPACITY;
     }
     int on = 0; /* checked once here; accumulate whitens each sample when it is on */
-    if (dhc_noise_model_check(opt->joint_noise_rad, opt->meas_noise_mm, model->arm.n_joints,
+    if (dhc_noise_model_check(&opt->noise, model->arm.n_joints,
                               &on) != DHC_OK) {
         return DHC_ERR_ARGUMENT;
     }

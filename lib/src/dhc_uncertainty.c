@@ -8,13 +8,13 @@
 /* the fit's own pivot tolerance (dhc_calib_options.rank_rel_tol's default) */
 #define UNCERTAINTY_RANK_TOL 1e-10
 
-static const double no_joint_noise[DHC_MAX_JOINTS] = {0.0};
+static const dhc_noise_model no_noise = {{0.0}, 0.0};
 
 dhc_status dhc_uncertainty_from_samples(dhc_uncertainty *u, const dhc_model *model,
                                         const dhc_param_set *set, const uint8_t *use,
                                         dhc_sample_reader read, void *ctx, size_t n,
-                                        const double *joint_noise_rad, double meas_noise_mm,
-                                        double weight_mm_per_rad, double sigma)
+                                        const dhc_noise_model *noise, double weight_mm_per_rad,
+                                        double sigma)
 {
     if (u == NULL || model == NULL || set == NULL || read == NULL || !dhc_is_finite(sigma) ||
         sigma < 0.0) {
@@ -24,10 +24,9 @@ dhc_status dhc_uncertainty_from_samples(dhc_uncertainty *u, const dhc_model *mod
         return DHC_ERR_NO_DATA;
     }
     const size_t p = set->count;
-    const double *joint_noise = joint_noise_rad != NULL ? joint_noise_rad : no_joint_noise;
+    const dhc_noise_model *const used = noise != NULL ? noise : &no_noise;
     int noise_on = 0;
-    const dhc_status ns =
-        dhc_noise_model_check(joint_noise, meas_noise_mm, model->arm.n_joints, &noise_on);
+    const dhc_status ns = dhc_noise_model_check(used, model->arm.n_joints, &noise_on);
     if (ns != DHC_OK) {
         return ns;
     }
@@ -56,8 +55,7 @@ dhc_status dhc_uncertainty_from_samples(dhc_uncertainty *u, const dhc_model *mod
         }
         if (st == DHC_OK && noise_on) {
             memset(r, 0, sizeof r); /* the rows only: the residual is not needed */
-            st = dhc_sample_whiten(model, &u->sample, joint_noise, meas_noise_mm,
-                                   weight_mm_per_rad, r, &jac);
+            st = dhc_sample_whiten(model, &u->sample, used, weight_mm_per_rad, r, &jac);
         }
         if (st == DHC_OK) {
             memset(r, 0, sizeof r);

@@ -148,11 +148,11 @@ static void test_noise_model_off_is_the_unweighted_fit_of_before(void)
     dhc_diagnose_options dopt;
     dhc_diagnose_default_options(&dopt);
     /* the defaults are off */
-    TEST_ASSERT_EQUAL_DOUBLE(0.0, opt.meas_noise_mm);
-    TEST_ASSERT_EQUAL_DOUBLE(0.0, dopt.meas_noise_mm);
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, opt.noise.meas_mm);
+    TEST_ASSERT_EQUAL_DOUBLE(0.0, dopt.noise.meas_mm);
     for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
-        TEST_ASSERT_EQUAL_DOUBLE(0.0, opt.joint_noise_rad[j]);
-        TEST_ASSERT_EQUAL_DOUBLE(0.0, dopt.joint_noise_rad[j]);
+        TEST_ASSERT_EQUAL_DOUBLE(0.0, opt.noise.joint_rad[j]);
+        TEST_ASSERT_EQUAL_DOUBLE(0.0, dopt.noise.joint_rad[j]);
     }
     /* The capture predates the convergence tests relative to the noise: those stop a fit
      * within a hundredth of a standard error of the minimum (checked below); switched off,
@@ -175,8 +175,8 @@ static void test_noise_model_off_is_the_unweighted_fit_of_before(void)
     /* A noise model of exactly 1 mm per row whitens by L = 1: every division by 1 and
      * subtraction of 0 x r is exact, so not one bit may change. */
     const double log10_p0 = diag.c[0].log10_p;
-    opt.meas_noise_mm = 1.0;
-    dopt.meas_noise_mm = 1.0;
+    opt.noise.meas_mm = 1.0;
+    dopt.noise.meas_mm = 1.0;
     dhc_model fitted1;
     fit_and_diagnose(&opt, &dopt, &fitted1, &rep_off);
     for (size_t k = 0U; k < set.count; ++k) {
@@ -366,9 +366,9 @@ static double dense_gls_step(dhc_model *m, const uint8_t *use, double *step_norm
 static void set_noise(dhc_calib_options *opt)
 {
     for (size_t j = 0U; j < 3U; ++j) {
-        opt->joint_noise_rad[j] = JOINT_SD[j];
+        opt->noise.joint_rad[j] = JOINT_SD[j];
     }
-    opt->meas_noise_mm = MEAS_SD;
+    opt->noise.meas_mm = MEAS_SD;
 }
 
 static void test_whitened_fit_equals_dense_gls(void)
@@ -477,24 +477,25 @@ static void test_bad_noise_models_are_refused(void)
     dhc_calib_default_options(&opt);
     dhc_model m = test_paper3_model();
     TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &m));
-    opt.joint_noise_rad[1] = 1e-5; /* joint noise without the measurement's own */
+    opt.noise.joint_rad[1] = 1e-5; /* joint noise without the measurement's own */
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_calib_fit(&m, &set, test_read_sample, &data, data.n,
                                                       data.flags, &opt, &cws, &rep));
-    opt.meas_noise_mm = -1.0;
+    opt.noise.meas_mm = -1.0;
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_calib_fit(&m, &set, test_read_sample, &data, data.n,
                                                       data.flags, &opt, &cws, &rep));
-    opt.meas_noise_mm = (double)NAN;
+    opt.noise.meas_mm = (double)NAN;
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_calib_fit(&m, &set, test_read_sample, &data, data.n,
                                                       data.flags, &opt, &cws, &rep));
     int on = 1;
-    const double zero[DHC_MAX_JOINTS] = {0.0};
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_noise_model_check(zero, 0.0, 3U, &on));
+    dhc_noise_model zero = {{0.0}, 0.0};
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_noise_model_check(&zero, 3U, &on));
     TEST_ASSERT_EQUAL_INT(0, on);
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_noise_model_check(zero, 0.01, 3U, &on));
+    zero.meas_mm = 0.01;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_noise_model_check(&zero, 3U, &on));
     TEST_ASSERT_EQUAL_INT(1, on);
     dhc_diagnose_options dopt;
     dhc_diagnose_default_options(&dopt);
-    dopt.joint_noise_rad[0] = 1e-5;
+    dopt.noise.joint_rad[0] = 1e-5;
     const size_t nc = dhc_diagnose_candidates(&m, &set, &no_covariates, cands, DHC_MAX_CANDIDATES);
     uint8_t ident[DHC_MAX_PARAMS];
     memset(ident, 1, sizeof ident);
@@ -569,11 +570,11 @@ static void test_false_alarms_are_rare_with_the_noise_model(void)
         fit_and_diagnose(&opt, &dopt, &fitted, &rep_off);
         flagged_off += (size_t)any_significant();
         for (size_t j = 0U; j < 3U; ++j) {
-            opt.joint_noise_rad[j] = (j == 0U ? MC_COUNT_RAD : MC_FINE_COUNT_RAD) / sqrt(12.0);
-            dopt.joint_noise_rad[j] = opt.joint_noise_rad[j];
+            opt.noise.joint_rad[j] = (j == 0U ? MC_COUNT_RAD : MC_FINE_COUNT_RAD) / sqrt(12.0);
+            dopt.noise.joint_rad[j] = opt.noise.joint_rad[j];
         }
-        opt.meas_noise_mm = MC_MEAS_MM;
-        dopt.meas_noise_mm = MC_MEAS_MM;
+        opt.noise.meas_mm = MC_MEAS_MM;
+        dopt.noise.meas_mm = MC_MEAS_MM;
         for (size_t k = 0U; k < data.n; ++k) {
             data.flags[k] = (uint8_t)DHC_SAMPLE_USED;
         }

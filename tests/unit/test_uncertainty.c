@@ -59,7 +59,7 @@ static void test_one_link_closed_form(void)
     }
     const double sigma = 0.05;
     TEST_ASSERT_EQUAL(DHC_OK, dhc_uncertainty_from_samples(&unc, &m, &set, NULL, read_sample,
-                                                           NULL, n, NULL, 0.0, 1000.0, sigma));
+                                                           NULL, n, NULL, 1000.0, sigma));
     for (double q = -3.0; q <= 3.0; q += 0.7) {
         double var = 0.0;
         TEST_ASSERT_EQUAL(DHC_OK, dhc_uncertainty_tool_point(&unc, &m, &set, &q, NULL, NULL,
@@ -215,12 +215,13 @@ static void test_table3_arm_against_finite_differences_and_gauss_jordan(void)
         test_random_q(&rng, &m.arm, q);
         position_sample(&m, q, &samples[i]);
     }
-    const double joint_noise[DHC_MAX_JOINTS] = {1e-4, 2e-4, 1.5e-4};
-    const double meas_noise = 0.02;
+    const dhc_noise_model noise = {{1e-4, 2e-4, 1.5e-4}, 0.02};
+    const double *const joint_noise = noise.joint_rad;
+    const double meas_noise = noise.meas_mm;
     const double sigma = 1.3; /* unit-free with the noise model on */
     TEST_ASSERT_EQUAL(DHC_OK,
                       dhc_uncertainty_from_samples(&unc, &m, &set, use, read_sample, NULL,
-                                                   N_SAMPLES, joint_noise, meas_noise, 1000.0,
+                                                   N_SAMPLES, &noise, 1000.0,
                                                    sigma));
     /* N = sum_i J_i^T S_i^-1 J_i, S_i = meas^2 I + Jq_i diag(joint^2) Jq_i^T, over the
      * parameters in use */
@@ -303,15 +304,15 @@ static void test_bad_arguments_are_refused(void)
     TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &m));
     TEST_ASSERT_EQUAL(DHC_ERR_NO_DATA, dhc_uncertainty_from_samples(&unc, &m, &set, NULL,
                                                                     read_sample, NULL, 0U,
-                                                                    NULL, 0.0, 1000.0, 1.0));
+                                                                    NULL, 1000.0, 1.0));
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_uncertainty_from_samples(&unc, &m, &set, NULL,
                                                                      read_sample, NULL, 3U,
-                                                                     NULL, 0.0, 1000.0, -1.0));
-    const double jn[DHC_MAX_JOINTS] = {1e-4, 1e-4, 1e-4};
+                                                                     NULL, 1000.0, -1.0));
+    const dhc_noise_model jn = {{1e-4, 1e-4, 1e-4}, 0.0};
     /* joint noise without wire or point noise: a singular weighting */
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_uncertainty_from_samples(&unc, &m, &set, NULL,
                                                                      read_sample, NULL, 3U,
-                                                                     jn, 0.0, 1000.0, 1.0));
+                                                                     &jn, 1000.0, 1.0));
     const double q[3] = {0.1, 0.2, 0.3};
     double v = 0.0;
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,

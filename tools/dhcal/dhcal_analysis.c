@@ -84,8 +84,10 @@ int dhcal_parse_noise(const char *text, dhcal_noise *out, dhcal_error *err)
         return DHCAL_IO_BAD_INPUT;
     }
     out->on = 1;
-    out->joint_rad = joint_deg * DHC_PI / 180.0;
-    out->meas_mm = meas_mm;
+    for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
+        out->model.joint_rad[j] = joint_deg * DHC_PI / 180.0;
+    }
+    out->model.meas_mm = meas_mm;
     return DHCAL_IO_OK;
 }
 
@@ -172,10 +174,7 @@ void dhcal_calib_options_for(const dhc_model *model, const dhcal_noise *noise,
     opt->max_std_angle_rad = 0.5 * DHCAL_PLAUSIBLE_ANGLE_DEG * DHC_PI / 180.0;
     opt->max_std_length_mm = 0.5 * DHCAL_PLAUSIBLE_LENGTH_SHARE * dhc_arm_reach(&model->arm);
     if (noise != NULL && noise->on) {
-        for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
-            opt->joint_noise_rad[j] = noise->joint_rad;
-        }
-        opt->meas_noise_mm = noise->meas_mm;
+        opt->noise = noise->model;
     }
 }
 
@@ -309,10 +308,7 @@ int dhcal_run_diagnose(const dhcal_fit *fit, const dhcal_samples *s, dhc_diagnos
     dhc_diagnose_options opt;
     dhc_diagnose_default_options(&opt);
     if (fit->noise.on) {
-        for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
-            opt.joint_noise_rad[j] = fit->noise.joint_rad;
-        }
-        opt.meas_noise_mm = fit->noise.meas_mm;
+        opt.noise = fit->noise.model;
     }
     const double sigma2 = fit->rep.sigma * fit->rep.sigma;
     if (!(sigma2 > 0.0)) {
@@ -559,7 +555,7 @@ static double predicted_row_variance(const dhcal_fit *fit, const dhc_sample *smp
     }
     double buf[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_JOINTS];
     dhc_mat jq;
-    const double meas2 = fit->noise.meas_mm * fit->noise.meas_mm;
+    const double meas2 = fit->noise.model.meas_mm * fit->noise.model.meas_mm;
     if (dhc_mat_init(&jq, dhc_sample_rows(smp), n, buf, sizeof buf / sizeof buf[0]) != DHC_OK ||
         dhc_model_jacobian(&fit->model, &thetas, smp, DHC_ORIENTATION_WEIGHT_MM_PER_RAD, &jq,
                            NULL) != DHC_OK) {
@@ -571,7 +567,8 @@ static double predicted_row_variance(const dhcal_fit *fit, const dhc_sample *smp
             sum += DHC_MAT_AT(&jq, r, j) * DHC_MAT_AT(&jq, r, j);
         }
     }
-    return meas2 + fit->noise.joint_rad * fit->noise.joint_rad * sum / 3.0;
+    const double joint_sd = fit->noise.model.joint_rad[0]; /* --noise: one for all joints */
+    return meas2 + joint_sd * joint_sd * sum / 3.0;
 }
 
 int dhcal_assess(const dhcal_fit *fit, const dhcal_samples *s, dhcal_adequacy *out)
@@ -703,7 +700,7 @@ int dhcal_extrapolate(const dhcal_fit *fit, const dhcal_samples *s, const dhcal_
             return DHCAL_IO_FAILED;
         }
         if (fit->noise.on &&
-            dhc_sample_whiten(&fit->model, smp, opt.joint_noise_rad, opt.meas_noise_mm,
+            dhc_sample_whiten(&fit->model, smp, &opt.noise,
                               opt.orientation_weight_mm_per_rad, r, &jac) != DHC_OK) {
             return DHCAL_IO_FAILED;
         }

@@ -7,12 +7,12 @@
 #include "dhcal_data.h"
 #include "dhcal_io.h"
 
-/* The samples' noise model (--noise): off, or each joint angle's and each measured row's
- * standard deviation; on, every sample is weighted by its covariance (dhc_calib_options). */
+/* The samples' noise model (--noise): off, or the library's noise model with one standard
+ * deviation for every joint angle and one for each measured row; on, every sample is weighted
+ * by its covariance (dhc_noise_model). */
 typedef struct {
     int on;
-    double joint_rad;
-    double meas_mm;
+    dhc_noise_model model; /* joint_rad: the same value for every joint */
 } dhcal_noise;
 
 /* Parses "JOINT_DEG,MEAS_MM" (e.g. "0.0009,0.004"): joint angle sd in degrees (0..1), the

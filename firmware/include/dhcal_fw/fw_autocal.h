@@ -54,8 +54,7 @@ typedef struct {
     double stored_rms_mm;    /* of the stored model on the samples (-1: none stored) */
     double new_median_mm;    /* median per-sample wire residual norm, new model */
     double stored_median_mm; /* the same for the stored model (-1: none stored) */
-    double joint_noise_rad[DHC_MAX_JOINTS]; /* the noise model the fits used (all 0: off) */
-    double meas_noise_mm;
+    dhc_noise_model noise;   /* the noise model the fits used (all 0: off) */
     int saved;               /* the new model was stored */
     uint32_t seq;
 } fw_autocal_result;

@@ -48,6 +48,20 @@ enum {
 /* 1 for the flags the fit sets (every kind of outlier), 0 for used and excluded samples. */
 int dhc_sample_is_outlier(uint8_t flag);
 
+/* The samples' noise (errors in variables; all 0 = off). The joint angles of a sample are
+ * measured too (an encoder's quantisation is uniform, sd = 1 count / sqrt(12)); mapped to
+ * the prediction through the pose-dependent Jacobian their noise is heteroscedastic and
+ * correlated between the rows of a sample. When on, each sample's residual and Jacobian
+ * rows are whitened by L^-1, with
+ *   L L^T = meas_mm^2 I + J_q diag(joint_rad^2) J_q^T,
+ * J_q = d(prediction)/d(measured joint angles) at the sample (dhc_sample_whiten). One shape
+ * for the fit, the diagnosis, the uncertainty and the controller's result. */
+typedef struct {
+    double joint_rad[DHC_MAX_JOINTS]; /* sd of each measured joint angle, rad */
+    double meas_mm; /* sd of each measured row, mm (orientation rows: in their mm-equivalents,
+                       i.e. meas_mm / weight rad); must be > 0 when a joint noise is set */
+} dhc_noise_model;
+
 typedef struct {
     size_t max_iterations;       /* LM iterations per fit round (default 100) */
     double rank_rel_tol;         /* pivot tolerance on the scaled normal matrix (1e-10) */
@@ -81,18 +95,10 @@ typedef struct {
                                     from it are left out first (1) */
     size_t max_outlier_rounds;   /* refits after removing outliers (3) */
     uint32_t structural_seed;    /* seed of the random poses used for the structural rank */
-    /* Noise model (errors in variables; all 0 by default = off, unweighted least squares).
-     * The joint angles of a sample are measured too (an encoder's quantisation is uniform,
-     * sd = 1 count / sqrt(12)); mapped to the prediction through the pose-dependent
-     * Jacobian their noise is heteroscedastic and correlated between the rows of a sample.
-     * When on, each sample's residual and Jacobian rows are whitened by L^-1, with
-     *   L L^T = meas_noise_mm^2 I + J_q diag(joint_noise_rad^2) J_q^T,
-     * J_q = d(prediction)/d(measured joint angles) at the sample (dhc_sample_whiten): the fit
-     * is generalized least squares and the report's sigma is unit-free (see below). */
-    double joint_noise_rad[DHC_MAX_JOINTS]; /* sd of each measured joint angle, rad */
-    double meas_noise_mm;        /* sd of each measured row, mm (orientation rows: in their
-                                    mm-equivalents, i.e. meas_noise_mm / weight rad); must be
-                                    > 0 when a joint noise is set */
+    /* Noise model (all 0 by default = off, unweighted least squares): see dhc_noise_model.
+     * When on, the fit is generalized least squares and the report's sigma is unit-free
+     * (see below). */
+    dhc_noise_model noise;
 } dhc_calib_options;
 
 typedef struct {
@@ -145,11 +151,10 @@ typedef struct {
 
 void dhc_calib_default_options(dhc_calib_options *opt);
 
-/* Checks a noise model (joint_noise_rad[0..n_joints), meas_noise_mm): *on = 1 when it is on
+/* Checks a noise model (joint_rad[0..n_joints), meas_mm): *on = 1 when it is on
  * (any value > 0), 0 when all are 0. DHC_ERR_ARGUMENT (*on = 0) for NULL, a negative or
  * non-finite value, or joint noise without a positive meas_noise_mm. */
-dhc_status dhc_noise_model_check(const double *joint_noise_rad, double meas_noise_mm,
-                                 size_t n_joints, int *on);
+dhc_status dhc_noise_model_check(const dhc_noise_model *noise, size_t n_joints, int *on);
 
 /* Whitens one sample under the noise model (see dhc_calib_options): r (dhc_sample_rows(s)
  * entries, as dhc_model_residual with the same weight) and, when jac is not NULL, its rows
@@ -163,8 +168,8 @@ dhc_status dhc_noise_model_check(const double *joint_noise_rad, double meas_nois
  * errors of dhc_model_jacobian; DHC_ERR_DIMENSION for a jac of the wrong row count. With the
  * noise model off, nothing is changed. O(rows^2 (n_joints + cols)). */
 dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_sample *s,
-                             const double *joint_noise_rad, double meas_noise_mm,
-                             double weight_mm_per_rad, double *r, dhc_mat *jac);
+                             const dhc_noise_model *noise, double weight_mm_per_rad, double *r,
+                             dhc_mat *jac);
 
 /* Fits the parameters of set to the samples. flags (n bytes) marks samples the caller
  * excludes; the fit adds outlier marks (DHC_SAMPLE_OUTLIER and the kinds after it, each

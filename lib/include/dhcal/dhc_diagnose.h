@@ -79,8 +79,7 @@ typedef struct {
      * so the score test's i.i.d. assumption holds for joint-angle noise too; sigma2 is then
      * the fit's unit-free sigma^2, ssr and explained_ss are whitened sums of squares and
      * explained their ratio. */
-    double joint_noise_rad[DHC_MAX_JOINTS];
-    double meas_noise_mm;
+    dhc_noise_model noise;
 } dhc_diagnose_options;
 
 /* Scratch of dhc_diagnose (about 10 * DHC_MAX_PARAMS^2 bytes; keep it static). Every array

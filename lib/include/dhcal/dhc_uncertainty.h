@@ -42,8 +42,7 @@ typedef struct {
 
 /* Builds C from the samples 0..n-1 (read through read/ctx, as dhc_calib_fit reads them) at
  * model for the parameters of set flagged nonzero in use (set->count entries; NULL: all).
- * joint_noise_rad (NULL or n_joints entries) and meas_noise_mm: the fit's noise model (all
- * 0 or NULL: off); weight_mm_per_rad: the fit's orientation weight (pose samples).
+ * noise: the fit's noise model (NULL or all 0: off); weight_mm_per_rad: the fit's orientation weight (pose samples).
  * sigma >= 0: the fit's residual standard deviation.
  * DHC_ERR_ARGUMENT (NULL, sigma negative or not finite, an invalid noise model),
  * DHC_ERR_NO_DATA (n = 0), the reader's status, errors of dhc_model_jacobian and
@@ -51,8 +50,8 @@ typedef struct {
 dhc_status dhc_uncertainty_from_samples(dhc_uncertainty *u, const dhc_model *model,
                                         const dhc_param_set *set, const uint8_t *use,
                                         dhc_sample_reader read, void *ctx, size_t n,
-                                        const double *joint_noise_rad, double meas_noise_mm,
-                                        double weight_mm_per_rad, double sigma);
+                                        const dhc_noise_model *noise, double weight_mm_per_rad,
+                                        double sigma);
 
 /* The positioning variance (mm^2) at joint angles q_rad (n_joints entries) approached from
  * dir (NULL: +1 for all), at the model's thermal reference: the parameters' share

@@ -71,7 +71,7 @@ static void test_the_job_calibrates_the_arm_and_stores_the_result(void)
     TEST_ASSERT_TRUE(wire_rms(&job.calibrated, job.samples, job.n_samples) < 0.05);
     /* the noise model was on: one encoder count / sqrt(12) at least, per joint */
     for (size_t j = 0U; j < 3U; ++j) {
-        TEST_ASSERT_TRUE(job.result.joint_noise_rad[j] >=
+        TEST_ASSERT_TRUE(job.result.noise.joint_rad[j] >=
                          1.0 / (io.counts_per_rad[j] * sqrt(12.0)));
     }
     /* the store holds the calibrated model */
@@ -93,16 +93,16 @@ static void test_a_job_does_not_depend_on_the_one_before(void)
     cfg.hold_ticks = 17U;
     cfg.plan_seed = 99U;
     TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_job_run(&job, &cfg, &nominal, &port, &io, NULL));
-    TEST_ASSERT_TRUE(fabs(job.result.joint_noise_rad[1] - first.result.joint_noise_rad[1]) >
+    TEST_ASSERT_TRUE(fabs(job.result.noise.joint_rad[1] - first.result.noise.joint_rad[1]) >
                      0.0);
     /* the first job again, in the struct the other one used */
     fresh_arm();
     TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_job_run(&job, &cfg, &nominal, &port, &io, NULL));
     TEST_ASSERT_EQUAL_size_t(first.n_samples, job.n_samples);
     TEST_ASSERT_EQUAL_MEMORY(first.samples, job.samples, first.n_samples * sizeof(dhc_sample));
-    TEST_ASSERT_EQUAL_MEMORY(first.result.joint_noise_rad, job.result.joint_noise_rad,
-                             sizeof job.result.joint_noise_rad);
-    TEST_ASSERT_EQUAL_DOUBLE(first.result.meas_noise_mm, job.result.meas_noise_mm);
+    TEST_ASSERT_EQUAL_MEMORY(first.result.noise.joint_rad, job.result.noise.joint_rad,
+                             sizeof job.result.noise.joint_rad);
+    TEST_ASSERT_EQUAL_DOUBLE(first.result.noise.meas_mm, job.result.noise.meas_mm);
     TEST_ASSERT_EQUAL_MEMORY(&first.calibrated, &job.calibrated, sizeof job.calibrated);
 }
 
