@@ -1,14 +1,34 @@
 #!/usr/bin/env python3
-"""dhcal fit vs scipy.optimize.least_squares on the same problem, timed in one run.
+"""dhcal fit against its peers on the same problem, timed in one run.
 
 Problem: the paper's 6-DOF arm (nominal Table 2, actual Table 1 with every joint offset
-2 deg), N tool positions with Gaussian noise. dhcal runs as a whole process (start-up,
-parsing the files, fitting, printing JSON). scipy gets only its solver call timed, on
-vectorised numpy forward kinematics with the same parameters (Hayati beta in place of d
-where Table 2 has alpha = 0), so the comparison favours scipy.
+2 deg), N tool positions with Gaussian noise (0.02 mm per coordinate), for N = 2000, 20 000
+and 200 000 rows. The generated model JSON and measurement CSV are the input of every peer
+that runs as a program:
 
-Usage: fit_vs_scipy.py --dhcal build/host/tools/dhcal [--poses 2000] [--repeat 3]
-Prints the times and the ratio; exits 1 if the two RMS values disagree.
+- `dhcal fit --json`, as a whole process (start-up, parsing the files, fitting, its
+  diagnostics, printing JSON);
+- the Ceres peer bench/ceres_fit.cc (build/bench-ceres/ceres_fit), as a whole process, in
+  three variants: ceres::Solve with Levenberg-Marquardt and DENSE_NORMAL_CHOLESKY, the same
+  with DENSE_QR, and ceres::TinySolver; analytic Jacobian, one thread. It also reports its
+  solver call's time alone;
+- scipy.optimize.least_squares on vectorised numpy forward kinematics with the same
+  parameters: its solver call only (no interpreter start-up, no file parsing), which favours
+  scipy. It is skipped above --scipy-max-rows (slow), and the table says so.
+
+All fit the parameters dhcal fits by default (the Ceres peer chooses them by dhcal's rules;
+the benchmark checks that the names agree, and gives scipy dhcal's list), with the residual
+predicted - measured tool point, so their RMS must agree. Times are the best of --repeat
+runs; ratios are peer time / dhcal time (below 1: the peer is faster). Peak memory is each
+process's maximum resident set size, from GNU time in one
+more run.
+
+Usage: fit_vs_peers.py --dhcal build/host/tools/dhcal --ceres build/bench-ceres/ceres_fit
+                       [--rows 2000,20000,200000] [--repeat 5] [--noise-mm 0.02]
+                       [--scipy-max-rows 20000] [--rms-tolerance 0.02]
+Exit status 1 when a program fails, when the parameter sets differ, or when an RMS differs
+from dhcal's by more than --rms-tolerance (relative). The issue's speed goals are printed
+as met or not met; they do not change the exit status.
 """
 import argparse
 import json
@@ -25,8 +45,9 @@ TABLE1 = [(91.2, 101.0, 201.0), (1.0, 104.0, 2.0), (1.8, 102.0, 100.1),
           (-92.1, -1.0, 12.0), (-0.8, 14.0, 110.0), (91.1, 3.0, 2.1)]
 TABLE2 = [(90.0, 100.0, 200.0), (0.0, 100.0, 0.0), (0.0, 100.0, 100.0),
           (-90.0, 0.0, 10.0), (0.0, 10.0, 100.0), (90.0, 0.0, 0.0)]
-# alpha = 0 in Table 2 and not the last joint: beta replaces d there.
-HAYATI = [False, True, True, False, True, False]
+SEED = 20261121
+GNU_TIME = '/usr/bin/time'  # Debian's package time (scripts/packages, need bench)
+DEG = np.pi / 180.0
 
 
 def fk_points(q, theta, d, a, alpha, beta):
@@ -51,80 +72,209 @@ def fk_points(q, theta, d, a, alpha, beta):
     return pos
 
 
-def unpack(p, nominal):
-    theta, d, a, alpha, beta = (np.array(v, dtype=float) for v in nominal)
-    for i in range(6):
-        k = 4 * i
-        theta[i] += p[k]
-        if HAYATI[i]:
-            beta[i] += p[k + 1]
-        else:
-            d[i] += p[k + 1]
-        a[i] += p[k + 2]
-        alpha[i] += p[k + 3]
-    return theta, d, a, alpha, beta
+# dhcal's parameter names -> (index into fk_points' parameter lists, joint)
+KINDS = {'theta': 0, 'd': 1, 'a': 2, 'alpha': 3, 'beta': 4}
+
+
+def split_name(name):
+    kind = name.rstrip('0123456789')
+    return KINDS[kind], int(name[len(kind):]) - 1
+
+
+def unpack(p, names, nominal):
+    params = [np.array(v, dtype=float) for v in nominal]
+    for value, name in zip(p, names):
+        kind, joint = split_name(name)
+        params[kind][joint] += value
+    return params
+
+
+def generate(rows, noise_mm):
+    rng = np.random.default_rng(SEED)
+    truth = ([2.0 * DEG] * 6, [r[2] for r in TABLE1], [r[1] for r in TABLE1],
+             [r[0] * DEG for r in TABLE1], [0.0] * 6)
+    q = rng.uniform(-np.pi, np.pi, size=(rows, 6))
+    meas = fk_points(q, *truth) + rng.normal(0.0, noise_mm, size=(rows, 3))
+    return q, meas
+
+
+def write_files(directory, q, meas):
+    model = {"name": "paper-6dof", "joints": [
+        {"alpha_deg": r[0], "a_mm": r[1], "d_mm": r[2], "theta_offset_deg": 0,
+         "min_deg": -180, "max_deg": 180} for r in TABLE2]}
+    model_path = os.path.join(directory, 'model.json')
+    data_path = os.path.join(directory, 'data.csv')
+    with open(model_path, 'w') as f:
+        json.dump(model, f)
+    table = np.hstack([q / DEG, meas])
+    with open(data_path, 'w') as f:
+        f.write('q1,q2,q3,q4,q5,q6,x,y,z\n')
+        np.savetxt(f, table, fmt=['%.12f'] * 6 + ['%.9f'] * 3, delimiter=',')
+    return model_path, data_path
+
+
+def run_process(cmd, directory):
+    """Runs cmd once, output to files: (wall seconds, exit code, stdout, stderr)."""
+    out_path = os.path.join(directory, 'stdout')
+    err_path = os.path.join(directory, 'stderr')
+    with open(out_path, 'w') as out, open(err_path, 'w') as err:
+        t0 = time.perf_counter()
+        code = subprocess.run(cmd, stdout=out, stderr=err, check=False).returncode
+        wall = time.perf_counter() - t0
+    with open(out_path) as out, open(err_path) as err:
+        return wall, code, out.read(), err.read()
+
+
+def best_of(repeat, cmd, directory, label):
+    """Best wall time of repeat runs, every run's JSON output, and the peak RSS in KiB of
+    one more run under GNU time. (A child of this interpreter cannot report its own peak:
+    Linux charges the interpreter's memory, which the child had until its exec, to it.)"""
+    best, results = None, []
+    for _ in range(repeat):
+        wall, code, out, err = run_process(cmd, directory)
+        if code != 0:
+            raise RuntimeError(f'{label} exited with {code}: {err.strip()[:400]}')
+        best = wall if best is None else min(best, wall)
+        results.append(json.loads(out))
+    _, code, _, err = run_process([GNU_TIME, '-f', 'peak_rss_kib %M', *cmd], directory)
+    last = err.strip().splitlines()[-1] if err.strip() else ''
+    if code != 0 or not last.startswith('peak_rss_kib '):
+        raise RuntimeError(f'{label} under {GNU_TIME} exited with {code}: {err.strip()[:400]}')
+    return best, int(last.split()[1]), results
+
+
+def scipy_fit(q, meas, names, repeat):
+    nominal = ([0.0] * 6, [r[2] for r in TABLE2], [r[1] for r in TABLE2],
+               [r[0] * DEG for r in TABLE2], [0.0] * 6)
+    # dhcal's names are in deg and mm; scipy works in rad and mm.
+    def residuals(p):
+        return (fk_points(q, *unpack(p, names, nominal)) - meas).ravel()
+
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        sol = least_squares(residuals, np.zeros(len(names)), x_scale='jac')
+        times.append(time.perf_counter() - t0)
+    r = sol.fun.reshape(-1, 3)
+    rms = float(np.sqrt(np.mean(np.sum(r * r, axis=1))))
+    return min(times), rms, sol.nfev, sol.njev
+
+
+def fmt_ms(seconds):
+    return f'{seconds * 1000:.1f}' if seconds is not None else '-'
+
+
+def run_case(args, rows, tmp):
+    """Measures one row count; returns (table lines, failures, times by solver)."""
+    q, meas = generate(rows, args.noise_mm)
+    directory = os.path.join(tmp, f'rows-{rows}')
+    os.mkdir(directory)
+    model_path, data_path = write_files(directory, q, meas)
+    files = ['--model', model_path, '--data', data_path]
+    failures = []
+
+    t_dhcal, rss_dhcal, dhcal_runs = best_of(args.repeat, [args.dhcal, 'fit', *files, '--json'],
+                                        directory, 'dhcal fit')
+    dhcal = dhcal_runs[-1]
+    names = [p['name'] for p in dhcal['parameters']]
+    line = {'solver': 'dhcal fit', 'time': t_dhcal, 'solve': None, 'iters': dhcal['iterations'],
+            'rms': dhcal['rms_mm'], 'rss': rss_dhcal}
+    lines = [line]
+    times = {'dhcal': t_dhcal}
+    if dhcal['outliers']:
+        failures.append(f'{rows} rows: dhcal left {len(dhcal["outliers"])} rows out as '
+                        'outliers: its RMS is over fewer rows than the peers\'')
+
+    for solver, label in (('solve', 'Ceres Solve, DENSE_NORMAL_CHOLESKY'),
+                          ('solve-qr', 'Ceres Solve, DENSE_QR'),
+                          ('tiny', 'Ceres TinySolver')):
+        t, rss, runs = best_of(args.repeat, [args.ceres, *files, '--solver', solver],
+                               directory, f'ceres_fit --solver {solver}')
+        res = runs[-1]
+        ceres_names = [p['name'] for p in res['parameters']]
+        if ceres_names != names:
+            failures.append(f'{rows} rows: {label} fits {ceres_names}, dhcal fits {names}: '
+                            'not the same problem')
+        solve = min(r['solve_ms'] for r in runs) / 1000.0
+        lines.append({'solver': label, 'time': t, 'solve': solve,
+                      'iters': res['iterations'], 'rms': res['rms_mm'], 'rss': rss})
+        times[solver] = t
+
+    if rows <= args.scipy_max_rows:
+        t, rms, nfev, njev = scipy_fit(q, meas, names, args.repeat)
+        lines.append({'solver': 'scipy least_squares (solve only)', 'time': t, 'solve': t,
+                      'iters': f'{njev} J, {nfev} f', 'rms': rms, 'rss': None})
+        times['scipy'] = t
+    else:
+        lines.append({'solver': f'scipy least_squares: skipped, {rows} rows > '
+                                f'--scipy-max-rows {args.scipy_max_rows}', 'time': None})
+
+    out = [f'{rows} rows, noise {args.noise_mm} mm, {len(names)} parameters, '
+           f'best of {args.repeat}; whole processes unless "solve only"',
+           f'  {"solver":36s} {"time ms":>9s} {"peer/dhcal":>10s} {"solve ms":>9s} '
+           f'{"iterations":>12s} {"RMS mm":>10s} {"peak MB":>8s}']
+    for ln in lines:
+        if ln['time'] is None:
+            out.append(f'  {ln["solver"]}')
+            continue
+        ratio = ln['time'] / t_dhcal
+        rss = f'{ln["rss"] / 1024:.1f}' if ln['rss'] is not None else '-'
+        out.append(f'  {ln["solver"]:36s} {fmt_ms(ln["time"]):>9s} {ratio:9.2f}x '
+                   f'{fmt_ms(ln["solve"]):>9s} {str(ln["iters"]):>12s} {ln["rms"]:10.6f} '
+                   f'{rss:>8s}')
+        if abs(ln['rms'] - dhcal['rms_mm']) > args.rms_tolerance * dhcal['rms_mm']:
+            failures.append(f'{rows} rows: {ln["solver"]} reaches RMS {ln["rms"]:.6f} mm, '
+                            f'dhcal {dhcal["rms_mm"]:.6f} mm: more than '
+                            f'{args.rms_tolerance * 100:g} % apart')
+    return out, failures, times
 
 
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument('--dhcal', required=True)
-    ap.add_argument('--poses', type=int, default=2000)
-    ap.add_argument('--noise-mm', type=float, default=0.01)
-    ap.add_argument('--repeat', type=int, default=3)
+    ap.add_argument('--ceres', required=True)
+    ap.add_argument('--rows', default='2000,20000,200000')
+    ap.add_argument('--noise-mm', type=float, default=0.02)
+    ap.add_argument('--repeat', type=int, default=5)
+    ap.add_argument('--scipy-max-rows', type=int, default=20000)
+    ap.add_argument('--rms-tolerance', type=float, default=0.02)
     args = ap.parse_args()
+    row_counts = [int(r) for r in args.rows.split(',')]
 
-    rng = np.random.default_rng(20261121)
-    deg = np.pi / 180.0
-    truth = ([2.0 * deg] * 6, [r[2] for r in TABLE1], [r[1] for r in TABLE1],
-             [r[0] * deg for r in TABLE1], [0.0] * 6)
-    nominal = ([0.0] * 6, [r[2] for r in TABLE2], [r[1] for r in TABLE2],
-               [r[0] * deg for r in TABLE2], [0.0] * 6)
-    q = rng.uniform(-np.pi, np.pi, size=(args.poses, 6))
-    meas = fk_points(q, *truth) + rng.normal(0.0, args.noise_mm, size=(args.poses, 3))
-
+    failures = []
+    goals = []
     with tempfile.TemporaryDirectory() as tmp:
-        model = {"name": "paper-6dof", "joints": [
-            {"alpha_deg": r[0], "a_mm": r[1], "d_mm": r[2], "theta_offset_deg": 0,
-             "min_deg": -180, "max_deg": 180} for r in TABLE2]}
-        model_path = os.path.join(tmp, 'model.json')
-        data_path = os.path.join(tmp, 'data.csv')
-        with open(model_path, 'w') as f:
-            json.dump(model, f)
-        with open(data_path, 'w') as f:
-            f.write('q1,q2,q3,q4,q5,q6,x,y,z\n')
-            for qi, pi in zip(q / deg, meas):
-                f.write(','.join('%.12f' % v for v in qi) + ',' +
-                        ','.join('%.9f' % v for v in pi) + '\n')
+        for rows in row_counts:
+            try:
+                out, fails, times = run_case(args, rows, tmp)
+            except (RuntimeError, ValueError, KeyError) as e:
+                print(f'{rows} rows: FAIL: {e}')
+                failures.append(f'{rows} rows: {e}')
+                continue
+            print('\n'.join(out))
+            print(flush=True)
+            failures += fails
+            t = times['dhcal']
+            if rows == 2000:
+                goals.append(('dhcal fit at least 2x faster than Ceres Solve (2000 rows)',
+                              times['solve'] / t >= 2.0,
+                              f'Ceres Solve / dhcal = {times["solve"] / t:.2f}'))
+                goals.append(('dhcal fit faster than TinySolver (2000 rows)',
+                              times['tiny'] / t > 1.0,
+                              f'TinySolver / dhcal = {times["tiny"] / t:.2f}'))
+                if 'scipy' in times:
+                    goals.append(('dhcal fit at least 30x faster than scipy (2000 rows)',
+                                  times['scipy'] / t >= 30.0,
+                                  f'scipy / dhcal = {times["scipy"] / t:.1f}'))
+            if rows == 200000:
+                goals.append(('200000 rows fitted in under 1 s', t < 1.0,
+                              f'dhcal fit {t * 1000:.0f} ms'))
 
-        dhcal_times = []
-        for _ in range(args.repeat):
-            t0 = time.perf_counter()
-            out = subprocess.run([args.dhcal, 'fit', '--model', model_path, '--data', data_path,
-                                  '--json'], check=True, capture_output=True, text=True)
-            dhcal_times.append(time.perf_counter() - t0)
-        dhcal_rms = json.loads(out.stdout)['rms_mm']
-
-    def residuals(p):
-        return (fk_points(q, *unpack(p, nominal)) - meas).ravel()
-
-    scipy_times = []
-    for _ in range(args.repeat):
-        t0 = time.perf_counter()
-        sol = least_squares(residuals, np.zeros(24), x_scale='jac')
-        scipy_times.append(time.perf_counter() - t0)
-    r = sol.fun.reshape(-1, 3)
-    scipy_rms = float(np.sqrt(np.mean(np.sum(r * r, axis=1))))
-
-    td, ts = min(dhcal_times), min(scipy_times)
-    print(f'poses: {args.poses}, noise {args.noise_mm} mm, best of {args.repeat}')
-    print(f'dhcal fit (whole process): {td * 1000:9.1f} ms   RMS {dhcal_rms:.6f} mm')
-    print(f'scipy least_squares (solve only): {ts * 1000:9.1f} ms   RMS {scipy_rms:.6f} mm '
-          f'({sol.nfev} evaluations)')
-    print(f'ratio scipy / dhcal: {ts / td:.1f}x')
-    if abs(dhcal_rms - scipy_rms) > 1e-6 * max(1.0, scipy_rms) + 1e-6:
-        print('FAIL: the two fits reach different RMS', file=sys.stderr)
-        return 1
-    return 0
+    for text, met, detail in goals:
+        print(f'goal: {text}: {"met" if met else "not met"} ({detail})')
+    for f in failures:
+        print(f'FAIL: {f}', file=sys.stderr)
+    return 1 if failures else 0
 
 
 if __name__ == '__main__':

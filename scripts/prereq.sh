@@ -311,6 +311,7 @@ probe_bench() {
   probe_demo || return 1
   prereq_scipy_python >/dev/null || prereq_fail "no python3 here imports numpy and scipy" ||
     return 1
+  [ -x /usr/bin/time ] || prereq_fail "no GNU time at /usr/bin/time (peak memory)" || return 1
   probe_ceres
 }
 
