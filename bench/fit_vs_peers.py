@@ -209,17 +209,14 @@ def run_case(args, rows, tmp):
         lines.append({'solver': f'scipy least_squares: skipped, {rows} rows > '
                                 f'--scipy-max-rows {args.scipy_max_rows}', 'time': None})
 
-    out = [f'{rows} rows, noise {args.noise_mm} mm, {len(names)} parameters, '
-           f'best of {args.repeat}; whole processes unless "solve only"',
-           f'  {"solver":36s} {"time ms":>9s} {"peer/dhcal":>10s} {"solve ms":>9s} '
-           f'{"iterations":>12s} {"RMS mm":>10s} {"peak MB":>8s}']
+    out = []
     for ln in lines:
         if ln['time'] is None:
-            out.append(f'  {ln["solver"]}')
+            out.append(f'{rows:>7d}  {ln["solver"]}')
             continue
         ratio = ln['time'] / t_dhcal
         rss = f'{ln["rss"] / 1024:.1f}' if ln['rss'] is not None else '-'
-        out.append(f'  {ln["solver"]:36s} {fmt_ms(ln["time"]):>9s} {ratio:9.2f}x '
+        out.append(f'{rows:>7d}  {ln["solver"]:36s} {fmt_ms(ln["time"]):>9s} {ratio:9.2f}x '
                    f'{fmt_ms(ln["solve"]):>9s} {str(ln["iters"]):>12s} {ln["rms"]:10.6f} '
                    f'{rss:>8s}')
         if abs(ln['rms'] - dhcal['rms_mm']) > args.rms_tolerance * dhcal['rms_mm']:
@@ -244,6 +241,11 @@ def main():
 
     failures = []
     goals = []
+    print(f'dhcal fit and its peers: paper 6-DOF, noise {args.noise_mm} mm, best of '
+          f'{args.repeat}; whole processes except scipy (solve only); peer/dhcal is the time '
+          'ratio')
+    print(f'{"rows":>7s}  {"solver":36s} {"time ms":>9s} {"peer/dhcal":>10s} {"solve ms":>9s} '
+          f'{"iterations":>12s} {"RMS mm":>10s} {"peak MB":>8s}', flush=True)
     with tempfile.TemporaryDirectory() as tmp:
         for rows in row_counts:
             try:
@@ -252,8 +254,7 @@ def main():
                 print(f'{rows} rows: FAIL: {e}')
                 failures.append(f'{rows} rows: {e}')
                 continue
-            print('\n'.join(out))
-            print(flush=True)
+            print('\n'.join(out), flush=True)
             failures += fails
             t = times['dhcal']
             if rows == 2000:
@@ -271,6 +272,7 @@ def main():
                 goals.append(('200000 rows fitted in under 1 s', t < 1.0,
                               f'dhcal fit {t * 1000:.0f} ms'))
 
+    print()
     for text, met, detail in goals:
         print(f'goal: {text}: {"met" if met else "not met"} ({detail})')
     for f in failures:
