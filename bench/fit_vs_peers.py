@@ -18,10 +18,11 @@ that runs as a program:
 
 All fit the parameters dhcal fits by default (the Ceres peer chooses them by dhcal's rules;
 the benchmark checks that the names agree, and gives scipy dhcal's list), with the residual
-predicted - measured tool point, so their RMS must agree. Times are the best of --repeat
-runs; ratios are peer time / dhcal time (below 1: the peer is faster). Peak memory is each
-process's maximum resident set size, from GNU time in one
-more run.
+predicted - measured tool point, so their RMS must agree. The programs run round-robin,
+--repeat times each, so that a change of a shared machine's load hits all alike; times are
+the best run's, wall clock (the ratio: peer time / dhcal time, below 1 the peer is faster)
+and CPU (user + system, less sensitive to neighbours). Peak memory is each process's
+maximum resident set size, from GNU time in one more run.
 
 Usage: fit_vs_peers.py --dhcal build/host/tools/dhcal --ceres build/bench-ceres/ceres_fit
                        [--rows 2000,20000,200000] [--repeat 5] [--noise-mm 0.02]
@@ -114,33 +115,48 @@ def write_files(directory, q, meas):
 
 
 def run_process(cmd, directory):
-    """Runs cmd once, output to files: (wall seconds, exit code, stdout, stderr)."""
+    """Runs cmd once, output to files: (wall s, CPU s (user + system), exit code, stdout,
+    stderr)."""
     out_path = os.path.join(directory, 'stdout')
     err_path = os.path.join(directory, 'stderr')
     with open(out_path, 'w') as out, open(err_path, 'w') as err:
         t0 = time.perf_counter()
-        code = subprocess.run(cmd, stdout=out, stderr=err, check=False).returncode
+        proc = subprocess.Popen(cmd, stdout=out, stderr=err)
+        _, status, usage = os.wait4(proc.pid, 0)
         wall = time.perf_counter() - t0
+    proc.returncode = os.waitstatus_to_exitcode(status)
     with open(out_path) as out, open(err_path) as err:
-        return wall, code, out.read(), err.read()
+        return (wall, usage.ru_utime + usage.ru_stime, proc.returncode, out.read(),
+                err.read())
 
 
-def best_of(repeat, cmd, directory, label):
-    """Best wall time of repeat runs, every run's JSON output, and the peak RSS in KiB of
-    one more run under GNU time. (A child of this interpreter cannot report its own peak:
-    Linux charges the interpreter's memory, which the child had until its exec, to it.)"""
-    best, results = None, []
-    for _ in range(repeat):
-        wall, code, out, err = run_process(cmd, directory)
-        if code != 0:
-            raise RuntimeError(f'{label} exited with {code}: {err.strip()[:400]}')
-        best = wall if best is None else min(best, wall)
-        results.append(json.loads(out))
-    _, code, _, err = run_process([GNU_TIME, '-f', 'peak_rss_kib %M', *cmd], directory)
+def peak_rss_kib(cmd, directory, label):
+    """Peak RSS of one run under GNU time. (A child of this interpreter cannot report its
+    own: Linux charges it the interpreter's memory, which it shared until its exec.)"""
+    _, _, code, _, err = run_process([GNU_TIME, '-f', 'peak_rss_kib %M', *cmd], directory)
     last = err.strip().splitlines()[-1] if err.strip() else ''
     if code != 0 or not last.startswith('peak_rss_kib '):
         raise RuntimeError(f'{label} under {GNU_TIME} exited with {code}: {err.strip()[:400]}')
-    return best, int(last.split()[1]), results
+    return int(last.split()[1])
+
+
+def best_of(repeat, programs, directory):
+    """Runs every program of programs ({key: (label, cmd)}) repeat times, round-robin, so
+    that a change of the machine's load hits all alike. Returns {key: (best wall s, best
+    CPU s, peak RSS KiB, [JSON output of every run])}."""
+    walls = {k: [] for k in programs}
+    cpus = {k: [] for k in programs}
+    results = {k: [] for k in programs}
+    for _ in range(repeat):
+        for key, (label, cmd) in programs.items():
+            wall, cpu, code, out, err = run_process(cmd, directory)
+            if code != 0:
+                raise RuntimeError(f'{label} exited with {code}: {err.strip()[:400]}')
+            walls[key].append(wall)
+            cpus[key].append(cpu)
+            results[key].append(json.loads(out))
+    return {k: (min(walls[k]), min(cpus[k]), peak_rss_kib(cmd, directory, label), results[k])
+            for k, (label, cmd) in programs.items()}
 
 
 def scipy_fit(q, meas, names, repeat):
@@ -150,14 +166,15 @@ def scipy_fit(q, meas, names, repeat):
     def residuals(p):
         return (fk_points(q, *unpack(p, names, nominal)) - meas).ravel()
 
-    times = []
+    times, cpus = [], []
     for _ in range(repeat):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         sol = least_squares(residuals, np.zeros(len(names)), x_scale='jac')
         times.append(time.perf_counter() - t0)
+        cpus.append(time.process_time() - c0)
     r = sol.fun.reshape(-1, 3)
     rms = float(np.sqrt(np.mean(np.sum(r * r, axis=1))))
-    return min(times), rms, sol.nfev, sol.njev
+    return min(times), min(cpus), rms, sol.nfev, sol.njev
 
 
 def fmt_ms(seconds):
@@ -173,36 +190,40 @@ def run_case(args, rows, tmp):
     files = ['--model', model_path, '--data', data_path]
     failures = []
 
-    t_dhcal, rss_dhcal, dhcal_runs = best_of(args.repeat, [args.dhcal, 'fit', *files, '--json'],
-                                        directory, 'dhcal fit')
-    dhcal = dhcal_runs[-1]
+    ceres = (('solve', 'Ceres Solve, DENSE_NORMAL_CHOLESKY'),
+             ('solve-qr', 'Ceres Solve, DENSE_QR'),
+             ('tiny', 'Ceres TinySolver'))
+    programs = {'dhcal': ('dhcal fit', [args.dhcal, 'fit', *files, '--json'])}
+    for solver, label in ceres:
+        programs[solver] = (label, [args.ceres, *files, '--solver', solver])
+    measured = best_of(args.repeat, programs, directory)
+
+    t_dhcal, cpu, rss, runs = measured['dhcal']
+    dhcal = runs[-1]
     names = [p['name'] for p in dhcal['parameters']]
-    line = {'solver': 'dhcal fit', 'time': t_dhcal, 'solve': None, 'iters': dhcal['iterations'],
-            'rms': dhcal['rms_mm'], 'rss': rss_dhcal}
-    lines = [line]
+    lines = [{'solver': 'dhcal fit', 'time': t_dhcal, 'cpu': cpu, 'solve': None,
+              'iters': dhcal['iterations'], 'rms': dhcal['rms_mm'], 'rss': rss}]
     times = {'dhcal': t_dhcal}
     if dhcal['outliers']:
         failures.append(f'{rows} rows: dhcal left {len(dhcal["outliers"])} rows out as '
                         'outliers: its RMS is over fewer rows than the peers\'')
 
-    for solver, label in (('solve', 'Ceres Solve, DENSE_NORMAL_CHOLESKY'),
-                          ('solve-qr', 'Ceres Solve, DENSE_QR'),
-                          ('tiny', 'Ceres TinySolver')):
-        t, rss, runs = best_of(args.repeat, [args.ceres, *files, '--solver', solver],
-                               directory, f'ceres_fit --solver {solver}')
+    for solver, label in ceres:
+        t, cpu, rss, runs = measured[solver]
         res = runs[-1]
         ceres_names = [p['name'] for p in res['parameters']]
         if ceres_names != names:
             failures.append(f'{rows} rows: {label} fits {ceres_names}, dhcal fits {names}: '
                             'not the same problem')
         solve = min(r['solve_ms'] for r in runs) / 1000.0
-        lines.append({'solver': label, 'time': t, 'solve': solve,
+        lines.append({'solver': label, 'time': t, 'cpu': cpu, 'solve': solve,
                       'iters': res['iterations'], 'rms': res['rms_mm'], 'rss': rss})
         times[solver] = t
 
     if rows <= args.scipy_max_rows:
-        t, rms, nfev, njev = scipy_fit(q, meas, names, args.repeat)
-        lines.append({'solver': 'scipy least_squares (solve only)', 'time': t, 'solve': t,
+        t, cpu, rms, nfev, njev = scipy_fit(q, meas, names, args.repeat)
+        lines.append({'solver': 'scipy least_squares (solve only)', 'time': t, 'cpu': cpu,
+                      'solve': t,
                       'iters': f'{njev} J, {nfev} f', 'rms': rms, 'rss': None})
         times['scipy'] = t
     else:
@@ -217,8 +238,8 @@ def run_case(args, rows, tmp):
         ratio = ln['time'] / t_dhcal
         rss = f'{ln["rss"] / 1024:.1f}' if ln['rss'] is not None else '-'
         out.append(f'{rows:>7d}  {ln["solver"]:36s} {fmt_ms(ln["time"]):>9s} {ratio:9.2f}x '
-                   f'{fmt_ms(ln["solve"]):>9s} {str(ln["iters"]):>12s} {ln["rms"]:10.6f} '
-                   f'{rss:>8s}')
+                   f'{fmt_ms(ln["cpu"]):>8s} {fmt_ms(ln["solve"]):>9s} {str(ln["iters"]):>12s} '
+                   f'{ln["rms"]:10.6f} {rss:>8s}')
         if abs(ln['rms'] - dhcal['rms_mm']) > args.rms_tolerance * dhcal['rms_mm']:
             rel = abs(ln['rms'] - dhcal['rms_mm']) / dhcal['rms_mm']
             failures.append(f'{rows} rows: {ln["solver"]} reaches RMS {ln["rms"]:.9f} mm, '
@@ -242,10 +263,10 @@ def main():
     failures = []
     goals = []
     print(f'dhcal fit and its peers: paper 6-DOF, noise {args.noise_mm} mm, best of '
-          f'{args.repeat}; whole processes except scipy (solve only); peer/dhcal is the time '
-          'ratio')
-    print(f'{"rows":>7s}  {"solver":36s} {"time ms":>9s} {"peer/dhcal":>10s} {"solve ms":>9s} '
-          f'{"iterations":>12s} {"RMS mm":>10s} {"peak MB":>8s}', flush=True)
+          f'{args.repeat} (programs run round-robin); whole processes except scipy (solve '
+          'only); peer/dhcal is the wall-time ratio; CPU = user + system')
+    print(f'{"rows":>7s}  {"solver":36s} {"time ms":>9s} {"peer/dhcal":>10s} {"CPU ms":>8s} '
+          f'{"solve ms":>9s} {"iterations":>12s} {"RMS mm":>10s} {"peak MB":>8s}', flush=True)
     with tempfile.TemporaryDirectory() as tmp:
         for rows in row_counts:
             try:
