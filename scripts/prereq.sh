@@ -260,9 +260,59 @@ prereq_scipy_python() {
   return 1
 }
 
+# The Ceres peer of bench/ceres: g++ compiles a hand-written cost function and a TinySolver
+# functor against Debian's Ceres and Eigen, links libceres, and both solvers find x = 3.
+probe_ceres() {
+  prereq_cmd g++ || return 1
+  cat >r.cc <<'EOF'
+#include <ceres/ceres.h>
+#include <ceres/tiny_solver.h>
+#include <cmath>
+struct Cost : ceres::SizedCostFunction<1, 1> {
+  bool Evaluate(double const *const *x, double *r, double **j) const override {
+    r[0] = x[0][0] - 3.0;
+    if (j != nullptr && j[0] != nullptr) j[0][0] = 1.0;
+    return true;
+  }
+};
+struct Tiny {
+  typedef double Scalar;
+  enum { NUM_RESIDUALS = 1, NUM_PARAMETERS = 1 };
+  bool operator()(const double *x, double *r, double *j) const {
+    r[0] = x[0] - 3.0;
+    if (j != nullptr) j[0] = 1.0;
+    return true;
+  }
+};
+int main() {
+  double x = 0.0;
+  ceres::Problem problem;
+  problem.AddResidualBlock(new Cost, nullptr, &x);
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  Eigen::Matrix<double, 1, 1> y(0.0);
+  ceres::TinySolver<Tiny> tiny;
+  tiny.Solve(Tiny(), &y);
+  return std::fabs(x - 3.0) < 1e-6 && std::fabs(y(0) - 3.0) < 1e-6 ? 0 : 1;
+}
+EOF
+  local flags
+  flags=$(pkg-config --cflags eigen3 2>/dev/null) ||
+    prereq_fail "pkg-config finds no eigen3 (Ceres' headers include Eigen)" || return 1
+  # shellcheck disable=SC2086 # word splitting intended: compiler flags
+  g++ -std=c++17 $flags -o r r.cc -lceres -lglog >log 2>&1 ||
+    prereq_fail "g++ cannot link Ceres: $(tail -3 log)" || return 1
+  ./r || prereq_fail "the Ceres program did not run or did not solve"
+}
+
 probe_bench() {
   probe_demo || return 1
-  prereq_scipy_python >/dev/null || prereq_fail "no python3 here imports numpy and scipy"
+  prereq_scipy_python >/dev/null || prereq_fail "no python3 here imports numpy and scipy" ||
+    return 1
+  [ -x /usr/bin/time ] || prereq_fail "no GNU time at /usr/bin/time (peak memory)" || return 1
+  probe_ceres
 }
 
 prereq_probe() {
