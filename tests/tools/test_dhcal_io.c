@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "dhcal_io.h"
+#include "dhc_test_files.h"
 #include "unity.h"
 
 #define PI 3.14159265358979323846
@@ -25,27 +26,6 @@ static char g_path[512];
 static dhcal_error g_err;
 static dhcal_dataset g_data;
 static dhcal_model g_model;
-
-static void remove_dir_contents(const char *dir)
-{
-    DIR *const d = opendir(dir);
-    if (d == NULL) {
-        return;
-    }
-    const struct dirent *e;
-    char p[600];
-    while ((e = readdir(d)) != NULL) {
-        if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0) {
-            continue;
-        }
-        (void)snprintf(p, sizeof p, "%s/%s", dir, e->d_name);
-        if (unlink(p) != 0) {
-            remove_dir_contents(p);
-            (void)rmdir(p);
-        }
-    }
-    (void)closedir(d);
-}
 
 static size_t count_dir_entries(void)
 {
@@ -62,10 +42,7 @@ static size_t count_dir_entries(void)
 
 void setUp(void)
 {
-    const char *const tmp = getenv("TMPDIR");
-    (void)snprintf(g_dir, sizeof g_dir, "%s/dhcal_io.XXXXXX",
-                   tmp != NULL && tmp[0] != '\0' ? tmp : "/tmp");
-    TEST_ASSERT_NOT_NULL(mkdtemp(g_dir));
+    test_make_dir(g_dir, sizeof g_dir, "io");
     memset(&g_err, 0, sizeof g_err);
     memset(&g_data, 0, sizeof g_data);
 }
@@ -73,8 +50,7 @@ void setUp(void)
 void tearDown(void)
 {
     dhcal_dataset_free(&g_data);
-    remove_dir_contents(g_dir);
-    (void)rmdir(g_dir);
+    test_remove_dir(g_dir);
 }
 
 static const char *path_of(const char *name)

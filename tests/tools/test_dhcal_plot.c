@@ -17,6 +17,7 @@
 #include <unistd.h>
 
 #include "dhcal_plot.h"
+#include "dhc_test_files.h"
 #include "unity.h"
 
 #ifndef DHCAL_SOURCE_DIR
@@ -42,27 +43,6 @@ static dhcal_plot_candidate g_cand[3];
 static dhcal_plot_data g_d;
 
 /* ------------------------------------------------------------------ fixtures */
-
-static void remove_tree(const char *dir)
-{
-    DIR *const d = opendir(dir);
-    if (d == NULL) {
-        return;
-    }
-    const struct dirent *e;
-    char p[800];
-    while ((e = readdir(d)) != NULL) {
-        if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0) {
-            continue;
-        }
-        (void)snprintf(p, sizeof p, "%s/%s", dir, e->d_name);
-        if (unlink(p) != 0) {
-            remove_tree(p);
-            (void)rmdir(p);
-        }
-    }
-    (void)closedir(d);
-}
 
 static size_t count_entries(const char *dir)
 {
@@ -99,14 +79,6 @@ static char *slurp(const char *path)
     s[n] = '\0';
     (void)fclose(f);
     return s;
-}
-
-static void write_text(const char *path, const char *text)
-{
-    FILE *const f = fopen(path, "wb");
-    TEST_ASSERT_NOT_NULL(f);
-    TEST_ASSERT_EQUAL_size_t(strlen(text), fwrite(text, 1U, strlen(text), f));
-    TEST_ASSERT_EQUAL_INT(0, fclose(f));
 }
 
 /* n rows of an nj-joint arm: z residual a cos(q2) wave, x two backlash clusters. Apparent
@@ -162,10 +134,7 @@ static void fill(size_t n, size_t nj)
 
 void setUp(void)
 {
-    const char *const tmp = getenv("TMPDIR");
-    (void)snprintf(g_dir, sizeof g_dir, "%s/dhcal_plot.XXXXXX",
-                   tmp != NULL && tmp[0] != '\0' ? tmp : "/tmp");
-    TEST_ASSERT_NOT_NULL(mkdtemp(g_dir));
+    test_make_dir(g_dir, sizeof g_dir, "plot");
     (void)snprintf(g_out, sizeof g_out, "%s/plots", g_dir);
     memset(&g_err, 0, sizeof g_err);
     fill(10U, 3U);
@@ -173,8 +142,7 @@ void setUp(void)
 
 void tearDown(void)
 {
-    remove_tree(g_dir);
-    (void)rmdir(g_dir);
+    test_remove_dir(g_dir);
 }
 
 /* ------------------------------------------------------------------ a small XML checker */
@@ -440,11 +408,11 @@ static void test_python_check_rejects_a_broken_file(void)
         TEST_IGNORE_MESSAGE("python3 not available: check_svg.py not run");
     }
     TEST_ASSERT_EQUAL_INT(0, mkdir(g_out, 0777));
-    write_text(out_path("bad.svg"), "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"10\" "
+    test_write_file(out_path("bad.svg"), "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"10\" "
                                     "height=\"10\" viewBox=\"0 0 10 10\"><circle cx=\"nan\" "
                                     "cy=\"1\" r=\"1\"/></svg>");
     TEST_ASSERT_FALSE(python_check("bad.svg 2>/dev/null"));
-    write_text(out_path("bad.svg"), "<svg><text>a & b</text></svg>");
+    test_write_file(out_path("bad.svg"), "<svg><text>a & b</text></svg>");
     TEST_ASSERT_FALSE(python_check("bad.svg 2>/dev/null"));
 }
 
@@ -667,7 +635,7 @@ static void test_tick_labels_are_round_numbers(void)
 static void test_existing_file_is_replaced_by_rename(void)
 {
     TEST_ASSERT_EQUAL_INT(0, mkdir(g_out, 0777));
-    write_text(out_path("residuals.svg"), "old picture");
+    test_write_file(out_path("residuals.svg"), "old picture");
     char keep[600];
     (void)snprintf(keep, sizeof keep, "%s/keep", g_out);
     TEST_ASSERT_EQUAL_INT(0, link(out_path("residuals.svg"), keep));
@@ -684,7 +652,7 @@ static void test_failed_rename_leaves_no_temporary_file(void)
 {
     TEST_ASSERT_EQUAL_INT(0, mkdir(g_out, 0777));
     TEST_ASSERT_EQUAL_INT(0, mkdir(out_path("residuals.svg"), 0777));
-    write_text(out_path("residuals.svg/x"), "in the way");
+    test_write_file(out_path("residuals.svg/x"), "in the way");
     TEST_ASSERT_EQUAL_INT(DHCAL_IO_FAILED, dhcal_plot_write(g_out, &g_d, &g_err));
     TEST_ASSERT_NOT_NULL_MESSAGE(strstr(g_err.msg, out_path("residuals.svg")), g_err.msg);
     TEST_ASSERT_EQUAL_size_t(1U, count_entries(g_out));
@@ -692,7 +660,7 @@ static void test_failed_rename_leaves_no_temporary_file(void)
 
 static void test_directory_path_that_is_a_file_fails_naming_it(void)
 {
-    write_text(g_out, "not a directory");
+    test_write_file(g_out, "not a directory");
     TEST_ASSERT_EQUAL_INT(DHCAL_IO_FAILED, dhcal_plot_write(g_out, &g_d, &g_err));
     TEST_ASSERT_NOT_NULL_MESSAGE(strstr(g_err.msg, g_out), g_err.msg);
     TEST_ASSERT_NOT_NULL_MESSAGE(strstr(g_err.msg, "not a directory"), g_err.msg);
@@ -703,7 +671,7 @@ static void test_directory_path_that_is_a_file_fails_naming_it(void)
 
 static void test_parent_that_is_a_file_fails_naming_it(void)
 {
-    write_text(g_out, "x");
+    test_write_file(g_out, "x");
     char sub[600];
     (void)snprintf(sub, sizeof sub, "%s/sub", g_out);
     TEST_ASSERT_EQUAL_INT(DHCAL_IO_FAILED, dhcal_plot_write(sub, &g_d, &g_err));
@@ -909,7 +877,7 @@ static void test_direction_other_than_minus_one_zero_plus_one_is_bad_input(void)
 static void test_nan_joint_error_writes_no_file(void)
 {
     TEST_ASSERT_EQUAL_INT(0, mkdir(g_out, 0777));
-    write_text(out_path("joints.svg"), "old picture");
+    test_write_file(out_path("joints.svg"), "old picture");
     g_je[7] = (double)NAN;
     TEST_ASSERT_EQUAL_INT(DHCAL_IO_BAD_INPUT, dhcal_plot_write(g_out, &g_d, &g_err));
     TEST_ASSERT_NOT_NULL_MESSAGE(strstr(g_err.msg, "joint_err_deg[2][1] is NaN"), g_err.msg);

@@ -14,6 +14,7 @@
 #include "dhcal/dhc_params.h"
 #include "dhcal_io.h"
 #include "dhcal_model_map.h"
+#include "dhc_test_files.h"
 #include "unity.h"
 
 #define PI 3.14159265358979323846
@@ -23,17 +24,13 @@ static char g_path[512];
 
 void setUp(void)
 {
-    const char *const tmp = getenv("TMPDIR");
-    (void)snprintf(g_dir, sizeof g_dir, "%s/dhcal_fx.XXXXXX",
-                   tmp != NULL && tmp[0] != '\0' ? tmp : "/tmp");
-    TEST_ASSERT_NOT_NULL(mkdtemp(g_dir));
+    test_make_dir(g_dir, sizeof g_dir, "fx");
     (void)snprintf(g_path, sizeof g_path, "%s/model.json", g_dir);
 }
 
 void tearDown(void)
 {
-    (void)unlink(g_path);
-    (void)rmdir(g_dir);
+    test_remove_dir(g_dir);
 }
 
 /* docs/formats.md, 2.5: the key (joint 2 of 3 for the per-joint ones), how many values the

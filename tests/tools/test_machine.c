@@ -14,6 +14,7 @@
 #include "dhcal_machine.h"
 #include "dhcal_model_file.h"
 #include "dhcal_model_map.h"
+#include "dhc_test_files.h"
 #include "unity.h"
 
 #define DEG (3.14159265358979323846 / 180.0)
@@ -27,10 +28,7 @@ static dhcal_machine g_machine;
 static const char *write_text(const char *name, const char *text)
 {
     (void)snprintf(g_path, sizeof g_path, "%s/%s", g_dir, name);
-    FILE *const f = fopen(g_path, "wb");
-    TEST_ASSERT_NOT_NULL(f);
-    TEST_ASSERT_EQUAL_size_t(strlen(text), fwrite(text, 1U, strlen(text), f));
-    TEST_ASSERT_EQUAL_INT(0, fclose(f));
+    test_write_file(g_path, text);
     return g_path;
 }
 
@@ -59,10 +57,7 @@ static const char *const MACHINE =
 
 void setUp(void)
 {
-    const char *const tmp = getenv("TMPDIR");
-    (void)snprintf(g_dir, sizeof g_dir, "%s/dhcal_machine.XXXXXX",
-                   tmp != NULL && tmp[0] != '\0' ? tmp : "/tmp");
-    TEST_ASSERT_NOT_NULL(mkdtemp(g_dir));
+    test_make_dir(g_dir, sizeof g_dir, "machine");
     (void)snprintf(g_model_path, sizeof g_model_path, "%s/m.json", g_dir);
     (void)write_text("m.json", MODEL);
     memset(&g_err, 0, sizeof g_err);
@@ -70,13 +65,7 @@ void setUp(void)
 
 void tearDown(void)
 {
-    char p[600];
-    const char *const names[] = {"m.json", "machine.json"};
-    for (size_t k = 0U; k < 2U; ++k) {
-        (void)snprintf(p, sizeof p, "%s/%s", g_dir, names[k]);
-        (void)unlink(p);
-    }
-    (void)rmdir(g_dir);
+    test_remove_dir(g_dir);
 }
 
 /* MACHINE with `from` replaced by `to` (which must occur once). */
