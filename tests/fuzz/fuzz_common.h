@@ -37,6 +37,18 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
         }                                                                                   \
     } while (0)
 
+/* 1 when n bytes at p are all zero: what a loader that failed must leave of its output. */
+static inline int fz_is_zero(const void *p, size_t n)
+{
+    const unsigned char *b = p;
+    for (size_t i = 0U; i < n; ++i) {
+        if (b[i] != 0U) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
 /* ---------------------------------------------------------------- bytes to values */
 
 typedef struct {

@@ -23,17 +23,6 @@ static dhcal_model mapped_back;
 static dhc_model lib;
 static dhc_model lib_again;
 
-static int is_zero(const void *p, size_t n)
-{
-    const unsigned char *b = p;
-    for (size_t i = 0U; i < n; ++i) {
-        if (b[i] != 0U) {
-            return 0;
-        }
-    }
-    return 1;
-}
-
 static int same(double a, double b)
 {
     return a <= b && a >= b;
@@ -177,7 +166,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     FZ_CHECK(unlink(in) == 0);
     FZ_CHECK(rc == DHCAL_IO_OK || rc == DHCAL_IO_BAD_INPUT);
     if (rc != DHCAL_IO_OK) {
-        FZ_CHECK(is_zero(&loaded, sizeof loaded));
+        FZ_CHECK(fz_is_zero(&loaded, sizeof loaded));
         FZ_CHECK(fz_message_ok(err.msg, sizeof err.msg, in));
         return 0;
     }

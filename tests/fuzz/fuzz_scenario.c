@@ -77,17 +77,6 @@ static void ensure_models(void)
     done = 1;
 }
 
-static int is_zero(const void *p, size_t n)
-{
-    const unsigned char *b = p;
-    for (size_t i = 0U; i < n; ++i) {
-        if (b[i] != 0U) {
-            return 0;
-        }
-    }
-    return 1;
-}
-
 static int all_finite(const double *v, size_t n)
 {
     for (size_t i = 0U; i < n; ++i) {
@@ -199,7 +188,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     FZ_CHECK(unlink(in) == 0);
     FZ_CHECK(rc == DHCAL_IO_OK || rc == DHCAL_IO_BAD_INPUT);
     if (rc != DHCAL_IO_OK) {
-        FZ_CHECK(is_zero(&loaded, sizeof loaded));
+        FZ_CHECK(fz_is_zero(&loaded, sizeof loaded));
         /* the scenario's messages name it; the model's name the model file */
         int named = fz_message_ok(err.msg, sizeof err.msg, in);
         for (size_t i = 0U; i < N_MODELS && !named; ++i) {
