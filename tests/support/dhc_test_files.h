@@ -46,6 +46,21 @@ static inline void test_remove_dir(const char *dir)
     (void)rmdir(dir);
 }
 
+/* How many entries dir holds ("." and ".." not counted): a write that leaves a temporary
+ * behind shows here. */
+static inline size_t test_count_entries(const char *dir)
+{
+    DIR *const d = opendir(dir);
+    TEST_ASSERT_NOT_NULL(d);
+    size_t n = 0U;
+    const struct dirent *e;
+    while ((e = readdir(d)) != NULL) {
+        n += strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0;
+    }
+    (void)closedir(d);
+    return n;
+}
+
 /* Writes text to path, whole, or fails the test. */
 static inline void test_write_file(const char *path, const char *text)
 {

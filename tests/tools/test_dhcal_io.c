@@ -27,19 +27,6 @@ static dhcal_error g_err;
 static dhcal_dataset g_data;
 static dhcal_model g_model;
 
-static size_t count_dir_entries(void)
-{
-    DIR *const d = opendir(g_dir);
-    TEST_ASSERT_NOT_NULL(d);
-    size_t n = 0U;
-    const struct dirent *e;
-    while ((e = readdir(d)) != NULL) {
-        n += strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0;
-    }
-    (void)closedir(d);
-    return n;
-}
-
 void setUp(void)
 {
     test_make_dir(g_dir, sizeof g_dir, "io");
@@ -924,7 +911,7 @@ static void test_save_then_load_gives_the_same_model(void)
             TEST_ASSERT_DOUBLE_WITHIN(1e-12 * 1e3, ta.pos[r], tb.pos[r]);
         }
     }
-    TEST_ASSERT_EQUAL_size_t(1U, count_dir_entries()); /* no temporary left behind */
+    TEST_ASSERT_EQUAL_size_t(1U, test_count_entries(g_dir)); /* no temporary left behind */
 }
 
 static void test_save_is_a_fixed_point_after_one_round(void)
@@ -998,7 +985,7 @@ static void test_failed_save_leaves_the_old_file_untouched(void)
     char *const text = slurp(keep, &n);
     TEST_ASSERT_EQUAL_STRING(OLD, text);
     free(text);
-    TEST_ASSERT_EQUAL_size_t(1U, count_dir_entries());
+    TEST_ASSERT_EQUAL_size_t(1U, test_count_entries(g_dir));
 }
 
 static void test_save_into_missing_directory_fails(void)
@@ -1024,7 +1011,7 @@ static void test_save_over_a_directory_fails_and_cleans_up(void)
     struct stat st;
     TEST_ASSERT_EQUAL_INT(0, stat(sub, &st));
     TEST_ASSERT_TRUE(S_ISDIR(st.st_mode));
-    TEST_ASSERT_EQUAL_size_t(1U, count_dir_entries()); /* the temporary was removed */
+    TEST_ASSERT_EQUAL_size_t(1U, test_count_entries(g_dir)); /* the temporary was removed */
 }
 
 static void test_save_replaces_an_existing_file(void)
@@ -1036,7 +1023,7 @@ static void test_save_replaces_an_existing_file(void)
     make_calibrated_model(&m);
     TEST_ASSERT_EQUAL_INT(DHCAL_IO_OK, dhcal_model_save(keep, &m, &g_err));
     TEST_ASSERT_EQUAL_INT(DHCAL_IO_OK, dhcal_model_load(keep, &g_model, &g_err));
-    TEST_ASSERT_EQUAL_size_t(1U, count_dir_entries());
+    TEST_ASSERT_EQUAL_size_t(1U, test_count_entries(g_dir));
 }
 
 int main(void)

@@ -44,19 +44,6 @@ static dhcal_plot_data g_d;
 
 /* ------------------------------------------------------------------ fixtures */
 
-static size_t count_entries(const char *dir)
-{
-    DIR *const d = opendir(dir);
-    TEST_ASSERT_NOT_NULL(d);
-    size_t n = 0U;
-    const struct dirent *e;
-    while ((e = readdir(d)) != NULL) {
-        n += strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0;
-    }
-    (void)closedir(d);
-    return n;
-}
-
 static const char *out_path(const char *name)
 {
     static char p[512];
@@ -645,7 +632,7 @@ static void test_existing_file_is_replaced_by_rename(void)
     char *const k = slurp(keep);
     TEST_ASSERT_EQUAL_STRING("old picture", k);
     free(k);
-    TEST_ASSERT_EQUAL_size_t(5U, count_entries(g_out)); /* no temporary file left */
+    TEST_ASSERT_EQUAL_size_t(5U, test_count_entries(g_out)); /* no temporary file left */
 }
 
 static void test_failed_rename_leaves_no_temporary_file(void)
@@ -655,7 +642,7 @@ static void test_failed_rename_leaves_no_temporary_file(void)
     test_write_file(out_path("residuals.svg/x"), "in the way");
     TEST_ASSERT_EQUAL_INT(DHCAL_IO_FAILED, dhcal_plot_write(g_out, &g_d, &g_err));
     TEST_ASSERT_NOT_NULL_MESSAGE(strstr(g_err.msg, out_path("residuals.svg")), g_err.msg);
-    TEST_ASSERT_EQUAL_size_t(1U, count_entries(g_out));
+    TEST_ASSERT_EQUAL_size_t(1U, test_count_entries(g_out));
 }
 
 static void test_directory_path_that_is_a_file_fails_naming_it(void)
@@ -692,7 +679,7 @@ static void test_missing_directories_are_created_with_the_umask(void)
     TEST_ASSERT_EQUAL_UINT(0750U, (unsigned)(st.st_mode & 0777U));
     TEST_ASSERT_EQUAL_INT(0, stat(g_out, &st));
     TEST_ASSERT_EQUAL_UINT(0750U, (unsigned)(st.st_mode & 0777U));
-    TEST_ASSERT_EQUAL_size_t(4U, count_entries(sub));
+    TEST_ASSERT_EQUAL_size_t(4U, test_count_entries(sub));
 }
 
 static void test_caller_errors_are_failed(void)
@@ -881,7 +868,7 @@ static void test_nan_joint_error_writes_no_file(void)
     g_je[7] = (double)NAN;
     TEST_ASSERT_EQUAL_INT(DHCAL_IO_BAD_INPUT, dhcal_plot_write(g_out, &g_d, &g_err));
     TEST_ASSERT_NOT_NULL_MESSAGE(strstr(g_err.msg, "joint_err_deg[2][1] is NaN"), g_err.msg);
-    TEST_ASSERT_EQUAL_size_t(1U, count_entries(g_out));
+    TEST_ASSERT_EQUAL_size_t(1U, test_count_entries(g_out));
     char *const s = slurp(out_path("joints.svg"));
     TEST_ASSERT_EQUAL_STRING("old picture", s);
     free(s);
