@@ -5,6 +5,7 @@
 #endif
 
 #include <errno.h>
+#include <getopt.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -91,44 +92,61 @@ static int parse_ulong(const char *s, unsigned long long max, unsigned long long
     return 1;
 }
 
+/* getopt_long over the words after the subcommand (which stands where getopt expects the
+ * program's name); errors are ours (opterr 0, ':' first): they name the option. */
+static int next_option(int argc, char **argv, const struct option *longs, const char **given)
+{
+    const int c = getopt_long(argc - 1, argv + 1, ":h", longs, NULL);
+    *given = c != -1 ? argv[optind] : NULL; /* optind counts argv + 1's words */
+    return c;
+}
+
+enum { OPT_HELP = 'h', OPT_WIRES = 256, OPT_SCENARIO, OPT_OUT, OPT_PLAN, OPT_MODEL_OUT,
+       OPT_POSES, OPT_SEED };
+
 static int parse_options(int argc, char **argv, options *o)
 {
     memset(o, 0, sizeof *o);
-    for (int k = 2; k < argc; ++k) {
-        const char *a = argv[k];
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+    static const struct option longs[] = {
+        {"help", no_argument, NULL, OPT_HELP},
+        {"wires", no_argument, NULL, OPT_WIRES},
+        {"scenario", required_argument, NULL, OPT_SCENARIO},
+        {"out", required_argument, NULL, OPT_OUT},
+        {"plan", required_argument, NULL, OPT_PLAN},
+        {"model-out", required_argument, NULL, OPT_MODEL_OUT},
+        {"poses", required_argument, NULL, OPT_POSES},
+        {"seed", required_argument, NULL, OPT_SEED},
+        {NULL, 0, NULL, 0}};
+    opterr = 0;
+    optind = 1;
+    const char *a = NULL;
+    int c;
+    while ((c = next_option(argc, argv, longs, &a)) != -1) {
+        const char **slot = NULL;
+        switch (c) {
+        case OPT_HELP:
             fputs(dataset_help, stdout);
             exit(0);
+        case OPT_WIRES: o->wires = 1; continue;
+        case OPT_SCENARIO: slot = &o->scenario; break;
+        case OPT_OUT: slot = &o->out; break;
+        case OPT_PLAN: slot = &o->plan; break;
+        case OPT_MODEL_OUT: slot = &o->model_out; break;
+        case OPT_POSES:
+        case OPT_SEED: break;
+        case ':': return usage_error("%s needs a value", a);
+        default: return usage_error("unknown option '%s'", a);
         }
-        if (strcmp(a, "--wires") == 0) {
-            o->wires = 1;
-            continue;
-        }
-        const char **slot = NULL;
-        if (strcmp(a, "--scenario") == 0) {
-            slot = &o->scenario;
-        } else if (strcmp(a, "--out") == 0) {
-            slot = &o->out;
-        } else if (strcmp(a, "--plan") == 0) {
-            slot = &o->plan;
-        } else if (strcmp(a, "--model-out") == 0) {
-            slot = &o->model_out;
-        } else if (strcmp(a, "--poses") != 0 && strcmp(a, "--seed") != 0) {
-            return usage_error("unknown option '%s'", a);
-        }
-        if (k + 1 >= argc) {
-            return usage_error("%s needs a value", a);
-        }
-        const char *v = argv[++k];
+        const char *v = optarg;
         if (slot != NULL) {
             if (*slot != NULL) {
-                return usage_error("%s given twice", a);
+                return usage_error("--%s given twice", longs[c - OPT_WIRES + 1].name);
             }
             if (v[0] == '\0') {
-                return usage_error("%s: empty value", a);
+                return usage_error("--%s: empty value", longs[c - OPT_WIRES + 1].name);
             }
             *slot = v;
-        } else if (strcmp(a, "--poses") == 0) {
+        } else if (c == OPT_POSES) {
             unsigned long long n = 0U;
             if (o->have_poses) {
                 return usage_error("--poses given twice");
@@ -147,6 +165,9 @@ static int parse_options(int argc, char **argv, options *o)
             }
             o->have_seed = 1;
         }
+    }
+    if (optind < argc - 1) {
+        return usage_error("unexpected argument '%s'", argv[optind + 1]);
     }
     if (o->scenario == NULL) {
         return usage_error("dataset needs --scenario");
@@ -534,31 +555,67 @@ static int run_bus(int argc, char **argv)
     go.steps = 16U;
     go.step_us = 2000U;
     int have_lines = 0;
-    for (int k = 2; k < argc; ++k) {
-        const char *a = argv[k];
-        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+    enum { BUS_SCENARIO = 256, BUS_CAN, BUS_ID_OFFSET, BUS_GPIO_CHIP, BUS_SEED, BUS_DROP,
+           BUS_STOP_AT, BUS_IDLE_EXIT, BUS_START_WAIT, BUS_LINES, BUS_STEPS, BUS_BURST,
+           BUS_PAUSE, BUS_START_DELAY, BUS_STEP_US };
+    static const struct option longs[] = {
+        {"help", no_argument, NULL, 'h'},
+        {"scenario", required_argument, NULL, BUS_SCENARIO},
+        {"can", required_argument, NULL, BUS_CAN},
+        {"can-id-offset", required_argument, NULL, BUS_ID_OFFSET},
+        {"gpio-chip", required_argument, NULL, BUS_GPIO_CHIP},
+        {"seed", required_argument, NULL, BUS_SEED},
+        {"drop-frame", required_argument, NULL, BUS_DROP},
+        {"stop-at", required_argument, NULL, BUS_STOP_AT},
+        {"idle-exit-ms", required_argument, NULL, BUS_IDLE_EXIT},
+        {"start-wait-ms", required_argument, NULL, BUS_START_WAIT},
+        {"lines", required_argument, NULL, BUS_LINES},
+        {"gpio-steps", required_argument, NULL, BUS_STEPS},
+        {"gpio-burst", required_argument, NULL, BUS_BURST},
+        {"gpio-pause-ms", required_argument, NULL, BUS_PAUSE},
+        {"gpio-start-delay-ms", required_argument, NULL, BUS_START_DELAY},
+        {"gpio-step-us", required_argument, NULL, BUS_STEP_US},
+        {NULL, 0, NULL, 0}};
+    opterr = 0;
+    optind = 1;
+    const char *given = NULL;
+    int opt;
+    while ((opt = next_option(argc, argv, longs, &given)) != -1) {
+        if (opt == 'h') {
             fputs(bus_help, stdout);
             return 0;
         }
-        if (k + 1 >= argc) {
-            return usage_error("%s needs a value", a);
+        if (opt == ':') {
+            return usage_error("%s needs a value", given);
         }
-        const char *v = argv[++k];
+        if (opt == '?') {
+            return usage_error("bus: unknown option '%s'", given);
+        }
+        /* "--name" for the messages, whichever way the option was written */
+        char a[40];
+        (void)snprintf(a, sizeof a, "--%s", longs[opt - BUS_SCENARIO + 1].name);
+        const char *v = optarg;
         unsigned long long n = 0U;
         int rc = 0;
-        if (strcmp(a, "--scenario") == 0) {
+        switch (opt) {
+        case BUS_SCENARIO: {
             scenario = v;
-        } else if (strcmp(a, "--can") == 0) {
+        } break;
+        case BUS_CAN: {
             bo.can = v;
-        } else if (strcmp(a, "--can-id-offset") == 0) {
+        } break;
+        case BUS_ID_OFFSET: {
             rc = bus_number(a, v, FW_CAN_OFFSET_MAX, &n);
             bo.id_offset = (uint32_t)n;
-        } else if (strcmp(a, "--gpio-chip") == 0) {
+        } break;
+        case BUS_GPIO_CHIP: {
             go.chip = v;
-        } else if (strcmp(a, "--seed") == 0) {
+        } break;
+        case BUS_SEED: {
             rc = bus_number(a, v, 18446744073709551615ULL, &n);
             bo.run_seed = n;
-        } else if (strcmp(a, "--drop-frame") == 0) {
+        } break;
+        case BUS_DROP: {
             char *end = NULL;
             errno = 0;
             const unsigned long id = strtoul(v, &end, 0);
@@ -569,17 +626,21 @@ static int run_bus(int argc, char **argv)
             bo.drop = 1;
             bo.drop_id = (uint32_t)id;
             bo.drop_tick = n;
-        } else if (strcmp(a, "--stop-at") == 0) {
+        } break;
+        case BUS_STOP_AT: {
             rc = bus_number(a, v, 18446744073709551615ULL, &n);
             bo.stop = 1;
             bo.stop_tick = n;
-        } else if (strcmp(a, "--idle-exit-ms") == 0) {
+        } break;
+        case BUS_IDLE_EXIT: {
             rc = bus_number(a, v, 3600000U, &n);
             bo.idle_exit_ms = (uint32_t)n;
-        } else if (strcmp(a, "--start-wait-ms") == 0) {
+        } break;
+        case BUS_START_WAIT: {
             rc = bus_number(a, v, 3600000U, &n);
             bo.start_wait_ms = (uint32_t)n;
-        } else if (strcmp(a, "--lines") == 0) {
+        } break;
+        case BUS_LINES: {
             unsigned long long la = 0U;
             unsigned long long lb = 0U;
             const char *comma = strchr(v, ',');
@@ -596,27 +657,36 @@ static int run_bus(int argc, char **argv)
             go.line[0] = (unsigned)la;
             go.line[1] = (unsigned)lb;
             have_lines = 1;
-        } else if (strcmp(a, "--gpio-steps") == 0) {
+        } break;
+        case BUS_STEPS: {
             rc = bus_number(a, v, 1000000U, &n);
             go.steps = (uint32_t)n;
-        } else if (strcmp(a, "--gpio-burst") == 0) {
+        } break;
+        case BUS_BURST: {
             rc = bus_number(a, v, 1000000U, &n);
             go.burst = (uint32_t)n;
-        } else if (strcmp(a, "--gpio-pause-ms") == 0) {
+        } break;
+        case BUS_PAUSE: {
             rc = bus_number(a, v, 3600000U, &n);
             go.pause_ms = (uint32_t)n;
-        } else if (strcmp(a, "--gpio-start-delay-ms") == 0) {
+        } break;
+        case BUS_START_DELAY: {
             rc = bus_number(a, v, 3600000U, &n);
             go.start_delay_ms = (uint32_t)n;
-        } else if (strcmp(a, "--gpio-step-us") == 0) {
+        } break;
+        case BUS_STEP_US: {
             rc = bus_number(a, v, 10000000U, &n);
             go.step_us = (uint32_t)n;
-        } else {
-            return usage_error("bus: unknown option '%s'", a);
+        } break;
+        default:
+            return usage_error("bus: unknown option '%s'", given);
         }
         if (rc != 0) {
             return rc;
         }
+    }
+    if (optind < argc - 1) {
+        return usage_error("bus: unexpected argument '%s'", argv[optind + 1]);
     }
     char why[320];
     if (go.chip != NULL || have_lines) {

@@ -197,6 +197,30 @@ class SimCli(unittest.TestCase):
             self.assertIn('--scenario', r.stdout)
             self.assertIn('--wires', r.stdout)
 
+    def test_usage_errors_name_the_option(self):
+        good = self.scenario()
+        base = ['dataset', '--scenario', good, '--out', self.out, '--poses', '5']
+        for args, words in ((base + ['stray'], "unexpected argument 'stray'"),
+                            (base + ['--seed'], '--seed needs a value'),
+                            (base + ['--out', self.out], '--out given twice'),
+                            (['bus', '--can', 'vcan0', 'stray'],
+                             "bus: unexpected argument 'stray'"),
+                            (['bus', '--cann', 'vcan0'], "bus: unknown option '--cann'")):
+            r = self.sim(*args)
+            self.assertEqual(r.returncode, 2, (args, r.stderr))
+            self.assertIn(words, r.stderr, args)
+        self.assertFalse(os.path.exists(self.out))
+
+    def test_option_value_after_an_equals_sign(self):
+        good = self.scenario()
+        spaced = self.sim('dataset', '--scenario', good, '--out', self.out, '--poses', '5')
+        self.assertEqual(spaced.returncode, 0, spaced.stderr)
+        first = read(self.out)
+        os.remove(self.out)
+        joined = self.sim('dataset', '--scenario=' + good, '--out=' + self.out, '--poses=5')
+        self.assertEqual(joined.returncode, 0, joined.stderr)
+        self.assertEqual(read(self.out), first)
+
     # ------------------------------------------------------------ good runs
     def read_csv(self, path):
         rows = []
