@@ -60,7 +60,8 @@ t0=$(cut -d' ' -f1 /proc/uptime)
 dhcal-sim bus --scenario "$SCENARIO" --can vcan0 >sim-a.json 2>sim-a.err &
 SIM=$!
 settle # (dhcal-fw repeats its first SYNC until the drives answer; this saves a timeout)
-dhcal-fw --config $CONF --nv nv-a.bin --params-out params-a.txt >fw-a.json 2>fw-a.err
+dhcal-fw --config $CONF --machine "$MACHINE" --nv nv-a.bin --params-out params-a.txt \
+    >fw-a.json 2>fw-a.err
 RC=$?
 wait $SIM
 t1=$(cut -d' ' -f1 /proc/uptime)
@@ -100,7 +101,8 @@ fault_case() { # name "dhcal-fw options" dhcal-sim-options...
     SIM=$!
     settle
     # shellcheck disable=SC2086 # word splitting intended: an option list
-    dhcal-fw --config $CONF --nv nv-$name.bin $fw_opts >fw-$name.json 2>fw-$name.err
+    dhcal-fw --config $CONF --machine "$MACHINE" --nv nv-$name.bin $fw_opts >fw-$name.json \
+        2>fw-$name.err
     RC=$?
     wait $SIM
     show "OUT fw-$name" fw-$name.json; show "OUT sim-$name" sim-$name.json
@@ -125,7 +127,7 @@ dhcal-sim bus --scenario "$SCENARIO" --can vcan0 --idle-exit-ms 3000 >sim-stop.j
     2>sim-stop.err &
 SIM=$!
 settle
-dhcal-fw --config $CONF --nv nv-stop.bin >fw-stop.json 2>fw-stop.err &
+dhcal-fw --config $CONF --machine "$MACHINE" --nv nv-stop.bin >fw-stop.json 2>fw-stop.err &
 FW=$!
 sleep 3
 kill -TERM $FW
@@ -179,7 +181,7 @@ fi
 # ---------------------------------------------------------------- configuration errors
 err_case() { # name expected-text dhcal-fw-options...
     name=$1; want=$2; shift 2
-    dhcal-fw --config $CONF "$@" >/dev/null 2>err-$name.txt
+    dhcal-fw --config $CONF --machine "$MACHINE" "$@" >/dev/null 2>err-$name.txt
     RC=$?
     if [ "$RC" = 2 ] && grep -q "$want" err-$name.txt; then
         result "$name" PASS "exit 2: $(head -n1 err-$name.txt)"

@@ -85,7 +85,6 @@ cat >"$R/etc/dhcal-fw.conf" <<EOF
 # dhcal-fw in the test VM (the same settings as the sim-port reference run)
 port = linux
 can = vcan0
-machine = /etc/machine.json
 samples = $SAMPLES
 # TCG emulates one CPU for both processes, on a host that may be busy with other tests:
 # give the drives a second to be scheduled (a lost frame still ends the run at once).
