@@ -540,6 +540,21 @@ static void test_model_syntax_error_reports_line_and_column(void)
     model_bad("// comment\n{}", ":1:1: ", "JSON syntax error");
 }
 
+/* JSON has no NaN or Infinity: the token is named with its JSON path and its line:column
+ * (cJSON stops at the token, so a plain syntax error could only give the position). */
+static void test_model_nan_and_infinity_name_their_path(void)
+{
+    model_bad("{\"joints\": [{\"alpha_deg\": 90, \"a_mm\": 0, \"d_mm\": 1},\n"
+              " {\"alpha_deg\": NaN, \"a_mm\": 0, \"d_mm\": 1}]}",
+              ": joints[1].alpha_deg: ", "NaN is not a number (JSON has no NaN or Infinity; line 2:16)");
+    model_bad("{\"tool_mm\": [0, -Infinity, 0], \"joints\": []}", ": tool_mm[1]: ",
+              "-Infinity is not a number");
+    /* a token the marker parse cannot place (the file is broken elsewhere too): position only */
+    model_bad("{\"joints\": [inf,", ":1:13: ", "inf is not a number");
+    /* a word that only starts like one is a plain syntax error */
+    model_bad("{\"joints\": [Info]}", ":1:13: ", "JSON syntax error near 'Info]}'");
+}
+
 static void test_model_syntax_error_column_is_exact(void)
 {
     /* The second comma of line 2 is column 19; cJSON 1.7 reports the start of the value
@@ -1099,6 +1114,7 @@ int main(void)
     RUN_TEST(test_model_missing_file);
     RUN_TEST(test_model_empty_file);
     RUN_TEST(test_model_syntax_error_reports_line_and_column);
+    RUN_TEST(test_model_nan_and_infinity_name_their_path);
     RUN_TEST(test_model_syntax_error_column_is_exact);
     RUN_TEST(test_model_nul_and_control_bytes);
     RUN_TEST(test_model_too_large);
