@@ -659,3 +659,50 @@ void dhcal_dataset_free(dhcal_dataset *data)
     free(data->rows);
     memset(data, 0, sizeof *data);
 }
+
+/* ------------------------------------------------------------------ writing */
+
+void dhcal_csv_write_header(dhcal_text *t, const dhcal_csv_columns *cols)
+{
+    for (size_t j = 0U; j < cols->n_joints; ++j) {
+        dhcal_text_printf(t, "%sq%zu", j > 0U ? "," : "", j + 1U);
+    }
+    for (size_t j = 0U; cols->has_dir && j < cols->n_joints; ++j) {
+        dhcal_text_printf(t, ",dir%zu", j + 1U);
+    }
+    dhcal_text_str(t, cols->has_xyz ? ",x,y,z" : "");
+    dhcal_text_str(t, cols->has_wires ? ",L1,L2,L3" : "");
+    dhcal_text_str(t, cols->has_quat ? ",qw,qx,qy,qz" : "");
+    dhcal_text_str(t, cols->has_temp ? ",temp_c" : "");
+    dhcal_text_str(t, cols->has_time ? ",t_s" : "");
+    dhcal_text_str(t, "\n");
+}
+
+void dhcal_csv_write_row(dhcal_text *t, const dhcal_csv_columns *cols, const dhcal_row *row)
+{
+    for (size_t j = 0U; j < cols->n_joints; ++j) {
+        /* 180 / pi, not 1 / DHC_DEG: the same double the writers produced before io had one */
+        dhcal_text_printf(t, "%s%.9f", j > 0U ? "," : "", row->q_rad[j] * 180.0 / DHC_PI);
+    }
+    for (size_t j = 0U; cols->has_dir && j < cols->n_joints; ++j) {
+        dhcal_text_printf(t, ",%d", row->dir[j]);
+    }
+    if (cols->has_xyz) {
+        dhcal_text_printf(t, ",%.6f,%.6f,%.6f", row->xyz_mm[0], row->xyz_mm[1], row->xyz_mm[2]);
+    }
+    if (cols->has_wires) {
+        dhcal_text_printf(t, ",%.6f,%.6f,%.6f", row->wires_mm[0], row->wires_mm[1],
+                          row->wires_mm[2]);
+    }
+    if (cols->has_quat) {
+        dhcal_text_printf(t, ",%.9f,%.9f,%.9f,%.9f", row->quat[0], row->quat[1], row->quat[2],
+                          row->quat[3]);
+    }
+    if (cols->has_temp) {
+        dhcal_text_printf(t, ",%.3f", row->temp_c);
+    }
+    if (cols->has_time) {
+        dhcal_text_printf(t, ",%.6f", row->t_s);
+    }
+    dhcal_text_str(t, "\n");
+}

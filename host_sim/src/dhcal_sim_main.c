@@ -160,44 +160,6 @@ static int parse_options(int argc, char **argv, options *o)
     return 0;
 }
 
-/* ------------------------------------------------------------------ output buffer */
-
-typedef struct {
-    char *data;
-    size_t len;
-    size_t cap;
-    int oom;
-} text_buf;
-
-static void put(text_buf *b, const char *fmt, ...)
-{
-    if (b->oom) {
-        return;
-    }
-    for (;;) {
-        va_list ap;
-        va_start(ap, fmt);
-        const int w = vsnprintf(b->data + b->len, b->cap - b->len, fmt, ap);
-        va_end(ap);
-        if (w < 0) {
-            b->oom = 1;
-            return;
-        }
-        if ((size_t)w < b->cap - b->len) {
-            b->len += (size_t)w;
-            return;
-        }
-        const size_t cap = 2U * b->cap + (size_t)w + 1U;
-        char *d = realloc(b->data, cap);
-        if (d == NULL) {
-            b->oom = 1;
-            return;
-        }
-        b->data = d;
-        b->cap = cap;
-    }
-}
-
 /* ------------------------------------------------------------------ plan file */
 
 typedef struct {
@@ -407,24 +369,24 @@ static int run_dataset(const options *o)
     }
     const size_t poses = o->plan != NULL ? pl.n : (size_t)o->poses;
 
-    text_buf b = {NULL, 0U, 0U, 0};
-    put(&b, "# dhcal-sim dataset: scenario '%s' (%s), run seed %llu, %zu poses\n", sc->name,
-        o->scenario, (unsigned long long)seed, poses);
-    put(&b, "# q: encoder angles (deg, the controller's nominal counts per degree); dir: "
-            "approach direction\n");
+    dhcal_text b = {NULL, 0U, 0U, 0};
+    dhcal_text_printf(&b, "# dhcal-sim dataset: scenario '%s' (%s), run seed %llu, %zu poses\n",
+                      sc->name, o->scenario, (unsigned long long)seed, poses);
+    dhcal_text_str(&b, "# q: encoder angles (deg, the controller's nominal counts per degree); "
+                       "dir: approach direction\n");
     if (o->wires) {
-        put(&b, "# L1,L2,L3: wire lengths from the measurer's counters (mm)\n");
+        dhcal_text_str(&b, "# L1,L2,L3: wire lengths from the measurer's counters (mm)\n");
     } else {
-        put(&b, "# x,y,z: tool point (mm, world), noise %.6g mm per coordinate\n",
-            sc->noise_xyz_mm);
+        dhcal_text_printf(&b, "# x,y,z: tool point (mm, world), noise %.6g mm per coordinate\n",
+                          sc->noise_xyz_mm);
     }
-    for (size_t j = 0U; j < n; ++j) {
-        put(&b, "%sq%zu", j > 0U ? "," : "", j + 1U);
-    }
-    for (size_t j = 0U; j < n; ++j) {
-        put(&b, ",dir%zu", j + 1U);
-    }
-    put(&b, o->wires ? ",L1,L2,L3\n" : ",x,y,z\n");
+    dhcal_csv_columns cols;
+    memset(&cols, 0, sizeof cols);
+    cols.n_joints = n;
+    cols.has_dir = 1;
+    cols.has_wires = o->wires;
+    cols.has_xyz = !o->wires;
+    dhcal_csv_write_header(&b, &cols);
 
     dhs_rng dir_rng;
     dhs_rng_seed(&dir_rng, seed, DHS_STREAM_POSES);
@@ -450,34 +412,35 @@ static int run_dataset(const options *o)
                         ? " (no target keeps clear of axis 1 and the anchor plane: check the "
                           "scenario's poses limits and the model's joint ranges)"
                         : "");
-            free(b.data);
+            free(b.p);
             free(pl.q_rad);
             free(pl.dir);
             return EXIT_COMPUTE;
         }
+        dhcal_row out;
+        memset(&out, 0, sizeof out);
         for (size_t j = 0U; j < n; ++j) {
-            put(&b, "%s%.9f", j > 0U ? "," : "", row.q_rad[j] * 180.0 / SIM_PI);
+            out.q_rad[j] = row.q_rad[j];
+            out.dir[j] = row.dir[j];
         }
-        for (size_t j = 0U; j < n; ++j) {
-            put(&b, ",%d", (int)row.dir[j]);
-        }
-        const double *v = o->wires ? row.wire_mm : row.xyz_mm;
-        put(&b, ",%.6f,%.6f,%.6f\n", v[0], v[1], v[2]);
+        dhc_vec3_copy(row.xyz_mm, out.xyz_mm);
+        dhc_vec3_copy(row.wire_mm, out.wires_mm);
+        dhcal_csv_write_row(&b, &cols, &out);
     }
     free(pl.q_rad);
     free(pl.dir);
-    if (b.oom) {
-        free(b.data);
+    if (b.failed) {
+        free(b.p);
         fprintf(stderr, "dhcal-sim: out of memory\n");
         return EXIT_COMPUTE;
     }
     if (o->model_out != NULL && dhcal_model_save(o->model_out, &sf.model, &err) != DHCAL_IO_OK) {
-        free(b.data);
+        free(b.p);
         fprintf(stderr, "dhcal-sim: %s\n", err.msg);
         return EXIT_COMPUTE;
     }
-    rc = dhcal_file_write_atomic(o->out, b.data, b.len, &err);
-    free(b.data);
+    rc = dhcal_file_write_atomic(o->out, b.p, b.len, &err);
+    free(b.p);
     if (rc != DHCAL_IO_OK) {
         fprintf(stderr, "dhcal-sim: %s\n", err.msg);
         return EXIT_COMPUTE;
