@@ -56,6 +56,11 @@ typedef struct {
  * Cost: O(file size) time; memory one line buffer (<= 64 KiB) plus the rows.
  * On error *data is empty (rows NULL), so dhcal_dataset_free is always safe. */
 int dhcal_csv_load(const char *path, size_t n_joints, dhcal_dataset *data, dhcal_error *err);
+/* Loads a pose plan (targets for a simulator): a measurement CSV without measurement columns.
+ * The header has q1..qN and optionally any of dir1..dirN, each on its own; a row's dir[j] is
+ * 0 where dirj is absent (the caller chooses), has_dir when any is present. Everything else
+ * (comments, numbers, ranges, messages, at least one row) as dhcal_csv_load. */
+int dhcal_csv_load_plan(const char *path, size_t n_joints, dhcal_dataset *plan, dhcal_error *err);
 /* Frees the rows and empties *data; NULL and already-empty datasets are fine. */
 void dhcal_dataset_free(dhcal_dataset *data);
 

@@ -283,7 +283,7 @@ class SimCli(unittest.TestCase):
         bad = self.write('bad.csv', 'q1,q2\n1,2\n')
         r = self.sim('dataset', '--scenario', good, '--plan', bad, '--out', self.out)
         self.assertEqual(r.returncode, 2)
-        self.assertIn('missing column q3', r.stderr)
+        self.assertIn("bad.csv:1: missing column 'q3'", r.stderr)
 
     def test_model_out_loads_in_dhcal(self):
         good = self.scenario()

@@ -473,6 +473,47 @@ static void test_dataset_free_is_idempotent(void)
     dhcal_dataset_free(&g_data);
 }
 
+/* ------------------------------------------------------------------ pose plans */
+
+static void plan_bad(const char *text, size_t line, const char *needle)
+{
+    const char *const p = write_text("plan.csv", text);
+    char where[600];
+    (void)snprintf(where, sizeof where, "%s:%zu: ", p, line);
+    TEST_ASSERT_EQUAL_INT(DHCAL_IO_BAD_INPUT, dhcal_csv_load_plan(p, 3U, &g_data, &g_err));
+    assert_msg_has(where);
+    assert_msg_has(needle);
+    TEST_ASSERT_NULL(g_data.rows);
+}
+
+/* A plan is a measurement CSV without measurements; each dir column stands on its own and a
+ * joint without one reads dir 0 (the simulator draws it). */
+static void test_plan_has_no_measurements_and_dirs_of_its_own(void)
+{
+    const char *const p = write_text("plan.csv", "# targets\nq1, q2, q3, dir2\n10, 45, -30, -1\n"
+                                                 "\n-120.5, 100, 60, +1\n");
+    TEST_ASSERT_EQUAL_INT_MESSAGE(DHCAL_IO_OK, dhcal_csv_load_plan(p, 3U, &g_data, &g_err),
+                                  g_err.msg);
+    TEST_ASSERT_EQUAL_size_t(2U, g_data.n_rows);
+    TEST_ASSERT_TRUE(g_data.has_dir);
+    TEST_ASSERT_FALSE(g_data.has_xyz || g_data.has_wires);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-15, 45.0 * DEG, g_data.rows[0].q_rad[1]);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-15, -120.5 * DEG, g_data.rows[1].q_rad[0]);
+    TEST_ASSERT_EQUAL_INT(0, g_data.rows[0].dir[0]);
+    TEST_ASSERT_EQUAL_INT(-1, g_data.rows[0].dir[1]);
+    TEST_ASSERT_EQUAL_INT(1, g_data.rows[1].dir[1]);
+    TEST_ASSERT_EQUAL_INT(0, g_data.rows[1].dir[2]);
+    TEST_ASSERT_EQUAL_size_t(5U, g_data.rows[1].line);
+    dhcal_dataset_free(&g_data);
+
+    plan_bad("q1,q2\n1,2\n", 1U, "missing column 'q3'");
+    plan_bad("q1,q2,q3,x,y,z\n1,2,3,4,5,6\n", 1U, "unknown column 'x' (a pose plan has q1..q3");
+    plan_bad("q1,q2,q3,dir4\n1,2,3,1\n", 1U, "column 'dir4' is beyond the model's 3 joints");
+    plan_bad("q1,q2,q3,dir1\n1,2,3,0\n", 2U, "column 'dir1': 0 is not -1 or +1");
+    plan_bad("q1,q2,q3\n1,2,800\n", 2U, "column 'q3': 800 is outside [-720, 720] deg");
+    plan_bad("q1,q2,q3\n", 1U, "header but no data rows");
+}
+
 /* ------------------------------------------------------------------ model helpers */
 
 static const char *const J3 =
@@ -1109,6 +1150,7 @@ int main(void)
     RUN_TEST(test_csv_row_limits_and_dirs_exact);
     RUN_TEST(test_csv_many_rows_grow);
     RUN_TEST(test_csv_joint_count_outside_limits_is_a_caller_error);
+    RUN_TEST(test_plan_has_no_measurements_and_dirs_of_its_own);
     RUN_TEST(test_dataset_free_is_idempotent);
     /* model */
     RUN_TEST(test_model_missing_file);
