@@ -228,7 +228,7 @@ static int write_outputs(const char *dir, size_t n, const char *effect)
         memset(&row, 0, sizeof row);
         for (size_t j = 0U; j < nj; ++j) {
             row.q_rad[j] = s->q_rad[j];
-            row.dir[j] = s->dir[j];
+            row.dir[j] = (int)s->dir[j];
         }
         dhc_vec3_copy(s->wire_mm, row.wires_mm);
         dhcal_csv_write_row(&t, &cols, &row);

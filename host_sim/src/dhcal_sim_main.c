@@ -244,7 +244,7 @@ static int run_dataset(const options *o)
         memset(&out, 0, sizeof out);
         for (size_t j = 0U; j < n; ++j) {
             out.q_rad[j] = row.q_rad[j];
-            out.dir[j] = row.dir[j];
+            out.dir[j] = (int)row.dir[j];
         }
         dhc_vec3_copy(row.xyz_mm, out.xyz_mm);
         dhc_vec3_copy(row.wire_mm, out.wires_mm);
