@@ -179,7 +179,8 @@ static int check_vector(const dhcal_jctx *c, const cJSON *item, const char *path
                         const bounds *b, double *out)
 {
     if (!cJSON_IsArray(item)) {
-        return dhcal_jfail(c, path, "expected an array of %zu numbers, got %s", n, dhcal_jtype(item));
+        return dhcal_jfail(c, path, "expected an array of %zu numbers, got %s", n,
+                           dhcal_jtype(item));
     }
     const size_t have = dhcal_jcount(item);
     if (have != n) {
@@ -321,6 +322,19 @@ int dhcal_jopt_whole(const dhcal_jctx *c, const cJSON *obj, const char *parent, 
     return dhcal_jwhole(c, item, kp, lo, hi, out);
 }
 
+int dhcal_jfile_beside(const dhcal_jctx *c, const char *jpath, const char *rel, char *out,
+                       size_t cap)
+{
+    const char *const slash = strrchr(c->file, '/');
+    const int w = rel[0] == '/' || slash == NULL
+                      ? snprintf(out, cap, "%s", rel)
+                      : snprintf(out, cap, "%.*s/%s", (int)(slash - c->file), c->file, rel);
+    if (w < 0 || (size_t)w >= cap) {
+        return dhcal_jfail(c, jpath, "path too long");
+    }
+    return DHCAL_IO_OK;
+}
+
 static const char *const FRAME_KEYS[] = {"xyz_mm", "rpy_deg"};
 
 int dhcal_jframe(const dhcal_jctx *c, const cJSON *obj, const char *parent, const char *key,
@@ -360,7 +374,8 @@ static int read_whole(const char *path, size_t max_bytes, const char *what, char
     *len = 0U;
     FILE *const f = fopen(path, "rb");
     if (f == NULL) {
-        return dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s: cannot open: %s", path, strerror(errno));
+        return dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s: cannot open: %s", path,
+                               strerror(errno));
     }
     size_t cap = 4096U;
     size_t n = 0U;

@@ -90,6 +90,11 @@ int dhcal_jopt_whole(const dhcal_jctx *c, const cJSON *obj, const char *parent, 
 int dhcal_jframe(const dhcal_jctx *c, const cJSON *obj, const char *parent, const char *key,
                  double len_max_mm, double angle_max_deg, dhc_frame *out, int *present);
 
+/* out := rel, a path given in the file at jpath, taken relative to the file's directory
+ * unless absolute. "path too long" when it does not fit in cap bytes. */
+int dhcal_jfile_beside(const dhcal_jctx *c, const char *jpath, const char *rel, char *out,
+                       size_t cap);
+
 /* A model object (the model file's schema) read from obj, which sits at jpath in file ("":
  * the file is the model). As dhcal_model_load otherwise. */
 int dhcal_model_from_json(const char *file, const char *jpath, const cJSON *obj,

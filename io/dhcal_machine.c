@@ -57,20 +57,6 @@ static int whole_number(const dhcal_jctx *c, const cJSON *item, const char *path
     return rc;
 }
 
-/* machine_dir/rel, or rel when absolute or the machine file has no directory. */
-static int resolve(const dhcal_jctx *c, const char *key, const char *rel, char out[DHCAL_MACHINE_PATH_CAP])
-{
-    const char *const slash = strrchr(c->file, '/');
-    const int w = rel[0] == '/' || slash == NULL
-                      ? snprintf(out, DHCAL_MACHINE_PATH_CAP, "%s", rel)
-                      : snprintf(out, DHCAL_MACHINE_PATH_CAP, "%.*s/%s", (int)(slash - c->file),
-                                 c->file, rel);
-    if (w < 0 || (size_t)w >= DHCAL_MACHINE_PATH_CAP) {
-        return dhcal_jfail(c, key, "path too long");
-    }
-    return DHCAL_IO_OK;
-}
-
 static int load_model(dhcal_jctx *c, const cJSON *root, dhcal_machine *m)
 {
     const cJSON *const item = cJSON_GetObjectItemCaseSensitive(root, "model");
@@ -84,7 +70,8 @@ static int load_model(dhcal_jctx *c, const cJSON *root, dhcal_machine *m)
         if (item->valuestring[0] == '\0') {
             return dhcal_jfail(c, "model", "empty path");
         }
-        if ((rc = resolve(c, "model", item->valuestring, m->model_path)) != DHCAL_IO_OK) {
+        if ((rc = dhcal_jfile_beside(c, "model", item->valuestring, m->model_path,
+                                      sizeof m->model_path)) != DHCAL_IO_OK) {
             return rc;
         }
         dhcal_error merr;
@@ -244,7 +231,7 @@ static int load_bus_and_store(const dhcal_jctx *c, const cJSON *root, dhcal_mach
         rc = opt_string(c, root, "", "store", store, sizeof store);
     }
     if (rc == DHCAL_IO_OK && store[0] != '\0') {
-        rc = resolve(c, "store", store, m->store_path);
+        rc = dhcal_jfile_beside(c, "store", store, m->store_path, sizeof m->store_path);
     }
     return rc;
 }

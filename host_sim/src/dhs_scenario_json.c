@@ -76,10 +76,12 @@ static int parse_joint(const dhcal_jctx *c, const cJSON *obj, const char *path, 
     if (o != NULL &&
         ((rc = get_num(c, o, p, "r_ohm", 0, DHCAL_JPOS, &j->r_ohm)) != DHCAL_IO_OK ||
          (rc = get_num(c, o, p, "l_h", 0, DHCAL_JPOS, &j->l_h)) != DHCAL_IO_OK ||
-         (rc = get_num(c, o, p, "ke_v_s_per_rad", 0, DHCAL_JPOS, &j->ke_v_s_per_rad)) != DHCAL_IO_OK ||
+         (rc = get_num(c, o, p, "ke_v_s_per_rad", 0, DHCAL_JPOS,
+                       &j->ke_v_s_per_rad)) != DHCAL_IO_OK ||
          (rc = get_num(c, o, p, "kt_nm_per_a", 0, DHCAL_JPOS, &j->kt_nm_per_a)) != DHCAL_IO_OK ||
          (rc = get_num(c, o, p, "jm_kgm2", 0, DHCAL_JPOS, &j->jm_kgm2)) != DHCAL_IO_OK ||
-         (rc = get_num(c, o, p, "bm_nms_per_rad", 0, DHCAL_JNONNEG, &j->bm_nms_per_rad)) != DHCAL_IO_OK ||
+         (rc = get_num(c, o, p, "bm_nms_per_rad", 0, DHCAL_JNONNEG,
+                       &j->bm_nms_per_rad)) != DHCAL_IO_OK ||
          (rc = get_num(c, o, p, "coulomb_nm", 0, DHCAL_JNONNEG, &j->coulomb_nm)) != DHCAL_IO_OK ||
          (rc = get_num(c, o, p, "brake_nm", 0, DHCAL_JNONNEG, &j->brake_nm)) != DHCAL_IO_OK)) {
         return rc;
@@ -90,9 +92,11 @@ static int parse_joint(const dhcal_jctx *c, const cJSON *obj, const char *path, 
         return rc;
     }
     if (o != NULL &&
-        ((rc = get_num(c, o, p, "gain_v_per_v", 0, DHCAL_JPOS, &j->amp_gain_v_per_v)) != DHCAL_IO_OK ||
+        ((rc = get_num(c, o, p, "gain_v_per_v", 0, DHCAL_JPOS,
+                       &j->amp_gain_v_per_v)) != DHCAL_IO_OK ||
          (rc = get_num(c, o, p, "supply_v", 0, DHCAL_JPOS, &j->supply_v)) != DHCAL_IO_OK ||
-         (rc = get_num(c, o, p, "current_limit_a", 0, DHCAL_JPOS, &j->current_limit_a)) != DHCAL_IO_OK)) {
+         (rc = get_num(c, o, p, "current_limit_a", 0, DHCAL_JPOS,
+                       &j->current_limit_a)) != DHCAL_IO_OK)) {
         return rc;
     }
 
@@ -103,7 +107,8 @@ static int parse_joint(const dhcal_jctx *c, const cJSON *obj, const char *path, 
     if (o != NULL) {
         double backlash_deg = j->backlash_rad / DHC_DEG;
         if ((rc = get_num(c, o, p, "ratio", 0, DHCAL_JPOS, &j->gear_ratio)) != DHCAL_IO_OK ||
-            (rc = get_num(c, o, p, "backlash_deg", 0, DHCAL_JNONNEG, &backlash_deg)) != DHCAL_IO_OK) {
+            (rc = get_num(c, o, p, "backlash_deg", 0, DHCAL_JNONNEG,
+                          &backlash_deg)) != DHCAL_IO_OK) {
             return rc;
         }
         if (backlash_deg >= 10.0) {
@@ -131,7 +136,8 @@ static int parse_joint(const dhcal_jctx *c, const cJSON *obj, const char *path, 
             char pt[DHCAL_JPATH_CAP];
             dhcal_jpath_key(pt, p, "transmission_error");
             if (!cJSON_IsArray(te)) {
-                return dhcal_jfail(c, pt, "expected an array of harmonics, got %s", dhcal_jtype(te));
+                return dhcal_jfail(c, pt, "expected an array of harmonics, got %s",
+                                   dhcal_jtype(te));
             }
             if ((size_t)cJSON_GetArraySize(te) > DHS_MAX_HARMONICS) {
                 return dhcal_jfail(c, pt, "at most %u harmonics", DHS_MAX_HARMONICS);
@@ -148,7 +154,8 @@ static int parse_joint(const dhcal_jctx *c, const cJSON *obj, const char *path, 
                 double s_mrad = 0.0;
                 double c_mrad = 0.0;
                 if ((rc = dhcal_jrequire(c, h, ph, "order")) != DHCAL_IO_OK ||
-                    (rc = dhcal_jopt_whole(c, h, ph, "order", 1.0, 1000.0, &order)) != DHCAL_IO_OK ||
+                    (rc = dhcal_jopt_whole(c, h, ph, "order", 1.0, 1000.0,
+                                           &order)) != DHCAL_IO_OK ||
                     (rc = get_num(c, h, ph, "sin_mrad", 0, DHCAL_JANY, &s_mrad)) != DHCAL_IO_OK ||
                     (rc = get_num(c, h, ph, "cos_mrad", 0, DHCAL_JANY, &c_mrad)) != DHCAL_IO_OK) {
                     return rc;
@@ -175,8 +182,10 @@ static int parse_joint(const dhcal_jctx *c, const cJSON *obj, const char *path, 
         if ((!is_default &&
              ((rc = get_num(c, o, p, "mass_kg", 1, DHCAL_JNONNEG, &j->mass_kg)) != DHCAL_IO_OK ||
               (rc = get_vec3(c, o, p, "com_mm", 1, DHCAL_JANY, com_mm)) != DHCAL_IO_OK)) ||
-            (rc = get_vec3(c, o, p, "inertia_kgm2", 0, DHCAL_JNONNEG, j->inertia_kgm2)) != DHCAL_IO_OK ||
-            (rc = get_num(c, o, p, "coulomb_nm", 0, DHCAL_JNONNEG, &j->link_coulomb_nm)) != DHCAL_IO_OK ||
+            (rc = get_vec3(c, o, p, "inertia_kgm2", 0, DHCAL_JNONNEG,
+                           j->inertia_kgm2)) != DHCAL_IO_OK ||
+            (rc = get_num(c, o, p, "coulomb_nm", 0, DHCAL_JNONNEG,
+                          &j->link_coulomb_nm)) != DHCAL_IO_OK ||
             (rc = get_num(c, o, p, "viscous_nms_per_rad", 0, DHCAL_JNONNEG,
                           &j->link_viscous_nms_per_rad)) != DHCAL_IO_OK) {
             return rc;
@@ -201,15 +210,18 @@ static int parse_joint(const dhcal_jctx *c, const cJSON *obj, const char *path, 
         return rc;
     }
     if (o != NULL) {
-        if ((rc = get_num(c, o, p, "v_s_per_rad", 0, DHCAL_JPOS, &j->tacho_v_s_per_rad)) != DHCAL_IO_OK ||
+        if ((rc = get_num(c, o, p, "v_s_per_rad", 0, DHCAL_JPOS,
+                          &j->tacho_v_s_per_rad)) != DHCAL_IO_OK ||
             (rc = get_num(c, o, p, "ripple", 0, DHCAL_JNONNEG, &j->tacho_ripple)) != DHCAL_IO_OK ||
-            (rc = get_num(c, o, p, "noise_v", 0, DHCAL_JNONNEG, &j->tacho_noise_v)) != DHCAL_IO_OK) {
+            (rc = get_num(c, o, p, "noise_v", 0, DHCAL_JNONNEG,
+                          &j->tacho_noise_v)) != DHCAL_IO_OK) {
             return rc;
         }
         if (j->tacho_ripple >= 1.0) {
             char q[DHCAL_JPATH_CAP];
             dhcal_jpath_key(q, p, "ripple");
-            return dhcal_jfail(c, q, "must be below 1 (relative amplitude), got %.17g", j->tacho_ripple);
+            return dhcal_jfail(c, q, "must be below 1 (relative amplitude), got %.17g",
+                               j->tacho_ripple);
         }
         if (cJSON_GetObjectItemCaseSensitive(o, "ripple_cycles") != NULL) {
             if ((rc = dhcal_jopt_whole(c, o, p, "ripple_cycles", 0.0, 1000.0, &u)) != DHCAL_IO_OK) {
@@ -257,7 +269,8 @@ static int parse_truth(const dhcal_jctx *c, const cJSON *root, dhs_scenario *sc)
     const cJSON *js = cJSON_GetObjectItemCaseSensitive(t, "joints");
     if (js != NULL) {
         if (!cJSON_IsArray(js) || (size_t)cJSON_GetArraySize(js) != sc->n_joints) {
-            return dhcal_jfail(c, "truth.joints", "expected an array of %zu objects (one per joint)",
+            return dhcal_jfail(c, "truth.joints",
+                               "expected an array of %zu objects (one per joint)",
                         sc->n_joints);
         }
         size_t i = 0U;
@@ -283,7 +296,8 @@ static int parse_truth(const dhcal_jctx *c, const cJSON *root, dhs_scenario *sc)
     }
     dhc_frame base_err;
     int has = 0;
-    if ((rc = dhcal_jframe(c, t, "truth", "base", HUGE_VAL, HUGE_VAL, &base_err, &has)) != DHCAL_IO_OK) {
+    if ((rc = dhcal_jframe(c, t, "truth", "base", HUGE_VAL, HUGE_VAL, &base_err,
+                           &has)) != DHCAL_IO_OK) {
         return rc;
     }
     if (has) {
@@ -296,7 +310,8 @@ static int parse_truth(const dhcal_jctx *c, const cJSON *root, dhs_scenario *sc)
     }
     dhc_vec3_add(sc->truth.tool_mm, tool, sc->truth.tool_mm);
     const cJSON *sd = NULL;
-    if ((rc = dhcal_jobject(c, t, "truth", "random_sd", 0, DHCAL_JKEYS(jkeys), &sd)) != DHCAL_IO_OK) {
+    if ((rc = dhcal_jobject(c, t, "truth", "random_sd", 0, DHCAL_JKEYS(jkeys),
+                            &sd)) != DHCAL_IO_OK) {
         return rc;
     }
     if (sd != NULL) {
@@ -307,7 +322,8 @@ static int parse_truth(const dhcal_jctx *c, const cJSON *root, dhs_scenario *sc)
                 return rc;
             }
         }
-        dhs_scenario_add_random_errors(sc, s[0] * DHC_DEG, s[1], s[2], s[3] * DHC_DEG, s[4] * DHC_DEG);
+        dhs_scenario_add_random_errors(sc, s[0] * DHC_DEG, s[1], s[2], s[3] * DHC_DEG,
+                                       s[4] * DHC_DEG);
     }
     return DHCAL_IO_OK;
 }
@@ -336,7 +352,8 @@ static int parse_measurer(const dhcal_jctx *c, const cJSON *root, const dhcal_mo
     const cJSON *ae = cJSON_GetObjectItemCaseSensitive(m, "anchor_errors_mm");
     if (ae != NULL) {
         if (!cJSON_IsArray(ae) || cJSON_GetArraySize(ae) != 3) {
-            return dhcal_jfail(c, "measurer.anchor_errors_mm", "expected 3 points [x, y, z], got %s",
+            return dhcal_jfail(c, "measurer.anchor_errors_mm",
+                               "expected 3 points [x, y, z], got %s",
                         dhcal_jtype(ae));
         }
         size_t k = 0U;
@@ -352,7 +369,8 @@ static int parse_measurer(const dhcal_jctx *c, const cJSON *root, const dhcal_mo
     }
     dhc_frame fe;
     int has = 0;
-    if ((rc = dhcal_jframe(c, m, "measurer", "frame_error", HUGE_VAL, HUGE_VAL, &fe, &has)) != DHCAL_IO_OK) {
+    if ((rc = dhcal_jframe(c, m, "measurer", "frame_error", HUGE_VAL, HUGE_VAL, &fe,
+                           &has)) != DHCAL_IO_OK) {
         return rc;
     }
     if (has) {
@@ -364,18 +382,22 @@ static int parse_measurer(const dhcal_jctx *c, const cJSON *root, const dhcal_mo
     double zero_err[3] = {0.0, 0.0, 0.0};
     if ((rc = get_num(c, m, "measurer", "wheel_radius_mm", 0, DHCAL_JPOS, &mp->wheel_radius_mm)) !=
             DHCAL_IO_OK ||
-        (rc = get_num(c, m, "measurer", "wheel_radius_error", 0, DHCAL_JANY, &rel)) != DHCAL_IO_OK ||
-        (rc = get_vec3(c, m, "measurer", "zero_length_mm", 0, DHCAL_JNONNEG, mp->zero_length_true_mm)) !=
+        (rc = get_num(c, m, "measurer", "wheel_radius_error", 0, DHCAL_JANY,
+                      &rel)) != DHCAL_IO_OK ||
+        (rc = get_vec3(c, m, "measurer", "zero_length_mm", 0, DHCAL_JNONNEG,
+                       mp->zero_length_true_mm)) !=
             DHCAL_IO_OK ||
         (rc = get_vec3(c, m, "measurer", "zero_length_error_mm", 0, DHCAL_JANY, zero_err)) !=
             DHCAL_IO_OK ||
         (rc = get_num(c, m, "measurer", "slip_sd_mm_per_sqrt_mm", 0, DHCAL_JNONNEG,
                       &mp->slip_sd_mm_per_sqrt_mm)) != DHCAL_IO_OK ||
-        (rc = get_num(c, m, "measurer", "noise_mm", 0, DHCAL_JNONNEG, &mp->noise_mm)) != DHCAL_IO_OK) {
+        (rc = get_num(c, m, "measurer", "noise_mm", 0, DHCAL_JNONNEG,
+                      &mp->noise_mm)) != DHCAL_IO_OK) {
         return rc;
     }
     if (!(fabs(rel) < 0.5)) {
-        return dhcal_jfail(c, "measurer.wheel_radius_error", "must be within (-0.5, 0.5), got %.17g",
+        return dhcal_jfail(c, "measurer.wheel_radius_error",
+                           "must be within (-0.5, 0.5), got %.17g",
                     rel);
     }
     mp->wheel_radius_true_mm = mp->wheel_radius_mm * (1.0 + rel);
@@ -389,7 +411,8 @@ static int parse_measurer(const dhcal_jctx *c, const cJSON *root, const dhcal_mo
         mp->lines = (uint32_t)u;
     }
     if (cJSON_GetObjectItemCaseSensitive(m, "counter_bits") != NULL) {
-        if ((rc = dhcal_jopt_whole(c, m, "measurer", "counter_bits", 1.0, 32.0, &u)) != DHCAL_IO_OK) {
+        if ((rc = dhcal_jopt_whole(c, m, "measurer", "counter_bits", 1.0, 32.0,
+                                   &u)) != DHCAL_IO_OK) {
             return rc;
         }
         mp->counter_bits = (unsigned)u;
@@ -431,9 +454,11 @@ static int parse_small_sections(const dhcal_jctx *c, const cJSON *root, dhs_scen
     dhc_vec3_scale(sc->truth.tool_mm, 1e-3, sc->payload_com_m); /* default: the tool point */
     if (o != NULL) {
         double com_mm[3] = {sc->truth.tool_mm[0], sc->truth.tool_mm[1], sc->truth.tool_mm[2]};
-        if ((rc = get_num(c, o, "payload", "mass_kg", 0, DHCAL_JNONNEG, &sc->payload_kg)) != DHCAL_IO_OK ||
+        if ((rc = get_num(c, o, "payload", "mass_kg", 0, DHCAL_JNONNEG,
+                          &sc->payload_kg)) != DHCAL_IO_OK ||
             (rc = get_vec3(c, o, "payload", "com_mm", 0, DHCAL_JANY, com_mm)) != DHCAL_IO_OK ||
-            (rc = get_vec3(c, o, "payload", "inertia_kgm2", 0, DHCAL_JNONNEG, sc->payload_inertia_kgm2)) !=
+            (rc = get_vec3(c, o, "payload", "inertia_kgm2", 0, DHCAL_JNONNEG,
+                           sc->payload_inertia_kgm2)) !=
                 DHCAL_IO_OK) {
             return rc;
         }
@@ -443,15 +468,18 @@ static int parse_small_sections(const dhcal_jctx *c, const cJSON *root, dhs_scen
         return rc;
     }
     if (o != NULL &&
-        ((rc = get_num(c, o, "drive", "dac_range_v", 0, DHCAL_JPOS, &sc->dac_range_v)) != DHCAL_IO_OK ||
-         (rc = get_num(c, o, "drive", "adc_range_v", 0, DHCAL_JPOS, &sc->adc_range_v)) != DHCAL_IO_OK)) {
+        ((rc = get_num(c, o, "drive", "dac_range_v", 0, DHCAL_JPOS,
+                       &sc->dac_range_v)) != DHCAL_IO_OK ||
+         (rc = get_num(c, o, "drive", "adc_range_v", 0, DHCAL_JPOS,
+                       &sc->adc_range_v)) != DHCAL_IO_OK)) {
         return rc;
     }
     if ((rc = dhcal_jobject(c, root, "", "noise", 0, DHCAL_JKEYS(noise), &o)) != DHCAL_IO_OK) {
         return rc;
     }
     if (o != NULL &&
-        (rc = get_num(c, o, "noise", "xyz_mm", 0, DHCAL_JNONNEG, &sc->noise_xyz_mm)) != DHCAL_IO_OK) {
+        (rc = get_num(c, o, "noise", "xyz_mm", 0, DHCAL_JNONNEG,
+                      &sc->noise_xyz_mm)) != DHCAL_IO_OK) {
         return rc;
     }
     if ((rc = dhcal_jobject(c, root, "", "poses", 0, DHCAL_JKEYS(poses), &o)) != DHCAL_IO_OK) {
@@ -467,24 +495,7 @@ static int parse_small_sections(const dhcal_jctx *c, const cJSON *root, dhs_scen
     return DHCAL_IO_OK;
 }
 
-/* The model path: relative to the directory of the scenario file. */
-static int resolve_model(const dhcal_jctx *c, const char *scenario_path, const char *model,
-                         char out[4096])
-{
-    const char *slash = strrchr(scenario_path, '/');
-    int w;
-    if (model[0] == '/' || slash == NULL) {
-        w = snprintf(out, 4096U, "%s", model);
-    } else {
-        w = snprintf(out, 4096U, "%.*s/%s", (int)(slash - scenario_path), scenario_path, model);
-    }
-    if (w < 0 || (size_t)w >= 4096U) {
-        return dhcal_jfail(c, "model", "path too long");
-    }
-    return DHCAL_IO_OK;
-}
-
-static int parse_root(const dhcal_jctx *c, const char *path, const cJSON *root, dhs_scenario_file *out)
+static int parse_root(const dhcal_jctx *c, const cJSON *root, dhs_scenario_file *out)
 {
     static const char *const keys[] = {"name", "comment", "seed", "model", "truth", "physics",
                                        "joint_defaults", "joints", "payload", "drive",
@@ -496,7 +507,8 @@ static int parse_root(const dhcal_jctx *c, const char *path, const cJSON *root, 
     /* seed, model first: everything else is sized by the model */
     uint64_t seed = 0U;
     if ((rc = dhcal_jrequire(c, root, "", "seed")) != DHCAL_IO_OK ||
-        (rc = dhcal_jopt_whole(c, root, "", "seed", 0.0, 9007199254740992.0, &seed)) != DHCAL_IO_OK) {
+        (rc = dhcal_jopt_whole(c, root, "", "seed", 0.0, 9007199254740992.0,
+                               &seed)) != DHCAL_IO_OK) {
         return rc;
     }
     const cJSON *m = cJSON_GetObjectItemCaseSensitive(root, "model");
@@ -506,7 +518,8 @@ static int parse_root(const dhcal_jctx *c, const char *path, const cJSON *root, 
     if (!cJSON_IsString(m) || m->valuestring[0] == '\0') {
         return dhcal_jfail(c, "model", "expected the path of a model file, got %s", dhcal_jtype(m));
     }
-    if ((rc = resolve_model(c, path, m->valuestring, out->model_path)) != DHCAL_IO_OK) {
+    if ((rc = dhcal_jfile_beside(c, "model", m->valuestring, out->model_path,
+                                  sizeof out->model_path)) != DHCAL_IO_OK) {
         return rc;
     }
     dhcal_error merr;
@@ -608,7 +621,7 @@ int dhs_scenario_load(const char *path, dhs_scenario_file *out, dhcal_error *err
     if (rc != DHCAL_IO_OK) {
         return rc;
     }
-    rc = parse_root(&c, path, root, out);
+    rc = parse_root(&c, root, out);
     cJSON_Delete(root);
     if (rc != DHCAL_IO_OK) {
         memset(out, 0, sizeof *out);
