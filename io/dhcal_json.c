@@ -249,6 +249,29 @@ int dhcal_jvector(const dhcal_jctx *c, const cJSON *item, const char *path, size
     return check_vector(c, item, path, n, &b, out);
 }
 
+int dhcal_jpoints(const dhcal_jctx *c, const cJSON *item, const char *path, size_t n, double lo,
+                  double hi, const char *unit, double (*out)[3])
+{
+    if (!cJSON_IsArray(item)) {
+        return dhcal_jfail(c, path, "expected an array of %zu points, got %s", n,
+                           dhcal_jtype(item));
+    }
+    const size_t have = dhcal_jcount(item);
+    if (have != n) {
+        return dhcal_jfail(c, path, "expected %zu points, got %zu", n, have);
+    }
+    char ip[DHCAL_JPATH_CAP];
+    size_t i = 0U;
+    for (const cJSON *e = item->child; e != NULL; e = e->next, ++i) {
+        dhcal_jpath_index(ip, path, i);
+        const int rc = dhcal_jvector(c, e, ip, 3U, lo, hi, unit, out[i]);
+        if (rc != DHCAL_IO_OK) {
+            return rc;
+        }
+    }
+    return DHCAL_IO_OK;
+}
+
 /* Optional member: absent leaves *out untouched. */
 int dhcal_jopt_number(const dhcal_jctx *c, const cJSON *obj, const char *parent, const char *key,
                        double lo, double hi, const char *unit, double *out)

@@ -71,6 +71,9 @@ int dhcal_jnumber_rule(const dhcal_jctx *c, const cJSON *item, const char *path,
 /* A whole number within [lo, hi] (at most 2^53). */
 int dhcal_jwhole(const dhcal_jctx *c, const cJSON *item, const char *path, double lo, double hi,
                  uint64_t *out);
+/* An array of exactly n points, each an array of 3 numbers within [lo, hi]. */
+int dhcal_jpoints(const dhcal_jctx *c, const cJSON *item, const char *path, size_t n, double lo,
+                  double hi, const char *unit, double (*out)[3]);
 /* Optional member: absent leaves *out untouched. */
 int dhcal_jopt_number(const dhcal_jctx *c, const cJSON *obj, const char *parent, const char *key,
                       double lo, double hi, const char *unit, double *out);

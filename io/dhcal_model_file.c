@@ -97,21 +97,10 @@ static int load_measurer(const dhcal_jctx *c, const cJSON *m, dhcal_model *model
     if (anchors == NULL) {
         return dhcal_jfail(c, "measurer.anchors_mm", "required key missing");
     }
-    if (!cJSON_IsArray(anchors)) {
-        return dhcal_jfail(c, "measurer.anchors_mm", "expected an array of 3 points, got %s",
-                     dhcal_jtype(anchors));
-    }
-    if (dhcal_jcount(anchors) != 3U) {
-        return dhcal_jfail(c, "measurer.anchors_mm", "expected 3 points, got %zu", dhcal_jcount(anchors));
-    }
-    char ip[DHCAL_JPATH_CAP];
-    size_t i = 0U;
-    for (const cJSON *e = anchors->child; e != NULL; e = e->next, ++i) {
-        dhcal_jpath_index(ip, "measurer.anchors_mm", i);
-        rc = dhcal_jvector(c, e, ip, 3U, -LEN_MAX_MM, LEN_MAX_MM, "mm", model->anchors_mm[i]);
-        if (rc != DHCAL_IO_OK) {
-            return rc;
-        }
+    rc = dhcal_jpoints(c, anchors, "measurer.anchors_mm", 3U, -LEN_MAX_MM, LEN_MAX_MM, "mm",
+                       model->anchors_mm);
+    if (rc != DHCAL_IO_OK) {
+        return rc;
     }
     double(*const an)[3] = model->anchors_mm;
     static const size_t PAIRS[3][2] = {{0U, 1U}, {0U, 2U}, {1U, 2U}};

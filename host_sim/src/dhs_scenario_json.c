@@ -351,20 +351,13 @@ static int parse_measurer(const dhcal_jctx *c, const cJSON *root, const dhcal_mo
     dhs_measurer_params *mp = &sc->measurer;
     const cJSON *ae = cJSON_GetObjectItemCaseSensitive(m, "anchor_errors_mm");
     if (ae != NULL) {
-        if (!cJSON_IsArray(ae) || cJSON_GetArraySize(ae) != 3) {
-            return dhcal_jfail(c, "measurer.anchor_errors_mm",
-                               "expected 3 points [x, y, z], got %s",
-                        dhcal_jtype(ae));
+        double d[3][3];
+        if ((rc = dhcal_jpoints(c, ae, "measurer.anchor_errors_mm", 3U, -HUGE_VAL, HUGE_VAL, "",
+                                d)) != DHCAL_IO_OK) {
+            return rc;
         }
-        size_t k = 0U;
-        for (const cJSON *e = ae->child; e != NULL; e = e->next, ++k) {
-            char p[DHCAL_JPATH_CAP];
-            dhcal_jpath_index(p, "measurer.anchor_errors_mm", k);
-            double d[3];
-            if ((rc = dhcal_jvector(c, e, p, 3U, -HUGE_VAL, HUGE_VAL, "", d)) != DHCAL_IO_OK) {
-                return rc;
-            }
-            dhc_vec3_add(mp->anchor_true_mm[k], d, mp->anchor_true_mm[k]);
+        for (size_t k = 0U; k < 3U; ++k) {
+            dhc_vec3_add(mp->anchor_true_mm[k], d[k], mp->anchor_true_mm[k]);
         }
     }
     dhc_frame fe;
