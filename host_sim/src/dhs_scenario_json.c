@@ -13,11 +13,9 @@
 #include <cjson/cJSON.h>
 #include <math.h>
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "dhcal_json.h"
-
 
 /* obj[key] as a number obeying r into *out; absent: an error when required, *out untouched
  * otherwise. */
