@@ -175,27 +175,32 @@ static int check_number(const dhcal_jctx *c, const cJSON *item, const char *path
     return DHCAL_IO_OK;
 }
 
-static int check_vector(const dhcal_jctx *c, const cJSON *item, const char *path, size_t n,
-                        const bounds *b, double *out)
+/* item must be an array of exactly n elements (what they are, for the message). */
+static int check_array(const dhcal_jctx *c, const cJSON *item, const char *path, size_t n,
+                       const char *what)
 {
     if (!cJSON_IsArray(item)) {
-        return dhcal_jfail(c, path, "expected an array of %zu numbers, got %s", n,
+        return dhcal_jfail(c, path, "expected an array of %zu %s, got %s", n, what,
                            dhcal_jtype(item));
     }
     const size_t have = dhcal_jcount(item);
     if (have != n) {
-        return dhcal_jfail(c, path, "expected %zu numbers, got %zu", n, have);
-    }
-    char ip[DHCAL_JPATH_CAP];
-    size_t i = 0U;
-    for (const cJSON *e = item->child; e != NULL; e = e->next, ++i) {
-        dhcal_jpath_index(ip, path, i);
-        const int rc = check_number(c, e, ip, b, &out[i]);
-        if (rc != DHCAL_IO_OK) {
-            return rc;
-        }
+        return dhcal_jfail(c, path, "expected %zu %s, got %zu", n, what, have);
     }
     return DHCAL_IO_OK;
+}
+
+static int check_vector(const dhcal_jctx *c, const cJSON *item, const char *path, size_t n,
+                        const bounds *b, double *out)
+{
+    int rc = check_array(c, item, path, n, "numbers");
+    char ip[DHCAL_JPATH_CAP];
+    size_t i = 0U;
+    for (const cJSON *e = item->child; rc == DHCAL_IO_OK && e != NULL; e = e->next, ++i) {
+        dhcal_jpath_index(ip, path, i);
+        rc = check_number(c, e, ip, b, &out[i]);
+    }
+    return rc;
 }
 
 static bounds range(double lo, double hi, const char *unit)
@@ -252,24 +257,14 @@ int dhcal_jvector(const dhcal_jctx *c, const cJSON *item, const char *path, size
 int dhcal_jpoints(const dhcal_jctx *c, const cJSON *item, const char *path, size_t n, double lo,
                   double hi, const char *unit, double (*out)[3])
 {
-    if (!cJSON_IsArray(item)) {
-        return dhcal_jfail(c, path, "expected an array of %zu points, got %s", n,
-                           dhcal_jtype(item));
-    }
-    const size_t have = dhcal_jcount(item);
-    if (have != n) {
-        return dhcal_jfail(c, path, "expected %zu points, got %zu", n, have);
-    }
+    int rc = check_array(c, item, path, n, "points");
     char ip[DHCAL_JPATH_CAP];
     size_t i = 0U;
-    for (const cJSON *e = item->child; e != NULL; e = e->next, ++i) {
+    for (const cJSON *e = item->child; rc == DHCAL_IO_OK && e != NULL; e = e->next, ++i) {
         dhcal_jpath_index(ip, path, i);
-        const int rc = dhcal_jvector(c, e, ip, 3U, lo, hi, unit, out[i]);
-        if (rc != DHCAL_IO_OK) {
-            return rc;
-        }
+        rc = dhcal_jvector(c, e, ip, 3U, lo, hi, unit, out[i]);
     }
-    return DHCAL_IO_OK;
+    return rc;
 }
 
 /* Optional member: absent leaves *out untouched. */
