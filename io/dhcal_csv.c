@@ -276,6 +276,7 @@ typedef struct {
     csv_col cols[CSV_MAX_COLS];
     size_t header_line;
     int has_quat;
+    int plan; /* a pose plan: q and dir columns only, each dir column on its own */
     span *spans;
     size_t spans_cap;
 } csv_ctx;
@@ -331,10 +332,16 @@ static int parse_header(csv_ctx *c, dhcal_dataset *data)
                              "%s:%zu: column '%s' is beyond the model's %zu joints", path, line,
                              dhcal_quote(f.s, f.n, sb), c->n_joints);
         }
-        if (cls == 0) {
+        if (cls == 0 && !c->plan) {
             return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
                              "%s:%zu: unknown column '%s' (known: q1..q%zu, x,y,z, L1,L2,L3, "
                              "qw,qx,qy,qz, dir1..dir%zu, temp_c, t_s)",
+                             path, line, dhcal_quote(f.s, f.n, sb), c->n_joints, c->n_joints);
+        }
+        if (cls == 0 || (c->plan && col.kind != COL_Q && col.kind != COL_DIR)) {
+            return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
+                             "%s:%zu: unknown column '%s' (a pose plan has q1..q%zu and "
+                             "optionally any of dir1..dir%zu)",
                              path, line, dhcal_quote(f.s, f.n, sb), c->n_joints, c->n_joints);
         }
         size_t *const slot = &seen[col.kind][col.idx];
@@ -353,6 +360,13 @@ static int parse_header(csv_ctx *c, dhcal_dataset *data)
                              "%s:%zu: missing column 'q%zu' (the model has %zu joints)", path,
                              line, j + 1U, c->n_joints);
         }
+    }
+    if (c->plan) {
+        /* a joint without its dir column gets a random approach direction (dir 0) */
+        for (size_t j = 0U; j < c->n_joints; ++j) {
+            data->has_dir |= seen[COL_DIR][j] != 0U;
+        }
+        return DHCAL_IO_OK;
     }
     int rc = check_group(c, seen[COL_XYZ], 3U, COL_XYZ, &data->has_xyz);
     if (rc == DHCAL_IO_OK) {
@@ -609,7 +623,8 @@ static int csv_read_all(csv_ctx *c, dhcal_dataset *data)
     return DHCAL_IO_OK;
 }
 
-int dhcal_csv_load(const char *path, size_t n_joints, dhcal_dataset *data, dhcal_error *err)
+static int load(const char *path, size_t n_joints, int plan, dhcal_dataset *data,
+                dhcal_error *err)
 {
     memset(data, 0, sizeof *data);
     if (n_joints == 0U || n_joints > DHC_MAX_JOINTS) {
@@ -623,6 +638,7 @@ int dhcal_csv_load(const char *path, size_t n_joints, dhcal_dataset *data, dhcal
     c->rd.path = path;
     c->rd.err = err;
     c->n_joints = n_joints;
+    c->plan = plan;
     c->rd.f = fopen(path, "rb");
     const int open_errno = errno;
     /* The first line may be empty: the buffer must hold its terminator from the start. */
@@ -651,6 +667,16 @@ int dhcal_csv_load(const char *path, size_t n_joints, dhcal_dataset *data, dhcal
     return rc;
 }
 
+int dhcal_csv_load(const char *path, size_t n_joints, dhcal_dataset *data, dhcal_error *err)
+{
+    return load(path, n_joints, 0, data, err);
+}
+
+int dhcal_csv_load_plan(const char *path, size_t n_joints, dhcal_dataset *plan, dhcal_error *err)
+{
+    return load(path, n_joints, 1, plan, err);
+}
+
 void dhcal_dataset_free(dhcal_dataset *data)
 {
     if (data == NULL) {
@@ -658,4 +684,51 @@ void dhcal_dataset_free(dhcal_dataset *data)
     }
     free(data->rows);
     memset(data, 0, sizeof *data);
+}
+
+/* ------------------------------------------------------------------ writing */
+
+void dhcal_csv_write_header(dhcal_text *t, const dhcal_csv_columns *cols)
+{
+    for (size_t j = 0U; j < cols->n_joints; ++j) {
+        dhcal_text_printf(t, "%sq%zu", j > 0U ? "," : "", j + 1U);
+    }
+    for (size_t j = 0U; cols->has_dir && j < cols->n_joints; ++j) {
+        dhcal_text_printf(t, ",dir%zu", j + 1U);
+    }
+    dhcal_text_str(t, cols->has_xyz ? ",x,y,z" : "");
+    dhcal_text_str(t, cols->has_wires ? ",L1,L2,L3" : "");
+    dhcal_text_str(t, cols->has_quat ? ",qw,qx,qy,qz" : "");
+    dhcal_text_str(t, cols->has_temp ? ",temp_c" : "");
+    dhcal_text_str(t, cols->has_time ? ",t_s" : "");
+    dhcal_text_str(t, "\n");
+}
+
+void dhcal_csv_write_row(dhcal_text *t, const dhcal_csv_columns *cols, const dhcal_row *row)
+{
+    for (size_t j = 0U; j < cols->n_joints; ++j) {
+        /* 180 / pi, not 1 / DHC_DEG: the same double the writers produced before io had one */
+        dhcal_text_printf(t, "%s%.9f", j > 0U ? "," : "", row->q_rad[j] * 180.0 / DHC_PI);
+    }
+    for (size_t j = 0U; cols->has_dir && j < cols->n_joints; ++j) {
+        dhcal_text_printf(t, ",%d", row->dir[j]);
+    }
+    if (cols->has_xyz) {
+        dhcal_text_printf(t, ",%.6f,%.6f,%.6f", row->xyz_mm[0], row->xyz_mm[1], row->xyz_mm[2]);
+    }
+    if (cols->has_wires) {
+        dhcal_text_printf(t, ",%.6f,%.6f,%.6f", row->wires_mm[0], row->wires_mm[1],
+                          row->wires_mm[2]);
+    }
+    if (cols->has_quat) {
+        dhcal_text_printf(t, ",%.9f,%.9f,%.9f,%.9f", row->quat[0], row->quat[1], row->quat[2],
+                          row->quat[3]);
+    }
+    if (cols->has_temp) {
+        dhcal_text_printf(t, ",%.3f", row->temp_c);
+    }
+    if (cols->has_time) {
+        dhcal_text_printf(t, ",%.6f", row->t_s);
+    }
+    dhcal_text_str(t, "\n");
 }

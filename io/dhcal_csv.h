@@ -1,4 +1,5 @@
-/* dhcal_csv.h - the measurement CSV (docs/formats.md).
+/* dhcal_csv.h - the measurement CSV (docs/formats.md): read, and written by the programs that
+ * measure (dhcal-sim, dhcal-demo).
  *
  * Host-only code (heap and stdio allowed). Units in files: mm, degrees, seconds; in memory
  * mm and radians. A defect is reported as e.g.
@@ -12,6 +13,7 @@
 
 #include "dhcal/dhc_config.h"
 #include "dhcal_error.h"
+#include "dhcal_text.h"
 
 /* Longest CSV line accepted (bytes, not counting the newline). */
 #define DHCAL_CSV_MAX_LINE 65536U
@@ -54,7 +56,28 @@ typedef struct {
  * Cost: O(file size) time; memory one line buffer (<= 64 KiB) plus the rows.
  * On error *data is empty (rows NULL), so dhcal_dataset_free is always safe. */
 int dhcal_csv_load(const char *path, size_t n_joints, dhcal_dataset *data, dhcal_error *err);
+/* Loads a pose plan (targets for a simulator): a measurement CSV without measurement columns.
+ * The header has q1..qN and optionally any of dir1..dirN, each on its own; a row's dir[j] is
+ * 0 where dirj is absent (the caller chooses), has_dir when any is present. Everything else
+ * (comments, numbers, ranges, messages, at least one row) as dhcal_csv_load. */
+int dhcal_csv_load_plan(const char *path, size_t n_joints, dhcal_dataset *plan, dhcal_error *err);
 /* Frees the rows and empties *data; NULL and already-empty datasets are fine. */
 void dhcal_dataset_free(dhcal_dataset *data);
+
+/* The columns a writer puts down (the has_ flags of dhcal_dataset), always in this order:
+ * q1..qN, dir1..dirN, x,y,z, L1,L2,L3, qw,qx,qy,qz, temp_c, t_s. */
+typedef struct {
+    size_t n_joints;
+    int has_xyz, has_wires, has_quat, has_dir, has_temp, has_time;
+} dhcal_csv_columns;
+
+/* Appends the header line for cols to t (comment lines, if any, go before it). */
+void dhcal_csv_write_header(dhcal_text *t, const dhcal_csv_columns *cols);
+/* Appends row's line: angles in degrees with 9 decimals (dhcal_csv_load reads them back
+ * within 5e-10 deg, far below an encoder count), lengths in mm with 6 decimals (1 nm),
+ * the quaternion with 9 decimals, temp_c with 3 and t_s with 6; dir as -1 or 1. The
+ * caller checks t->failed once at the end and writes the file through
+ * dhcal_file_write_atomic. */
+void dhcal_csv_write_row(dhcal_text *t, const dhcal_csv_columns *cols, const dhcal_row *row);
 
 #endif /* DHCAL_CSV_H */

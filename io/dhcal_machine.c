@@ -13,17 +13,12 @@
 static const char *const TOP_KEYS[] = {"comment", "name",     "model",   "n_joints",
                                        "start_pose_deg", "joints", "drives", "measurer",
                                        "can",     "gpio",     "store"};
-#define TOP_KEYS_TEXT \
-    "comment, name, model, n_joints, start_pose_deg, joints, drives, measurer, can, gpio, store"
 static const char *const JOINT_KEYS[] = {"comment", "encoder_counts_per_rev", "gear_ratio",
                                          "tacho_v_s_per_rad"};
-#define JOINT_KEYS_TEXT "comment, encoder_counts_per_rev, gear_ratio, tacho_v_s_per_rad"
 static const char *const DRIVE_KEYS[] = {"comment", "dac_range_v", "adc_range_v",
                                          "max_speed_deg_s", "max_accel_deg_s2"};
-#define DRIVE_KEYS_TEXT "comment, dac_range_v, adc_range_v, max_speed_deg_s, max_accel_deg_s2"
 static const char *const MEASURER_KEYS[] = {"comment", "wheel_radius_mm", "counts_per_rev",
                                             "zero_length_mm"};
-#define MEASURER_KEYS_TEXT "comment, wheel_radius_mm, counts_per_rev, zero_length_mm"
 static const char *const CAN_KEYS[] = {"comment", "interface", "id_offset"};
 static const char *const GPIO_KEYS[] = {"comment", "chip", "encoder_lines"};
 
@@ -50,34 +45,16 @@ static int opt_string(const dhcal_jctx *c, const cJSON *obj, const char *parent,
     return DHCAL_IO_OK;
 }
 
-/* A whole number in [lo, hi]. */
+/* A whole number in [lo, hi], as the machine's unsigned fields hold it. */
 static int whole_number(const dhcal_jctx *c, const cJSON *item, const char *path, double lo,
                         double hi, unsigned *out)
 {
-    double v = 0.0;
-    const int rc = dhcal_jnumber(c, item, path, lo, hi, "", &v);
-    if (rc != DHCAL_IO_OK) {
-        return rc;
+    uint64_t v = 0U;
+    const int rc = dhcal_jwhole(c, item, path, lo, hi, &v);
+    if (rc == DHCAL_IO_OK) {
+        *out = (unsigned)v;
     }
-    if (!same_double(v, floor(v))) {
-        return dhcal_jfail(c, path, "%.15g is not a whole number", v);
-    }
-    *out = (unsigned)v;
-    return DHCAL_IO_OK;
-}
-
-/* machine_dir/rel, or rel when absolute or the machine file has no directory. */
-static int resolve(const dhcal_jctx *c, const char *key, const char *rel, char out[DHCAL_MACHINE_PATH_CAP])
-{
-    const char *const slash = strrchr(c->file, '/');
-    const int w = rel[0] == '/' || slash == NULL
-                      ? snprintf(out, DHCAL_MACHINE_PATH_CAP, "%s", rel)
-                      : snprintf(out, DHCAL_MACHINE_PATH_CAP, "%.*s/%s", (int)(slash - c->file),
-                                 c->file, rel);
-    if (w < 0 || (size_t)w >= DHCAL_MACHINE_PATH_CAP) {
-        return dhcal_jfail(c, key, "path too long");
-    }
-    return DHCAL_IO_OK;
+    return rc;
 }
 
 static int load_model(dhcal_jctx *c, const cJSON *root, dhcal_machine *m)
@@ -93,7 +70,8 @@ static int load_model(dhcal_jctx *c, const cJSON *root, dhcal_machine *m)
         if (item->valuestring[0] == '\0') {
             return dhcal_jfail(c, "model", "empty path");
         }
-        if ((rc = resolve(c, "model", item->valuestring, m->model_path)) != DHCAL_IO_OK) {
+        if ((rc = dhcal_jfile_beside(c, "model", item->valuestring, m->model_path,
+                                      sizeof m->model_path)) != DHCAL_IO_OK) {
             return rc;
         }
         dhcal_error merr;
@@ -140,8 +118,7 @@ static int load_joints(dhcal_jctx *c, const cJSON *root, dhcal_machine *m)
     int rc = DHCAL_IO_OK;
     for (const cJSON *j = joints->child; j != NULL && rc == DHCAL_IO_OK; j = j->next, ++i) {
         dhcal_jpath_index(ip, "joints", i);
-        rc = dhcal_jcheck_object(c, j, ip, JOINT_KEYS, sizeof JOINT_KEYS / sizeof JOINT_KEYS[0],
-                                 JOINT_KEYS_TEXT);
+        rc = dhcal_jcheck_object(c, j, ip, DHCAL_JKEYS(JOINT_KEYS));
         if (rc == DHCAL_IO_OK) {
             rc = dhcal_jreq_number(c, j, ip, "encoder_counts_per_rev", 1.0, 1e9, "",
                                    &m->encoder_counts_per_rev[i]);
@@ -164,8 +141,7 @@ static int load_drives(const dhcal_jctx *c, const cJSON *root, dhcal_machine *m)
     if (d == NULL) {
         return dhcal_jfail(c, "drives", "required key missing (dac_range_v, adc_range_v)");
     }
-    int rc = dhcal_jcheck_object(c, d, "drives", DRIVE_KEYS,
-                                 sizeof DRIVE_KEYS / sizeof DRIVE_KEYS[0], DRIVE_KEYS_TEXT);
+    int rc = dhcal_jcheck_object(c, d, "drives", DHCAL_JKEYS(DRIVE_KEYS));
     if (rc == DHCAL_IO_OK) {
         rc = dhcal_jreq_number(c, d, "drives", "dac_range_v", 1e-3, 1e3, "V", &m->dac_range_v);
     }
@@ -193,9 +169,7 @@ static int load_measurer(const dhcal_jctx *c, const cJSON *root, dhcal_machine *
         return dhcal_jfail(c, "measurer", "required key missing (wheel_radius_mm, "
                                           "counts_per_rev)");
     }
-    int rc = dhcal_jcheck_object(c, w, "measurer", MEASURER_KEYS,
-                                 sizeof MEASURER_KEYS / sizeof MEASURER_KEYS[0],
-                                 MEASURER_KEYS_TEXT);
+    int rc = dhcal_jcheck_object(c, w, "measurer", DHCAL_JKEYS(MEASURER_KEYS));
     if (rc == DHCAL_IO_OK) {
         rc = dhcal_jreq_number(c, w, "measurer", "wheel_radius_mm", 1e-3, 1e4, "mm",
                                &m->wire_wheel_radius_mm);
@@ -216,8 +190,7 @@ static int load_bus_and_store(const dhcal_jctx *c, const cJSON *root, dhcal_mach
     int rc = DHCAL_IO_OK;
     const cJSON *const can = cJSON_GetObjectItemCaseSensitive(root, "can");
     if (can != NULL) {
-        rc = dhcal_jcheck_object(c, can, "can", CAN_KEYS, sizeof CAN_KEYS / sizeof CAN_KEYS[0],
-                                 "comment, interface, id_offset");
+        rc = dhcal_jcheck_object(c, can, "can", DHCAL_JKEYS(CAN_KEYS));
         if (rc == DHCAL_IO_OK) {
             rc = opt_string(c, can, "can", "interface", m->can_interface,
                             sizeof m->can_interface);
@@ -230,9 +203,7 @@ static int load_bus_and_store(const dhcal_jctx *c, const cJSON *root, dhcal_mach
     }
     const cJSON *const gpio = cJSON_GetObjectItemCaseSensitive(root, "gpio");
     if (rc == DHCAL_IO_OK && gpio != NULL) {
-        rc = dhcal_jcheck_object(c, gpio, "gpio", GPIO_KEYS,
-                                 sizeof GPIO_KEYS / sizeof GPIO_KEYS[0],
-                                 "comment, chip, encoder_lines");
+        rc = dhcal_jcheck_object(c, gpio, "gpio", DHCAL_JKEYS(GPIO_KEYS));
         const cJSON *const lines = cJSON_GetObjectItemCaseSensitive(gpio, "encoder_lines");
         if (rc == DHCAL_IO_OK && (cJSON_GetObjectItemCaseSensitive(gpio, "chip") == NULL ||
                                   lines == NULL)) {
@@ -260,15 +231,14 @@ static int load_bus_and_store(const dhcal_jctx *c, const cJSON *root, dhcal_mach
         rc = opt_string(c, root, "", "store", store, sizeof store);
     }
     if (rc == DHCAL_IO_OK && store[0] != '\0') {
-        rc = resolve(c, "store", store, m->store_path);
+        rc = dhcal_jfile_beside(c, "store", store, m->store_path, sizeof m->store_path);
     }
     return rc;
 }
 
 static int load_root(dhcal_jctx *c, const cJSON *root, dhcal_machine *m)
 {
-    int rc = dhcal_jcheck_object(c, root, "", TOP_KEYS, sizeof TOP_KEYS / sizeof TOP_KEYS[0],
-                                 TOP_KEYS_TEXT);
+    int rc = dhcal_jcheck_object(c, root, "", DHCAL_JKEYS(TOP_KEYS));
     if (rc == DHCAL_IO_OK) {
         rc = opt_string(c, root, "", "name", m->name, sizeof m->name);
     }

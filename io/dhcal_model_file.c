@@ -33,13 +33,11 @@
 
 static const char *const JOINT_KEYS[] = {"alpha_deg", "a_mm",    "d_mm",   "theta_offset_deg",
                                          "beta_deg",  "min_deg", "max_deg"};
-#define JOINT_KEYS_TEXT "alpha_deg, a_mm, d_mm, theta_offset_deg, beta_deg, min_deg, max_deg"
 
 static int load_joint(const dhcal_jctx *c, const cJSON *j, const char *path, dhc_joint *out,
                       int *has_beta)
 {
-    int rc = dhcal_jcheck_object(c, j, path, JOINT_KEYS, sizeof JOINT_KEYS / sizeof JOINT_KEYS[0],
-                          JOINT_KEYS_TEXT);
+    int rc = dhcal_jcheck_object(c, j, path, DHCAL_JKEYS(JOINT_KEYS));
     double alpha = 0.0;
     double a = 0.0;
     double d = 0.0;
@@ -87,42 +85,11 @@ static int load_joint(const dhcal_jctx *c, const cJSON *j, const char *path, dhc
     return rc;
 }
 
-static const char *const FRAME_KEYS[] = {"xyz_mm", "rpy_deg"};
-
-/* Optional frame object: absent is the identity, absent members are 0. */
-static int load_frame(const dhcal_jctx *c, const cJSON *obj, const char *parent, const char *key,
-                      dhc_frame *out)
-{
-    dhc_frame_identity(out);
-    const cJSON *const f = cJSON_GetObjectItemCaseSensitive(obj, key);
-    if (f == NULL) {
-        return DHCAL_IO_OK;
-    }
-    char kp[DHCAL_JPATH_CAP];
-    dhcal_jpath_key(kp, parent, key);
-    double xyz[3] = {0.0, 0.0, 0.0};
-    double rpy[3] = {0.0, 0.0, 0.0};
-    int rc = dhcal_jcheck_object(c, f, kp, FRAME_KEYS, 2U, "xyz_mm, rpy_deg");
-    if (rc == DHCAL_IO_OK) {
-        rc = dhcal_jopt_vector(c, f, kp, "xyz_mm", 3U, -LEN_MAX_MM, LEN_MAX_MM, "mm", xyz);
-    }
-    if (rc == DHCAL_IO_OK) {
-        rc = dhcal_jopt_vector(c, f, kp, "rpy_deg", 3U, -MODEL_ANGLE_MAX_DEG, MODEL_ANGLE_MAX_DEG,
-                         "deg", rpy);
-    }
-    if (rc == DHCAL_IO_OK) {
-        const double rpy_rad[3] = {rpy[0] * DHC_DEG, rpy[1] * DHC_DEG,
-                                   rpy[2] * DHC_DEG};
-        dhc_frame_from_xyz_rpy(xyz, rpy_rad, out);
-    }
-    return rc;
-}
-
 static const char *const MEASURER_KEYS[] = {"anchors_mm", "frame"};
 
 static int load_measurer(const dhcal_jctx *c, const cJSON *m, dhcal_model *model)
 {
-    int rc = dhcal_jcheck_object(c, m, "measurer", MEASURER_KEYS, 2U, "anchors_mm, frame");
+    int rc = dhcal_jcheck_object(c, m, "measurer", DHCAL_JKEYS(MEASURER_KEYS));
     if (rc != DHCAL_IO_OK) {
         return rc;
     }
@@ -130,21 +97,10 @@ static int load_measurer(const dhcal_jctx *c, const cJSON *m, dhcal_model *model
     if (anchors == NULL) {
         return dhcal_jfail(c, "measurer.anchors_mm", "required key missing");
     }
-    if (!cJSON_IsArray(anchors)) {
-        return dhcal_jfail(c, "measurer.anchors_mm", "expected an array of 3 points, got %s",
-                     dhcal_jtype(anchors));
-    }
-    if (dhcal_jcount(anchors) != 3U) {
-        return dhcal_jfail(c, "measurer.anchors_mm", "expected 3 points, got %zu", dhcal_jcount(anchors));
-    }
-    char ip[DHCAL_JPATH_CAP];
-    size_t i = 0U;
-    for (const cJSON *e = anchors->child; e != NULL; e = e->next, ++i) {
-        dhcal_jpath_index(ip, "measurer.anchors_mm", i);
-        rc = dhcal_jvector(c, e, ip, 3U, -LEN_MAX_MM, LEN_MAX_MM, "mm", model->anchors_mm[i]);
-        if (rc != DHCAL_IO_OK) {
-            return rc;
-        }
+    rc = dhcal_jpoints(c, anchors, "measurer.anchors_mm", 3U, -LEN_MAX_MM, LEN_MAX_MM, "mm",
+                       model->anchors_mm);
+    if (rc != DHCAL_IO_OK) {
+        return rc;
     }
     double(*const an)[3] = model->anchors_mm;
     static const size_t PAIRS[3][2] = {{0U, 1U}, {0U, 2U}, {1U, 2U}};
@@ -169,7 +125,8 @@ static int load_measurer(const dhcal_jctx *c, const cJSON *m, dhcal_model *model
                      "the three anchors are collinear (trilateration needs a triangle)");
     }
     model->has_measurer = 1;
-    return load_frame(c, m, "measurer", "frame", &model->measurer_frame);
+    return dhcal_jframe(c, m, "measurer", "frame", LEN_MAX_MM, MODEL_ANGLE_MAX_DEG,
+                        &model->measurer_frame, NULL);
 }
 
 /* The effect catalogue is the library's (dhc_effects): one list of names for every program. */
@@ -239,8 +196,7 @@ static const char *const TOP_KEYS[] = {"name",    "joints",   "tool_mm", "base",
 
 static int load_root(dhcal_jctx *c, const cJSON *root, dhcal_model *model)
 {
-    int rc = dhcal_jcheck_object(c, root, "", TOP_KEYS, sizeof TOP_KEYS / sizeof TOP_KEYS[0],
-                          "name, joints, tool_mm, base, gravity, measurer, effects");
+    int rc = dhcal_jcheck_object(c, root, "", DHCAL_JKEYS(TOP_KEYS));
     if (rc != DHCAL_IO_OK) {
         return rc;
     }
@@ -286,7 +242,8 @@ static int load_root(dhcal_jctx *c, const cJSON *root, dhcal_model *model)
     rc = dhcal_jopt_vector(c, root, "", "tool_mm", 3U, -LEN_MAX_MM, LEN_MAX_MM, "mm",
                      model->arm.tool_mm);
     if (rc == DHCAL_IO_OK) {
-        rc = load_frame(c, root, "", "base", &model->arm.base);
+        rc = dhcal_jframe(c, root, "", "base", LEN_MAX_MM, MODEL_ANGLE_MAX_DEG, &model->arm.base,
+                          NULL);
     }
     if (rc == DHCAL_IO_OK) {
         rc = dhcal_jopt_vector(c, root, "", "gravity", 3U, -2.0, 2.0, "", model->gravity);

@@ -1,5 +1,6 @@
-/* dhcal_text.h - a growing text buffer on the heap: what the writers of model files and of
- * pictures build a document in before it goes to disk whole (dhcal_file_write_atomic).
+/* dhcal_text.h - a growing text buffer on the heap: what the writers of model files, of
+ * measurement CSV and of pictures build a document in before it goes to disk whole
+ * (dhcal_file_write_atomic).
  *
  * A failed allocation (or a printf failure) sets `failed` and every later append does
  * nothing: the caller checks once, at the end, and writes nothing. p is NUL-terminated

@@ -15,7 +15,7 @@
  * fit's (dhc_sample_whiten), and s is the fit's unit-free sigma, so C is again the
  * covariance of the parameters the fit identified. lib computes it (dhc_uncertainty.h). */
 #ifndef _POSIX_C_SOURCE
-#define _POSIX_C_SOURCE 200809L /* open_memstream */
+#define _POSIX_C_SOURCE 200809L
 #endif
 
 #include <getopt.h>
@@ -191,21 +191,18 @@ static void where_it_fails(const dhc_model *m, size_t n, FILE *log)
     }
 }
 
-/* path := the text f received (an open_memstream), replaced whole (io's atomic write). */
-static int finish_file(const char *path, FILE *f, char **text, size_t *len)
+/* path := t's text, replaced whole (io's atomic write); t is freed. */
+static int finish_file(const char *path, dhcal_text *t)
 {
-    const int bad = ferror(f);
-    if (fclose(f) != 0 || bad || *text == NULL) {
-        free(*text);
-        *text = NULL;
+    if (t->failed || t->p == NULL) {
+        free(t->p);
         fprintf(stderr, "dhcal-demo: %s: out of memory\n", path);
         return -1;
     }
     dhcal_error err;
     memset(&err, 0, sizeof err);
-    const int rc = dhcal_file_write_atomic(path, *text, *len, &err);
-    free(*text);
-    *text = NULL;
+    const int rc = dhcal_file_write_atomic(path, t->p, t->len, &err);
+    free(t->p);
     if (rc != DHCAL_IO_OK) {
         fprintf(stderr, "dhcal-demo: %s\n", err.msg);
         return -1;
@@ -217,47 +214,39 @@ static int write_outputs(const char *dir, size_t n, const char *effect)
 {
     const size_t nj = nominal.arm.n_joints;
     char path[4200];
-    char *text = NULL;
-    size_t len = 0U;
     snprintf(path, sizeof path, "%s/samples.csv", dir);
-    FILE *f = open_memstream(&text, &len);
-    if (f == NULL) {
-        return -1;
-    }
-    for (size_t j = 0U; j < nj; ++j) {
-        fprintf(f, "q%zu,", j + 1U);
-    }
-    for (size_t j = 0U; j < nj; ++j) {
-        fprintf(f, "dir%zu,", j + 1U);
-    }
-    fprintf(f, "L1,L2,L3\n");
+    dhcal_text t = {NULL, 0U, 0U, 0};
+    dhcal_csv_columns cols;
+    memset(&cols, 0, sizeof cols);
+    cols.n_joints = nj;
+    cols.has_dir = 1;
+    cols.has_wires = 1;
+    dhcal_csv_write_header(&t, &cols);
     for (size_t i = 0U; i < n; ++i) {
         const dhc_sample *s = &job.samples[i];
+        dhcal_row row;
+        memset(&row, 0, sizeof row);
         for (size_t j = 0U; j < nj; ++j) {
-            fprintf(f, "%.9f,", s->q_rad[j] * 180.0 / DHC_PI);
+            row.q_rad[j] = s->q_rad[j];
+            row.dir[j] = (int)s->dir[j];
         }
-        for (size_t j = 0U; j < nj; ++j) {
-            fprintf(f, "%d,", s->dir[j]);
-        }
-        fprintf(f, "%.6f,%.6f,%.6f\n", s->wire_mm[0], s->wire_mm[1], s->wire_mm[2]);
+        dhc_vec3_copy(s->wire_mm, row.wires_mm);
+        dhcal_csv_write_row(&t, &cols, &row);
     }
-    if (finish_file(path, f, &text, &len) != 0) {
+    if (finish_file(path, &t) != 0) {
         return -1;
     }
     snprintf(path, sizeof path, "%s/positioning.csv", dir);
-    f = open_memstream(&text, &len);
-    if (f == NULL) {
-        return -1;
-    }
-    fprintf(f, "phase,x_mm,y_mm,z_mm,error_mm\n");
+    dhcal_text p = {NULL, 0U, 0U, 0};
+    dhcal_text_str(&p, "phase,x_mm,y_mm,z_mm,error_mm\n");
     const char *names[3] = {"nominal", "geometric", effect};
     for (size_t k = 0U; k < 3U; ++k) {
         for (size_t i = 0U; i < ph[k].n; ++i) {
-            fprintf(f, "%s,%.4f,%.4f,%.4f,%.6f\n", names[k], ph[k].target[i][0],
-                    ph[k].target[i][1], ph[k].target[i][2], ph[k].err[i]);
+            dhcal_text_printf(&p, "%s,%.4f,%.4f,%.4f,%.6f\n", names[k], ph[k].target[i][0],
+                              ph[k].target[i][1], ph[k].target[i][2], ph[k].err[i]);
         }
     }
-    return finish_file(path, f, &text, &len);
+    return finish_file(path, &p);
 }
 
 static const char *const usage_text =

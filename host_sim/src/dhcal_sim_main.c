@@ -181,220 +181,6 @@ static int parse_options(int argc, char **argv, options *o)
     return 0;
 }
 
-/* ------------------------------------------------------------------ output buffer */
-
-typedef struct {
-    char *data;
-    size_t len;
-    size_t cap;
-    int oom;
-} text_buf;
-
-static void put(text_buf *b, const char *fmt, ...)
-{
-    if (b->oom) {
-        return;
-    }
-    for (;;) {
-        va_list ap;
-        va_start(ap, fmt);
-        const int w = vsnprintf(b->data + b->len, b->cap - b->len, fmt, ap);
-        va_end(ap);
-        if (w < 0) {
-            b->oom = 1;
-            return;
-        }
-        if ((size_t)w < b->cap - b->len) {
-            b->len += (size_t)w;
-            return;
-        }
-        const size_t cap = 2U * b->cap + (size_t)w + 1U;
-        char *d = realloc(b->data, cap);
-        if (d == NULL) {
-            b->oom = 1;
-            return;
-        }
-        b->data = d;
-        b->cap = cap;
-    }
-}
-
-/* ------------------------------------------------------------------ plan file */
-
-typedef struct {
-    size_t n;
-    double *q_rad;  /* n x joints */
-    int8_t *dir;    /* n x joints, 0: random */
-} plan;
-
-static int load_plan(const char *path, size_t joints, plan *p)
-{
-    memset(p, 0, sizeof *p);
-    FILE *f = fopen(path, "r");
-    if (f == NULL) {
-        fprintf(stderr, "dhcal-sim: %s: cannot open: %s\n", path, strerror(errno));
-        return EXIT_USAGE;
-    }
-    char line[4096];
-    size_t line_no = 0U;
-    int col_q[DHC_MAX_JOINTS];
-    int col_dir[DHC_MAX_JOINTS];
-    int have_header = 0;
-    int ncols = 0;
-    size_t cap = 0U;
-    int rc = 0;
-    for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
-        col_q[j] = -1;
-        col_dir[j] = -1;
-    }
-    while (fgets(line, sizeof line, f) != NULL) {
-        ++line_no;
-        const size_t len = strlen(line);
-        if (len == sizeof line - 1U && line[len - 1U] != '\n') {
-            fprintf(stderr, "dhcal-sim: %s:%zu: line too long\n", path, line_no);
-            rc = EXIT_USAGE;
-            break;
-        }
-        line[strcspn(line, "\r\n")] = '\0';
-        const char *s = line + strspn(line, " \t");
-        if (*s == '\0' || *s == '#') {
-            continue;
-        }
-        char *fields[2U * DHC_MAX_JOINTS + 1U];
-        int nf = 0;
-        for (char *tok = line;;) {
-            char *comma = strchr(tok, ',');
-            if (comma != NULL) {
-                *comma = '\0';
-            }
-            if (nf >= (int)(2U * DHC_MAX_JOINTS)) {
-                nf = -1;
-                break;
-            }
-            tok += strspn(tok, " \t");
-            size_t l = strlen(tok);
-            while (l > 0U && (tok[l - 1U] == ' ' || tok[l - 1U] == '\t')) {
-                tok[--l] = '\0';
-            }
-            fields[nf++] = tok;
-            if (comma == NULL) {
-                break;
-            }
-            tok = comma + 1;
-        }
-        if (nf < 0) {
-            fprintf(stderr, "dhcal-sim: %s:%zu: too many columns\n", path, line_no);
-            rc = EXIT_USAGE;
-            break;
-        }
-        if (!have_header) {
-            for (int c = 0; c < nf; ++c) {
-                unsigned long long k = 0U;
-                int *slot = NULL;
-                if (fields[c][0] == 'q' && parse_ulong(fields[c] + 1, joints, &k) && k >= 1U) {
-                    slot = &col_q[k - 1U];
-                } else if (strncmp(fields[c], "dir", 3U) == 0 &&
-                           parse_ulong(fields[c] + 3, joints, &k) && k >= 1U) {
-                    slot = &col_dir[k - 1U];
-                }
-                if (slot == NULL || *slot >= 0) {
-                    fprintf(stderr, "dhcal-sim: %s:%zu: column '%s' is %s (expected q1..q%zu, "
-                            "optional dir1..dir%zu)\n", path, line_no, fields[c],
-                            slot == NULL ? "unknown" : "repeated", joints, joints);
-                    rc = EXIT_USAGE;
-                    break;
-                }
-                *slot = c;
-            }
-            if (rc != 0) {
-                break;
-            }
-            for (size_t j = 0U; j < joints && rc == 0; ++j) {
-                if (col_q[j] < 0) {
-                    fprintf(stderr, "dhcal-sim: %s:%zu: missing column q%zu\n", path, line_no,
-                            j + 1U);
-                    rc = EXIT_USAGE;
-                }
-            }
-            if (rc != 0) {
-                break;
-            }
-            have_header = 1;
-            ncols = nf;
-            continue;
-        }
-        if (nf != ncols) {
-            fprintf(stderr, "dhcal-sim: %s:%zu: %d fields, the header has %d\n", path, line_no,
-                    nf, ncols);
-            rc = EXIT_USAGE;
-            break;
-        }
-        if (p->n == cap) {
-            cap = cap == 0U ? 64U : 2U * cap;
-            double *q = realloc(p->q_rad, cap * joints * sizeof *q);
-            if (q != NULL) {
-                p->q_rad = q;
-            }
-            int8_t *d = realloc(p->dir, cap * joints * sizeof *d);
-            if (d != NULL) {
-                p->dir = d;
-            }
-            if (q == NULL || d == NULL) {
-                fprintf(stderr, "dhcal-sim: out of memory\n");
-                rc = EXIT_COMPUTE;
-                break;
-            }
-        }
-        for (size_t j = 0U; j < joints && rc == 0; ++j) {
-            char *end = NULL;
-            const char *fq = fields[col_q[j]];
-            const double deg = strtod(fq, &end);
-            if (end == fq || *end != '\0' || !dhc_is_finite(deg) || deg < -720.0 || deg > 720.0) {
-                fprintf(stderr, "dhcal-sim: %s:%zu: q%zu: '%s' is not an angle in [-720, 720] "
-                        "deg\n", path, line_no, j + 1U, fq);
-                rc = EXIT_USAGE;
-                break;
-            }
-            p->q_rad[p->n * joints + j] = deg * SIM_PI / 180.0;
-            int8_t dv = 0;
-            if (col_dir[j] >= 0) {
-                const char *fd = fields[col_dir[j]];
-                if (strcmp(fd, "1") == 0 || strcmp(fd, "+1") == 0) {
-                    dv = 1;
-                } else if (strcmp(fd, "-1") == 0) {
-                    dv = -1;
-                } else {
-                    fprintf(stderr, "dhcal-sim: %s:%zu: dir%zu: '%s' is not -1 or +1\n", path,
-                            line_no, j + 1U, fd);
-                    rc = EXIT_USAGE;
-                    break;
-                }
-            }
-            p->dir[p->n * joints + j] = dv;
-        }
-        if (rc != 0) {
-            break;
-        }
-        p->n++;
-    }
-    if (rc == 0 && ferror(f)) {
-        fprintf(stderr, "dhcal-sim: %s: read error\n", path);
-        rc = EXIT_USAGE;
-    }
-    (void)fclose(f);
-    if (rc == 0 && p->n == 0U) {
-        fprintf(stderr, "dhcal-sim: %s: no poses (a header q1..q%zu and one line per pose)\n",
-                path, joints);
-        rc = EXIT_USAGE;
-    }
-    if (rc != 0) {
-        free(p->q_rad);
-        free(p->dir);
-        memset(p, 0, sizeof *p);
-    }
-    return rc;
-}
-
 /* ------------------------------------------------------------------ dataset */
 
 static int run_dataset(const options *o)
@@ -413,39 +199,39 @@ static int run_dataset(const options *o)
                 sf.model_path);
         return EXIT_USAGE;
     }
-    plan pl;
+    dhcal_dataset pl;
     memset(&pl, 0, sizeof pl);
-    if (o->plan != NULL && (rc = load_plan(o->plan, n, &pl)) != 0) {
-        return rc;
+    if (o->plan != NULL && (rc = dhcal_csv_load_plan(o->plan, n, &pl, &err)) != DHCAL_IO_OK) {
+        fprintf(stderr, "dhcal-sim: %s\n", err.msg);
+        return rc == DHCAL_IO_BAD_INPUT ? EXIT_USAGE : EXIT_COMPUTE;
     }
     const uint64_t seed = o->have_seed ? (uint64_t)o->seed : sc->seed;
     static dhs_dataset ds;
     if (dhs_dataset_init(&ds, sc, seed) != DHC_OK) {
         fprintf(stderr, "dhcal-sim: %s: scenario rejected by the plant\n", o->scenario);
-        free(pl.q_rad);
-        free(pl.dir);
+        dhcal_dataset_free(&pl);
         return EXIT_USAGE;
     }
-    const size_t poses = o->plan != NULL ? pl.n : (size_t)o->poses;
+    const size_t poses = o->plan != NULL ? pl.n_rows : (size_t)o->poses;
 
-    text_buf b = {NULL, 0U, 0U, 0};
-    put(&b, "# dhcal-sim dataset: scenario '%s' (%s), run seed %llu, %zu poses\n", sc->name,
-        o->scenario, (unsigned long long)seed, poses);
-    put(&b, "# q: encoder angles (deg, the controller's nominal counts per degree); dir: "
-            "approach direction\n");
+    dhcal_text b = {NULL, 0U, 0U, 0};
+    dhcal_text_printf(&b, "# dhcal-sim dataset: scenario '%s' (%s), run seed %llu, %zu poses\n",
+                      sc->name, o->scenario, (unsigned long long)seed, poses);
+    dhcal_text_str(&b, "# q: encoder angles (deg, the controller's nominal counts per degree); "
+                       "dir: approach direction\n");
     if (o->wires) {
-        put(&b, "# L1,L2,L3: wire lengths from the measurer's counters (mm)\n");
+        dhcal_text_str(&b, "# L1,L2,L3: wire lengths from the measurer's counters (mm)\n");
     } else {
-        put(&b, "# x,y,z: tool point (mm, world), noise %.6g mm per coordinate\n",
-            sc->noise_xyz_mm);
+        dhcal_text_printf(&b, "# x,y,z: tool point (mm, world), noise %.6g mm per coordinate\n",
+                          sc->noise_xyz_mm);
     }
-    for (size_t j = 0U; j < n; ++j) {
-        put(&b, "%sq%zu", j > 0U ? "," : "", j + 1U);
-    }
-    for (size_t j = 0U; j < n; ++j) {
-        put(&b, ",dir%zu", j + 1U);
-    }
-    put(&b, o->wires ? ",L1,L2,L3\n" : ",x,y,z\n");
+    dhcal_csv_columns cols;
+    memset(&cols, 0, sizeof cols);
+    cols.n_joints = n;
+    cols.has_dir = 1;
+    cols.has_wires = o->wires;
+    cols.has_xyz = !o->wires;
+    dhcal_csv_write_header(&b, &cols);
 
     dhs_rng dir_rng;
     dhs_rng_seed(&dir_rng, seed, DHS_STREAM_POSES);
@@ -456,12 +242,12 @@ static int run_dataset(const options *o)
             int8_t dir[DHC_MAX_JOINTS];
             for (size_t j = 0U; j < n; ++j) {
                 const double u = dhs_rng_uniform(&dir_rng); /* drawn always: same stream */
-                dir[j] = pl.dir[k * n + j];
+                dir[j] = (int8_t)pl.rows[k].dir[j];
                 if (dir[j] == 0) {
                     dir[j] = u < 0.5 ? INT8_C(-1) : INT8_C(1);
                 }
             }
-            st = dhs_dataset_at(&ds, &pl.q_rad[k * n], dir, &row);
+            st = dhs_dataset_at(&ds, pl.rows[k].q_rad, dir, &row);
         } else {
             st = dhs_dataset_next(&ds, &row);
         }
@@ -471,34 +257,33 @@ static int run_dataset(const options *o)
                         ? " (no target keeps clear of axis 1 and the anchor plane: check the "
                           "scenario's poses limits and the model's joint ranges)"
                         : "");
-            free(b.data);
-            free(pl.q_rad);
-            free(pl.dir);
+            free(b.p);
+            dhcal_dataset_free(&pl);
             return EXIT_COMPUTE;
         }
+        dhcal_row out;
+        memset(&out, 0, sizeof out);
         for (size_t j = 0U; j < n; ++j) {
-            put(&b, "%s%.9f", j > 0U ? "," : "", row.q_rad[j] * 180.0 / SIM_PI);
+            out.q_rad[j] = row.q_rad[j];
+            out.dir[j] = (int)row.dir[j];
         }
-        for (size_t j = 0U; j < n; ++j) {
-            put(&b, ",%d", (int)row.dir[j]);
-        }
-        const double *v = o->wires ? row.wire_mm : row.xyz_mm;
-        put(&b, ",%.6f,%.6f,%.6f\n", v[0], v[1], v[2]);
+        dhc_vec3_copy(row.xyz_mm, out.xyz_mm);
+        dhc_vec3_copy(row.wire_mm, out.wires_mm);
+        dhcal_csv_write_row(&b, &cols, &out);
     }
-    free(pl.q_rad);
-    free(pl.dir);
-    if (b.oom) {
-        free(b.data);
+    dhcal_dataset_free(&pl);
+    if (b.failed) {
+        free(b.p);
         fprintf(stderr, "dhcal-sim: out of memory\n");
         return EXIT_COMPUTE;
     }
     if (o->model_out != NULL && dhcal_model_save(o->model_out, &sf.model, &err) != DHCAL_IO_OK) {
-        free(b.data);
+        free(b.p);
         fprintf(stderr, "dhcal-sim: %s\n", err.msg);
         return EXIT_COMPUTE;
     }
-    rc = dhcal_file_write_atomic(o->out, b.data, b.len, &err);
-    free(b.data);
+    rc = dhcal_file_write_atomic(o->out, b.p, b.len, &err);
+    free(b.p);
     if (rc != DHCAL_IO_OK) {
         fprintf(stderr, "dhcal-sim: %s\n", err.msg);
         return EXIT_COMPUTE;

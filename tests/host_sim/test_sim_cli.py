@@ -81,11 +81,11 @@ class SimCli(unittest.TestCase):
     def test_missing_keys_are_named(self):
         for key in ('seed', 'model', 'joints'):
             path = self.mutated(lambda s, k=key: s.pop(k))
-            self.assert_bad(self.dataset(path), path, "missing key '%s'" % key)
+            self.assert_bad(self.dataset(path), path, ': %s: required key missing' % key)
         path = self.mutated(lambda s: s['joints'][1]['link'].pop('mass_kg'))
-        self.assert_bad(self.dataset(path), path, 'joints[1].link', "'mass_kg'")
+        self.assert_bad(self.dataset(path), path, ': joints[1].link.mass_kg: required key missing')
         path = self.mutated(lambda s: s['joints'][2].pop('link'))
-        self.assert_bad(self.dataset(path), path, 'joints[2]', "'link'")
+        self.assert_bad(self.dataset(path), path, ': joints[2].link: required key missing')
 
     def test_negative_masses_and_stiffness_are_refused(self):
         cases = [
@@ -118,14 +118,14 @@ class SimCli(unittest.TestCase):
     def test_wrong_types_are_named(self):
         cases = [
             (lambda s: s.__setitem__('seed', 'one'), 'seed', 'got a string'),
-            (lambda s: s.__setitem__('seed', 1.5), 'seed', 'integer'),
+            (lambda s: s.__setitem__('seed', 1.5), 'seed', '1.5 is not a whole number'),
             (lambda s: s.__setitem__('joints', {}), 'joints', 'expected an array'),
             (lambda s: s['joints'][2]['link'].__setitem__('com_mm', 'x'),
              'joints[2].link.com_mm', 'array of 3 numbers'),
             (lambda s: s['joints'][0].__setitem__('motor', [1, 2]), 'joints[0].motor',
              'expected an object'),
             (lambda s: s['joint_defaults']['encoder'].__setitem__('lines', 500.5),
-             'joint_defaults.encoder.lines', 'integer'),
+             'joint_defaults.encoder.lines', '500.5 is not a whole number'),
             (lambda s: s['noise'].__setitem__('xyz_mm', True), 'noise.xyz_mm', 'boolean'),
             (lambda s: s.__setitem__('model', 7), 'model', 'path of a model file'),
         ]
@@ -144,7 +144,7 @@ class SimCli(unittest.TestCase):
             (lambda s: s['joints'][0].__setitem__(
                 'gear', {'stiffness_nm_per_rad': 1e4,
                          'transmission_error': [{'order': 0, 'sin_mrad': 1}]}),
-             'joints[0].gear.transmission_error[0].order', 'integer in [1, 1000]'),
+             'joints[0].gear.transmission_error[0].order', '0 is outside [1, 1000]'),
             (lambda s: s.__setitem__('physics', {'step_us': 150}), 'physics.step_us',
              '10 kHz or finer'),
             (lambda s: s['measurer'].__setitem__('wheel_radius_error', 0.7),
@@ -160,11 +160,11 @@ class SimCli(unittest.TestCase):
         path = self.scenario(text='{"seed": 1,\n  "model": "paper-3dof-model.json",\n  oops}')
         self.assert_bad(self.dataset(path), path + ':3:', 'syntax error')
         path = self.scenario(text='{"seed": 1, "seed": 2}')
-        self.assert_bad(self.dataset(path), path, 'seed', 'twice')
+        self.assert_bad(self.dataset(path), path, ': seed: key repeated')
         path = self.scenario(text='[1, 2]')
         self.assert_bad(self.dataset(path), path, 'expected an object')
         path = self.scenario(text='')
-        self.assert_bad(self.dataset(path), path, 'syntax error')
+        self.assert_bad(self.dataset(path), path, 'empty file')
         self.assert_bad(self.dataset(os.path.join(self.dir, 'missing.json')), 'missing.json',
                         'cannot open')
 
@@ -307,7 +307,7 @@ class SimCli(unittest.TestCase):
         bad = self.write('bad.csv', 'q1,q2\n1,2\n')
         r = self.sim('dataset', '--scenario', good, '--plan', bad, '--out', self.out)
         self.assertEqual(r.returncode, 2)
-        self.assertIn('missing column q3', r.stderr)
+        self.assertIn("bad.csv:1: missing column 'q3'", r.stderr)
 
     def test_model_out_loads_in_dhcal(self):
         good = self.scenario()

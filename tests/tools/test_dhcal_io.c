@@ -1,13 +1,15 @@
 /* test_dhcal_io.c - the file layer (io/), model JSON and measurement CSV: every bad input gets
  * DHCAL_IO_BAD_INPUT and one message naming the file and line (CSV) or JSON path (model);
- * good files load exactly; saved models load back to the same arm; a failed save leaves
- * the old file alone. Files are written into a fresh mkdtemp directory per test. */
+ * good files load exactly; written measurement CSV and saved models load back to what was
+ * written; a failed save leaves the old file alone. Files are written into a fresh mkdtemp
+ * directory per test. */
 /* POSIX.1-2008: mkdtemp, dirent, mkdir. */
 #ifndef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 200809L
 #endif
 #include <dirent.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -26,17 +28,23 @@ static char g_path[512];
 static dhcal_error g_err;
 static dhcal_dataset g_data;
 static dhcal_model g_model;
+static dhcal_text g_text;   /* what the CSV writer tests write */
+static uint64_t g_rng;      /* their values' generator */
 
 void setUp(void)
 {
     test_make_dir(g_dir, sizeof g_dir, "io");
     memset(&g_err, 0, sizeof g_err);
     memset(&g_data, 0, sizeof g_data);
+    memset(&g_text, 0, sizeof g_text);
+    g_rng = 0x9e3779b97f4a7c15U;
 }
 
 void tearDown(void)
 {
     dhcal_dataset_free(&g_data);
+    free(g_text.p);
+    memset(&g_text, 0, sizeof g_text);
     test_remove_dir(g_dir);
 }
 
@@ -436,6 +444,207 @@ static void test_dataset_free_is_idempotent(void)
     dhcal_dataset_free(&g_data);
 }
 
+/* ------------------------------------------------------------------ CSV: writing */
+
+/* The writer against the reader: rows written by dhcal_csv_write_header/_row and read back by
+ * dhcal_csv_load are the rows written, to the precision the writer promises, for every column
+ * set (positions or wire lengths, with or without dir, the optional columns). */
+
+/* Uniform in [lo, hi): 53 bits of a 64-bit LCG (Knuth's MMIX constants). */
+static double uniform(double lo, double hi)
+{
+    g_rng = g_rng * 6364136223846793005U + 1442695040888963407U;
+    return lo + (hi - lo) * (double)(g_rng >> 11) * (1.0 / 9007199254740992.0);
+}
+
+/* Values with more digits than the file keeps, inside the reader's ranges. */
+static void random_row(size_t n_joints, dhcal_row *r)
+{
+    memset(r, 0, sizeof *r);
+    for (size_t j = 0U; j < n_joints; ++j) {
+        r->q_rad[j] = uniform(-700.0, 700.0) / (1.0 / DEG);
+        r->dir[j] = uniform(0.0, 1.0) < 0.5 ? -1 : 1;
+    }
+    for (size_t k = 0U; k < 3U; ++k) {
+        r->xyz_mm[k] = uniform(-2500.0, 2500.0);
+        r->wires_mm[k] = uniform(50.0, 3000.0);
+    }
+    double norm = 0.0;
+    for (size_t k = 0U; k < 4U; ++k) {
+        r->quat[k] = uniform(-1.0, 1.0);
+        norm += r->quat[k] * r->quat[k];
+    }
+    for (size_t k = 0U; k < 4U; ++k) {
+        r->quat[k] /= sqrt(norm);
+    }
+    r->temp_c = uniform(-40.0, 120.0);
+    r->t_s = uniform(0.0, 1e6);
+}
+
+/* Half a unit of the last written decimal, and a little for the decimal-binary conversions. */
+static void assert_close(double half_unit, double want, double got)
+{
+    TEST_ASSERT_DOUBLE_WITHIN(half_unit * 1.02, want, got);
+}
+
+static void round_trip(const dhcal_csv_columns *cols, size_t n_rows)
+{
+    static dhcal_row rows[40];
+    TEST_ASSERT_TRUE(n_rows <= sizeof rows / sizeof rows[0]);
+    free(g_text.p);
+    memset(&g_text, 0, sizeof g_text);
+    dhcal_text_str(&g_text, "# a comment line before the header, as dhcal-sim writes\n");
+    dhcal_csv_write_header(&g_text, cols);
+    for (size_t i = 0U; i < n_rows; ++i) {
+        random_row(cols->n_joints, &rows[i]);
+        dhcal_csv_write_row(&g_text, cols, &rows[i]);
+    }
+    TEST_ASSERT_FALSE(g_text.failed);
+    const char *const p = path_of("written.csv");
+    TEST_ASSERT_EQUAL_INT(DHCAL_IO_OK, dhcal_file_write_atomic(p, g_text.p, g_text.len, &g_err));
+    dhcal_dataset_free(&g_data);
+    TEST_ASSERT_EQUAL_INT_MESSAGE(DHCAL_IO_OK, dhcal_csv_load(p, cols->n_joints, &g_data, &g_err),
+                                  g_err.msg);
+    TEST_ASSERT_EQUAL_size_t(n_rows, g_data.n_rows);
+    TEST_ASSERT_EQUAL_size_t(cols->n_joints, g_data.n_joints);
+    TEST_ASSERT_EQUAL_INT(cols->has_xyz, g_data.has_xyz);
+    TEST_ASSERT_EQUAL_INT(cols->has_wires, g_data.has_wires);
+    TEST_ASSERT_EQUAL_INT(cols->has_dir, g_data.has_dir);
+    TEST_ASSERT_EQUAL_INT(cols->has_quat, g_data.has_quat);
+    TEST_ASSERT_EQUAL_INT(cols->has_temp, g_data.has_temp);
+    TEST_ASSERT_EQUAL_INT(cols->has_time, g_data.has_time);
+    for (size_t i = 0U; i < n_rows; ++i) {
+        const dhcal_row *const w = &rows[i];
+        const dhcal_row *const r = &g_data.rows[i];
+        TEST_ASSERT_EQUAL_size_t(i + 3U, r->line); /* comment, header, then the rows */
+        for (size_t j = 0U; j < cols->n_joints; ++j) {
+            assert_close(5e-10, w->q_rad[j] * (1.0 / DEG), r->q_rad[j] * (1.0 / DEG));
+            if (cols->has_dir) {
+                TEST_ASSERT_EQUAL_INT(w->dir[j], r->dir[j]);
+            }
+        }
+        for (size_t k = 0U; k < 3U; ++k) {
+            if (cols->has_xyz) {
+                assert_close(5e-7, w->xyz_mm[k], r->xyz_mm[k]);
+            }
+            if (cols->has_wires) {
+                assert_close(5e-7, w->wires_mm[k], r->wires_mm[k]);
+            }
+        }
+        for (size_t k = 0U; cols->has_quat && k < 4U; ++k) {
+            /* four roundings of 5e-10, then the reader's normalisation */
+            assert_close(2e-9, w->quat[k], r->quat[k]);
+        }
+        if (cols->has_temp) {
+            assert_close(5e-4, w->temp_c, r->temp_c);
+        }
+        if (cols->has_time) {
+            assert_close(5e-7, w->t_s, r->t_s);
+        }
+    }
+}
+
+static void test_header_and_row_text(void)
+{
+    dhcal_csv_columns cols;
+    memset(&cols, 0, sizeof cols);
+    cols.n_joints = 2U;
+    cols.has_dir = 1;
+    cols.has_wires = 1;
+    dhcal_csv_write_header(&g_text, &cols);
+    dhcal_row r;
+    memset(&r, 0, sizeof r);
+    r.q_rad[0] = 3.14159265358979323846 / 2.0;
+    r.q_rad[1] = -0.5 / (1.0 / DEG);
+    r.dir[0] = 1;
+    r.dir[1] = -1;
+    r.wires_mm[0] = 1000.0;
+    r.wires_mm[1] = 0.0000004;
+    r.wires_mm[2] = 1234.5678906;
+    dhcal_csv_write_row(&g_text, &cols, &r);
+    TEST_ASSERT_FALSE(g_text.failed);
+    TEST_ASSERT_EQUAL_STRING("q1,q2,dir1,dir2,L1,L2,L3\n"
+                             "90.000000000,-0.500000000,1,-1,1000.000000,0.000000,1234.567891\n",
+                             g_text.p);
+
+    free(g_text.p);
+    memset(&g_text, 0, sizeof g_text);
+    cols.n_joints = 1U;
+    cols.has_xyz = cols.has_wires = cols.has_quat = cols.has_dir = 1;
+    cols.has_temp = cols.has_time = 1;
+    dhcal_csv_write_header(&g_text, &cols);
+    TEST_ASSERT_EQUAL_STRING("q1,dir1,x,y,z,L1,L2,L3,qw,qx,qy,qz,temp_c,t_s\n", g_text.p);
+}
+
+static void test_positions_or_wire_lengths_with_and_without_dir(void)
+{
+    for (int wires = 0; wires <= 1; ++wires) {
+        for (int dir = 0; dir <= 1; ++dir) {
+            dhcal_csv_columns cols;
+            memset(&cols, 0, sizeof cols);
+            cols.n_joints = 3U;
+            cols.has_xyz = !wires;
+            cols.has_wires = wires;
+            cols.has_dir = dir;
+            round_trip(&cols, 25U);
+        }
+    }
+}
+
+static void test_every_optional_column(void)
+{
+    dhcal_csv_columns cols;
+    memset(&cols, 0, sizeof cols);
+    cols.n_joints = DHC_MAX_JOINTS;
+    cols.has_xyz = cols.has_wires = cols.has_quat = cols.has_dir = 1;
+    cols.has_temp = cols.has_time = 1;
+    round_trip(&cols, 40U);
+    cols.n_joints = 1U;
+    cols.has_wires = cols.has_dir = 0;
+    round_trip(&cols, 10U);
+}
+
+/* ------------------------------------------------------------------ pose plans */
+
+static void plan_bad(const char *text, size_t line, const char *needle)
+{
+    const char *const p = write_text("plan.csv", text);
+    char where[600];
+    (void)snprintf(where, sizeof where, "%s:%zu: ", p, line);
+    TEST_ASSERT_EQUAL_INT(DHCAL_IO_BAD_INPUT, dhcal_csv_load_plan(p, 3U, &g_data, &g_err));
+    assert_msg_has(where);
+    assert_msg_has(needle);
+    TEST_ASSERT_NULL(g_data.rows);
+}
+
+/* A plan is a measurement CSV without measurements; each dir column stands on its own and a
+ * joint without one reads dir 0 (the simulator draws it). */
+static void test_plan_has_no_measurements_and_dirs_of_its_own(void)
+{
+    const char *const p = write_text("plan.csv", "# targets\nq1, q2, q3, dir2\n10, 45, -30, -1\n"
+                                                 "\n-120.5, 100, 60, +1\n");
+    TEST_ASSERT_EQUAL_INT_MESSAGE(DHCAL_IO_OK, dhcal_csv_load_plan(p, 3U, &g_data, &g_err),
+                                  g_err.msg);
+    TEST_ASSERT_EQUAL_size_t(2U, g_data.n_rows);
+    TEST_ASSERT_TRUE(g_data.has_dir);
+    TEST_ASSERT_FALSE(g_data.has_xyz || g_data.has_wires);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-15, 45.0 * DEG, g_data.rows[0].q_rad[1]);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-15, -120.5 * DEG, g_data.rows[1].q_rad[0]);
+    TEST_ASSERT_EQUAL_INT(0, g_data.rows[0].dir[0]);
+    TEST_ASSERT_EQUAL_INT(-1, g_data.rows[0].dir[1]);
+    TEST_ASSERT_EQUAL_INT(1, g_data.rows[1].dir[1]);
+    TEST_ASSERT_EQUAL_INT(0, g_data.rows[1].dir[2]);
+    TEST_ASSERT_EQUAL_size_t(5U, g_data.rows[1].line);
+    dhcal_dataset_free(&g_data);
+
+    plan_bad("q1,q2\n1,2\n", 1U, "missing column 'q3'");
+    plan_bad("q1,q2,q3,x,y,z\n1,2,3,4,5,6\n", 1U, "unknown column 'x' (a pose plan has q1..q3");
+    plan_bad("q1,q2,q3,dir4\n1,2,3,1\n", 1U, "column 'dir4' is beyond the model's 3 joints");
+    plan_bad("q1,q2,q3,dir1\n1,2,3,0\n", 2U, "column 'dir1': 0 is not -1 or +1");
+    plan_bad("q1,q2,q3\n1,2,800\n", 2U, "column 'q3': 800 is outside [-720, 720] deg");
+    plan_bad("q1,q2,q3\n", 1U, "header but no data rows");
+}
+
 /* ------------------------------------------------------------------ model helpers */
 
 static const char *const J3 =
@@ -501,6 +710,21 @@ static void test_model_syntax_error_reports_line_and_column(void)
     model_bad("{\"joints\": []} trailing", ":1:", "JSON syntax error near 'trailing'");
     model_bad("{\"joints\": [1,]}", ":1:", "JSON syntax error");
     model_bad("// comment\n{}", ":1:1: ", "JSON syntax error");
+}
+
+/* JSON has no NaN or Infinity: the token is named with its JSON path and its line:column
+ * (cJSON stops at the token, so a plain syntax error could only give the position). */
+static void test_model_nan_and_infinity_name_their_path(void)
+{
+    model_bad("{\"joints\": [{\"alpha_deg\": 90, \"a_mm\": 0, \"d_mm\": 1},\n"
+              " {\"alpha_deg\": NaN, \"a_mm\": 0, \"d_mm\": 1}]}",
+              ": joints[1].alpha_deg: ", "NaN is not a number (JSON has no NaN or Infinity; line 2:16)");
+    model_bad("{\"tool_mm\": [0, -Infinity, 0], \"joints\": []}", ": tool_mm[1]: ",
+              "-Infinity is not a number");
+    /* a token the marker parse cannot place (the file is broken elsewhere too): position only */
+    model_bad("{\"joints\": [inf,", ":1:13: ", "inf is not a number");
+    /* a word that only starts like one is a plain syntax error */
+    model_bad("{\"joints\": [Info]}", ":1:13: ", "JSON syntax error near 'Info]}'");
 }
 
 static void test_model_syntax_error_column_is_exact(void)
@@ -1057,11 +1281,16 @@ int main(void)
     RUN_TEST(test_csv_row_limits_and_dirs_exact);
     RUN_TEST(test_csv_many_rows_grow);
     RUN_TEST(test_csv_joint_count_outside_limits_is_a_caller_error);
+    RUN_TEST(test_header_and_row_text);
+    RUN_TEST(test_positions_or_wire_lengths_with_and_without_dir);
+    RUN_TEST(test_every_optional_column);
+    RUN_TEST(test_plan_has_no_measurements_and_dirs_of_its_own);
     RUN_TEST(test_dataset_free_is_idempotent);
     /* model */
     RUN_TEST(test_model_missing_file);
     RUN_TEST(test_model_empty_file);
     RUN_TEST(test_model_syntax_error_reports_line_and_column);
+    RUN_TEST(test_model_nan_and_infinity_name_their_path);
     RUN_TEST(test_model_syntax_error_column_is_exact);
     RUN_TEST(test_model_nul_and_control_bytes);
     RUN_TEST(test_model_too_large);

@@ -67,7 +67,7 @@ typedef struct {
 /* Loads and validates a scenario and its model file. Returns DHCAL_IO_OK, or
  * DHCAL_IO_BAD_INPUT with one message in err naming the file and the JSON path, e.g.
  *     S.json: joints[1].gear.stiffness_nm_per_rad: must be > 0, got -5
- *     S.json:4:21: NaN is not a number (JSON has no NaN or Infinity) at joints[0].gear.ratio
+ *     S.json: joints[0].gear.ratio: NaN is not a number (JSON has no NaN or Infinity; line 4:21)
  * (errors in the model file name the model file, as dhcal_model_load reports them), or
  * DHCAL_IO_FAILED (out of memory). On error *out is zeroed. O(file size). */
 int dhs_scenario_load(const char *path, dhs_scenario_file *out, dhcal_error *err);
