@@ -92,6 +92,25 @@ def cost(label, target):
     return []
 
 
+def bits(x):
+    return "0x%016x" % struct.unpack("<Q", struct.pack("<d", x))[0]
+
+
+def comparison_sees_differences():
+    """The comparison itself: a parameter off by 2e-9 relative, or another rank, fails;
+    1e-10 passes."""
+    base = f"rank 11\np.a2 {bits(400.25)}\n"
+    near = f"rank 11\np.a2 {bits(400.25 * (1 + 1e-10))}\n"
+    far = f"rank 11\np.a2 {bits(400.25 * (1 + 2e-9))}\n"
+    rank = f"rank 10\np.a2 {bits(400.25)}\n"
+    import contextlib
+    import io
+    with contextlib.redirect_stdout(io.StringIO()):
+        ok = (not compare("self", base, near)[0] and compare("self", base, far)[0] and
+              compare("self", base, rank)[0])
+    return ok
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--emulator", required=True)
@@ -102,6 +121,9 @@ def main():
     ap.add_argument("--host", required=True)
     ap.add_argument("--target", required=True)
     a = ap.parse_args()
+    if not comparison_sees_differences():
+        print("FAIL: the comparison does not tell a 2e-9 difference from a 1e-10 one")
+        return 1
     os.makedirs(a.scratch, exist_ok=True)
     demo = os.path.abspath(os.path.join(a.scratch, f"{a.what}_demo3.bin"))
     arm6 = os.path.abspath(os.path.join(a.scratch, f"{a.what}_arm6.bin"))
