@@ -6,7 +6,7 @@ from the same sample files, in this run, and compares what they computed.
                 fit|job --host PROG --target ELF
 
 fit: parity_fit on the demo's 3-DOF wire samples and on a 6-DOF pose set; job: job_replay on
-the demo's samples. Every parameter ("p." lines) must agree to 1e-9 relative, and so must
+the demo's samples, with the diagnosis and with the effect configured instead. Every parameter ("p." lines) must agree to 1e-9 relative, and so must
 the fit's other numbers; counts and names (status, rank, effect, stored sequence) must be
 equal. The target runs with -icount shift=0: the instructions it reports for the fit or the
 job's calibration are printed with their time at 168 MHz."""
@@ -133,16 +133,16 @@ def main():
             print(out, end="")
             print(f"FAIL: {' '.join(cmd)} exited {rc}")
             return 1
-    cases = [("3-DOF wires + joint_compliance:2", demo)]
     if a.what == "fit":
-        cases.append(("6-DOF poses", arm6))
+        cases = [("3-DOF wires + joint_compliance:2", [demo]), ("6-DOF poses", [arm6])]
     else:
-        cases = [("job on the demo's samples", demo)]
+        cases = [("job, diagnosis on", [demo]),
+                 ("job, joint_compliance:2 configured, no diagnosis", [demo, "configured"])]
     env = dict(os.environ, DHCAL_QEMU_OPTS="-icount shift=0")
     bad = []
-    for label, path in cases:
-        rc_h, out_h = run([a.host, path])
-        rc_t, out_t = run([a.emulator, a.target, path], env=env)
+    for label, args in cases:
+        rc_h, out_h = run([a.host] + args)
+        rc_t, out_t = run([a.emulator, a.target] + args, env=env)
         if rc_h != 0 or rc_t != 0:
             print(f"--- host ({rc_h})\n{out_h}--- target ({rc_t})\n{out_t}", end="")
             bad.append(f"{label}: host exited {rc_h}, target {rc_t}")

@@ -1,10 +1,12 @@
 /* job_replay.c - the controller's job (fw_job) on recorded samples, the same on the
  * Cortex-M4 and on the host (twin.h):
- *   job_replay FILE
+ *   job_replay FILE [configured]
  * FILE: wire samples of the paper's 3-DOF arm as dhcal-demo collected them. The job boots
  * on a port whose arm stands still at the start pose (nothing moves: the samples are
  * recorded), plans, takes the recording as its acquisition (fw_job_acquire_recorded),
- * calibrates with the demo's configuration (noise model on, the diagnosis on) and stores
+ * calibrates with the demo's configuration (noise model on, the diagnosis on; with
+ * `configured`, as `dhcal-demo --effects joint_compliance:2 --no-diagnose`: the effect
+ * known and fitted from the start, no diagnosis) and stores
  * into a RAM store through fw_calstore. Prints what the job found, the parameters of the
  * calibration it stored (read back with fw_cal_load), the store's bytes and the
  * instructions fw_job_calibrate took (0 on the host). */
@@ -114,9 +116,11 @@ int twin_main(int argc, char **argv)
 {
     size_t n = 0U;
     size_t nj = 0U;
-    if (argc != 2 || twin_load_samples(argv[1], recorded, TWIN_MAX_SAMPLES, &n, &nj) != 0 ||
-        nj != 3U) {
-        twin_puts("usage: job_replay FILE (wire samples of the 3-DOF paper arm)\n");
+    const int configured = argc == 3 && strcmp(argv[2], "configured") == 0;
+    if ((argc != 2 && !configured) ||
+        twin_load_samples(argv[1], recorded, TWIN_MAX_SAMPLES, &n, &nj) != 0 || nj != 3U) {
+        twin_puts("usage: job_replay FILE [configured] (wire samples of the 3-DOF paper "
+                  "arm)\n");
         return 2;
     }
     dhc_model nominal = test_paper3_model();
@@ -143,6 +147,12 @@ int twin_main(int argc, char **argv)
     cfg.noise_model = 1;
     /* the wires' noise the demo measured over its holds; the recording has no holds */
     cfg.autocal.wire_noise_mm = 0.0036;
+    if (configured) {
+        cfg.autocal.n_effects = 1U;
+        cfg.autocal.effect[0] = DHC_EFFECT_JOINT_COMPLIANCE;
+        cfg.autocal.effect_joint[0] = 1U;
+        cfg.autocal.diagnose = 0;
+    }
 
     fw_fault f = fw_job_boot(&job, &cfg, &nominal, &port, &io);
     if (f == FW_FAULT_NONE) {
