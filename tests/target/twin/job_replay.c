@@ -164,7 +164,9 @@ int twin_main(int argc, char **argv)
     uint64_t took = 0U;
     if (f == FW_FAULT_NONE) {
         const uint64_t t0 = twin_instructions();
+        twin_measure_begin();
         f = fw_job_calibrate(&job, &port.nv);
+        twin_measure_end();
         took = twin_instructions() - t0;
     }
     twin_puts("fault ");

@@ -34,6 +34,11 @@ int twin_read_file(const char *path, void *buf, size_t cap, size_t *len);
  * twin_target.c), 0 where there is none (the host). */
 uint64_t twin_instructions(void);
 
+/* Around the part of a program whose cost is measured: the target's profile mode samples
+ * the program counter there (twin_target.c); elsewhere nothing. */
+void twin_measure_begin(void);
+void twin_measure_end(void);
+
 /* ---- shared by the programs (twin_common.c) */
 
 void twin_puts(const char *s);
