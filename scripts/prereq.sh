@@ -187,7 +187,8 @@ probe_fuzz() {
 # it enables the FPU, computes, and leaves through semihosting SYS_EXIT with "application
 # exit" (QEMU status 0) or a run-time error (status 1).
 probe_cortex_m4() {
-  probe_build_tools || return 1
+  # the host side of the twin programs (tests/target/twin) is built with the host's gcc
+  probe_build_tools && probe_host_c || return 1
   prereq_cmd arm-none-eabi-gcc && prereq_cmd qemu-system-arm || return 1
   cat >m.c <<'EOF'
 #include <math.h>

@@ -3,6 +3,8 @@
 
 #include <string.h>
 
+#include "dhcal/dhc_matrix.h"
+
 void fw_job_default_config(fw_job_config *cfg, const dhc_model *nominal)
 {
     memset(cfg, 0, sizeof *cfg);
@@ -93,6 +95,35 @@ fw_fault fw_job_acquire(fw_job *job)
     }
     return fw_acquire(&job->ctrl, &job->nominal, job->plan, job->n_plan, job->cfg.hold_ticks,
                       &job->acq, job->samples, &job->n_samples);
+}
+
+fw_fault fw_job_acquire_recorded(fw_job *job, const dhc_sample *samples, size_t n,
+                                 const fw_acq_stats *acq)
+{
+    job->n_samples = 0U;
+    fw_acq_stats_reset(&job->acq);
+    if (job->ctrl.fault != FW_FAULT_NONE) {
+        return job->ctrl.fault;
+    }
+    if (samples == NULL || n == 0U || n > FW_ACQ_MAX_SAMPLES) {
+        return FW_FAULT_ARGUMENT;
+    }
+    const size_t nj = job->nominal.arm.n_joints;
+    for (size_t i = 0U; i < n; ++i) {
+        const dhc_sample *s = &samples[i];
+        /* a recording is outside input: the fit's screens expect the acquisition's checks */
+        const int ok = s->kind == (uint8_t)DHC_MEAS_WIRES && dhc_is_finite(s->temp_c) &&
+                 dhc_all_finite(s->wire_mm, 3U) && dhc_all_finite(s->q_rad, nj);
+        if (!ok) {
+            return FW_FAULT_ARGUMENT;
+        }
+    }
+    memcpy(job->samples, samples, n * sizeof *samples);
+    job->n_samples = n;
+    if (acq != NULL) {
+        job->acq = *acq;
+    }
+    return FW_FAULT_NONE;
 }
 
 fw_fault fw_job_calibrate(fw_job *job, const fw_nvstore *nv)

@@ -82,6 +82,16 @@ fw_fault fw_job_plan(fw_job *job);
 /* Acquire: one sample per planned pose (fw_acquire), the holds' noise counted afresh. */
 fw_fault fw_job_acquire(fw_job *job);
 
+/* Acquire from a recording instead of the port: n wire samples taken earlier on this
+ * machine (the samples file dhcal-demo writes, a log of the arm), and what their holds
+ * showed (acq; NULL: nothing measured, as after fw_acq_stats_reset). The arm does not move.
+ * Lets a controller without the arm attached (a bench, a bare-metal test under an emulator)
+ * calibrate exactly as the job that collected them would. FW_FAULT_ARGUMENT (nothing kept)
+ * when n is 0 or above FW_ACQ_MAX_SAMPLES, or a sample is not a DHC_MEAS_WIRES sample
+ * with finite angles and lengths. */
+fw_fault fw_job_acquire_recorded(fw_job *job, const dhc_sample *samples, size_t n,
+                                 const fw_acq_stats *acq);
+
 /* Calibrate, diagnose, refit and store (fw_autocal_configured) on the job's samples; nv
  * may be NULL (nothing stored). FW_FAULT_STORAGE still leaves the calibration valid
  * (calibrated_ok). */

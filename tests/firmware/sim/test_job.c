@@ -135,6 +135,42 @@ static void test_too_few_samples_is_not_an_argument_error(void)
     TEST_ASSERT_EQUAL_STRING("underdetermined", fw_fault_name(FW_FAULT_UNDERDETERMINED));
 }
 
+/* A job that takes another job's samples and hold statistics as a recording calibrates to
+ * the same bits without moving the arm; a recording it cannot fit is refused whole. */
+static void test_a_recorded_acquisition_calibrates_like_the_live_one(void)
+{
+    static fw_job live;
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_job_run(&live, &cfg, &nominal, &port, &io, NULL));
+    fresh_arm();
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_job_boot(&job, &cfg, &nominal, &port, &io));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_job_plan(&job));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE,
+                      fw_job_acquire_recorded(&job, live.samples, live.n_samples, &live.acq));
+    TEST_ASSERT_EQUAL_UINT64(0U, sim.ticks); /* nothing moved */
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_job_calibrate(&job, NULL));
+    TEST_ASSERT_EQUAL_MEMORY(&live.calibrated, &job.calibrated, sizeof job.calibrated);
+    TEST_ASSERT_EQUAL_MEMORY(&live.result.noise, &job.result.noise, sizeof job.result.noise);
+
+    /* without the holds' statistics the noise model has no dither: another weighting */
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE,
+                      fw_job_acquire_recorded(&job, live.samples, live.n_samples, NULL));
+    TEST_ASSERT_EQUAL_UINT32(0U, job.acq.wire_sem_count);
+
+    static dhc_sample bad[FW_ACQ_MAX_SAMPLES + 1U];
+    memcpy(bad, live.samples, live.n_samples * sizeof bad[0]);
+    TEST_ASSERT_EQUAL(FW_FAULT_ARGUMENT, fw_job_acquire_recorded(&job, bad, 0U, NULL));
+    TEST_ASSERT_EQUAL(FW_FAULT_ARGUMENT,
+                      fw_job_acquire_recorded(&job, bad, FW_ACQ_MAX_SAMPLES + 1U, NULL));
+    bad[3].kind = (uint8_t)DHC_MEAS_POSITION;
+    TEST_ASSERT_EQUAL(FW_FAULT_ARGUMENT,
+                      fw_job_acquire_recorded(&job, bad, live.n_samples, NULL));
+    bad[3] = live.samples[3];
+    bad[5].wire_mm[1] = (double)NAN;
+    TEST_ASSERT_EQUAL(FW_FAULT_ARGUMENT,
+                      fw_job_acquire_recorded(&job, bad, live.n_samples, NULL));
+    TEST_ASSERT_EQUAL_size_t(0U, job.n_samples);
+}
+
 static void test_lib_failures_map_to_distinct_faults(void)
 {
     TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_fault_of_status(DHC_OK));
@@ -171,6 +207,7 @@ int main(void)
     RUN_TEST(test_a_job_does_not_depend_on_the_one_before);
     RUN_TEST(test_boot_refuses_a_configuration_the_machine_cannot_run);
     RUN_TEST(test_too_few_samples_is_not_an_argument_error);
+    RUN_TEST(test_a_recorded_acquisition_calibrates_like_the_live_one);
     RUN_TEST(test_lib_failures_map_to_distinct_faults);
     RUN_TEST(test_the_effect_label_is_the_effect_table_name);
     return UNITY_END();

@@ -1,0 +1,159 @@
+#!/usr/bin/env python3
+"""check_twin.py - runs one twin program (twin.h) on the Cortex-M4 under QEMU and on the host
+from the same sample files, in this run, and compares what they computed.
+
+  check_twin.py --emulator QEMU_SH --prepare TWIN_PREPARE --csv DEMO.csv --scratch DIR
+                fit|job --host PROG --target ELF
+
+fit: parity_fit on the demo's 3-DOF wire samples and on a 6-DOF pose set; job: job_replay on
+the demo's samples, with the diagnosis and with the effect configured instead. Every parameter ("p." lines) must agree to 1e-9 relative, and so must
+the fit's other numbers; counts and names (status, rank, effect, stored sequence) must be
+equal. The target runs with -icount shift=0: the instructions it reports for the fit or the
+job's calibration are printed with their time at 168 MHz."""
+import argparse
+import os
+import struct
+import subprocess
+import sys
+
+REL = 1e-9
+MHZ = 168.0
+# reported, not required equal: a last-bit difference may cost the fit one more step
+INFO = {"iterations", "instructions", "instructions_per_tick_q10"}
+
+
+def run(cmd, env=None):
+    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                       env=env, check=False)
+    return p.returncode, p.stdout
+
+
+def parse(text):
+    values, store = {}, []
+    for line in text.splitlines():
+        key, _, value = line.partition(" ")
+        if key == "store":
+            store.append(value)
+        elif key and value:
+            values[key] = value
+    return values, bytes.fromhex("".join(store))
+
+
+def as_double(hexbits):
+    return struct.unpack("<d", struct.pack("<Q", int(hexbits, 16)))[0]
+
+
+def compare(label, host_text, target_text):
+    """Failures (strings) and the largest relative difference of the parameters."""
+    host, host_store = parse(host_text)
+    target, target_store = parse(target_text)
+    bad, worst = [], 0.0
+    for key in sorted(set(host) | set(target)):
+        if key in INFO:
+            continue
+        if key not in host or key not in target:
+            bad.append(f"{label}: {key} only on the {'host' if key in host else 'target'}")
+            continue
+        h, t = host[key], target[key]
+        if h.startswith("0x") and t.startswith("0x"):
+            a, b = as_double(h), as_double(t)
+            scale = max(abs(a), abs(b))
+            rel = 0.0 if a == b else abs(a - b) / scale
+            if key.startswith("p."):
+                worst = max(worst, rel)
+            if not rel <= REL:
+                bad.append(f"{label}: {key} host {a!r} target {b!r} (relative {rel:.3g})")
+        elif h != t:
+            bad.append(f"{label}: {key} host {h} target {t}")
+    n_params = sum(1 for k in host if k.startswith("p."))
+    if n_params == 0:
+        bad.append(f"{label}: no parameters printed")
+    print(f"{label}: {n_params} parameters, largest relative difference {worst:.3g} "
+          f"(bit-identical: {'yes' if worst == 0.0 else 'no'}); iterations host "
+          f"{host.get('iterations', '-')} target {target.get('iterations', '-')}")
+    if host_store or target_store:
+        same = host_store == target_store
+        diff = sum(1 for x, y in zip(host_store, target_store) if x != y)
+        print(f"{label}: store of {len(host_store)} bytes; target's "
+              f"{'identical' if same else f'differs in {diff} bytes'}")
+        if len(host_store) != len(target_store):
+            bad.append(f"{label}: store sizes differ")
+    return bad, target
+
+
+def cost(label, target):
+    n = int(target.get("instructions", "0"))
+    ratio = int(target.get("instructions_per_tick_q10", "0")) / 1024.0
+    if n <= 0 or ratio <= 0.0:
+        return [f"{label}: the target counted no instructions (QEMU without -icount?)"]
+    ms = n / (MHZ * 1e3)
+    print(f"{label}: {n} instructions on the Cortex-M4 ({ratio:.2f} per timer tick); at "
+          f"{MHZ:.0f} MHz and 1 cycle per instruction {ms:.1f} ms")
+    return []
+
+
+def bits(x):
+    return "0x%016x" % struct.unpack("<Q", struct.pack("<d", x))[0]
+
+
+def comparison_sees_differences():
+    """The comparison itself: a parameter off by 2e-9 relative, or another rank, fails;
+    1e-10 passes."""
+    base = f"rank 11\np.a2 {bits(400.25)}\n"
+    near = f"rank 11\np.a2 {bits(400.25 * (1 + 1e-10))}\n"
+    far = f"rank 11\np.a2 {bits(400.25 * (1 + 2e-9))}\n"
+    rank = f"rank 10\np.a2 {bits(400.25)}\n"
+    import contextlib
+    import io
+    with contextlib.redirect_stdout(io.StringIO()):
+        ok = (not compare("self", base, near)[0] and compare("self", base, far)[0] and
+              compare("self", base, rank)[0])
+    return ok
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--emulator", required=True)
+    ap.add_argument("--prepare", required=True)
+    ap.add_argument("--csv", required=True)
+    ap.add_argument("--scratch", required=True)
+    ap.add_argument("what", choices=["fit", "job"])
+    ap.add_argument("--host", required=True)
+    ap.add_argument("--target", required=True)
+    a = ap.parse_args()
+    if not comparison_sees_differences():
+        print("FAIL: the comparison does not tell a 2e-9 difference from a 1e-10 one")
+        return 1
+    os.makedirs(a.scratch, exist_ok=True)
+    demo = os.path.abspath(os.path.join(a.scratch, f"{a.what}_demo3.bin"))
+    arm6 = os.path.abspath(os.path.join(a.scratch, f"{a.what}_arm6.bin"))
+    for cmd in ([a.prepare, "csv", a.csv, demo], [a.prepare, "arm6", arm6]):
+        rc, out = run(cmd)
+        if rc != 0:
+            print(out, end="")
+            print(f"FAIL: {' '.join(cmd)} exited {rc}")
+            return 1
+    if a.what == "fit":
+        cases = [("3-DOF wires + joint_compliance:2", [demo]), ("6-DOF poses", [arm6])]
+    else:
+        cases = [("job, diagnosis on", [demo]),
+                 ("job, joint_compliance:2 configured, no diagnosis", [demo, "configured"])]
+    env = dict(os.environ, DHCAL_QEMU_OPTS="-icount shift=0")
+    bad = []
+    for label, args in cases:
+        rc_h, out_h = run([a.host] + args)
+        rc_t, out_t = run([a.emulator, a.target] + args, env=env)
+        if rc_h != 0 or rc_t != 0:
+            print(f"--- host ({rc_h})\n{out_h}--- target ({rc_t})\n{out_t}", end="")
+            bad.append(f"{label}: host exited {rc_h}, target {rc_t}")
+            continue
+        b, target = compare(label, out_h, out_t)
+        bad += b + cost(label, target)
+    for b in bad:
+        print("FAIL:", b)
+    print(f"{'FAILED' if bad else 'OK'}: {a.what} parity of the Cortex-M4 and the host")
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

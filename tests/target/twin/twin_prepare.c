@@ -1,0 +1,154 @@
+/* twin_prepare.c - host only: writes the sample files (twin.h) that the twin programs read on
+ * both sides, so that the target and the host start from the same bits.
+ *   twin_prepare csv IN.csv OUT   dhcal-demo's samples.csv (q1..qn deg, dir1..dirn, L1..L3)
+ *                                 as wire samples; degrees to radians here, once
+ *   twin_prepare arm6 OUT         60 pose samples of the paper's actual 6-DOF arm (Table 1,
+ *                                 every joint offset 2 deg) at random poses, with noise:
+ *                                 uniform +-0.05 mm on the point, +-0.1 mrad about each axis */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dhc_test_arms.h"
+#include "dhcal/dhc_geometry.h"
+#include "dhcal/dhc_model.h"
+
+#define MAX_DOUBLES 8192U
+#define TWIN_ROWS_MAX 128U
+static double out[MAX_DOUBLES];
+static size_t n_out;
+
+static void put(double v)
+{
+    if (n_out == MAX_DOUBLES) {
+        fprintf(stderr, "twin_prepare: too many samples\n");
+        exit(2);
+    }
+    out[n_out++] = v;
+}
+
+static int write_out(const char *path)
+{
+    FILE *f = fopen(path, "wb");
+    if (f == NULL || fwrite(out, sizeof(double), n_out, f) != n_out || fclose(f) != 0) {
+        fprintf(stderr, "twin_prepare: cannot write %s\n", path);
+        return 1;
+    }
+    return 0;
+}
+
+static int from_csv(const char *in, const char *path)
+{
+    FILE *f = fopen(in, "r");
+    if (f == NULL) {
+        fprintf(stderr, "twin_prepare: cannot read %s\n", in);
+        return 1;
+    }
+    char line[1024];
+    size_t nj = 0U;
+    if (fgets(line, sizeof line, f) != NULL) {
+        for (const char *p = line; (p = strchr(p, 'q')) != NULL; ++p) {
+            ++nj;
+        }
+    }
+    static double rows[TWIN_ROWS_MAX][2U * DHC_MAX_JOINTS + 3U];
+    size_t n = 0U;
+    const size_t cols = 2U * nj + 3U;
+    while (nj > 0U && nj <= DHC_MAX_JOINTS && fgets(line, sizeof line, f) != NULL) {
+        if (n == TWIN_ROWS_MAX) {
+            fprintf(stderr, "twin_prepare: %s: more than %u samples\n", in, TWIN_ROWS_MAX);
+            (void)fclose(f);
+            return 1;
+        }
+        char *p = line;
+        for (size_t c = 0U; c < cols; ++c) {
+            char *end = NULL;
+            rows[n][c] = strtod(p, &end);
+            if (end == p || (*end != ',' && c + 1U < cols)) {
+                fprintf(stderr, "twin_prepare: %s:%zu: not %zu numbers\n", in, n + 2U, cols);
+                (void)fclose(f);
+                return 1;
+            }
+            p = end + 1;
+        }
+        ++n;
+    }
+    (void)fclose(f);
+    if (nj == 0U || nj > DHC_MAX_JOINTS || n == 0U) {
+        fprintf(stderr, "twin_prepare: %s: no samples\n", in);
+        return 1;
+    }
+    put(1.0);
+    put((double)nj);
+    put((double)DHC_MEAS_WIRES);
+    put((double)n);
+    for (size_t i = 0U; i < n; ++i) {
+        for (size_t j = 0U; j < nj; ++j) {
+            put(rows[i][j] * DHC_PI / 180.0);
+        }
+        for (size_t c = nj; c < cols; ++c) {
+            put(rows[i][c]);
+        }
+    }
+    return write_out(path);
+}
+
+static int arm6(const char *path)
+{
+    dhc_arm truth_arm;
+    test_arm_from_table(&truth_arm, TEST_TABLE1, 6U, TEST_PAPER_OFFSET_DEG);
+    const dhc_model truth = test_model_of(&truth_arm);
+    test_rng rng = {20261124U};
+    const size_t n = 60U;
+    put(1.0);
+    put(6.0);
+    put((double)DHC_MEAS_POSE);
+    put((double)n);
+    for (size_t i = 0U; i < n; ++i) {
+        dhc_sample s;
+        memset(&s, 0, sizeof s);
+        s.kind = (uint8_t)DHC_MEAS_POSE;
+        s.temp_c = truth.thermal_ref_c;
+        test_random_q(&rng, &truth.arm, s.q_rad);
+        dhc_prediction pr;
+        if (dhc_model_predict(&truth, &s, &pr) != DHC_OK) {
+            fprintf(stderr, "twin_prepare: the 6-DOF arm does not predict\n");
+            return 1;
+        }
+        for (size_t j = 0U; j < 6U; ++j) {
+            put(s.q_rad[j]);
+        }
+        for (size_t j = 0U; j < 6U; ++j) {
+            put(test_uniform(&rng) < 0.5 ? -1.0 : 1.0);
+        }
+        for (size_t k = 0U; k < 3U; ++k) {
+            put(pr.p_mm[k] + test_range(&rng, -0.05, 0.05));
+        }
+        double w[3];
+        for (size_t k = 0U; k < 3U; ++k) {
+            w[k] = test_range(&rng, -1e-4, 1e-4);
+        }
+        dhc_mat3 noise;
+        dhc_mat3 rot;
+        dhc_rot_exp(w, &noise);
+        dhc_rot_mul(&pr.rot, &noise, &rot);
+        for (size_t r = 0U; r < 3U; ++r) {
+            for (size_t c = 0U; c < 3U; ++c) {
+                put(rot.m[r][c]);
+            }
+        }
+    }
+    return write_out(path);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc == 4 && strcmp(argv[1], "csv") == 0) {
+        return from_csv(argv[2], argv[3]);
+    }
+    if (argc == 3 && strcmp(argv[1], "arm6") == 0) {
+        return arm6(argv[2]);
+    }
+    fprintf(stderr, "usage: twin_prepare csv IN.csv OUT | twin_prepare arm6 OUT\n");
+    return 2;
+}
