@@ -3,6 +3,7 @@
 #ifndef DHC_TEST_ARMS_H
 #define DHC_TEST_ARMS_H
 
+#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <string.h>
@@ -55,6 +56,14 @@ static inline double test_uniform(test_rng *r)
     r->s ^= r->s >> 27;
     const uint64_t x = r->s * 2685821657736338717ULL;
     return (double)(x >> 11) * (1.0 / 9007199254740992.0);
+}
+
+/* Standard normal deviate (Box-Muller), independent of the library. */
+static inline double test_gauss(test_rng *r)
+{
+    const double u1 = fmax(test_uniform(r), 1e-300);
+    const double u2 = test_uniform(r);
+    return sqrt(-2.0 * log(u1)) * cos(2.0 * TEST_PI * u2);
 }
 
 static inline double test_range(test_rng *r, double lo, double hi)

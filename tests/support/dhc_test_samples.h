@@ -27,6 +27,19 @@ static inline dhc_status test_read_sample(void *ctx, size_t index, dhc_sample *o
     return DHC_OK;
 }
 
+/* The sample's measurement (kind) as the true model makes it, noise-free, at the sample's
+ * angles and directions and the model's reference temperature. */
+static inline void test_measure_exactly(const dhc_model *truth, dhc_meas_kind kind, dhc_sample *s)
+{
+    s->temp_c = truth->thermal_ref_c;
+    s->kind = (uint8_t)kind;
+    dhc_prediction pred;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_model_predict(truth, s, &pred));
+    dhc_vec3_copy(pred.p_mm, s->p_mm);
+    s->rot = pred.rot;
+    dhc_vec3_copy(pred.wire_mm, s->wire_mm);
+}
+
 /* n noise-free measurements of the true model at random poses and approach directions. */
 static inline void test_measure_model(test_dataset *d, const dhc_model *truth, size_t n,
                                       dhc_meas_kind kind, test_rng *rng)
@@ -40,13 +53,7 @@ static inline void test_measure_model(test_dataset *d, const dhc_model *truth, s
         for (size_t i = 0U; i < truth->arm.n_joints; ++i) {
             s->dir[i] = test_uniform(rng) < 0.5 ? -1 : 1;
         }
-        s->temp_c = truth->thermal_ref_c;
-        s->kind = (uint8_t)kind;
-        dhc_prediction pred;
-        TEST_ASSERT_EQUAL(DHC_OK, dhc_model_predict(truth, s, &pred));
-        dhc_vec3_copy(pred.p_mm, s->p_mm);
-        s->rot = pred.rot;
-        dhc_vec3_copy(pred.wire_mm, s->wire_mm);
+        test_measure_exactly(truth, kind, s);
         d->flags[k] = (uint8_t)DHC_SAMPLE_USED;
     }
 }

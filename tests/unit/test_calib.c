@@ -17,14 +17,6 @@ static dhc_calib_workspace ws;
 static dhc_calib_report rep;
 static dhc_param_set set;
 
-/* Standard normal deviate (Box-Muller), independent of the library. */
-static double test_gauss(test_rng *r)
-{
-    const double u1 = fmax(test_uniform(r), 1e-300);
-    const double u2 = test_uniform(r);
-    return sqrt(-2.0 * log(u1)) * cos(2.0 * TEST_PI * u2);
-}
-
 static void add_noise(test_dataset *d, double sigma_mm, test_rng *r)
 {
     for (size_t k = 0U; k < d->n; ++k) {

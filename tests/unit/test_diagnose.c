@@ -67,13 +67,6 @@ static void test_chi2_tail_matches_closed_forms(void)
 
 static test_rng noise_rng = {0x1234ULL};
 
-static double gauss(void)
-{
-    const double u1 = fmax(test_uniform(&noise_rng), 1e-300);
-    const double u2 = test_uniform(&noise_rng);
-    return sqrt(-2.0 * log(u1)) * cos(2.0 * TEST_PI * u2);
-}
-
 static dhc_model nominal_model(void)
 {
     return test_paper3_model();
@@ -98,7 +91,7 @@ static void simulate(const dhc_model *truth, uint64_t seed)
     test_measure_model(&data, truth, 60U, DHC_MEAS_POSITION, &rng);
     for (size_t k = 0U; k < data.n; ++k) {
         for (size_t c = 0U; c < 3U; ++c) {
-            data.s[k].p_mm[c] += 0.05 * gauss();
+            data.s[k].p_mm[c] += 0.05 * test_gauss(&noise_rng);
         }
     }
 }

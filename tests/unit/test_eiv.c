@@ -15,6 +15,7 @@
 #include "dhc_test_arms.h"
 #include "dhc_test_samples.h"
 #include "dhcal/dhc_diagnose.h"
+#include "dhc_test_linalg.h"
 #include "unity.h"
 
 void setUp(void) {}
@@ -32,13 +33,6 @@ static dhc_param_set set;
 static dhc_candidate cands[DHC_MAX_CANDIDATES];
 
 static test_rng noise_rng = {0x5EEDULL};
-
-static double gauss(void)
-{
-    const double u1 = fmax(test_uniform(&noise_rng), 1e-300);
-    const double u2 = test_uniform(&noise_rng);
-    return sqrt(-2.0 * log(u1)) * cos(2.0 * TEST_PI * u2);
-}
 
 /* The arm as built: nominal with small geometric errors (as test_diagnose.c). */
 static dhc_model true_model(void)
@@ -90,7 +84,7 @@ static void simulate_positions(uint64_t seed)
     test_measure_model(&data, &truth, 60U, DHC_MEAS_POSITION, &rng);
     for (size_t k = 0U; k < data.n; ++k) {
         for (size_t c = 0U; c < 3U; ++c) {
-            data.s[k].p_mm[c] += 0.05 * gauss();
+            data.s[k].p_mm[c] += 0.05 * test_gauss(&noise_rng);
         }
     }
 }
@@ -218,36 +212,6 @@ static void residual_of(const dhc_model *m, const dhc_sample *s, double *r, size
     TEST_ASSERT_EQUAL(DHC_OK, dhc_model_residual(m, s, 1000.0, r, rows));
 }
 
-/* Gauss-Jordan with partial pivoting on a (n x 2n, row stride cols); 0 when singular. */
-static int gauss_jordan(double *a, size_t n, size_t cols)
-{
-    for (size_t c = 0U; c < n; ++c) {
-        size_t piv = c;
-        for (size_t r = c + 1U; r < n; ++r) {
-            piv = fabs(a[r * cols + c]) > fabs(a[piv * cols + c]) ? r : piv;
-        }
-        if (!(fabs(a[piv * cols + c]) > 0.0)) {
-            return 0;
-        }
-        for (size_t j = 0U; j < cols; ++j) {
-            const double t = a[c * cols + j];
-            a[c * cols + j] = a[piv * cols + j];
-            a[piv * cols + j] = t;
-        }
-        const double f = 1.0 / a[c * cols + c];
-        for (size_t j = 0U; j < cols; ++j) {
-            a[c * cols + j] *= f;
-        }
-        for (size_t r = 0U; r < n; ++r) {
-            const double g = a[r * cols + c];
-            for (size_t j = 0U; r != c && j < cols; ++j) {
-                a[r * cols + j] -= g * a[c * cols + j];
-            }
-        }
-    }
-    return 1;
-}
-
 /* One Gauss-Newton step of the dense GLS at m over the identifiable parameters; returns
  * r' W r at m. Jacobians by central differences, the covariance as one dense matrix. */
 static double dense_gls_step(dhc_model *m, const uint8_t *use, double *step_norm)
@@ -308,7 +272,7 @@ static double dense_gls_step(dhc_model *m, const uint8_t *use, double *step_norm
         }
     }
     /* blocks of different samples stay 0: the full matrix is inverted as it is */
-    TEST_ASSERT_TRUE(gauss_jordan(&big_cov[0][0], GLS_ROWS, 2U * GLS_ROWS));
+    TEST_ASSERT_TRUE(test_gauss_jordan(&big_cov[0][0], GLS_ROWS, 2U * GLS_ROWS, 2U * GLS_ROWS));
     /* normal equations over the identifiable parameters */
     size_t idx[GLS_MAXP];
     size_t q = 0U;
@@ -351,7 +315,7 @@ static double dense_gls_step(dhc_model *m, const uint8_t *use, double *step_norm
         nmat[c][q] = g;
     }
     /* solve with the right-hand side as an extra column (row stride GLS_MAXP + 1) */
-    TEST_ASSERT_TRUE(gauss_jordan(&nmat[0][0], q, GLS_MAXP + 1U) != 0 || q == 0U);
+    TEST_ASSERT_TRUE(test_gauss_jordan(&nmat[0][0], q, GLS_MAXP + 1U, GLS_MAXP + 1U) != 0 || q == 0U);
     double delta[GLS_MAXP] = {0.0};
     double norm = 0.0;
     for (size_t c = 0U; c < q; ++c) {
@@ -389,16 +353,17 @@ static void test_whitened_fit_equals_dense_gls(void)
             dhc_prediction pr;
             s->kind = (uint8_t)DHC_MEAS_POSE;
             TEST_ASSERT_EQUAL(DHC_OK, dhc_model_predict(&truth, s, &pr));
-            const double w[3] = {2e-5 * gauss(), 2e-5 * gauss(), 2e-5 * gauss()};
+            const double w[3] = {2e-5 * test_gauss(&noise_rng), 2e-5 * test_gauss(&noise_rng),
+                                 2e-5 * test_gauss(&noise_rng)};
             dhc_mat3 e;
             dhc_rot_exp(w, &e);
             dhc_rot_mul(&e, &pr.rot, &s->rot);
         }
         for (size_t c = 0U; c < 3U; ++c) {
-            s->p_mm[c] += MEAS_SD * gauss();
+            s->p_mm[c] += MEAS_SD * test_gauss(&noise_rng);
         }
         for (size_t j = 0U; j < 3U; ++j) {
-            s->q_rad[j] += JOINT_SD[j] * gauss(); /* the encoder's error */
+            s->q_rad[j] += JOINT_SD[j] * test_gauss(&noise_rng); /* the encoder's error */
         }
     }
     dhc_model nominal = test_paper3_model();
@@ -559,7 +524,7 @@ static void test_false_alarms_are_rare_with_the_noise_model(void)
                 data.s[k].q_rad[j] = count * floor(q / count + 0.5);
             }
             for (size_t c = 0U; c < 3U; ++c) {
-                data.s[k].p_mm[c] += MC_MEAS_MM * gauss();
+                data.s[k].p_mm[c] += MC_MEAS_MM * test_gauss(&noise_rng);
             }
         }
         dhc_calib_options opt;

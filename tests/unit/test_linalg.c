@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "dhcal/dhc_linalg.h"
+#include "dhc_test_linalg.h"
 #include "unity.h"
 
 #define TEST_RNG_SEED 0x9E3779B97F4A7C15ULL
@@ -1293,27 +1294,7 @@ static void gauss_jordan_inverse_diagonal(const dhc_mat *a, size_t n, double *ou
             w[i][n + j] = i == j ? 1.0 : 0.0;
         }
     }
-    for (size_t c = 0U; c < n; ++c) {
-        size_t p = c;
-        for (size_t i = c + 1U; i < n; ++i) {
-            p = fabs(w[i][c]) > fabs(w[p][c]) ? i : p;
-        }
-        for (size_t j = 0U; j < 2U * n; ++j) {
-            const double tmp = w[c][j];
-            w[c][j] = w[p][j];
-            w[p][j] = tmp;
-        }
-        const double piv = w[c][c];
-        for (size_t j = 0U; j < 2U * n; ++j) {
-            w[c][j] /= piv;
-        }
-        for (size_t i = 0U; i < n; ++i) {
-            const double f = w[i][c];
-            for (size_t j = 0U; i != c && j < 2U * n; ++j) {
-                w[i][j] -= f * w[c][j];
-            }
-        }
-    }
+    TEST_ASSERT_TRUE(test_gauss_jordan(&w[0][0], n, 2U * n, 2U * MAXN));
     for (size_t i = 0U; i < n; ++i) {
         out[i] = w[i][n + i];
     }

@@ -561,13 +561,7 @@ static void measure(const dhc_model *truth, size_t count, dhc_meas_kind kind, te
         if (fixed < truth->arm.n_joints) {
             s->q_rad[fixed] = fixed_q;
         }
-        s->temp_c = truth->thermal_ref_c;
-        s->kind = (uint8_t)kind;
-        dhc_prediction pred;
-        TEST_ASSERT_EQUAL(DHC_OK, dhc_model_predict(truth, s, &pred));
-        dhc_vec3_copy(pred.p_mm, s->p_mm);
-        s->rot = pred.rot;
-        dhc_vec3_copy(pred.wire_mm, s->wire_mm);
+        test_measure_exactly(truth, kind, s);
         data.flags[k] = (uint8_t)DHC_SAMPLE_USED;
     }
 }

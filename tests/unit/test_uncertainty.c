@@ -7,6 +7,7 @@
 
 #include "dhc_test_arms.h"
 #include "dhcal/dhc_uncertainty.h"
+#include "dhc_test_linalg.h"
 #include "unity.h"
 
 void setUp(void) {}
@@ -158,32 +159,7 @@ static void gauss_jordan(double a[DHC_MAX_PARAMS][DHC_MAX_PARAMS], size_t q)
             aug[i][q + j] = i == j ? 1.0 : 0.0;
         }
     }
-    for (size_t c = 0U; c < q; ++c) {
-        size_t piv = c;
-        for (size_t r = c + 1U; r < q; ++r) {
-            if (fabs(aug[r][c]) > fabs(aug[piv][c])) {
-                piv = r;
-            }
-        }
-        TEST_ASSERT_TRUE(fabs(aug[piv][c]) > 0.0);
-        for (size_t j = 0U; j < 2U * q; ++j) {
-            const double t = aug[c][j];
-            aug[c][j] = aug[piv][j];
-            aug[piv][j] = t;
-        }
-        const double f = aug[c][c];
-        for (size_t j = 0U; j < 2U * q; ++j) {
-            aug[c][j] /= f;
-        }
-        for (size_t r = 0U; r < q; ++r) {
-            const double g = aug[r][c];
-            if (r != c) {
-                for (size_t j = 0U; j < 2U * q; ++j) {
-                    aug[r][j] -= g * aug[c][j];
-                }
-            }
-        }
-    }
+    TEST_ASSERT_TRUE(test_gauss_jordan(&aug[0][0], q, 2U * q, 2U * DHC_MAX_PARAMS));
     for (size_t i = 0U; i < q; ++i) {
         for (size_t j = 0U; j < q; ++j) {
             a[i][j] = aug[i][q + j];
