@@ -108,6 +108,20 @@ static inline dhc_model test_paper3_model(void)
     return test_model_of(&arm);
 }
 
+/* The Table 3 arm as built: the nominal one with small geometric errors (a fraction of a
+ * degree, a fraction of a millimetre) that a calibration must find. */
+static inline dhc_model test_paper3_as_built(void)
+{
+    dhc_model m = test_paper3_model();
+    m.arm.joint[0].theta_offset_rad = 0.2 * TEST_DEG;
+    m.arm.joint[0].d_mm += 0.4;
+    m.arm.joint[1].a_mm += -0.3;
+    m.arm.joint[1].beta_rad = 0.05 * TEST_DEG;
+    m.arm.joint[2].a_mm += 0.5;
+    m.arm.joint[2].alpha_rad = 0.1 * TEST_DEG;
+    return m;
+}
+
 /* Random joint angles uniform over each joint's range. */
 static inline void test_random_q(test_rng *r, const dhc_arm *arm, double *q)
 {

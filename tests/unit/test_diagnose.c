@@ -75,14 +75,7 @@ static dhc_model nominal_model(void)
 /* True arm: nominal with small geometric errors plus the effect set up by the caller. */
 static dhc_model true_model(void)
 {
-    dhc_model m = nominal_model();
-    m.arm.joint[0].theta_offset_rad = 0.2 * TEST_DEG;
-    m.arm.joint[0].d_mm += 0.4;
-    m.arm.joint[1].a_mm += -0.3;
-    m.arm.joint[1].beta_rad = 0.05 * TEST_DEG;
-    m.arm.joint[2].a_mm += 0.5;
-    m.arm.joint[2].alpha_rad = 0.1 * TEST_DEG;
-    return m;
+    return test_paper3_as_built();
 }
 
 static void simulate(const dhc_model *truth, uint64_t seed)

@@ -34,17 +34,10 @@ static dhc_candidate cands[DHC_MAX_CANDIDATES];
 
 static test_rng noise_rng = {0x5EEDULL};
 
-/* The arm as built: nominal with small geometric errors (as test_diagnose.c). */
+/* The arm as built: nominal with small geometric errors. */
 static dhc_model true_model(void)
 {
-    dhc_model m = test_paper3_model();
-    m.arm.joint[0].theta_offset_rad = 0.2 * TEST_DEG;
-    m.arm.joint[0].d_mm += 0.4;
-    m.arm.joint[1].a_mm += -0.3;
-    m.arm.joint[1].beta_rad = 0.05 * TEST_DEG;
-    m.arm.joint[2].a_mm += 0.5;
-    m.arm.joint[2].alpha_rad = 0.1 * TEST_DEG;
-    return m;
+    return test_paper3_as_built();
 }
 
 /* ------------------------------------------------------------ (a) off = before */
