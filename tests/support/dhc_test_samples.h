@@ -7,6 +7,7 @@
 
 #include "dhc_test_arms.h"
 #include "dhcal/dhc_calib.h"
+#include "dhcal/dhc_diagnose.h"
 #include "unity.h"
 
 #define TEST_MAX_SAMPLES 200U
@@ -26,6 +27,10 @@ static inline dhc_status test_read_sample(void *ctx, size_t index, dhc_sample *o
     *out = d->s[index];
     return DHC_OK;
 }
+
+/* The diagnosis' scope for data of poses only: no wires, no temperature, no time that
+ * varies apart from the pose. */
+static const dhc_candidate_scope test_no_covariates = {0, 0, 0};
 
 /* The sample's measurement (kind) as the true model makes it, noise-free, at the sample's
  * angles and directions and the model's reference temperature. */

@@ -12,8 +12,6 @@
 void setUp(void) {}
 void tearDown(void) {}
 
-/* pose only: no wires, no temperature, no time that varies apart from the pose */
-static const dhc_candidate_scope no_covariates = {0, 0, 0};
 static test_dataset data;
 static dhc_calib_workspace cws;
 static dhc_calib_report rep;
@@ -99,7 +97,7 @@ static void fit_and_diagnose(dhc_model *fitted)
     TEST_ASSERT_EQUAL(DHC_OK, dhc_calib_fit(fitted, &set, test_read_sample, &data, data.n,
                                             data.flags, &opt, &cws, &rep));
     dhc_candidate cands[DHC_MAX_CANDIDATES];
-    const size_t nc = dhc_diagnose_candidates(fitted, &set, &no_covariates, cands, DHC_MAX_CANDIDATES);
+    const size_t nc = dhc_diagnose_candidates(fitted, &set, &test_no_covariates, cands, DHC_MAX_CANDIDATES);
     dhc_diagnose_options dopt;
     dhc_diagnose_default_options(&dopt);
     TEST_ASSERT_EQUAL(DHC_OK, dhc_diagnose(fitted, &set, rep.identifiable, rep.sigma * rep.sigma,
@@ -213,7 +211,7 @@ static void test_bad_arguments_are_refused(void)
                                                      &data, data.n, data.flags, &dopt, &dws, &diag));
     /* ... and the candidate list leaves it out. */
     dhc_candidate cands[DHC_MAX_CANDIDATES];
-    const size_t nc = dhc_diagnose_candidates(&m, &set, &no_covariates, cands, DHC_MAX_CANDIDATES);
+    const size_t nc = dhc_diagnose_candidates(&m, &set, &test_no_covariates, cands, DHC_MAX_CANDIDATES);
     for (size_t i = 0U; i < nc; ++i) {
         TEST_ASSERT_FALSE(cands[i].effect == DHC_EFFECT_JOINT_SCALE && cands[i].joint == 0U);
         TEST_ASSERT_TRUE(cands[i].effect != DHC_EFFECT_MEASURER_SCALE); /* no wire data */
@@ -355,7 +353,7 @@ static void test_time_in_step_with_the_pose(void)
     }
     TEST_ASSERT_EQUAL(2U, drift);
     TEST_ASSERT_EQUAL(1U, thermal);
-    const size_t nc0 = dhc_diagnose_candidates(&m, &set, &no_covariates, cands,
+    const size_t nc0 = dhc_diagnose_candidates(&m, &set, &test_no_covariates, cands,
                                                DHC_MAX_CANDIDATES);
     TEST_ASSERT_EQUAL(nc - 3U, nc0);
 }

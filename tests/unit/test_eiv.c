@@ -13,16 +13,14 @@
 #include <string.h>
 
 #include "dhc_test_arms.h"
+#include "dhc_test_linalg.h"
 #include "dhc_test_samples.h"
 #include "dhcal/dhc_diagnose.h"
-#include "dhc_test_linalg.h"
 #include "unity.h"
 
 void setUp(void) {}
 void tearDown(void) {}
 
-/* pose only: no wires, no temperature, no time that varies apart from the pose */
-static const dhc_candidate_scope no_covariates = {0, 0, 0};
 static test_dataset data;
 static dhc_calib_workspace cws;
 static dhc_calib_report rep;
@@ -54,7 +52,7 @@ static void fit_and_diagnose(const dhc_calib_options *opt, const dhc_diagnose_op
     TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, fitted));
     TEST_ASSERT_EQUAL(DHC_OK, dhc_calib_fit(fitted, &set, test_read_sample, &data, data.n,
                                             data.flags, opt, &cws, r));
-    size_t nc = dhc_diagnose_candidates(fitted, &set, &no_covariates, cands, DHC_MAX_CANDIDATES);
+    size_t nc = dhc_diagnose_candidates(fitted, &set, &test_no_covariates, cands, DHC_MAX_CANDIDATES);
     if (first_catalogue_only) {
         size_t kept = 0U;
         for (size_t c = 0U; c < nc; ++c) {
@@ -454,7 +452,7 @@ static void test_bad_noise_models_are_refused(void)
     dhc_diagnose_options dopt;
     dhc_diagnose_default_options(&dopt);
     dopt.noise.joint_rad[0] = 1e-5;
-    const size_t nc = dhc_diagnose_candidates(&m, &set, &no_covariates, cands, DHC_MAX_CANDIDATES);
+    const size_t nc = dhc_diagnose_candidates(&m, &set, &test_no_covariates, cands, DHC_MAX_CANDIDATES);
     uint8_t ident[DHC_MAX_PARAMS];
     memset(ident, 1, sizeof ident);
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,

@@ -7,8 +7,8 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "dhcal/dhc_linalg.h"
 #include "dhc_test_linalg.h"
+#include "dhcal/dhc_linalg.h"
 #include "unity.h"
 
 #define TEST_RNG_SEED 0x9E3779B97F4A7C15ULL

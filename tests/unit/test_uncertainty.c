@@ -6,8 +6,8 @@
 #include <string.h>
 
 #include "dhc_test_arms.h"
-#include "dhcal/dhc_uncertainty.h"
 #include "dhc_test_linalg.h"
+#include "dhcal/dhc_uncertainty.h"
 #include "unity.h"
 
 void setUp(void) {}
