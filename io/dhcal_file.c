@@ -7,34 +7,16 @@
 
 #include <errno.h>
 #include <fcntl.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
-
-#if defined(__GNUC__)
-#define FILE_PRINTF(fmt_index, first_arg) __attribute__((format(printf, fmt_index, first_arg)))
-#else
-#define FILE_PRINTF(fmt_index, first_arg)
-#endif
 
 /* Tries for a free temporary name before giving up (each a stale file of this pid). */
 #define FILE_TMP_TRIES 100U
 /* One write() at most: below SSIZE_MAX everywhere (Linux moves at most ~2 GiB per call). */
 #define FILE_MAX_CHUNK ((size_t)1 << 30)
 
-static int fail(dhcal_error *err, const char *fmt, ...) FILE_PRINTF(2, 3);
-static int fail(dhcal_error *err, const char *fmt, ...)
-{
-    if (err != NULL) {
-        va_list ap;
-        va_start(ap, fmt);
-        (void)vsnprintf(err->msg, sizeof err->msg, fmt, ap);
-        va_end(ap);
-    }
-    return DHCAL_IO_FAILED;
-}
 
 /* 0, or -1 with errno set. */
 static int write_all(int fd, const char *p, size_t n)
@@ -84,15 +66,15 @@ static void sync_parent_dir(const char *path)
 int dhcal_file_write_atomic(const char *path, const char *data, size_t len, dhcal_error *err)
 {
     if (path == NULL || path[0] == '\0') {
-        return fail(err, "(no path): not written: empty file name");
+        return dhcal_error_set(err, DHCAL_IO_FAILED, "(no path): not written: empty file name");
     }
     if (data == NULL && len > 0U) {
-        return fail(err, "%s: not written: no data", path);
+        return dhcal_error_set(err, DHCAL_IO_FAILED, "%s: not written: no data", path);
     }
     const size_t tmp_cap = strlen(path) + 48U;
     char *const tmp = malloc(tmp_cap);
     if (tmp == NULL) {
-        return fail(err, "%s: not written: out of memory", path);
+        return dhcal_error_set(err, DHCAL_IO_FAILED, "%s: not written: out of memory", path);
     }
     int fd = -1;
     for (unsigned k = 0U; k < FILE_TMP_TRIES && fd < 0; ++k) {
@@ -104,7 +86,8 @@ int dhcal_file_write_atomic(const char *path, const char *data, size_t len, dhca
     }
     int rc = DHCAL_IO_OK;
     if (fd < 0) {
-        rc = fail(err, "%s: cannot create temporary file '%s': %s", path, tmp, strerror(errno));
+        rc = dhcal_error_set(err, DHCAL_IO_FAILED, "%s: cannot create temporary file '%s': %s",
+                             path, tmp, strerror(errno));
     } else {
         int saved = 0;
         if ((len > 0U && write_all(fd, data, len) != 0) || fsync(fd) != 0) {
@@ -115,10 +98,12 @@ int dhcal_file_write_atomic(const char *path, const char *data, size_t len, dhca
             saved = errno;
         }
         if (saved != 0) {
-            rc = fail(err, "%s: cannot write temporary file '%s': %s", path, tmp,
-                      strerror(saved));
+            rc = dhcal_error_set(err, DHCAL_IO_FAILED,
+                                 "%s: cannot write temporary file '%s': %s", path, tmp,
+                                 strerror(saved));
         } else if (rename(tmp, path) != 0) {
-            rc = fail(err, "%s: cannot replace it with '%s': %s", path, tmp, strerror(errno));
+            rc = dhcal_error_set(err, DHCAL_IO_FAILED, "%s: cannot replace it with '%s': %s",
+                                 path, tmp, strerror(errno));
         } else {
             sync_parent_dir(path);
         }

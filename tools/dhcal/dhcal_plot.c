@@ -38,10 +38,16 @@ static const char *const component_color[3] = {DHCAL_COLOR_X, DHCAL_COLOR_Y, DHC
 
 /* "<prefix><model name>" into t (the name may be anything: dhcal_svg_put_text() escapes it
  * later). */
-static void title_text(dhcal_text *t, const char *prefix, const dhcal_plot_data *d)
+/* Opens a picture of width x height titled "<prefix><model name>". */
+static void begin_titled(dhcal_text *b, double width, double height, const char *prefix,
+                         const dhcal_plot_data *d)
 {
-    dhcal_text_str(t, prefix);
-    dhcal_text_str(t, d->title[0] != '\0' ? d->title : "(unnamed model)");
+    dhcal_text t = {NULL, 0U, 0U, 0};
+    dhcal_text_str(&t, prefix);
+    dhcal_text_str(&t, d->title[0] != '\0' ? d->title : "(unnamed model)");
+    dhcal_svg_begin(b, width, height, t.failed ? "" : t.p, t.failed ? 0U : t.len);
+    b->failed |= t.failed;
+    free(t.p);
 }
 
 static void residuals_svg(dhcal_text *b, const dhcal_plot_data *d)
@@ -70,11 +76,7 @@ static void residuals_svg(dhcal_text *b, const dhcal_plot_data *d)
     const double width = fmax(640.0, 20.0 + (double)cols * cell_w);
     const double height = top + (double)rows * cell_h + 6.0;
 
-    dhcal_text t = {NULL, 0U, 0U, 0};
-    title_text(&t, "Residuals vs joint angle: ", d);
-    dhcal_svg_begin(b, width, height, t.failed ? "" : t.p, t.failed ? 0U : t.len);
-    b->failed |= t.failed;
-    free(t.p);
+    begin_titled(b, width, height, "Residuals vs joint angle: ", d);
 
     static const char *const xyz[3] = {"x", "y", "z"};
     static const char *const wires[3] = {"L1", "L2", "L3"};
@@ -282,11 +284,7 @@ static void joints_svg(dhcal_text *b, const dhcal_plot_data *d)
     const double width = 20.0 + 2.0 * cell_w;
     const double height = top + (double)nj * cell_h + 6.0;
 
-    dhcal_text t = {NULL, 0U, 0U, 0};
-    title_text(&t, "Apparent joint error: ", d);
-    dhcal_svg_begin(b, width, height, t.failed ? "" : t.p, t.failed ? 0U : t.len);
-    b->failed |= t.failed;
-    free(t.p);
+    begin_titled(b, width, height, "Apparent joint error: ", d);
 
     /* Legend: the directions that occur (all three when there are no rows). */
     static const char *const dir_label[3] = {"direction unknown", "approach +", "approach -"};
@@ -464,11 +462,7 @@ static void errors_svg(dhcal_text *b, const dhcal_plot_data *d)
                                dhcal_svg_fit_axis(0.0, xhi, plot_w, 11.0, 1, 1), ay};
     const double height = f.y + f.h + 48.0;
 
-    dhcal_text t = {NULL, 0U, 0U, 0};
-    title_text(&t, "Error per row, before and after: ", d);
-    dhcal_svg_begin(b, width, height, t.failed ? "" : t.p, t.failed ? 0U : t.len);
-    b->failed |= t.failed;
-    free(t.p);
+    begin_titled(b, width, height, "Error per row, before and after: ", d);
 
     /* The labels, built once: the legend and the RMS lines say the same thing. */
     dhcal_text after = {NULL, 0U, 0U, 0};
@@ -570,11 +564,7 @@ static void candidates_svg(dhcal_text *b, const dhcal_plot_data *d)
     const double width = f.x + f.w + 170.0;
     const double height = f.y + f.h + 48.0;
 
-    dhcal_text t = {NULL, 0U, 0U, 0};
-    title_text(&t, "Candidate effects: ", d);
-    dhcal_svg_begin(b, width, height, t.failed ? "" : t.p, t.failed ? 0U : t.len);
-    b->failed |= t.failed;
-    free(t.p);
+    begin_titled(b, width, height, "Candidate effects: ", d);
     const double lx = dhcal_svg_legend_item(b, 20.0, 52.0, DHCAL_COLOR_SIGNIFICANT, 0,
                                             "significant", SIZE_MAX);
     (void)dhcal_svg_legend_item(b, lx, 52.0, DHCAL_COLOR_OTHER, 0, "not significant", SIZE_MAX);
