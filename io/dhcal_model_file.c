@@ -93,10 +93,11 @@ static int load_measurer(const dhcal_jctx *c, const cJSON *m, dhcal_model *model
     if (rc != DHCAL_IO_OK) {
         return rc;
     }
-    const cJSON *const anchors = cJSON_GetObjectItemCaseSensitive(m, "anchors_mm");
-    if (anchors == NULL) {
-        return dhcal_jfail(c, "measurer.anchors_mm", "required key missing");
+    rc = dhcal_jrequire(c, m, "measurer", "anchors_mm");
+    if (rc != DHCAL_IO_OK) {
+        return rc;
     }
+    const cJSON *const anchors = cJSON_GetObjectItemCaseSensitive(m, "anchors_mm");
     rc = dhcal_jpoints(c, anchors, "measurer.anchors_mm", 3U, -LEN_MAX_MM, LEN_MAX_MM, "mm",
                        model->anchors_mm);
     if (rc != DHCAL_IO_OK) {
@@ -200,10 +201,11 @@ static int load_root(dhcal_jctx *c, const cJSON *root, dhcal_model *model)
     if (rc != DHCAL_IO_OK) {
         return rc;
     }
-    const cJSON *const joints = cJSON_GetObjectItemCaseSensitive(root, "joints");
-    if (joints == NULL) {
-        return dhcal_jfail(c, "joints", "required key missing");
+    rc = dhcal_jrequire(c, root, "", "joints");
+    if (rc != DHCAL_IO_OK) {
+        return rc;
     }
+    const cJSON *const joints = cJSON_GetObjectItemCaseSensitive(root, "joints");
     if (!cJSON_IsArray(joints)) {
         return dhcal_jfail(c, "joints", "expected an array of joint objects, got %s", dhcal_jtype(joints));
     }
