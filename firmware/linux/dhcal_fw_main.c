@@ -398,14 +398,24 @@ static double elapsed_s(const struct timespec *t0)
 
 /* ---------------------------------------------------------------- GPIO encoder check */
 
-static int run_gpio_watch(const options *o)
+/* Requests the encoder's A/B lines of --gpio-chip and --enc-lines; a failure is said on
+ * standard error. */
+static fw_linux_gpio_status open_encoder_lines(const options *o, fw_linux_gpio_enc *enc)
 {
-    static fw_linux_gpio_enc enc;
     char why[256];
-    const fw_linux_gpio_status st = fw_linux_gpio_open(&enc, o->gpio_chip, o->enc_line[0],
+    const fw_linux_gpio_status st = fw_linux_gpio_open(enc, o->gpio_chip, o->enc_line[0],
                                                        o->enc_line[1], why, sizeof why);
     if (st != FW_LINUX_GPIO_OK) {
         fprintf(stderr, "dhcal-fw: %s\n", why);
+    }
+    return st;
+}
+
+static int run_gpio_watch(const options *o)
+{
+    static fw_linux_gpio_enc enc;
+    const fw_linux_gpio_status st = open_encoder_lines(o, &enc);
+    if (st != FW_LINUX_GPIO_OK) {
         return st == FW_LINUX_GPIO_ERR ? EXIT_FAULT : EXIT_USAGE;
     }
     /* Tell a waiting test that the lines are requested: edges from now on are seen. */
@@ -639,11 +649,7 @@ static int run_calibration(options *o)
         /* Encoder lines configured: a missing chip or line is a configuration error now,
          * not a fault in the middle of the run. */
         static fw_linux_gpio_enc enc;
-        char why[256];
-        const fw_linux_gpio_status gs = fw_linux_gpio_open(&enc, o->gpio_chip, o->enc_line[0],
-                                                           o->enc_line[1], why, sizeof why);
-        if (gs != FW_LINUX_GPIO_OK) {
-            fprintf(stderr, "dhcal-fw: %s\n", why);
+        if (open_encoder_lines(o, &enc) != FW_LINUX_GPIO_OK) {
             return EXIT_USAGE;
         }
         fw_linux_gpio_close(&enc);
