@@ -10,8 +10,6 @@
 
 #include "dhcal/dhc_calib.h"
 
-#define PI 3.14159265358979323846
-#define DEG (PI / 180.0)
 #define MAX_POSES 10U
 
 static const double table1[6][3] = {{91.2, 101.0, 201.0}, {1.0, 104.0, 2.0},
@@ -36,10 +34,10 @@ static void arm_from_table(dhc_arm *arm, const double t[6][3], double offset_deg
 {
     (void)dhc_arm_init(arm, 6U);
     for (size_t i = 0U; i < 6U; ++i) {
-        arm->joint[i].alpha_rad = t[i][0] * DEG;
+        arm->joint[i].alpha_rad = t[i][0] * DHC_DEG;
         arm->joint[i].a_mm = t[i][1];
         arm->joint[i].d_mm = t[i][2];
-        arm->joint[i].theta_offset_rad = offset_deg * DEG;
+        arm->joint[i].theta_offset_rad = offset_deg * DHC_DEG;
     }
 }
 
@@ -47,7 +45,7 @@ static void arm_from_table(dhc_arm *arm, const double t[6][3], double offset_deg
 static double next_angle(uint32_t *state)
 {
     *state = *state * 1664525U + 1013904223U;
-    return ((double)(*state >> 8) / 16777216.0 * 2.0 - 1.0) * PI;
+    return ((double)(*state >> 8) / 16777216.0 * 2.0 - 1.0) * DHC_PI;
 }
 
 static int calibrate(size_t poses, dhc_arm *out)
@@ -95,7 +93,7 @@ static int calibrate(size_t poses, dhc_arm *out)
         if (out->joint[i].convention == DHC_CONV_HAYATI) {
             printf("  joint %zu: axes %zu-%zu nominally parallel: fitted with Hayati beta "
                    "(%.6f deg), shown below in standard DH\n",
-                   i + 1U, i + 1U, i + 2U, out->joint[i].beta_rad / DEG);
+                   i + 1U, i + 1U, i + 2U, out->joint[i].beta_rad / DHC_DEG);
         }
     }
     return 1;
@@ -122,7 +120,7 @@ int main(void)
         const dhc_joint *j = &ten_dh.joint[i];
         const double actual[4] = {2.0, table1[i][0], table1[i][1], table1[i][2]};
         const double nominal[4] = {0.0, table2[i][0], table2[i][1], table2[i][2]};
-        const double fitted[4] = {j->theta_offset_rad / DEG, j->alpha_rad / DEG, j->a_mm,
+        const double fitted[4] = {j->theta_offset_rad / DHC_DEG, j->alpha_rad / DHC_DEG, j->a_mm,
                                   j->d_mm};
         for (size_t k = 0U; k < 4U; ++k) {
             printf("%-6zu %-10s %12.4f %12.4f %14.8f %12.2e\n", i + 1U, names[k], nominal[k],

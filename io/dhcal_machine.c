@@ -5,10 +5,10 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "dhcal/dhc_geometry.h"
 #include "dhcal_json.h"
 #include "dhcal_model_map.h"
 
-#define DEG (3.14159265358979323846 / 180.0)
 
 static const char *const TOP_KEYS[] = {"comment", "name",     "model",   "n_joints",
                                        "start_pose_deg", "joints", "drives", "measurer",
@@ -152,12 +152,12 @@ static int load_drives(const dhcal_jctx *c, const cJSON *root, dhcal_machine *m)
     if (rc == DHCAL_IO_OK && cJSON_GetObjectItemCaseSensitive(d, "max_speed_deg_s") != NULL) {
         rc = dhcal_jopt_number(c, d, "drives", "max_speed_deg_s", 1e-3, 1e5, "deg/s", &v);
         m->has_speed_limit = rc == DHCAL_IO_OK;
-        m->max_speed_rad_s = v * DEG;
+        m->max_speed_rad_s = v * DHC_DEG;
     }
     if (rc == DHCAL_IO_OK && cJSON_GetObjectItemCaseSensitive(d, "max_accel_deg_s2") != NULL) {
         rc = dhcal_jopt_number(c, d, "drives", "max_accel_deg_s2", 1e-3, 1e6, "deg/s^2", &v);
         m->has_accel_limit = rc == DHCAL_IO_OK;
-        m->max_accel_rad_s2 = v * DEG;
+        m->max_accel_rad_s2 = v * DHC_DEG;
     }
     return rc;
 }
@@ -273,7 +273,7 @@ static int load_root(dhcal_jctx *c, const cJSON *root, dhcal_machine *m)
                            m->start_pose_rad);
     }
     for (size_t j = 0U; j < n && rc == DHCAL_IO_OK; ++j) {
-        m->start_pose_rad[j] *= DEG;
+        m->start_pose_rad[j] *= DHC_DEG;
     }
     if (rc == DHCAL_IO_OK) {
         rc = load_joints(c, root, m);

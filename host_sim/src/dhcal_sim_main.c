@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "dhcal/dhc_geometry.h"
 #include "dhcal_file.h"
 #include "dhcal_io.h"
 #include "dhcal_sim/dhs_dataset.h"
@@ -22,7 +23,6 @@
 
 #define EXIT_COMPUTE 1
 #define EXIT_USAGE 2
-#define SIM_PI 3.14159265358979323846
 #define MAX_POSES 1000000UL
 
 static const char *const usage_text =
@@ -500,7 +500,7 @@ static int run_bus(int argc, char **argv)
     }
     /* dhcal-fw's start pose (and dhcal-demo's): the plant must start where the
      * controller homes its counters. */
-    const double q_start[3] = {0.0, 60.0 * SIM_PI / 180.0, -60.0 * SIM_PI / 180.0};
+    const double q_start[3] = {0.0, 60.0 * DHC_DEG, -60.0 * DHC_DEG};
     if (sf.sc.n_joints != 3U) {
         fprintf(stderr, "dhcal-sim: bus: %s: a 3-joint arm is needed\n", scenario);
         return EXIT_USAGE;

@@ -4,9 +4,9 @@
 #include <math.h>
 #include <string.h>
 
+#include "dhcal/dhc_geometry.h"
 #include "dhcal_sim/dhs_rng.h"
 
-#define DHS_PI 3.14159265358979323846
 
 static void joint_defaults(dhs_joint_params *j)
 {
@@ -267,10 +267,10 @@ void dhs_scenario_add_random_errors(dhs_scenario *sc, double sd_theta_rad, doubl
 
 double dhs_nominal_counts_per_rad(const dhs_joint_params *j)
 {
-    return 4.0 * (double)j->nominal_encoder_lines * j->nominal_gear_ratio / (2.0 * DHS_PI);
+    return 4.0 * (double)j->nominal_encoder_lines * j->nominal_gear_ratio / (2.0 * DHC_PI);
 }
 
 double dhs_motor_counts_per_rad(const dhs_joint_params *j)
 {
-    return 4.0 * (double)j->encoder_lines / (2.0 * DHS_PI);
+    return 4.0 * (double)j->encoder_lines / (2.0 * DHC_PI);
 }

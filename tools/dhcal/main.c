@@ -1152,7 +1152,7 @@ static int cmd_plot(const options *o, session *s)
     }
     for (size_t i = 0U; rc == 0 && i < n; ++i) {
         for (size_t j = 0U; j < nj; ++j) {
-            q_deg[i * nj + j] = s->samples.samples[i].q_rad[j] * 180.0 / 3.14159265358979323846;
+            q_deg[i * nj + j] = s->samples.samples[i].q_rad[j] / DHC_DEG;
             dir[i * nj + j] = (signed char)s->samples.samples[i].dir[j];
         }
     }
