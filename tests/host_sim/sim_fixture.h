@@ -14,8 +14,8 @@
 #include "dhcal_sim/dhs_plant.h"
 #include "dhcal_sim/dhs_scenario.h"
 
-#define SIM_PI 3.14159265358979323846
-#define SIM_DEG (SIM_PI / 180.0)
+#define SIM_PI DHC_PI
+#define SIM_DEG DHC_DEG
 
 enum {
     SIM_FIXTURE_RIGID = 0,       /* stiff exact arm: geometry errors only */

@@ -16,12 +16,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "dhc_test_arms.h"
 #include "dhcal_io.h"
 #include "dhc_test_files.h"
 #include "unity.h"
 
-#define PI 3.14159265358979323846
-#define DEG (PI / 180.0)
 
 static char g_dir[256];
 static char g_path[512];
@@ -332,9 +331,9 @@ static void test_csv_crlf_bom_whitespace_blank_lines_are_accepted(void)
     TEST_ASSERT_FALSE(g_data.has_temp);
     TEST_ASSERT_EQUAL_size_t(4U, g_data.rows[0].line);
     TEST_ASSERT_EQUAL_size_t(6U, g_data.rows[1].line);
-    TEST_ASSERT_DOUBLE_WITHIN(0.0, 10.0 * DEG, g_data.rows[0].q_rad[0]);
-    TEST_ASSERT_DOUBLE_WITHIN(0.0, 20.0 * DEG, g_data.rows[0].q_rad[1]);
-    TEST_ASSERT_DOUBLE_WITHIN(0.0, -10.0 * DEG, g_data.rows[1].q_rad[0]);
+    TEST_ASSERT_DOUBLE_WITHIN(0.0, 10.0 * TEST_DEG, g_data.rows[0].q_rad[0]);
+    TEST_ASSERT_DOUBLE_WITHIN(0.0, 20.0 * TEST_DEG, g_data.rows[0].q_rad[1]);
+    TEST_ASSERT_DOUBLE_WITHIN(0.0, -10.0 * TEST_DEG, g_data.rows[1].q_rad[0]);
     TEST_ASSERT_DOUBLE_WITHIN(0.0, 6.0, g_data.rows[1].xyz_mm[2]);
 }
 
@@ -365,8 +364,8 @@ static void test_csv_all_columns_load_exactly(void)
                      g_data.has_temp);
     const dhcal_row *const r = &g_data.rows[0];
     TEST_ASSERT_EQUAL_size_t(3U, r->line);
-    TEST_ASSERT_DOUBLE_WITHIN(0.0, 33.3 * DEG, r->q_rad[0]);
-    TEST_ASSERT_DOUBLE_WITHIN(0.0, -45.125 * DEG, r->q_rad[1]);
+    TEST_ASSERT_DOUBLE_WITHIN(0.0, 33.3 * TEST_DEG, r->q_rad[0]);
+    TEST_ASSERT_DOUBLE_WITHIN(0.0, -45.125 * TEST_DEG, r->q_rad[1]);
     TEST_ASSERT_DOUBLE_WITHIN(0.0, 123.456, r->xyz_mm[0]);
     TEST_ASSERT_DOUBLE_WITHIN(0.0, -700.0, r->xyz_mm[1]);
     TEST_ASSERT_DOUBLE_WITHIN(0.0, 1.5e-3, r->xyz_mm[2]);
@@ -380,8 +379,8 @@ static void test_csv_all_columns_load_exactly(void)
     TEST_ASSERT_DOUBLE_WITHIN(0.0, 21.5, r->temp_c);
     const dhcal_row *const s = &g_data.rows[1];
     TEST_ASSERT_EQUAL_size_t(4U, s->line);
-    TEST_ASSERT_DOUBLE_WITHIN(0.0, -720.0 * DEG, s->q_rad[0]);
-    TEST_ASSERT_DOUBLE_WITHIN(0.0, 720.0 * DEG, s->q_rad[1]);
+    TEST_ASSERT_DOUBLE_WITHIN(0.0, -720.0 * TEST_DEG, s->q_rad[0]);
+    TEST_ASSERT_DOUBLE_WITHIN(0.0, 720.0 * TEST_DEG, s->q_rad[1]);
     TEST_ASSERT_DOUBLE_WITHIN(0.0, 1e5, s->wires_mm[0]);
     TEST_ASSERT_DOUBLE_WITHIN(0.0, 1e-3, s->wires_mm[2]);
     TEST_ASSERT_DOUBLE_WITHIN(0.0, 1.0, s->quat[0]);
@@ -402,8 +401,8 @@ static void test_csv_underflow_reads_as_tiny_but_wire_must_be_positive(void)
 static void test_csv_row_limits_and_dirs_exact(void)
 {
     csv_ok("q1,q2,x,y,z,dir1,dir2\n720,-720,1e5,-1e5,0,-1.0,+1\n", 2U);
-    TEST_ASSERT_DOUBLE_WITHIN(0.0, 720.0 * DEG, g_data.rows[0].q_rad[0]);
-    TEST_ASSERT_DOUBLE_WITHIN(0.0, -720.0 * DEG, g_data.rows[0].q_rad[1]);
+    TEST_ASSERT_DOUBLE_WITHIN(0.0, 720.0 * TEST_DEG, g_data.rows[0].q_rad[0]);
+    TEST_ASSERT_DOUBLE_WITHIN(0.0, -720.0 * TEST_DEG, g_data.rows[0].q_rad[1]);
     TEST_ASSERT_EQUAL_INT(-1, g_data.rows[0].dir[0]);
     TEST_ASSERT_EQUAL_INT(1, g_data.rows[0].dir[1]);
 }
@@ -462,7 +461,7 @@ static void random_row(size_t n_joints, dhcal_row *r)
 {
     memset(r, 0, sizeof *r);
     for (size_t j = 0U; j < n_joints; ++j) {
-        r->q_rad[j] = uniform(-700.0, 700.0) / (1.0 / DEG);
+        r->q_rad[j] = uniform(-700.0, 700.0) / (1.0 / TEST_DEG);
         r->dir[j] = uniform(0.0, 1.0) < 0.5 ? -1 : 1;
     }
     for (size_t k = 0U; k < 3U; ++k) {
@@ -518,7 +517,7 @@ static void round_trip(const dhcal_csv_columns *cols, size_t n_rows)
         const dhcal_row *const r = &g_data.rows[i];
         TEST_ASSERT_EQUAL_size_t(i + 3U, r->line); /* comment, header, then the rows */
         for (size_t j = 0U; j < cols->n_joints; ++j) {
-            assert_close(5e-10, w->q_rad[j] * (1.0 / DEG), r->q_rad[j] * (1.0 / DEG));
+            assert_close(5e-10, w->q_rad[j] * (1.0 / TEST_DEG), r->q_rad[j] * (1.0 / TEST_DEG));
             if (cols->has_dir) {
                 TEST_ASSERT_EQUAL_INT(w->dir[j], r->dir[j]);
             }
@@ -555,7 +554,7 @@ static void test_header_and_row_text(void)
     dhcal_row r;
     memset(&r, 0, sizeof r);
     r.q_rad[0] = 3.14159265358979323846 / 2.0;
-    r.q_rad[1] = -0.5 / (1.0 / DEG);
+    r.q_rad[1] = -0.5 / (1.0 / TEST_DEG);
     r.dir[0] = 1;
     r.dir[1] = -1;
     r.wires_mm[0] = 1000.0;
@@ -628,8 +627,8 @@ static void test_plan_has_no_measurements_and_dirs_of_its_own(void)
     TEST_ASSERT_EQUAL_size_t(2U, g_data.n_rows);
     TEST_ASSERT_TRUE(g_data.has_dir);
     TEST_ASSERT_FALSE(g_data.has_xyz || g_data.has_wires);
-    TEST_ASSERT_DOUBLE_WITHIN(1e-15, 45.0 * DEG, g_data.rows[0].q_rad[1]);
-    TEST_ASSERT_DOUBLE_WITHIN(1e-15, -120.5 * DEG, g_data.rows[1].q_rad[0]);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-15, 45.0 * TEST_DEG, g_data.rows[0].q_rad[1]);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-15, -120.5 * TEST_DEG, g_data.rows[1].q_rad[0]);
     TEST_ASSERT_EQUAL_INT(0, g_data.rows[0].dir[0]);
     TEST_ASSERT_EQUAL_INT(-1, g_data.rows[0].dir[1]);
     TEST_ASSERT_EQUAL_INT(1, g_data.rows[1].dir[1]);
@@ -923,8 +922,8 @@ static void test_model_minimal_gets_the_defaults(void)
              " {\"alpha_deg\": 0, \"a_mm\": 1, \"d_mm\": 2}]}");
     TEST_ASSERT_EQUAL_size_t(2U, g_model.arm.n_joints);
     TEST_ASSERT_EQUAL_STRING("", g_model.name);
-    TEST_ASSERT_DOUBLE_WITHIN(0.0, -180.0 * DEG, g_model.arm.joint[0].min_rad);
-    TEST_ASSERT_DOUBLE_WITHIN(0.0, 180.0 * DEG, g_model.arm.joint[1].max_rad);
+    TEST_ASSERT_DOUBLE_WITHIN(0.0, -180.0 * TEST_DEG, g_model.arm.joint[0].min_rad);
+    TEST_ASSERT_DOUBLE_WITHIN(0.0, 180.0 * TEST_DEG, g_model.arm.joint[1].max_rad);
     TEST_ASSERT_DOUBLE_WITHIN(0.0, -1.0, g_model.gravity[2]);
     TEST_ASSERT_DOUBLE_WITHIN(0.0, 1.0, g_model.arm.base.rot.m[1][1]);
     TEST_ASSERT_FALSE(g_model.has_measurer);
@@ -948,13 +947,13 @@ static void test_model_full_file_loads_exactly(void)
              " \"effects\": {\"joint_compliance:2\": [1e-06, 2e-06], \"tool_offset\": [1, 2, 3]}}\n");
     TEST_ASSERT_EQUAL_STRING("full \"one\"", g_model.name);
     const dhc_joint *const j = g_model.arm.joint;
-    TEST_ASSERT_DOUBLE_WITHIN(0.0, 90.0 * DEG, j[0].alpha_rad);
+    TEST_ASSERT_DOUBLE_WITHIN(0.0, 90.0 * TEST_DEG, j[0].alpha_rad);
     TEST_ASSERT_DOUBLE_WITHIN(0.0, 0.5, j[0].a_mm);
     TEST_ASSERT_DOUBLE_WITHIN(0.0, 433.0, j[0].d_mm);
-    TEST_ASSERT_DOUBLE_WITHIN(0.0, -2.0 * DEG, j[0].theta_offset_rad);
-    TEST_ASSERT_DOUBLE_WITHIN(0.0, -170.0 * DEG, j[0].min_rad);
-    TEST_ASSERT_DOUBLE_WITHIN(0.0, 0.25 * DEG, j[1].beta_rad);
-    TEST_ASSERT_DOUBLE_WITHIN(0.0, 1.0 * DEG, j[2].beta_rad);
+    TEST_ASSERT_DOUBLE_WITHIN(0.0, -2.0 * TEST_DEG, j[0].theta_offset_rad);
+    TEST_ASSERT_DOUBLE_WITHIN(0.0, -170.0 * TEST_DEG, j[0].min_rad);
+    TEST_ASSERT_DOUBLE_WITHIN(0.0, 0.25 * TEST_DEG, j[1].beta_rad);
+    TEST_ASSERT_DOUBLE_WITHIN(0.0, 1.0 * TEST_DEG, j[2].beta_rad);
     TEST_ASSERT_TRUE(g_model.has_beta[1] && g_model.has_beta[2] && !g_model.has_beta[0]);
     TEST_ASSERT_EQUAL_INT(DHC_CONV_DH, j[0].convention);
     TEST_ASSERT_EQUAL_INT(DHC_CONV_HAYATI, j[1].convention); /* 0.01 deg < 1e-3 rad */
@@ -989,7 +988,7 @@ static void test_fixture_paper_3dof_is_table_3_with_the_measurer(void)
     static const double TABLE3[3][3] = {{90.0, 0.0, 433.0}, {0.0, 400.0, 0.0}, {0.0, 345.0, 0.0}};
     TEST_ASSERT_EQUAL_size_t(3U, g_model.arm.n_joints);
     for (size_t i = 0U; i < 3U; ++i) {
-        TEST_ASSERT_DOUBLE_WITHIN(0.0, TABLE3[i][0] * DEG, g_model.arm.joint[i].alpha_rad);
+        TEST_ASSERT_DOUBLE_WITHIN(0.0, TABLE3[i][0] * TEST_DEG, g_model.arm.joint[i].alpha_rad);
         TEST_ASSERT_DOUBLE_WITHIN(0.0, TABLE3[i][1], g_model.arm.joint[i].a_mm);
         TEST_ASSERT_DOUBLE_WITHIN(0.0, TABLE3[i][2], g_model.arm.joint[i].d_mm);
     }
@@ -1017,7 +1016,7 @@ static void test_fixture_paper_6dof_nominal_is_table_2(void)
                                         {0.0, 10.0, 100.0},   {90.0, 0.0, 0.0}};
     TEST_ASSERT_EQUAL_size_t(6U, g_model.arm.n_joints);
     for (size_t i = 0U; i < 6U; ++i) {
-        TEST_ASSERT_DOUBLE_WITHIN(0.0, TABLE2[i][0] * DEG, g_model.arm.joint[i].alpha_rad);
+        TEST_ASSERT_DOUBLE_WITHIN(0.0, TABLE2[i][0] * TEST_DEG, g_model.arm.joint[i].alpha_rad);
         TEST_ASSERT_DOUBLE_WITHIN(0.0, TABLE2[i][1], g_model.arm.joint[i].a_mm);
         TEST_ASSERT_DOUBLE_WITHIN(0.0, TABLE2[i][2], g_model.arm.joint[i].d_mm);
         const int parallel = i == 1U || i == 2U || i == 4U;
@@ -1041,13 +1040,13 @@ static void make_calibrated_model(dhcal_model *m)
     static const double ALPHA[3] = {90.0, 0.0, 0.0};
     for (size_t i = 0U; i < 3U; ++i) {
         dhc_joint *const j = &m->arm.joint[i];
-        j->alpha_rad = ALPHA[i] * DEG + 1e-3 / (3.0 + (double)i);
+        j->alpha_rad = ALPHA[i] * TEST_DEG + 1e-3 / (3.0 + (double)i);
         j->a_mm = 400.0 / 3.0 + (double)i * 1e-7;
         j->d_mm = (i == 0U) ? 433.0 + 1.0 / 7.0 : 0.0;
-        j->theta_offset_rad = 2.0 * DEG / 3.0;
+        j->theta_offset_rad = 2.0 * TEST_DEG / 3.0;
         j->beta_rad = (i == 1U) ? 1e-4 / 3.0 : 0.0;
-        j->min_rad = -170.0 * DEG;
-        j->max_rad = 171.5 * DEG;
+        j->min_rad = -170.0 * TEST_DEG;
+        j->max_rad = 171.5 * TEST_DEG;
     }
     dhc_arm_choose_conventions(&m->arm, 1e-3);
     TEST_ASSERT_EQUAL_INT(DHC_CONV_HAYATI, m->arm.joint[1].convention);
@@ -1062,7 +1061,7 @@ static void make_calibrated_model(dhcal_model *m)
     const double an[3][3] = {{0, 0, 1200.0 / 7.0}, {0, 600, 300}, {0, -600, 300}};
     memcpy(m->anchors_mm, an, sizeof an);
     const double mxyz[3] = {1300.0, 0.0, 0.0};
-    const double mrpy[3] = {0.0, 0.0, PI};
+    const double mrpy[3] = {0.0, 0.0, TEST_PI};
     dhc_frame_from_xyz_rpy(mxyz, mrpy, &m->measurer_frame);
     m->n_effects = 2U;
     (void)snprintf(m->effects[0].name, sizeof m->effects[0].name, "joint_compliance:2");

@@ -11,13 +11,13 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "dhc_test_arms.h"
 #include "dhcal/dhc_params.h"
 #include "dhcal_io.h"
 #include "dhcal_model_map.h"
 #include "dhc_test_files.h"
 #include "unity.h"
 
-#define PI 3.14159265358979323846
 
 static char g_dir[256];
 static char g_path[512];
@@ -131,7 +131,7 @@ static void test_every_effect_round_trips_through_a_model_file_under_its_documen
         TEST_ASSERT_EQUAL_STRING(DOCUMENTED[i].key, reread.effects[0].name);
         TEST_ASSERT_EQUAL_size_t(DOCUMENTED[i].values, reread.effects[0].n_values);
         /* the file's units: degrees where the documentation says so */
-        const double unit = DOCUMENTED[i].degrees ? 180.0 / PI : 1.0;
+        const double unit = DOCUMENTED[i].degrees ? 180.0 / TEST_PI : 1.0;
         for (size_t k = 0U; k < set.count; ++k) {
             TEST_ASSERT_DOUBLE_WITHIN(1e-12 * fabs(value[k] * unit), value[k] * unit,
                                       reread.effects[0].values[k]);

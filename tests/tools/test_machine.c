@@ -11,13 +11,13 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "dhc_test_arms.h"
 #include "dhcal_machine.h"
 #include "dhcal_model_file.h"
 #include "dhcal_model_map.h"
 #include "dhc_test_files.h"
 #include "unity.h"
 
-#define DEG (3.14159265358979323846 / 180.0)
 
 static char g_dir[256];
 static char g_path[512];
@@ -87,8 +87,8 @@ static void test_a_machine_with_its_model_beside_it(void)
     TEST_ASSERT_EQUAL_size_t(2U, g_machine.n_joints);
     TEST_ASSERT_EQUAL_size_t(2U, g_machine.model.arm.n_joints);
     TEST_ASSERT_TRUE(g_machine.model.measurer.present);
-    TEST_ASSERT_DOUBLE_WITHIN(1e-15, 10.0 * DEG, g_machine.start_pose_rad[0]);
-    TEST_ASSERT_DOUBLE_WITHIN(1e-15, -20.0 * DEG, g_machine.start_pose_rad[1]);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-15, 10.0 * TEST_DEG, g_machine.start_pose_rad[0]);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-15, -20.0 * TEST_DEG, g_machine.start_pose_rad[1]);
     TEST_ASSERT_EQUAL_DOUBLE(4096.0, g_machine.encoder_counts_per_rev[1]);
     TEST_ASSERT_EQUAL_DOUBLE(50.0, g_machine.gear_ratio[1]);
     TEST_ASSERT_EQUAL_DOUBLE(0.02, g_machine.tacho_v_s_per_rad[1]);

@@ -7,6 +7,7 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "dhc_test_arms.h"
 #include "dhc_test_linalg.h"
 #include "dhcal/dhc_linalg.h"
 #include "unity.h"
@@ -14,7 +15,6 @@
 #define TEST_RNG_SEED 0x9E3779B97F4A7C15ULL
 #include "dhc_test_guard.h"
 
-#define PI 3.14159265358979323846
 #define MAXN ((size_t)10)
 
 void setUp(void) {}
@@ -72,7 +72,7 @@ static void random_rot(dhc_mat3 *r)
 {
     double u[3];
     random_unit(u);
-    const double t = uniform(0.0, PI);
+    const double t = uniform(0.0, TEST_PI);
     const double w[3] = {t * u[0], t * u[1], t * u[2]};
     dhc_rot_exp(w, r);
 }
@@ -211,13 +211,13 @@ static void test_elementary_rotations_turn_axes_the_right_way(void)
     const double x[3] = {1.0, 0.0, 0.0};
     const double y[3] = {0.0, 1.0, 0.0};
     const double z[3] = {0.0, 0.0, 1.0};
-    dhc_rot_x(PI / 2.0, &r);
+    dhc_rot_x(TEST_PI / 2.0, &r);
     dhc_rot_apply(&r, y, out);
     assert_vec3(z, out, 1e-15);
-    dhc_rot_y(PI / 2.0, &r);
+    dhc_rot_y(TEST_PI / 2.0, &r);
     dhc_rot_apply(&r, z, out);
     assert_vec3(x, out, 1e-15);
-    dhc_rot_z(PI / 2.0, &r);
+    dhc_rot_z(TEST_PI / 2.0, &r);
     dhc_rot_apply(&r, x, out);
     assert_vec3(y, out, 1e-15);
     dhc_rot_z(0.3, &r);
@@ -297,7 +297,7 @@ static void test_rotation_products_match_explicit_sums(void)
 
 static void test_rot_exp_about_z_is_rot_z(void)
 {
-    const double angles[] = {-3.0, -1.0, -1e-3, 0.5, 2.0, PI};
+    const double angles[] = {-3.0, -1.0, -1e-3, 0.5, 2.0, TEST_PI};
     for (size_t i = 0U; i < sizeof angles / sizeof angles[0]; ++i) {
         const double w[3] = {0.0, 0.0, angles[i]};
         dhc_mat3 r;
@@ -369,7 +369,7 @@ static void test_rot_log_round_trips_random_rotations(void)
     for (int trial = 0; trial < 200; ++trial) {
         double u[3];
         random_unit(u);
-        const double t = uniform(0.0, PI);
+        const double t = uniform(0.0, TEST_PI);
         const double w[3] = {t * u[0], t * u[1], t * u[2]};
         dhc_mat3 r;
         double back[3];
@@ -409,7 +409,7 @@ static void test_rot_log_is_accurate_near_pi(void)
         for (int trial = 0; trial < 10; ++trial) {
             double u[3];
             random_unit(u);
-            const double t = PI - gaps[i];
+            const double t = TEST_PI - gaps[i];
             const double w[3] = {t * u[0], t * u[1], t * u[2]};
             dhc_mat3 r;
             double back[3];
@@ -436,10 +436,10 @@ static void test_rot_log_at_exactly_pi_gives_either_sign(void)
         }
         double back[3];
         dhc_rot_log(&r, back);
-        TEST_ASSERT_DOUBLE_WITHIN(1e-15, PI, dhc_vec3_norm(back));
+        TEST_ASSERT_DOUBLE_WITHIN(1e-15, TEST_PI, dhc_vec3_norm(back));
         const double sign = dhc_vec3_dot(back, axes[i]) < 0.0 ? -1.0 : 1.0;
         for (size_t k = 0U; k < 3U; ++k) {
-            TEST_ASSERT_DOUBLE_WITHIN(1e-14, sign * PI * axes[i][k], back[k]);
+            TEST_ASSERT_DOUBLE_WITHIN(1e-14, sign * TEST_PI * axes[i][k], back[k]);
         }
         dhc_mat3 again;
         dhc_rot_exp(back, &again);
@@ -468,8 +468,8 @@ static void test_rpy_is_z_then_y_then_x_product(void)
 static void test_rpy_round_trips(void)
 {
     for (int trial = 0; trial < 200; ++trial) {
-        const double rpy[3] = {uniform(-PI, PI), uniform(-PI / 2.0 + 1e-3, PI / 2.0 - 1e-3),
-                               uniform(-PI, PI)};
+        const double rpy[3] = {uniform(-TEST_PI, TEST_PI), uniform(-TEST_PI / 2.0 + 1e-3, TEST_PI / 2.0 - 1e-3),
+                               uniform(-TEST_PI, TEST_PI)};
         dhc_mat3 r;
         double back[3];
         dhc_rot_from_rpy(rpy, &r);
@@ -480,7 +480,7 @@ static void test_rpy_round_trips(void)
 
 static void test_rpy_at_gimbal_lock_still_reproduces_the_rotation(void)
 {
-    const double pitches[] = {PI / 2.0, -PI / 2.0};
+    const double pitches[] = {TEST_PI / 2.0, -TEST_PI / 2.0};
     for (size_t i = 0U; i < 2U; ++i) {
         const double rpy[3] = {0.4, pitches[i], -1.2};
         dhc_mat3 r;
@@ -520,7 +520,7 @@ static void test_quat_round_trips_through_every_branch(void)
             double u[3];
             random_unit(u);
             const size_t ax = (size_t)trial % 3U;
-            const double t = PI - uniform(0.0, 0.3);
+            const double t = TEST_PI - uniform(0.0, 0.3);
             const double w[3] = {t * (axes[ax][0] + 0.2 * u[0]), t * (axes[ax][1] + 0.2 * u[1]),
                                  t * (axes[ax][2] + 0.2 * u[2])};
             dhc_rot_exp(w, &r);
@@ -575,14 +575,14 @@ static void random_frame(dhc_frame *f)
 {
     const double xyz[3] = {uniform(-500.0, 500.0), uniform(-500.0, 500.0),
                            uniform(-500.0, 500.0)};
-    const double rpy[3] = {uniform(-PI, PI), uniform(-1.5, 1.5), uniform(-PI, PI)};
+    const double rpy[3] = {uniform(-TEST_PI, TEST_PI), uniform(-1.5, 1.5), uniform(-TEST_PI, TEST_PI)};
     dhc_frame_from_xyz_rpy(xyz, rpy, f);
 }
 
 static void test_frame_from_xyz_rpy_maps_child_to_parent(void)
 {
     const double xyz[3] = {10.0, 20.0, 30.0};
-    const double rpy[3] = {0.0, 0.0, PI / 2.0};
+    const double rpy[3] = {0.0, 0.0, TEST_PI / 2.0};
     dhc_frame f;
     dhc_frame_from_xyz_rpy(xyz, rpy, &f);
     const double p[3] = {1.0, 0.0, 0.0};

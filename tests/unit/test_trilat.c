@@ -4,13 +4,13 @@
 #include <math.h>
 #include <stdint.h>
 
+#include "dhc_test_arms.h"
 #include "dhcal/dhc_trilat.h"
 #include "unity.h"
 
 void setUp(void) {}
 void tearDown(void) {}
 
-#define PI 3.14159265358979323846
 
 /* The paper's measurer (docs/formats.md, section 2): anchors (0,0,1200), (0,600,300), (0,-600,300)
  * and T_Meas = xyz (1300, 0, 0), rpy (0, 0, 180 deg). */
@@ -50,7 +50,7 @@ static double rng_range(rng64 *r, double lo, double hi)
 static void paper_measurer(double x_sign, dhc_measurer *m)
 {
     const double xyz[3] = {1300.0, 0.0, 0.0};
-    const double rpy[3] = {0.0, 0.0, PI};
+    const double rpy[3] = {0.0, 0.0, TEST_PI};
     m->a_mm = PAPER_A;
     m->b_mm = PAPER_B;
     m->c_mm = PAPER_C;
@@ -275,8 +275,8 @@ static void test_round_trip_other_layouts_and_frames(void)
             const double pos[3] = {rng_range(&rng, -2000.0, 2000.0),
                                    rng_range(&rng, -2000.0, 2000.0),
                                    rng_range(&rng, -2000.0, 2000.0)};
-            hand_frame(rng_range(&rng, -PI, PI), rng_range(&rng, -1.5, 1.5),
-                       rng_range(&rng, -PI, PI), pos, &m.frame);
+            hand_frame(rng_range(&rng, -TEST_PI, TEST_PI), rng_range(&rng, -1.5, 1.5),
+                       rng_range(&rng, -TEST_PI, TEST_PI), pos, &m.frame);
             const double q_local[3] = {side * rng_range(&rng, 0.1 * scale, 2.0 * scale),
                                        rng_range(&rng, -2.0 * scale, 2.0 * scale),
                                        rng_range(&rng, -2.0 * scale, 2.0 * scale)};
@@ -307,7 +307,7 @@ static void test_world_is_frame_applied_to_local(void)
         local_measurer(PAPER_A, PAPER_B, PAPER_C, 1.0, &m);
         const double pos[3] = {rng_range(&rng, -5000.0, 5000.0), rng_range(&rng, -5000.0, 5000.0),
                                rng_range(&rng, -5000.0, 5000.0)};
-        hand_frame(rng_range(&rng, -PI, PI), rng_range(&rng, -1.5, 1.5), rng_range(&rng, -PI, PI),
+        hand_frame(rng_range(&rng, -TEST_PI, TEST_PI), rng_range(&rng, -1.5, 1.5), rng_range(&rng, -TEST_PI, TEST_PI),
                    pos, &m.frame);
         const double q_local[3] = {rng_range(&rng, 100.0, 1500.0), rng_range(&rng, -900.0, 900.0),
                                    rng_range(&rng, -300.0, 1600.0)};
