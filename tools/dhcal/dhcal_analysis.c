@@ -36,14 +36,13 @@ int dhcal_parse_effects(const char *list, const dhc_model *model, dhc_param_set 
             return DHCAL_IO_BAD_INPUT;
         }
         const dhc_status st = dhc_params_add_effect(set, model, effect, joint);
+        const dhc_effect_info *const fx = dhc_effect_info_of(effect);
         if (st != DHC_OK) {
             snprintf(err->msg, sizeof err->msg, "--effects: cannot add '%.*s': %s%s",
                      (int)(len > 60U ? 60U : len), p,
                      st == DHC_ERR_CAPACITY ? "too many parameters" : "given twice",
-                     st != DHC_ERR_CAPACITY && !model->measurer.present &&
-                             (effect == DHC_EFFECT_MEASURER_SCALE ||
-                              effect == DHC_EFFECT_MEASURER_OFFSET ||
-                              effect == DHC_EFFECT_MEASURER_ANCHORS)
+                     st != DHC_ERR_CAPACITY && !model->measurer.present && fx != NULL &&
+                             (fx->needs & DHC_NEEDS_WIRES) != 0U
                          ? " or the model has no 'measurer'"
                          : "");
             return DHCAL_IO_BAD_INPUT;

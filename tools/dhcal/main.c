@@ -709,9 +709,9 @@ static void text_covariates_fitted(const dhcal_fit *fit, const dhcal_samples *sa
     int drift = 0;
     int thermal = 0;
     for (size_t k = 0U; k < fit->set.count; ++k) {
-        const dhc_effect e = dhc_params_effect_of(&fit->set.id[k]);
-        drift |= e == DHC_EFFECT_DRIFT_SCALE || e == DHC_EFFECT_DRIFT_OFFSET;
-        thermal |= e == DHC_EFFECT_THERMAL_SCALE;
+        const dhc_effect_info *const fx = dhc_effect_info_of(dhc_params_effect_of(&fit->set.id[k]));
+        drift |= fx != NULL && (fx->needs & DHC_NEEDS_TIME) != 0U;
+        thermal |= fx != NULL && (fx->needs & DHC_NEEDS_TEMPERATURE) != 0U;
     }
     dhcal_covariates cov;
     dhcal_error err;
