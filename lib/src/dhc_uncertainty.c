@@ -33,14 +33,14 @@ dhc_status dhc_uncertainty_from_samples(dhc_uncertainty *u, const dhc_model *mod
     dhc_status st = dhc_normal_eq_init(&u->ne, p);
     u->fac.n = 0U;
     u->sigma2 = sigma * sigma;
-    double jac_buf[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS];
-    double r[DHC_MAX_ROWS_PER_SAMPLE];
+    double *const jac_buf = u->jac;
+    double *const r = u->r;
     for (size_t i = 0U; i < n && st == DHC_OK; ++i) {
         st = read(ctx, i, &u->sample);
         const size_t rows = dhc_sample_rows(&u->sample);
         dhc_mat jac;
         if (st == DHC_OK) {
-            st = dhc_mat_init(&jac, rows, p, jac_buf, sizeof jac_buf / sizeof jac_buf[0]);
+            st = dhc_mat_init(&jac, rows, p, jac_buf, sizeof u->jac / sizeof u->jac[0]);
         }
         if (st == DHC_OK) {
             st = dhc_model_jacobian(model, set, &u->sample, weight_mm_per_rad, &jac, NULL);
@@ -54,11 +54,11 @@ dhc_status dhc_uncertainty_from_samples(dhc_uncertainty *u, const dhc_model *mod
             }
         }
         if (st == DHC_OK && noise_on) {
-            memset(r, 0, sizeof r); /* the rows only: the residual is not needed */
+            memset(r, 0, sizeof u->r); /* the rows only: the residual is not needed */
             st = dhc_sample_whiten(model, &u->sample, used, weight_mm_per_rad, r, &jac);
         }
         if (st == DHC_OK) {
-            memset(r, 0, sizeof r);
+            memset(r, 0, sizeof u->r);
             st = dhc_normal_eq_add(&u->ne, &jac, r, NULL, rows);
         }
     }
@@ -71,7 +71,7 @@ dhc_status dhc_uncertainty_from_samples(dhc_uncertainty *u, const dhc_model *mod
     return st;
 }
 
-dhc_status dhc_uncertainty_tool_point(const dhc_uncertainty *u, const dhc_model *model,
+dhc_status dhc_uncertainty_tool_point(dhc_uncertainty *u, const dhc_model *model,
                                       const dhc_param_set *set, const double *q_rad,
                                       const int8_t *dir, const double *joint_sd_rad,
                                       double *variance_mm2)
@@ -81,23 +81,23 @@ dhc_status dhc_uncertainty_tool_point(const dhc_uncertainty *u, const dhc_model 
         return DHC_ERR_ARGUMENT;
     }
     const size_t nj = model->arm.n_joints;
-    dhc_sample s;
-    memset(&s, 0, sizeof s);
-    s.kind = (uint8_t)DHC_MEAS_POSITION;
-    s.temp_c = model->thermal_ref_c;
+    dhc_sample *const s = &u->sample;
+    memset(s, 0, sizeof *s);
+    s->kind = (uint8_t)DHC_MEAS_POSITION;
+    s->temp_c = model->thermal_ref_c;
     for (size_t j = 0U; j < nj && j < DHC_MAX_JOINTS; ++j) {
-        s.q_rad[j] = q_rad[j];
-        s.dir[j] = 1;
+        s->q_rad[j] = q_rad[j];
+        s->dir[j] = 1;
         if (dir != NULL) {
-            s.dir[j] = dir[j];
+            s->dir[j] = dir[j];
         }
     }
     const size_t p = set->count;
-    double jac_buf[3U * DHC_MAX_PARAMS];
+    double *const jac_buf = u->jac;
     dhc_mat jp;
-    dhc_status st = dhc_mat_init(&jp, 3U, p, jac_buf, sizeof jac_buf / sizeof jac_buf[0]);
+    dhc_status st = dhc_mat_init(&jp, 3U, p, jac_buf, sizeof u->jac / sizeof u->jac[0]);
     if (st == DHC_OK) {
-        st = dhc_model_jacobian(model, set, &s, 1.0, &jp, NULL);
+        st = dhc_model_jacobian(model, set, s, 1.0, &jp, NULL);
     }
     double var = 0.0;
     for (size_t row = 0U; row < 3U && st == DHC_OK; ++row) {
@@ -107,17 +107,17 @@ dhc_status dhc_uncertainty_tool_point(const dhc_uncertainty *u, const dhc_model 
     }
     if (st == DHC_OK && joint_sd_rad != NULL) {
         /* dp/dq_eff is the joint-offset column of each joint (the same screw) */
-        dhc_param_set thetas;
-        dhc_params_clear(&thetas);
+        dhc_param_set *const thetas = &u->thetas;
+        dhc_params_clear(thetas);
         for (size_t j = 0U; j < nj && st == DHC_OK; ++j) {
-            st = dhc_params_add(&thetas, model, DHC_P_THETA, j, 0U);
+            st = dhc_params_add(thetas, model, DHC_P_THETA, j, 0U);
         }
         dhc_mat jq;
         if (st == DHC_OK) {
-            st = dhc_mat_init(&jq, 3U, nj, jac_buf, sizeof jac_buf / sizeof jac_buf[0]);
+            st = dhc_mat_init(&jq, 3U, nj, jac_buf, sizeof u->jac / sizeof u->jac[0]);
         }
         if (st == DHC_OK) {
-            st = dhc_model_jacobian(model, &thetas, &s, 1.0, &jq, NULL);
+            st = dhc_model_jacobian(model, thetas, s, 1.0, &jq, NULL);
         }
         for (size_t j = 0U; j < nj && st == DHC_OK; ++j) {
             if (!(joint_sd_rad[j] >= 0.0) || !dhc_is_finite(joint_sd_rad[j])) {

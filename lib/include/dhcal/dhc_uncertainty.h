@@ -37,12 +37,17 @@ typedef struct {
     dhc_normal_eq ne;   /* J^T W J of the parameters in use */
     dhc_lsq_factor fac; /* its analysis */
     double sigma2;      /* the fit's residual variance per row */
-    dhc_sample sample;  /* scratch */
+    /* scratch: here, not on the stack, so the calls stay within a controller's stack */
+    dhc_sample sample;
+    double jac[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS];
+    double r[DHC_MAX_ROWS_PER_SAMPLE];
+    dhc_param_set thetas;
 } dhc_uncertainty;
 
 /* Builds C from the samples 0..n-1 (read through read/ctx, as dhc_calib_fit reads them) at
  * model for the parameters of set flagged nonzero in use (set->count entries; NULL: all).
- * noise: the fit's noise model (NULL or all 0: off); weight_mm_per_rad: the fit's orientation weight (pose samples).
+ * noise: the fit's noise model (NULL or all 0: off); weight_mm_per_rad: the fit's orientation
+ * weight (pose samples).
  * sigma >= 0: the fit's residual standard deviation.
  * DHC_ERR_ARGUMENT (NULL, sigma negative or not finite, an invalid noise model),
  * DHC_ERR_NO_DATA (n = 0), the reader's status, errors of dhc_model_jacobian and
@@ -58,8 +63,8 @@ dhc_status dhc_uncertainty_from_samples(dhc_uncertainty *u, const dhc_model *mod
  * trace(J_p C J_p^T) plus, when joint_sd_rad is not NULL (n_joints entries), the joint
  * angles' share sum_j sd_j^2 |dp/dq_j|^2. model and set as given to
  * dhc_uncertainty_from_samples. DHC_ERR_ARGUMENT (NULL, u not built, a negative sd), errors
- * of dhc_model_jacobian. O(P^2). */
-dhc_status dhc_uncertainty_tool_point(const dhc_uncertainty *u, const dhc_model *model,
+ * of dhc_model_jacobian. O(P^2). Uses u's scratch (the factor is left as it was). */
+dhc_status dhc_uncertainty_tool_point(dhc_uncertainty *u, const dhc_model *model,
                                       const dhc_param_set *set, const double *q_rad,
                                       const int8_t *dir, const double *joint_sd_rad,
                                       double *variance_mm2);
