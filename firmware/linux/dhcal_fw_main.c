@@ -42,7 +42,9 @@
 #define MAX_CONFIG_BYTES 65536U
 
 static const char *const help_text =
-    "usage: dhcal-fw [--config FILE] [options]\n"
+    "usage: dhcal-fw --machine M.json [--config FILE] [options]\n"
+    "       dhcal-fw --machine M.json --port sim --scenario S.json [options]\n"
+    "       dhcal-fw --gpio-chip NAME --enc-lines A,B --gpio-watch N\n"
     "The controller's calibration run: plan the poses, move the arm through them and read\n"
     "the draw-wire measurer, calibrate (geometry, diagnosis, the named effect) and store the\n"
     "result; prints one JSON object. Options (each also a 'key = value' line of --config,\n"
