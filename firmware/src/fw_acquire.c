@@ -6,15 +6,6 @@
 
 #include "dhcal/dhc_trilat.h"
 
-static void model_measurer(const dhc_model *m, dhc_measurer *out)
-{
-    out->a_mm = m->measurer.anchor_mm[0][2];
-    out->b_mm = m->measurer.anchor_mm[1][1];
-    out->c_mm = m->measurer.anchor_mm[1][2];
-    out->x_sign = 1.0;
-    out->frame = m->measurer.frame;
-}
-
 void fw_acq_stats_reset(fw_acq_stats *st)
 {
     memset(st, 0, sizeof *st);
@@ -124,11 +115,9 @@ fw_fault fw_acquire_one(fw_ctrl *c, const dhc_model *model, uint32_t hold_ticks,
     }
     memcpy(s.wire_mm, w, sizeof w);
     if (model->measurer.present) {
-        dhc_measurer m;
-        model_measurer(model, &m);
         double pt[3];
         double pm[3];
-        const dhc_status ts = dhc_trilat_world(&m, w, 1.0, pt);
+        const dhc_status ts = dhc_model_wire_point(model, w, 1.0, pt);
         if (ts != DHC_OK || dhc_model_tool_point(model, s.q_rad, s.dir, pm) != DHC_OK) {
             fw_ctrl_fault(c, FW_FAULT_WIRES_INCONSISTENT, 0U);
             return c->fault;

@@ -141,3 +141,49 @@ void dhc_trilat_lengths(const dhc_measurer *m, const double q_world_mm[3], doubl
         len_mm[k] = dhc_vec3_norm(d);
     }
 }
+
+dhc_status dhc_measurer_of_model(const dhc_measurer_model *mm, dhc_measurer *out)
+{
+    if (mm == NULL || out == NULL || !mm->present) {
+        return DHC_ERR_ARGUMENT;
+    }
+    const double(*p)[3] = mm->anchor_mm;
+    double big = 0.0;
+    for (size_t k = 0U; k < 3U; ++k) {
+        for (size_t c = 0U; c < 3U; ++c) {
+            big = fmax(big, fabs(p[k][c]));
+        }
+    }
+    const double tol = fmax(1e-9 * big, 1e-9);
+    const int paper = fabs(p[0][0]) <= tol && fabs(p[1][0]) <= tol && fabs(p[2][0]) <= tol &&
+                      fabs(p[0][1]) <= tol && fabs(p[1][1] + p[2][1]) <= tol &&
+                      fabs(p[1][2] - p[2][2]) <= tol;
+    if (!paper) {
+        return DHC_ERR_ARGUMENT;
+    }
+    out->a_mm = p[0][2];
+    out->b_mm = p[1][1];
+    out->c_mm = p[1][2];
+    out->x_sign = 1.0;
+    out->frame = mm->frame;
+    return DHC_OK;
+}
+
+dhc_status dhc_model_wire_point(const dhc_model *model, const double wire_mm[3], double tol_mm2,
+                                double p_world_mm[3])
+{
+    if (model == NULL || wire_mm == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    dhc_measurer m;
+    const dhc_status st = dhc_measurer_of_model(&model->measurer, &m);
+    if (st != DHC_OK) {
+        return st;
+    }
+    /* the model reads L_k = (1 + s) |p - P_k| + o_k */
+    double len[3];
+    for (size_t k = 0U; k < 3U; ++k) {
+        len[k] = (wire_mm[k] - model->measurer.offset_mm[k]) / (1.0 + model->measurer.scale);
+    }
+    return dhc_trilat_world(&m, len, tol_mm2, p_world_mm);
+}

@@ -690,6 +690,47 @@ static void test_lengths_and_trilateration_are_inverse(void)
     TEST_ASSERT_DOUBLE_ARRAY_WITHIN(ROUND_TRIP_TOL_MM, q, back, 3U);
 }
 
+/* A model's measurer with wire scale and zero offsets: lengths computed here by hand (the
+ * measurer frame 1.3 m along x, turned half a turn about z, maps (x, y, z) to
+ * (1300 - x, -y, z)) are read back as the point they came from; a layout that is not the
+ * paper's, or no measurer, is refused rather than solved with the wrong geometry. */
+static void test_a_model_measurer_reads_its_own_lengths_back(void)
+{
+    dhc_model m;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_model_init(&m, 3U));
+    double p[3] = {0.0};
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_model_wire_point(&m, p, 1.0, p));
+    test_put_paper_measurer(&m);
+    m.measurer.scale = 2e-3;
+    m.measurer.offset_mm[0] = 0.5;
+    m.measurer.offset_mm[1] = -0.3;
+    m.measurer.offset_mm[2] = 0.2;
+    const double anchor_world[3][3] = {{1300.0, 0.0, 1200.0}, {1300.0, -600.0, 300.0},
+                                       {1300.0, 600.0, 300.0}};
+    test_rng g = {0x77ULL};
+    for (size_t t = 0U; t < 50U; ++t) {
+        /* points on the arm's side of the anchor plane (world x < 1300) */
+        const double q[3] = {test_range(&g, -200.0, 1000.0), test_range(&g, -600.0, 600.0),
+                             test_range(&g, 0.0, 1200.0)};
+        double wire[3];
+        for (size_t k = 0U; k < 3U; ++k) {
+            const double dx = q[0] - anchor_world[k][0];
+            const double dy = q[1] - anchor_world[k][1];
+            const double dz = q[2] - anchor_world[k][2];
+            wire[k] = (1.0 + 2e-3) * sqrt(dx * dx + dy * dy + dz * dz) + m.measurer.offset_mm[k];
+        }
+        double back[3];
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_model_wire_point(&m, wire, 1.0, back));
+        for (size_t c = 0U; c < 3U; ++c) {
+            TEST_ASSERT_DOUBLE_WITHIN(1e-7, q[c], back[c]);
+        }
+    }
+    m.measurer.anchor_mm[0][0] = 5.0; /* P1 off the anchor plane */
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_model_wire_point(&m, p, 1.0, p));
+    dhc_measurer out;
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_measurer_of_model(&m.measurer, &out));
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -720,5 +761,6 @@ int main(void)
     RUN_TEST(test_success_writes_exactly_three_values);
     RUN_TEST(test_lengths_match_plain_distances);
     RUN_TEST(test_lengths_and_trilateration_are_inverse);
+    RUN_TEST(test_a_model_measurer_reads_its_own_lengths_back);
     return UNITY_END();
 }

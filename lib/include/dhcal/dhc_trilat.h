@@ -15,6 +15,7 @@
 #define DHC_TRILAT_H
 
 #include "dhc_linalg.h"
+#include "dhc_model.h"
 #include "dhc_status.h"
 
 #ifdef __cplusplus
@@ -50,6 +51,19 @@ dhc_status dhc_trilat_world(const dhc_measurer *m, const double len_mm[3], doubl
 /* Wire lengths from a world point (the forward model the measurer calibration uses).
  * Total on finite inputs; no status. O(1). */
 void dhc_trilat_lengths(const dhc_measurer *m, const double q_world_mm[3], double len_mm[3]);
+
+/* The closed form's measurer of a model's draw-wire measurer, whose anchors must lie as the
+ * paper's: P1 = (0, 0, a), P2 = (0, b, c), P3 = (0, -b, c) in the measurer frame (to 1e-9 of
+ * the largest coordinate, at least 1e-9 mm), the work space on the frame's +x side.
+ * DHC_ERR_ARGUMENT for NULL, a model without a measurer, or another layout (the closed form
+ * does not apply: say so rather than solve the wrong geometry). */
+dhc_status dhc_measurer_of_model(const dhc_measurer_model *mm, dhc_measurer *out);
+
+/* The world point at which the model's measurer reads the wire lengths wire_mm: its wire
+ * scale and zero offsets (measurer_scale, measurer_offset) undone, then dhc_trilat_world.
+ * Errors of dhc_measurer_of_model and dhc_trilat_world; p_world_mm untouched then. */
+dhc_status dhc_model_wire_point(const dhc_model *model, const double wire_mm[3], double tol_mm2,
+                                double p_world_mm[3]);
 
 #ifdef __cplusplus
 }
