@@ -186,8 +186,11 @@ static void where_it_fails(const dhc_model *m, size_t n, FILE *log)
     fprintf(log, "    the geometric model fails most at (q deg -> |wire residual| mm):\n");
     for (size_t k = 0U; k < 3U && wv[k] >= 0.0; ++k) {
         const dhc_sample *s = &job.samples[worst[k]];
-        fprintf(log, "      (%7.1f %7.1f %7.1f) -> %.4f\n", s->q_rad[0] * 180.0 / DHC_PI,
-                s->q_rad[1] * 180.0 / DHC_PI, s->q_rad[2] * 180.0 / DHC_PI, wv[k]);
+        fprintf(log, "      (");
+        for (size_t j = 0U; j < nominal.arm.n_joints; ++j) {
+            fprintf(log, "%s%7.1f", j > 0U ? " " : "", s->q_rad[j] / DHC_DEG);
+        }
+        fprintf(log, ") -> %.4f\n", wv[k]);
     }
 }
 
@@ -252,6 +255,9 @@ static int write_outputs(const char *dir, size_t n, const char *effect)
 static const char *const usage_text =
     "usage: dhcal-demo --scenario S.json [--json] [--out DIR] [--samples N] [--targets N]\n"
     "                  [--mixed-directions] [--effects LIST] [--no-diagnose] [--unweighted]\n"
+    "                  [--start-deg Q1,...,QN]\n"
+    "  --start-deg LIST where the arm stands when the controller starts, one angle per joint\n"
+    "                   (default for the paper's 3-joint arm: 0,60,-60)\n"
     "  --effects LIST   the controller's configured effects, fitted in every calibration\n"
     "                   (e.g. joint_compliance:2,measurer_scale)\n"
     "  --no-diagnose    fit only those; do not look for a missing one\n"
@@ -282,8 +288,27 @@ enum {
     OPT_TARGETS,
     OPT_EFFECTS,
     OPT_NO_DIAGNOSE,
-    OPT_UNWEIGHTED
+    OPT_UNWEIGHTED,
+    OPT_START
 };
+
+/* "a,b,c" into q_deg (at most DHC_MAX_JOINTS finite angles in [-720, 720]); the count, or 0
+ * for anything else. */
+static size_t parse_angles(const char *s, double q_deg[DHC_MAX_JOINTS])
+{
+    size_t n = 0U;
+    while (s != NULL && *s != '\0') {
+        char *end = NULL;
+        const double v = strtod(s, &end);
+        if (end == s || n == DHC_MAX_JOINTS || !isfinite(v) || fabs(v) > 720.0 ||
+            (*end != ',' && *end != '\0')) {
+            return 0U;
+        }
+        q_deg[n++] = v;
+        s = *end == ',' ? end + 1 : end;
+    }
+    return n;
+}
 
 int main(int argc, char **argv)
 {
@@ -297,6 +322,7 @@ int main(int argc, char **argv)
         {"effects", required_argument, NULL, OPT_EFFECTS},
         {"no-diagnose", no_argument, NULL, OPT_NO_DIAGNOSE},
         {"unweighted", no_argument, NULL, OPT_UNWEIGHTED},
+        {"start-deg", required_argument, NULL, OPT_START},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
     const char *scenario = NULL;
@@ -309,6 +335,8 @@ int main(int argc, char **argv)
     fw_autocal_default_config(&autocal);
     const char *effects = NULL;
     int weighted = 1;
+    double start_deg[DHC_MAX_JOINTS] = {0.0};
+    size_t n_start = 0U;
     opterr = 0;
     int c;
     while ((c = getopt_long(argc, argv, ":h", long_options, NULL)) != -1) {
@@ -341,6 +369,14 @@ int main(int argc, char **argv)
         case OPT_UNWEIGHTED:
             weighted = 0;
             break;
+        case OPT_START:
+            n_start = parse_angles(optarg, start_deg);
+            if (n_start == 0U) {
+                fprintf(stderr, "dhcal-demo: --start-deg: '%s' is not a list of angles in "
+                                "[-720, 720] deg\n", optarg);
+                bad = 1;
+            }
+            break;
         case 'h':
             fputs(usage_text, stdout);
             return 0;
@@ -367,20 +403,6 @@ int main(int argc, char **argv)
         fprintf(stderr, "dhcal-demo: unexpected argument '%s'\n%s", argv[optind], usage_text);
         return 2;
     }
-    /* The configured effects, comma separated, by their names in docs/effects.md. */
-    for (const char *e = effects; e != NULL && *e != '\0';) {
-        const char *comma = strchr(e, ',');
-        const size_t len = comma != NULL ? (size_t)(comma - e) : strlen(e);
-        if (autocal.n_effects == FW_AUTOCAL_MAX_EFFECTS ||
-            dhc_effect_parse(e, len, 3U, &autocal.effect[autocal.n_effects],
-                             &autocal.effect_joint[autocal.n_effects]) != DHC_OK) {
-            fprintf(stderr, "dhcal-demo: --effects: '%.*s' is not an effect of a 3-joint arm "
-                            "(at most %u)\n", (int)len, e, FW_AUTOCAL_MAX_EFFECTS);
-            return 2;
-        }
-        ++autocal.n_effects;
-        e = comma != NULL ? comma + 1 : e + len;
-    }
     if (scenario == NULL || n_samples < 10U || n_samples > FW_ACQ_MAX_SAMPLES ||
         n_targets == 0U || n_targets > MAX_TARGETS) {
         fprintf(stderr, "dhcal-demo: need --scenario; 10 <= samples <= %u, 1 <= targets <= %u\n",
@@ -394,17 +416,45 @@ int main(int argc, char **argv)
         fprintf(stderr, "dhcal-demo: %s\n", err.msg);
         return 2;
     }
-    const double q_start[3] = {0.0, 60.0 * DHC_PI / 180.0, -60.0 * DHC_PI / 180.0};
-    if (sf.sc.n_joints != 3U || !nominal.measurer.present ||
-        fw_sim_init(&sim, &sf.sc, 7U, q_start, &port) != DHC_OK) {
-        fprintf(stderr, "dhcal-demo: %s: the scenario must be a 3-joint arm with a measurer\n",
+    const size_t nj = sf.sc.n_joints;
+    if (n_start == 0U && nj == 3U) { /* the paper's arm, elbow up */
+        start_deg[1] = 60.0;
+        start_deg[2] = -60.0;
+        n_start = 3U;
+    }
+    if (n_start != nj) {
+        fprintf(stderr, "dhcal-demo: %s: the arm has %zu joints: --start-deg needs %zu angles\n",
+                scenario, nj, nj);
+        return 2;
+    }
+    double q_start[DHC_MAX_JOINTS] = {0.0};
+    for (size_t j = 0U; j < nj; ++j) {
+        q_start[j] = start_deg[j] * DHC_DEG;
+    }
+    if (!nominal.measurer.present || fw_sim_init(&sim, &sf.sc, 7U, q_start, &port) != DHC_OK) {
+        fprintf(stderr, "dhcal-demo: %s: the scenario must be an arm with a measurer\n",
                 scenario);
         return 2;
     }
+    /* The configured effects, comma separated, by their names in docs/effects.md. */
+    for (const char *e = effects; e != NULL && *e != '\0';) {
+        const char *comma = strchr(e, ',');
+        const size_t len = comma != NULL ? (size_t)(comma - e) : strlen(e);
+        if (autocal.n_effects == FW_AUTOCAL_MAX_EFFECTS ||
+            dhc_effect_parse(e, len, nj, &autocal.effect[autocal.n_effects],
+                             &autocal.effect_joint[autocal.n_effects]) != DHC_OK) {
+            fprintf(stderr, "dhcal-demo: --effects: '%.*s' is not an effect of a %zu-joint arm "
+                            "(at most %u)\n", (int)len, e, nj, FW_AUTOCAL_MAX_EFFECTS);
+            return 2;
+        }
+        ++autocal.n_effects;
+        e = comma != NULL ? comma + 1 : e + len;
+    }
+
     fw_sim_io_config(&sf.sc, &io);
     fw_job_config jc;
     fw_job_default_config(&jc, &nominal);
-    memcpy(jc.q_start_rad, q_start, sizeof q_start);
+    memcpy(jc.q_start_rad, q_start, sizeof jc.q_start_rad);
     jc.n_samples = n_samples;
     jc.plan_seed = 4242U;
     jc.mixed_dirs = mixed_dirs;
@@ -457,10 +507,12 @@ int main(int argc, char **argv)
     char effect[64];
     (void)fw_autocal_effect_label(res, effect, sizeof effect);
     if (res->noise.meas_mm > 0.0) {
-        fprintf(log, "    noise model: joint angles %.3g %.3g %.3g urad (1 count / sqrt 12 with the "
-                     "holds' dither), wires %.4f mm (measured over the holds)\n",
-                res->noise.joint_rad[0] * 1e6, res->noise.joint_rad[1] * 1e6,
-                res->noise.joint_rad[2] * 1e6, res->noise.meas_mm);
+        fprintf(log, "    noise model: joint angles");
+        for (size_t j = 0U; j < nominal.arm.n_joints; ++j) {
+            fprintf(log, " %.3g", res->noise.joint_rad[j] * 1e6);
+        }
+        fprintf(log, " urad (1 count / sqrt 12 with the holds' dither), wires %.4f mm "
+                     "(measured over the holds)\n", res->noise.meas_mm);
     }
     fprintf(log, "(c) geometric fit%s%s: wire residual RMS %.4f mm, max %.4f mm (%zu params, "
                  "rank %zu)\n", effects != NULL ? " with the configured " : "",
@@ -524,7 +576,7 @@ int main(int argc, char **argv)
         /* the noise model the controller measured and fitted with: what `dhcal --noise`
          * takes at the desk (largest joint sd, in degrees) */
         double joint_sd_deg = 0.0;
-        for (size_t j = 0U; j < 3U; ++j) {
+        for (size_t j = 0U; j < nominal.arm.n_joints; ++j) {
             joint_sd_deg = fmax(joint_sd_deg, res->noise.joint_rad[j] * 180.0 / DHC_PI);
         }
         printf("\"noise_model\": {\"joint_deg\": %.6g, \"meas_mm\": %.6g}}\n", joint_sd_deg,
