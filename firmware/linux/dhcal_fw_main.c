@@ -14,6 +14,7 @@
 
 #include <errno.h>
 #include <getopt.h>
+#include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -391,6 +392,28 @@ static void machine_io_config(const dhcal_machine *m, fw_io_config *out)
     fw_io_set_wires(out, m->wire_wheel_radius_mm, m->wire_counts_per_rev, m->wire_zero_mm);
 }
 
+/* The first conversion in which the machine and the simulated arm disagree (relative 1e-9),
+ * or NULL: a sim-port reference run with other scaling would be silently mis-scaled. */
+static const char *io_mismatch(const fw_io_config *machine, const fw_io_config *sim, size_t n)
+{
+    const double tol = 1e-9;
+    for (size_t j = 0U; j < n; ++j) {
+        if (fabs(machine->counts_per_rad[j] - sim->counts_per_rad[j]) >
+            tol * fabs(sim->counts_per_rad[j])) {
+            return "encoder counts per joint radian (encoder_counts_per_rev, gear_ratio)";
+        }
+        if (fabs(machine->tacho_v_per_rad_s[j] - sim->tacho_v_per_rad_s[j]) >
+            tol * fabs(sim->tacho_v_per_rad_s[j])) {
+            return "tacho volts per joint rad/s (tacho_v_s_per_rad)";
+        }
+    }
+    if (fabs(machine->wire_mm_per_count - sim->wire_mm_per_count) >
+        tol * fabs(sim->wire_mm_per_count)) {
+        return "wire mm per count (the measurer's wheel)";
+    }
+    return NULL;
+}
+
 static double elapsed_s(const struct timespec *t0)
 {
     struct timespec t1;
@@ -643,6 +666,14 @@ static int run_calibration(options *o)
         if (sf.sc.n_joints != machine.n_joints) {
             fprintf(stderr, "dhcal-fw: %s: a %zu-joint arm for the %zu-joint machine %s\n",
                     o->scenario, sf.sc.n_joints, machine.n_joints, o->machine);
+            return EXIT_USAGE;
+        }
+        fw_io_config sim_io;
+        fw_sim_io_config(&sf.sc, &sim_io);
+        const char *const differs = io_mismatch(&io, &sim_io, machine.n_joints);
+        if (differs != NULL) {
+            fprintf(stderr, "dhcal-fw: %s and %s disagree on the %s\n", o->machine,
+                    o->scenario, differs);
             return EXIT_USAGE;
         }
     }
