@@ -72,13 +72,9 @@ static int run_targets(const dhc_model *model, size_t n, uint32_t seed, phase_re
 {
     memset(r, 0, sizeof *r);
     const size_t got = fw_plan_poses(&nominal, n, seed, 0, targets_pose);
+    static const double q_zero[DHC_MAX_JOINTS] = {0.0};
     dhc_sample tmpl;
-    memset(&tmpl, 0, sizeof tmpl);
-    tmpl.kind = (uint8_t)DHC_MEAS_POSITION;
-    tmpl.temp_c = model->thermal_ref_c;
-    for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
-        tmpl.dir[j] = 1;
-    }
+    dhc_model_sample_at(model, q_zero, NULL, DHC_MEAS_POSITION, &tmpl);
     double ss = 0.0;
     for (size_t i = 0U; i < got; ++i) {
         double target[3];

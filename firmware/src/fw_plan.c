@@ -64,11 +64,7 @@ size_t fw_plan_poses(const dhc_model *model, size_t n, uint32_t seed, int mixed_
 /* A wire sample at the pose, nothing measured: what the Jacobian and the prediction need. */
 static void pose_sample(const dhc_model *model, const fw_pose *pose, dhc_sample *s)
 {
-    memset(s, 0, sizeof *s);
-    s->kind = (uint8_t)DHC_MEAS_WIRES;
-    s->temp_c = model->thermal_ref_c;
-    memcpy(s->q_rad, pose->q_rad, sizeof s->q_rad);
-    memcpy(s->dir, pose->dir, sizeof s->dir);
+    dhc_model_sample_at(model, pose->q_rad, pose->dir, DHC_MEAS_WIRES, s);
 }
 
 dhc_status fw_pose_wires(const dhc_model *model, const fw_pose *pose, double wire_mm[3])

@@ -220,6 +220,21 @@ dhc_status dhc_model_predict(const dhc_model *model, const dhc_sample *s, dhc_pr
     return dhc_model_evaluate(model, s, 0, &ev, out);
 }
 
+void dhc_model_sample_at(const dhc_model *model, const double *q_rad, const int8_t *dir,
+                         dhc_meas_kind kind, dhc_sample *s)
+{
+    DHC_ASSERT(model != NULL && q_rad != NULL && s != NULL &&
+               model->arm.n_joints <= DHC_MAX_JOINTS);
+    memset(s, 0, sizeof *s);
+    s->kind = (uint8_t)kind;
+    s->temp_c = model->thermal_ref_c;
+    s->t_s = model->drift_ref_s;
+    for (size_t j = 0U; j < model->arm.n_joints; ++j) {
+        s->q_rad[j] = q_rad[j];
+        s->dir[j] = (int8_t)(dir != NULL ? dir[j] : 1);
+    }
+}
+
 dhc_status dhc_model_tool_point(const dhc_model *model, const double *q_rad, const int8_t *dir,
                                 double p_mm[3])
 {
@@ -227,14 +242,7 @@ dhc_status dhc_model_tool_point(const dhc_model *model, const double *q_rad, con
         return DHC_ERR_ARGUMENT;
     }
     dhc_sample s;
-    memset(&s, 0, sizeof s);
-    s.kind = (uint8_t)DHC_MEAS_POSITION;
-    s.temp_c = model->thermal_ref_c;
-    s.t_s = model->drift_ref_s; /* a controller plans without the session's drift */
-    for (size_t j = 0U; j < model->arm.n_joints; ++j) {
-        s.q_rad[j] = q_rad[j];
-        s.dir[j] = (int8_t)(dir != NULL ? dir[j] : 1);
-    }
+    dhc_model_sample_at(model, q_rad, dir, DHC_MEAS_POSITION, &s);
     dhc_prediction pr;
     const dhc_status st = dhc_model_predict(model, &s, &pr);
     if (st == DHC_OK) {

@@ -142,6 +142,13 @@ void dhc_measurer_anchor_world(const dhc_measurer_model *m, size_t k, double out
  * result is not finite. O(N^2) for compliance, O(N) otherwise. */
 dhc_status dhc_model_predict(const dhc_model *model, const dhc_sample *s, dhc_prediction *out);
 
+/* A sample at joint angles q_rad (n_joints entries) approached from dir (NULL: all from
+ * +1), nothing measured yet, at the model's thermal reference and at its drift reference
+ * time (a controller plans without the session's drift): what a prediction or a Jacobian at
+ * a commanded pose needs. */
+void dhc_model_sample_at(const dhc_model *model, const double *q_rad, const int8_t *dir,
+                         dhc_meas_kind kind, dhc_sample *s);
+
 /* The tool point (world, mm) the model puts at joint angles q_rad (n_joints entries), each
  * joint approached from dir (NULL: all from +1), at the thermal reference temperature: what
  * a controller commands and plans with. Errors as dhc_model_predict; p_mm untouched then. */
