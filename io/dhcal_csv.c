@@ -175,8 +175,9 @@ typedef struct {
     size_t idx; /* joint (0-based), axis, wire or quaternion component */
 } csv_col;
 
-/* Each column can appear once, so a valid header has at most this many. */
-#define CSV_MAX_COLS (2U * DHC_MAX_JOINTS + 11U)
+/* Each column can appear once, so a valid header has at most this many: q and dir per joint,
+ * x,y,z, L1..L3, qw..qz, temp_c and t_s. */
+#define CSV_MAX_COLS (2U * DHC_MAX_JOINTS + 3U + 3U + 4U + 2U)
 #define SEEN_WIDTH (DHC_MAX_JOINTS > 4U ? DHC_MAX_JOINTS : 4U)
 
 static const char *const XYZ_NAMES[3] = {"x", "y", "z"};
