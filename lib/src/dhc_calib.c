@@ -240,6 +240,7 @@ static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *mod
     const size_t p = fc->set->count;
     const double w = fc->opt->orientation_weight_mm_per_rad;
     memset(tot, 0, sizeof *tot);
+    dhc_arm_prepare(&model->arm, &ws->trig);
     if (accumulate) {
         const dhc_status st = dhc_normal_eq_init(&ws->ne, p);
         if (st != DHC_OK) {
@@ -268,10 +269,12 @@ static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *mod
             st = dhc_mat_init(&jac, rows, p, ws->jac_buf,
                               sizeof ws->jac_buf / sizeof ws->jac_buf[0]);
             if (st == DHC_OK) {
-                st = dhc_model_linearize(model, fc->set, s, w, r, &got_rows, &jac);
+                st = dhc_model_linearize_prepared(model, &ws->trig, fc->set, s, w, r, &got_rows,
+                                                  &jac);
             }
         } else {
-            st = dhc_model_residual(model, s, w, r, &got_rows);
+            st = dhc_model_linearize_prepared(model, &ws->trig, fc->set, s, w, r, &got_rows,
+                                              NULL);
         }
         if (st == DHC_OK) {
             memcpy(rw, r, sizeof r);
@@ -400,8 +403,8 @@ static dhc_status sample_error2(const fit_context *fc, const dhc_model *model, s
         return st;
     }
     double r[DHC_MAX_ROWS_PER_SAMPLE];
-    st = dhc_model_residual(model, &fc->ws->sample, fc->opt->orientation_weight_mm_per_rad, r,
-                            rows);
+    st = dhc_model_linearize_prepared(model, &fc->ws->trig, fc->set, &fc->ws->sample,
+                                      fc->opt->orientation_weight_mm_per_rad, r, rows, NULL);
     if (st == DHC_OK && fc->whiten) {
         /* screened in units of each sample's own noise: a sample at a pose where the joint
          * noise maps large is not an outlier for being larger */
@@ -433,6 +436,7 @@ static dhc_status scan_errors(const fit_context *fc, const dhc_model *model, dou
                               uint8_t mark, error_scan *out)
 {
     memset(out, 0, sizeof *out);
+    dhc_arm_prepare(&model->arm, &fc->ws->trig);
     for (size_t i = 0U; i < fc->n; ++i) {
         if (fc->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
             continue;

@@ -143,6 +143,7 @@ typedef struct {
     dhc_model current;
     dhc_model trial;
     dhc_sample sample;
+    dhc_arm_trig trig; /* of the model the current pass evaluates */
     double delta[DHC_MAX_PARAMS];
     double scratch[DHC_MAX_PARAMS];
     double weights_residual[DHC_MAX_ROWS_PER_SAMPLE];
