@@ -60,54 +60,79 @@ dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double
     if (jac->rows != k || jac->cols != n) {
         return DHC_ERR_DIMENSION;
     }
-    if (!dhc_all_finite(jac->data, k * n) || !dhc_all_finite(r, k)) {
-        return DHC_ERR_NONFINITE;
-    }
     if (w != NULL) {
         for (size_t e = 0U; e < k; ++e) {
             if (!(w[e] > 0.0) || !dhc_is_finite(w[e])) {
-                return DHC_ERR_ARGUMENT;
+                /* a NaN or infinite entry elsewhere is reported first, as it always was */
+                return dhc_all_finite(jac->data, k * n) && dhc_all_finite(r, k)
+                           ? DHC_ERR_ARGUMENT
+                           : DHC_ERR_NONFINITE;
             }
         }
     }
     /* Finite rows can still overflow the sums (entries above ~1e154), which would poison
      * every later analysis. Every entry of J^T W J and J^T W r is at most the largest of the
      * diagonal and the SSR (Cauchy-Schwarz), and each row adds at most w max(|J|, |r|)^2
-     * to any of them: a finite bound, with room for rounding, means finite sums. */
+     * to any of them: a finite bound, with room for rounding, means finite sums.
+     * The same sweep finds a non-finite entry: x * 0 is NaN for NaN and infinities, and the
+     * sum keeps it (the comparisons of the maximum skip NaN). */
     double bound = ne->ssr;
     for (size_t i = 0U; i < n; ++i) {
-        bound = fmax(bound, ne->jtj[i * n + i]);
+        const double d = ne->jtj[i * n + i];
+        bound = d > bound ? d : bound;
     }
+    double poison = 0.0;
     for (size_t e = 0U; e < k; ++e) {
+        const double *const row = &DHC_MAT_AT(jac, e, 0U);
         double m = fabs(r[e]);
+        poison += r[e] * 0.0;
         for (size_t i = 0U; i < n; ++i) {
-            m = fmax(m, fabs(DHC_MAT_AT(jac, e, i)));
+            const double a = fabs(row[i]);
+            poison += row[i] * 0.0;
+            m = a > m ? a : m;
         }
         bound += (w != NULL ? w[e] : 1.0) * m * m;
+    }
+    if (!(poison >= 0.0 || poison <= 0.0)) {
+        return DHC_ERR_NONFINITE;
     }
     if (!dhc_is_finite(2.0 * bound)) {
         return DHC_ERR_NONFINITE;
     }
-    for (size_t e = 0U; e < k; ++e) {
-        const double we = w != NULL ? w[e] : 1.0;
-        const double *const row = &DHC_MAT_AT(jac, e, 0U);
-        for (size_t i = 0U; i < n; ++i) {
-            const double wji = we * row[i];
-            if (!(fabs(wji) > 0.0)) {
-                continue; /* identification Jacobians are sparse; skipping is exact */
-            }
-            for (size_t j = 0U; j <= i; ++j) {
-                ne->jtj[i * n + j] += wji * row[j];
-            }
-            ne->jtr[i] += wji * r[e];
-        }
-        ne->ssr += we * r[e] * r[e];
-    }
-    /* Accumulate one triangle, keep the stored matrix full and exactly symmetric. */
+    /* Row by row of the matrix, each equation's term in turn (every sum in the equations'
+     * order): the lower triangle from (w_e J_ei) J_ej, the upper from the very products of
+     * its mirror, (w_e J_ej) J_ei. One sweep, exactly symmetric, no transposed copy. */
     for (size_t i = 0U; i < n; ++i) {
-        for (size_t j = 0U; j < i; ++j) {
-            ne->jtj[j * n + i] = ne->jtj[i * n + j];
+        double *const out = &ne->jtj[i * n];
+        /* three equations per sweep of the row (a sample's tool point): a third of the
+         * loads and stores of one at a time, the same sums */
+        for (size_t e = 0U; e < k; e += 3U) {
+            const size_t m = k - e < 3U ? k - e : 3U;
+            double we[3] = {1.0, 0.0, 0.0};
+            const double *row[3];
+            double ji[3] = {0.0, 0.0, 0.0};
+            for (size_t t = 0U; t < 3U; ++t) {
+                /* a missing third row is the first again with weight 0: adds exact zeros */
+                const size_t et = t < m ? e + t : e;
+                we[t] = t < m ? (w != NULL ? w[et] : 1.0) : 0.0;
+                row[t] = &DHC_MAT_AT(jac, et, 0U);
+                ji[t] = row[t][i];
+                ne->jtr[i] += t < m ? (we[t] * ji[t]) * r[et] : 0.0;
+            }
+            const double w0 = we[0] * ji[0];
+            const double w1 = we[1] * ji[1];
+            const double w2 = we[2] * ji[2];
+            for (size_t j = 0U; j <= i; ++j) {
+                out[j] = ((out[j] + w0 * row[0][j]) + w1 * row[1][j]) + w2 * row[2][j];
+            }
+            for (size_t j = i + 1U; j < n; ++j) {
+                out[j] = ((out[j] + (we[0] * row[0][j]) * ji[0]) + (we[1] * row[1][j]) * ji[1]) +
+                         (we[2] * row[2][j]) * ji[2];
+            }
         }
+    }
+    for (size_t e = 0U; e < k; ++e) {
+        ne->ssr += (w != NULL ? w[e] : 1.0) * r[e] * r[e];
     }
     ne->rows += k;
     return DHC_OK;
