@@ -204,6 +204,8 @@ typedef struct {
     size_t pose_samples;
     size_t rows;
     data_traits traits;
+    double max_e2;     /* largest squared sample error, as sample_error2 defines it ... */
+    int own_weights;   /* ... when 1: each sample whitened at the model itself */
 } pass_totals;
 
 static void note_traits(data_traits *t, const dhc_sample *s, size_t n_joints, int first)
@@ -240,6 +242,7 @@ static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *mod
     const size_t p = fc->set->count;
     const double w = fc->opt->orientation_weight_mm_per_rad;
     memset(tot, 0, sizeof *tot);
+    tot->own_weights = weights == model;
     dhc_arm_prepare(&model->arm, &ws->trig);
     if (accumulate) {
         const dhc_status st = dhc_normal_eq_init(&ws->ne, p);
@@ -311,6 +314,11 @@ static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *mod
             tot->rot_ss += o2 / (w * w);
             tot->pose_samples++;
         }
+        double screened = 0.0; /* the outlier screen's error: sample_error2's sum */
+        for (size_t k = 0U; k < rows; ++k) {
+            screened += sq(rw[k]);
+        }
+        tot->max_e2 = fmax(tot->max_e2, screened);
         tot->samples++;
         tot->rows += rows;
     }
@@ -459,25 +467,74 @@ static dhc_status scan_errors(const fit_context *fc, const dhc_model *model, dou
     return DHC_OK;
 }
 
-/* A quantile (share 0.5: the median) of the squared sample errors by bisection on the value
- * (each step one pass over the data): the library keeps no per-sample storage, so no sort. */
+/* Bisection steps that one pass over the data decides: the pass counts the errors below
+ * every midpoint the next QUANTILE_LEVELS steps could visit (2^QUANTILE_LEVELS - 1 of them),
+ * and the steps then follow their path through those counts. */
+#define QUANTILE_LEVELS 5U
+#define QUANTILE_POINTS ((1U << QUANTILE_LEVELS) - 1U)
+
+/* A quantile (share 0.5: the median) of the squared sample errors by bisection on the value:
+ * the library keeps no per-sample storage, so no sort. The same steps, midpoints and result
+ * as one pass per step, in a fifth of the passes. */
 static dhc_status quantile_error2(const fit_context *fc, const dhc_model *model,
                                   const error_scan *all, double share, double *median)
 {
     double lo = 0.0;
     double hi = all->max_e2;
     const size_t half = (size_t)ceil(share * (double)all->used);
-    for (size_t it = 0U; it < MEDIAN_BISECTIONS && hi - lo > MEDIAN_REL_PRECISION * hi; ++it) {
-        const double mid = 0.5 * (lo + hi);
-        error_scan scan;
-        const dhc_status st = scan_errors(fc, model, mid, (uint8_t)DHC_SAMPLE_USED, &scan);
-        if (st != DHC_OK) {
-            return st;
+    size_t it = 0U;
+    while (it < MEDIAN_BISECTIONS && hi - lo > MEDIAN_REL_PRECISION * hi) {
+        /* the midpoints in increasing order: point m at depth d (2^(L-1-d) from its
+         * interval's ends, which are points of lower depth, lo or hi) */
+        double mid[QUANTILE_POINTS];
+        for (size_t d = 0U; d < QUANTILE_LEVELS; ++d) {
+            const size_t half_width = (size_t)1U << (QUANTILE_LEVELS - 1U - d);
+            for (size_t m = half_width - 1U; m < QUANTILE_POINTS; m += 2U * half_width) {
+                const double a = m + 1U > half_width ? mid[m - half_width] : lo;
+                const double b = m + half_width < QUANTILE_POINTS ? mid[m + half_width] : hi;
+                mid[m] = 0.5 * (a + b);
+            }
         }
-        if (scan.at_most >= half) {
-            hi = mid;
-        } else {
-            lo = mid;
+        size_t below[QUANTILE_POINTS + 1U]; /* errors in (mid[m-1], mid[m]] */
+        memset(below, 0, sizeof below);
+        dhc_arm_prepare(&model->arm, &fc->ws->trig);
+        for (size_t i = 0U; i < fc->n; ++i) {
+            if (fc->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
+                continue;
+            }
+            double e2;
+            size_t rows;
+            const dhc_status st = sample_error2(fc, model, i, &e2, &rows);
+            if (st != DHC_OK) {
+                return st;
+            }
+            size_t first = 0U; /* the first midpoint at or above e2 */
+            size_t last = QUANTILE_POINTS;
+            while (first < last) {
+                const size_t m = (first + last) / 2U;
+                if (e2 <= mid[m]) {
+                    last = m;
+                } else {
+                    first = m + 1U;
+                }
+            }
+            below[first]++;
+        }
+        for (size_t m = 1U; m <= QUANTILE_POINTS; ++m) {
+            below[m] += below[m - 1U]; /* now: errors at or below mid[m] */
+        }
+        size_t m = (QUANTILE_POINTS - 1U) / 2U;
+        for (size_t d = 0U; d < QUANTILE_LEVELS && it < MEDIAN_BISECTIONS &&
+                            hi - lo > MEDIAN_REL_PRECISION * hi;
+             ++d, ++it) {
+            const size_t step = ((size_t)1U << (QUANTILE_LEVELS - 1U - d)) / 2U;
+            if (below[m] >= half) {
+                hi = mid[m];
+                m -= step;
+            } else {
+                lo = mid[m];
+                m += step;
+            }
         }
     }
     *median = hi;
@@ -492,13 +549,28 @@ static int redundant(const pass_totals *tot, const dhc_calib_report *rep)
     return tot->rows >= 2U * rep->structural_rank;
 }
 
+/* The scan of all used samples at the model: from the totals of a pass at it when they
+ * hold it (tot not NULL, each sample whitened at the model itself), else a pass. */
+static dhc_status scan_all(const fit_context *fc, const dhc_model *model,
+                           const pass_totals *tot, error_scan *out)
+{
+    if (tot == NULL || !tot->own_weights) {
+        return scan_errors(fc, model, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, out);
+    }
+    out->used = tot->samples;
+    out->pose = tot->pose_samples;
+    out->at_most = tot->samples;
+    out->max_e2 = tot->max_e2;
+    return DHC_OK;
+}
+
 /* Robust sigma of the used samples at the model, from their median squared error; *used
- * counts them. */
-static dhc_status robust_sigma(const fit_context *fc, const dhc_model *model, double *sigma,
-                               size_t *used)
+ * counts them. tot: NULL, or the totals of a pass at the model over the same samples. */
+static dhc_status robust_sigma(const fit_context *fc, const dhc_model *model,
+                               const pass_totals *tot, double *sigma, size_t *used)
 {
     error_scan all;
-    dhc_status st = scan_errors(fc, model, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, &all);
+    dhc_status st = scan_all(fc, model, tot, &all);
     double median = 0.0;
     if (st == DHC_OK && all.used > 0U) {
         st = quantile_error2(fc, model, &all, 0.5, &median);
@@ -509,8 +581,10 @@ static dhc_status robust_sigma(const fit_context *fc, const dhc_model *model, do
     return st;
 }
 
-/* Flags samples whose error is many robust sigmas; returns how many were newly flagged. */
-static dhc_status flag_outliers(const fit_context *fc, const dhc_model *model, size_t *flagged)
+/* Flags samples whose error is many robust sigmas; returns how many were newly flagged.
+ * tot as robust_sigma's. */
+static dhc_status flag_outliers(const fit_context *fc, const dhc_model *model,
+                                const pass_totals *tot, size_t *flagged)
 {
     *flagged = 0U;
     if (fc->opt->outlier_threshold <= 0.0) {
@@ -518,7 +592,7 @@ static dhc_status flag_outliers(const fit_context *fc, const dhc_model *model, s
     }
     double sigma;
     size_t used;
-    dhc_status st = robust_sigma(fc, model, &sigma, &used);
+    dhc_status st = robust_sigma(fc, model, tot, &sigma, &used);
     if (st != DHC_OK || used < 3U) {
         return st;
     }
@@ -942,7 +1016,7 @@ static dhc_status robust_start(const fit_context *fc, dhc_calib_report *rep, pas
     /* one scan and one level reused throughout: this is on the M4's deepest call chain */
     error_scan scan;
     double level = 0.0;
-    dhc_status st = scan_errors(fc, &ws->current, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, &scan);
+    dhc_status st = scan_all(fc, &ws->current, tot, &scan);
     if (st == DHC_OK && scan.used >= 4U) {
         st = quantile_error2(fc, &ws->current, &scan, 0.5, &level);
     }
@@ -969,7 +1043,7 @@ static dhc_status robust_start(const fit_context *fc, dhc_calib_report *rep, pas
         return st == DHC_ERR_NONFINITE || st == DHC_ERR_ARGUMENT ? st : DHC_OK;
     }
     size_t used;
-    st = robust_sigma(fc, &ws->current, &level, &used);
+    st = robust_sigma(fc, &ws->current, NULL, &level, &used);
     return st == DHC_OK ? scan_errors(fc, &ws->current, sq(ROBUST_K * level),
                                       (uint8_t)DHC_SAMPLE_ROBUST, &scan)
                         : st;
@@ -1061,7 +1135,7 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
         }
         size_t flagged = 0U;
         if (round < opt->max_outlier_rounds && redundant(&tot, rep)) {
-            st = flag_outliers(&fc, &ws->current, &flagged);
+            st = flag_outliers(&fc, &ws->current, &tot, &flagged);
             if (st != DHC_OK) {
                 return st;
             }
