@@ -86,11 +86,16 @@ int dhcal_samples_errors(const dhc_model *model, const dhcal_samples *s, double 
     double sum = 0.0;
     double mx = 0.0;
     size_t used = 0U;
+    if (model->arm.n_joints == 0U || model->arm.n_joints > DHC_MAX_JOINTS) {
+        return DHCAL_IO_FAILED;
+    }
+    dhc_arm_trig trig; /* one model for every row */
+    dhc_arm_prepare(&model->arm, &trig);
     for (size_t i = 0U; i < s->n; ++i) {
         double r[DHC_MAX_ROWS_PER_SAMPLE];
         size_t rows;
-        if (dhc_model_residual(model, &s->samples[i], DHC_ORIENTATION_WEIGHT_MM_PER_RAD, r,
-                               &rows) != DHC_OK) {
+        if (dhc_model_residual_prepared(model, &trig, &s->samples[i],
+                                        DHC_ORIENTATION_WEIGHT_MM_PER_RAD, r, &rows) != DHC_OK) {
             return DHCAL_IO_FAILED;
         }
         if (resid != NULL) {

@@ -276,8 +276,7 @@ static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *mod
                                                   &jac);
             }
         } else {
-            st = dhc_model_linearize_prepared(model, &ws->trig, fc->set, s, w, r, &got_rows,
-                                              NULL);
+            st = dhc_model_residual_prepared(model, &ws->trig, s, w, r, &got_rows);
         }
         if (st == DHC_OK) {
             memcpy(rw, r, sizeof r);
@@ -411,8 +410,8 @@ static dhc_status sample_error2(const fit_context *fc, const dhc_model *model, s
         return st;
     }
     double r[DHC_MAX_ROWS_PER_SAMPLE];
-    st = dhc_model_linearize_prepared(model, &fc->ws->trig, fc->set, &fc->ws->sample,
-                                      fc->opt->orientation_weight_mm_per_rad, r, rows, NULL);
+    st = dhc_model_residual_prepared(model, &fc->ws->trig, &fc->ws->sample,
+                                     fc->opt->orientation_weight_mm_per_rad, r, rows);
     if (st == DHC_OK && fc->whiten) {
         /* screened in units of each sample's own noise: a sample at a pose where the joint
          * noise maps large is not an outlier for being larger */

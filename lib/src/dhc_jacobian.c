@@ -379,20 +379,14 @@ dhc_status dhc_model_linearize_prepared(const dhc_model *model, const dhc_arm_tr
     }
     dhc_prediction pred;
     memset(&pred, 0, sizeof pred);
-    dhc_status st;
-    if (jac != NULL) {
-        st = check_jac(jac, dhc_sample_rows(s), set->count);
-        if (st == DHC_OK) {
-            st = jacobian_prepared(model, trig, set, s, weight_mm_per_rad, jac, &pred);
-        }
-    } else {
-        dhc_model_eval ev;
-        st = dhc_model_evaluate_prepared(model, trig, s, 0, &ev, &pred);
+    dhc_status st = check_jac(jac, dhc_sample_rows(s), set->count);
+    if (st == DHC_OK) {
+        st = jacobian_prepared(model, trig, set, s, weight_mm_per_rad, jac, &pred);
     }
     if (st == DHC_OK) {
         st = dhc_model_residual_of(s, &pred, weight_mm_per_rad, r, rows);
     }
-    if (st == DHC_OK && jac != NULL) {
+    if (st == DHC_OK) {
         dhc_model_residual_slope(s, r, weight_mm_per_rad, jac);
     }
     return st;

@@ -288,6 +288,20 @@ dhc_status dhc_model_residual(const dhc_model *model, const dhc_sample *s,
     return st == DHC_OK ? dhc_model_residual_of(s, &pred, weight_mm_per_rad, r, rows) : st;
 }
 
+dhc_status dhc_model_residual_prepared(const dhc_model *model, const dhc_arm_trig *trig,
+                                       const dhc_sample *s, double weight_mm_per_rad,
+                                       double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows)
+{
+    if (r == NULL || rows == NULL || model == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    dhc_prediction pred;
+    dhc_model_eval ev;
+    memset(&pred, 0, sizeof pred);
+    const dhc_status st = dhc_model_evaluate_prepared(model, trig, s, 0, &ev, &pred);
+    return st == DHC_OK ? dhc_model_residual_of(s, &pred, weight_mm_per_rad, r, rows) : st;
+}
+
 dhc_status dhc_model_residual_of(const dhc_sample *s, const dhc_prediction *pred,
                                  double weight_mm_per_rad, double r[DHC_MAX_ROWS_PER_SAMPLE],
                                  size_t *rows)

@@ -67,8 +67,7 @@ dhc_status dhc_model_linearize(const dhc_model *model, const dhc_param_set *set,
                                double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows, dhc_mat *jac);
 
 /* dhc_model_linearize at the arm's trigonometry from dhc_arm_prepare (model->arm's, unchanged
- * since): a pass over many samples at one model prepares once. jac may be NULL: the
- * residual alone (as dhc_model_residual gives it), from the same evaluation. */
+ * since): a pass over many samples at one model prepares once. */
 dhc_status dhc_model_linearize_prepared(const dhc_model *model, const dhc_arm_trig *trig,
                                        const dhc_param_set *set, const dhc_sample *s,
                                        double weight_mm_per_rad,

@@ -168,6 +168,12 @@ dhc_status dhc_model_residual(const dhc_model *model, const dhc_sample *s,
                               double weight_mm_per_rad, double r[DHC_MAX_ROWS_PER_SAMPLE],
                               size_t *rows);
 
+/* dhc_model_residual at the arm's trigonometry from dhc_arm_prepare (model->arm's,
+ * unchanged since): for passes over many samples at one model. */
+dhc_status dhc_model_residual_prepared(const dhc_model *model, const dhc_arm_trig *trig,
+                                       const dhc_sample *s, double weight_mm_per_rad,
+                                       double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows);
+
 /* The residual of a sample from a prediction already made (dhc_model_predict, or the one
  * dhc_model_jacobian returns): as dhc_model_residual without evaluating the model again. */
 dhc_status dhc_model_residual_of(const dhc_sample *s, const dhc_prediction *pred,
