@@ -829,8 +829,23 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
         }
         ws->trial = ws->current;
         st = dhc_params_apply(fc->set, &ws->trial, ws->delta, p);
+        /* from the accumulation at the current estimate, before a trial overwrites it */
+        const double predicted = predicted_decrease(&ws->ne, ws->delta);
+        /* Most steps are accepted: the trial's pass accumulates its normal equations too,
+         * and an accepted step needs no pass of its own (a rejected one pays a pass to
+         * accumulate the current estimate again). Not with the noise model on: a trial is
+         * judged with its start's weights, but accumulated with its own. */
+        const int speculate = !fc->whiten;
+        int ne_at_trial = 0;
         pass_totals trial_tot;
-        if (st == DHC_OK) {
+        if (st == DHC_OK && speculate) {
+            st = data_pass(fc, &ws->trial, 1, &trial_tot);
+            ne_at_trial = st == DHC_OK;
+            if (st != DHC_OK) {
+                /* slopes can fail where residuals do not: judge the trial as before */
+                st = data_pass_weighted(fc, &ws->trial, &ws->current, 0, &trial_tot);
+            }
+        } else if (st == DHC_OK) {
             st = data_pass_weighted(fc, &ws->trial, &ws->current, 0, &trial_tot);
         }
         if (st != DHC_OK) {
@@ -839,13 +854,16 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
         if (trial_tot.ssr < tot->ssr) {
             const double gain = tot->ssr - trial_tot.ssr;
             const double step = scaled_step_norm(&ws->fac, ws->delta, p);
-            const double predicted = predicted_decrease(&ws->ne, ws->delta);
             const double rho = predicted > 0.0 ? gain / predicted : 0.0;
             const double t = 2.0 * rho - 1.0;
             ws->current = ws->trial;
             lambda = fmax(lambda * fmax(0.1, 1.0 - t * t * t), 1e-12);
             nu = 2.0;
-            st = data_pass(fc, &ws->current, 1, tot);
+            if (ne_at_trial) {
+                *tot = trial_tot;
+            } else {
+                st = data_pass(fc, &ws->current, 1, tot);
+            }
             if (st == DHC_OK) {
                 st = analyse_keeping_set(fc, rep);
             }
@@ -859,6 +877,14 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
             }
             previous_gain = gain;
         } else {
+            if (speculate) {
+                /* the same accumulation again: ws->fac is still its analysis */
+                pass_totals again;
+                st = data_pass(fc, &ws->current, 1, &again);
+                if (st != DHC_OK) {
+                    break;
+                }
+            }
             lambda *= nu;
             nu *= 2.0;
             if (lambda > LAMBDA_MAX) {
