@@ -802,7 +802,7 @@ static double predicted_decrease(const dhc_normal_eq *ne, const double *delta)
  * gradually, a rejected step doubles the growth. A fixed x10 / /10 schedule oscillates in
  * the curved valleys of real arms' barely determined parameters and creeps along them. */
 static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *rep,
-                                      pass_totals *tot, int *converged)
+                                      pass_totals *tot, int accumulated, int *converged)
 {
     dhc_calib_workspace *const ws = fc->ws;
     const size_t p = fc->set->count;
@@ -810,7 +810,8 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
     double nu = 2.0;
     double previous_gain = 0.0;
     *converged = 0;
-    dhc_status st = data_pass(fc, &ws->current, 1, tot);
+    /* accumulated: ws->ne and *tot already hold the pass at ws->current */
+    dhc_status st = accumulated ? DHC_OK : data_pass(fc, &ws->current, 1, tot);
     if (st == DHC_OK) {
         st = analyse_keeping_set(fc, rep);
     }
@@ -987,11 +988,14 @@ static dhc_status fit_to_convergence(const fit_context *fc, dhc_calib_report *re
 {
     size_t checks = 0U;
     size_t holds = 0U;
+    int accumulated = 0;
     for (;;) {
-        dhc_status st = levenberg_marquardt(fc, rep, tot, converged);
+        dhc_status st = levenberg_marquardt(fc, rep, tot, accumulated, converged);
         if (st != DHC_OK || !*converged) {
             return st;
         }
+        /* LM ends with ws->ne and *tot at its estimate, which freeing parameters keeps */
+        accumulated = 1;
         size_t freed = 0U;
         if (checks < fc->opt->max_identifiability_checks) {
             st = free_identifiable(fc, rep, &freed);
@@ -1014,6 +1018,7 @@ static dhc_status fit_to_convergence(const fit_context *fc, dhc_calib_report *re
         if (!held) {
             return DHC_OK;
         }
+        accumulated = 0; /* a held parameter moved the estimate */
         holds++;
     }
 }
