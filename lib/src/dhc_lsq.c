@@ -100,8 +100,10 @@ dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double
         return DHC_ERR_NONFINITE;
     }
     /* Row by row of the matrix, each equation's term in turn (every sum in the equations'
-     * order): the lower triangle from (w_e J_ei) J_ej, the upper from the very products of
-     * its mirror, (w_e J_ej) J_ei. One sweep, exactly symmetric, no transposed copy. */
+     * order): the lower triangle from (w_e J_ei) J_ej; the upper from the very products of
+     * its mirror, (w_e J_ej) J_ei, for a sample's few rows, or for many rows (a batch),
+     * where that costs more than a transposed copy, by the copy. Exactly symmetric. */
+    const int mirror_by_copy = k > 3U;
     for (size_t i = 0U; i < n; ++i) {
         double *const out = &ne->jtj[i * n];
         /* three equations per sweep of the row (a sample's tool point): a third of the
@@ -125,10 +127,15 @@ dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double
             for (size_t j = 0U; j <= i; ++j) {
                 out[j] = ((out[j] + w0 * row[0][j]) + w1 * row[1][j]) + w2 * row[2][j];
             }
-            for (size_t j = i + 1U; j < n; ++j) {
+            for (size_t j = i + 1U; j < n && !mirror_by_copy; ++j) {
                 out[j] = ((out[j] + (we[0] * row[0][j]) * ji[0]) + (we[1] * row[1][j]) * ji[1]) +
                          (we[2] * row[2][j]) * ji[2];
             }
+        }
+    }
+    for (size_t i = 0U; i < n && mirror_by_copy; ++i) {
+        for (size_t j = 0U; j < i; ++j) {
+            ne->jtj[j * n + i] = ne->jtj[i * n + j];
         }
     }
     for (size_t e = 0U; e < k; ++e) {
