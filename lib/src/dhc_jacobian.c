@@ -30,9 +30,11 @@ static int is_geometric(uint8_t kind)
  *   z: joint axis (z of frame i-1), through origin of frame i-1
  *   u: x after Rz(q + theta): direction of a, axis of alpha, through origin of frame i
  *   v: y after Rz Rx(alpha): axis of beta, through origin of frame i */
-static void geometric_column(const dhc_arm *arm, const dhc_frame *f, double axes[][2][3],
-                             const double p[3], const dhc_param_id *id, double dp[3],
-                             double dw[3])
+/* inline: returned through memory, its 3-vectors are read back as pairs, and the stores
+ * cannot forward to those loads (a stall per column) */
+static inline void geometric_column(const dhc_arm *arm, const dhc_frame *f,
+                                    double axes[][2][3], const double p[3],
+                                    const dhc_param_id *id, double dp[3], double dw[3])
 {
     dhc_vec3_set(dp, 0.0, 0.0, 0.0);
     dhc_vec3_set(dw, 0.0, 0.0, 0.0);
