@@ -124,8 +124,11 @@ dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double
             const double w0 = we[0] * ji[0];
             const double w1 = we[1] * ji[1];
             const double w2 = we[2] * ji[2];
+            const double *const r0 = row[0];
+            const double *const r1 = row[1];
+            const double *const r2 = row[2];
             for (size_t j = 0U; j <= i; ++j) {
-                out[j] = ((out[j] + w0 * row[0][j]) + w1 * row[1][j]) + w2 * row[2][j];
+                out[j] = ((out[j] + w0 * r0[j]) + w1 * r1[j]) + w2 * r2[j];
             }
             for (size_t j = i + 1U; j < n && !mirror_by_copy; ++j) {
                 out[j] = ((out[j] + (we[0] * row[0][j]) * ji[0]) + (we[1] * row[1][j]) * ji[1]) +
