@@ -56,6 +56,13 @@ void dhc_calib_default_options(dhc_calib_options *opt)
     opt->max_outlier_rounds = 3U;
     opt->structural_seed = 12345U;
     memset(&opt->noise, 0, sizeof opt->noise);
+    opt->joint_sincos = NULL;
+}
+
+/* The caller's trigonometry of sample i, or NULL (dhc_calib_options.joint_sincos). */
+static const double *sample_sincos(const dhc_calib_options *opt, size_t n_joints, size_t i)
+{
+    return opt->joint_sincos != NULL ? opt->joint_sincos + 2U * n_joints * i : NULL;
 }
 
 dhc_status dhc_noise_model_check(const dhc_noise_model *noise, size_t n_joints, int *on)
@@ -289,6 +296,7 @@ static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *mod
         /* the sample is checked by its evaluation */
         dhc_status st = fc->read(fc->ctx, i, &ws->sample);
         const dhc_sample *const s = &ws->sample;
+        const double *const sincos = sample_sincos(fc->opt, model->arm.n_joints, i);
         const size_t rows = dhc_sample_rows(s);
         double r[DHC_MAX_ROWS_PER_SAMPLE];
         double rw[DHC_MAX_ROWS_PER_SAMPLE]; /* whitened (a copy of r with the model off) */
@@ -298,11 +306,11 @@ static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *mod
             /* residual and slope from one evaluation of the model */
             st = dhc_mat_init(&jac, rows, p, ws->jac_buf + batch * p, jac_len - batch * p);
             if (st == DHC_OK) {
-                st = dhc_model_linearize_prepared(model, &ws->trig, fc->set, s, w, r, &got_rows,
-                                                  &jac);
+                st = dhc_model_linearize_prepared(model, &ws->trig, fc->set, s, sincos, w, r,
+                                                  &got_rows, &jac);
             }
         } else if (st == DHC_OK) {
-            st = dhc_model_residual_prepared(model, &ws->trig, s, w, r, &got_rows);
+            st = dhc_model_residual_prepared(model, &ws->trig, s, sincos, w, r, &got_rows);
         }
         if (st == DHC_OK) {
             memcpy(rw, r, sizeof r);
@@ -441,6 +449,7 @@ static dhc_status sample_error2(const fit_context *fc, const dhc_model *model, s
     }
     double r[DHC_MAX_ROWS_PER_SAMPLE];
     st = dhc_model_residual_prepared(model, &fc->ws->trig, &fc->ws->sample,
+                                     sample_sincos(fc->opt, model->arm.n_joints, i),
                                      fc->opt->orientation_weight_mm_per_rad, r, rows);
     if (st == DHC_OK && fc->whiten) {
         /* screened in units of each sample's own noise: a sample at a pose where the joint

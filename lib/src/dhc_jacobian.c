@@ -241,7 +241,8 @@ static void wire_rows(const dhc_model *model, const dhc_param_id *id, const doub
 
 static dhc_status jacobian_prepared(const dhc_model *model, const dhc_arm_trig *trig,
                                     const dhc_param_set *set, const dhc_sample *s,
-                                    double weight_mm_per_rad, dhc_mat *jac, dhc_prediction *pr);
+                                    const double *sincos_q, double weight_mm_per_rad,
+                                    dhc_mat *jac, dhc_prediction *pr);
 
 dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set,
                               const dhc_sample *s, double weight_mm_per_rad, dhc_mat *jac,
@@ -261,18 +262,19 @@ dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set,
     memset(&local, 0, sizeof local); /* written before read; zeroed so no tool has to see it */
     dhc_arm_trig trig;
     dhc_arm_prepare(&model->arm, &trig);
-    return jacobian_prepared(model, &trig, set, s, weight_mm_per_rad, jac,
+    return jacobian_prepared(model, &trig, set, s, NULL, weight_mm_per_rad, jac,
                              pred != NULL ? pred : &local);
 }
 
 /* dhc_model_jacobian after its argument checks, at the caller's trigonometry. */
 static dhc_status jacobian_prepared(const dhc_model *model, const dhc_arm_trig *trig,
                                     const dhc_param_set *set, const dhc_sample *s,
-                                    double weight_mm_per_rad, dhc_mat *jac, dhc_prediction *pr)
+                                    const double *sincos_q, double weight_mm_per_rad,
+                                    dhc_mat *jac, dhc_prediction *pr)
 {
     dhc_model_eval ev;
     const dhc_status st =
-        dhc_model_evaluate_prepared(model, trig, s, set_has_compliance(set), &ev, pr);
+        dhc_model_evaluate_prepared(model, trig, s, sincos_q, set_has_compliance(set), &ev, pr);
     if (st != DHC_OK) {
         return st;
     }
@@ -372,7 +374,7 @@ dhc_status dhc_joint_jacobian(const dhc_arm *arm, const double *q_rad, size_t q_
 
 dhc_status dhc_model_linearize_prepared(const dhc_model *model, const dhc_arm_trig *trig,
                                        const dhc_param_set *set, const dhc_sample *s,
-                                       double weight_mm_per_rad,
+                                       const double *sincos_q, double weight_mm_per_rad,
                                        double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows,
                                        dhc_mat *jac)
 {
@@ -383,7 +385,7 @@ dhc_status dhc_model_linearize_prepared(const dhc_model *model, const dhc_arm_tr
     memset(&pred, 0, sizeof pred);
     dhc_status st = check_jac(jac, dhc_sample_rows(s), set->count);
     if (st == DHC_OK) {
-        st = jacobian_prepared(model, trig, set, s, weight_mm_per_rad, jac, &pred);
+        st = jacobian_prepared(model, trig, set, s, sincos_q, weight_mm_per_rad, jac, &pred);
     }
     if (st == DHC_OK) {
         st = dhc_model_residual_of(s, &pred, weight_mm_per_rad, r, rows);

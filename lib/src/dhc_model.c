@@ -155,12 +155,13 @@ dhc_status dhc_model_evaluate(const dhc_model *model, const dhc_sample *s, int n
     }
     dhc_arm_trig trig;
     dhc_arm_prepare(&model->arm, &trig);
-    return dhc_model_evaluate_prepared(model, &trig, s, need_moments, ev, out);
+    return dhc_model_evaluate_prepared(model, &trig, s, NULL, need_moments, ev, out);
 }
 
 dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_trig *trig,
-                                       const dhc_sample *s, int need_moments,
-                                       dhc_model_eval *ev, dhc_prediction *out)
+                                       const dhc_sample *s, const double *sincos_q,
+                                       int need_moments, dhc_model_eval *ev,
+                                       dhc_prediction *out)
 {
     if (ev == NULL || out == NULL || trig == NULL) {
         return DHC_ERR_ARGUMENT;
@@ -183,8 +184,8 @@ dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_tri
     double sin_q[DHC_MAX_JOINTS];
     double cos_q[DHC_MAX_JOINTS];
     for (size_t i = 0U; i < n; ++i) {
-        sin_q[i] = sin(s->q_rad[i]);
-        cos_q[i] = cos(s->q_rad[i]);
+        sin_q[i] = sincos_q != NULL ? sincos_q[2U * i] : sin(s->q_rad[i]);
+        cos_q[i] = sincos_q != NULL ? sincos_q[2U * i + 1U] : cos(s->q_rad[i]);
     }
     if (ev->has_moments) {
         dhc_forward_frames_trig(&model->arm, trig, ev->length_scale, sin_q, cos_q, ev->frames,
@@ -289,7 +290,8 @@ dhc_status dhc_model_residual(const dhc_model *model, const dhc_sample *s,
 }
 
 dhc_status dhc_model_residual_prepared(const dhc_model *model, const dhc_arm_trig *trig,
-                                       const dhc_sample *s, double weight_mm_per_rad,
+                                       const dhc_sample *s, const double *sincos_q,
+                                       double weight_mm_per_rad,
                                        double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows)
 {
     if (r == NULL || rows == NULL || model == NULL) {
@@ -298,7 +300,7 @@ dhc_status dhc_model_residual_prepared(const dhc_model *model, const dhc_arm_tri
     dhc_prediction pred;
     dhc_model_eval ev;
     memset(&pred, 0, sizeof pred);
-    const dhc_status st = dhc_model_evaluate_prepared(model, trig, s, 0, &ev, &pred);
+    const dhc_status st = dhc_model_evaluate_prepared(model, trig, s, sincos_q, 0, &ev, &pred);
     return st == DHC_OK ? dhc_model_residual_of(s, &pred, weight_mm_per_rad, r, rows) : st;
 }
 

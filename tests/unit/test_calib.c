@@ -91,6 +91,47 @@ static void test_noise_estimate_and_residual_match_the_noise_level(void)
     TEST_ASSERT_TRUE(max_mm < 0.05);
 }
 
+/* The caller's table of the samples' joint trigonometry (dhc_calib_options.joint_sincos)
+ * stands for the sines and cosines each pass would compute: the same fit to the bit, with
+ * gross rows in the data so that the outlier screens read it too. */
+static void test_joint_sincos_table_gives_the_same_fit(void)
+{
+    dhc_arm truth;
+    dhc_arm nominal;
+    table3_arms(&truth, &nominal);
+    test_rng rng = {31ULL};
+    test_measure(&data, &truth, 120U, DHC_MEAS_POSITION, &rng);
+    add_noise(&data, 0.05, &rng);
+    data.s[7].p_mm[0] += 40.0;
+    data.s[50].p_mm[2] -= 25.0;
+    static double table[2U * 3U * TEST_MAX_SAMPLES];
+    for (size_t i = 0U; i < data.n; ++i) {
+        for (size_t j = 0U; j < 3U; ++j) {
+            table[2U * (3U * i + j)] = sin(data.s[i].q_rad[j]);
+            table[2U * (3U * i + j) + 1U] = cos(data.s[i].q_rad[j]);
+        }
+    }
+    dhc_calib_options opt;
+    dhc_calib_default_options(&opt);
+    TEST_ASSERT_NULL(opt.joint_sincos);
+    static uint8_t flags0[TEST_MAX_SAMPLES];
+    memcpy(flags0, data.flags, sizeof flags0);
+    dhc_arm plain = nominal;
+    TEST_ASSERT_EQUAL(DHC_OK, fit(&plain, &opt));
+    static dhc_calib_report plain_rep;
+    plain_rep = rep;
+    memcpy(data.flags, flags0, sizeof flags0);
+    opt.joint_sincos = table;
+    dhc_arm tabled = nominal;
+    TEST_ASSERT_EQUAL(DHC_OK, fit(&tabled, &opt));
+    TEST_ASSERT_EQUAL(2U, rep.outliers);
+    TEST_ASSERT_EQUAL(plain_rep.outliers, rep.outliers);
+    TEST_ASSERT_EQUAL(plain_rep.iterations, rep.iterations);
+    TEST_ASSERT_EQUAL_MEMORY(plain_rep.value, rep.value, sizeof rep.value);
+    TEST_ASSERT_EQUAL_MEMORY(plain_rep.std_err, rep.std_err, sizeof rep.std_err);
+    TEST_ASSERT_EQUAL_MEMORY(&plain_rep.sigma, &rep.sigma, sizeof rep.sigma);
+}
+
 static void test_standard_errors_match_the_spread_of_repeated_fits(void)
 {
     dhc_arm truth;
@@ -363,6 +404,7 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_noise_estimate_and_residual_match_the_noise_level);
+    RUN_TEST(test_joint_sincos_table_gives_the_same_fit);
     RUN_TEST(test_standard_errors_match_the_spread_of_repeated_fits);
     RUN_TEST(test_gross_errors_are_flagged_left_out_and_the_fit_repeated);
     RUN_TEST(test_poses_outside_the_joint_ranges_are_outliers);

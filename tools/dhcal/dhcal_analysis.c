@@ -200,6 +200,7 @@ int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhcal
     set_drift_reference(&out->model, s);
     dhc_calib_options opt;
     dhcal_calib_options_for(start, &out->noise, &opt);
+    opt.joint_sincos = dhcal_samples_sincos(s, start->arm.n_joints);
     out->status = dhc_calib_fit(&out->model, &out->set, dhcal_samples_read, s, s->n, s->flags,
                                 &opt, &calib_ws, &out->rep);
     if (out->status == DHC_ERR_UNDERDETERMINED) {

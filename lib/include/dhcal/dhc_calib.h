@@ -99,6 +99,12 @@ typedef struct {
      * When on, the fit is generalized least squares and the report's sigma is unit-free
      * (see below). */
     dhc_noise_model noise;
+    /* NULL (the default), or the samples' joint trigonometry, kept by a caller that holds
+     * its samples: sample i's sin(q_j), cos(q_j) pairs at joint_sincos[2 N i + 2 j] and
+     * [2 N i + 2 j + 1], N = n_joints, exactly what sin() and cos() give for the angles
+     * the reader hands out (not checked). Each pass over the data then computes no sine or
+     * cosine of its own; the memory is the caller's, the library's stays O(P^2). */
+    const double *joint_sincos;
 } dhc_calib_options;
 
 typedef struct {

@@ -137,10 +137,14 @@ dhc_status dhc_model_evaluate(const dhc_model *model, const dhc_sample *s, int n
                               dhc_model_eval *ev, dhc_prediction *out);
 
 /* dhc_model_evaluate with the arm's trigonometry prepared by the caller (dhc_arm_prepare on
- * model->arm, unchanged since): what a pass over many samples at one model uses. */
+ * model->arm, unchanged since): what a pass over many samples at one model uses.
+ * sincos_q: NULL, or the sample's sin(q_i), cos(q_i) pairs (2 n_joints values, exactly what
+ * sin() and cos() give for s->q_rad: not checked), kept by a caller that evaluates the same
+ * samples again and again. */
 dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_trig *trig,
-                                       const dhc_sample *s, int need_moments,
-                                       dhc_model_eval *ev, dhc_prediction *out);
+                                       const dhc_sample *s, const double *sincos_q,
+                                       int need_moments, dhc_model_eval *ev,
+                                       dhc_prediction *out);
 
 /* World position of anchor k (0..2). */
 void dhc_measurer_anchor_world(const dhc_measurer_model *m, size_t k, double out[3]);
@@ -169,9 +173,11 @@ dhc_status dhc_model_residual(const dhc_model *model, const dhc_sample *s,
                               size_t *rows);
 
 /* dhc_model_residual at the arm's trigonometry from dhc_arm_prepare (model->arm's,
- * unchanged since): for passes over many samples at one model. */
+ * unchanged since): for passes over many samples at one model. sincos_q as
+ * dhc_model_evaluate_prepared's. */
 dhc_status dhc_model_residual_prepared(const dhc_model *model, const dhc_arm_trig *trig,
-                                       const dhc_sample *s, double weight_mm_per_rad,
+                                       const dhc_sample *s, const double *sincos_q,
+                                       double weight_mm_per_rad,
                                        double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows);
 
 /* The residual of a sample from a prediction already made (dhc_model_predict, or the one
