@@ -104,35 +104,64 @@ dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double
      * its mirror, (w_e J_ej) J_ei, for a sample's few rows, or for many rows (a batch),
      * where that costs more than a transposed copy, by the copy. Exactly symmetric. */
     const int mirror_by_copy = k > 3U;
-    for (size_t i = 0U; i < n; ++i) {
-        double *const out = &ne->jtj[i * n];
-        /* three equations per sweep of the row (a sample's tool point): a third of the
-         * loads and stores of one at a time, the same sums */
-        for (size_t e = 0U; e < k; e += 3U) {
-            const size_t m = k - e < 3U ? k - e : 3U;
-            double we[3] = {1.0, 0.0, 0.0};
-            const double *row[3];
-            double ji[3] = {0.0, 0.0, 0.0};
-            for (size_t t = 0U; t < 3U; ++t) {
-                /* a missing third row is the first again with weight 0: adds exact zeros */
-                const size_t et = t < m ? e + t : e;
-                we[t] = t < m ? (w != NULL ? w[et] : 1.0) : 0.0;
-                row[t] = &DHC_MAT_AT(jac, et, 0U);
-                ji[t] = row[t][i];
-                ne->jtr[i] += t < m ? (we[t] * ji[t]) * r[et] : 0.0;
+    /* three equations per sweep (a sample's tool point) and, for a batch, two rows of the
+     * matrix at once: each equation's entry is loaded once for both (loads, not
+     * arithmetic, bound this loop) */
+    for (size_t e = 0U; e < k; e += 3U) {
+        const size_t m = k - e < 3U ? k - e : 3U;
+        double we[3];
+        const double *row[3];
+        for (size_t t = 0U; t < 3U; ++t) {
+            /* a missing third row is the first again with weight 0: adds exact zeros */
+            const size_t et = t < m ? e + t : e;
+            we[t] = t < m ? (w != NULL ? w[et] : 1.0) : 0.0;
+            row[t] = &DHC_MAT_AT(jac, et, 0U);
+        }
+        const double *const r0 = row[0];
+        const double *const r1 = row[1];
+        const double *const r2 = row[2];
+        for (size_t i = 0U; i < n; ++i) {
+            const double a0 = we[0] * r0[i];
+            const double a1 = we[1] * r1[i];
+            const double a2 = we[2] * r2[i];
+            ne->jtr[i] += a0 * r[e];
+            if (m > 1U) {
+                ne->jtr[i] += a1 * r[e + 1U];
             }
-            const double w0 = we[0] * ji[0];
-            const double w1 = we[1] * ji[1];
-            const double w2 = we[2] * ji[2];
-            const double *const r0 = row[0];
-            const double *const r1 = row[1];
-            const double *const r2 = row[2];
+            if (m > 2U) {
+                ne->jtr[i] += a2 * r[e + 2U];
+            }
+            double *const out = &ne->jtj[i * n];
+            if (mirror_by_copy && i + 1U < n) {
+                const double b0 = we[0] * r0[i + 1U];
+                const double b1 = we[1] * r1[i + 1U];
+                const double b2 = we[2] * r2[i + 1U];
+                ne->jtr[i + 1U] += b0 * r[e];
+                if (m > 1U) {
+                    ne->jtr[i + 1U] += b1 * r[e + 1U];
+                }
+                if (m > 2U) {
+                    ne->jtr[i + 1U] += b2 * r[e + 2U];
+                }
+                double *const next = out + n;
+                for (size_t j = 0U; j <= i; ++j) {
+                    const double x0 = r0[j];
+                    const double x1 = r1[j];
+                    const double x2 = r2[j];
+                    out[j] = ((out[j] + a0 * x0) + a1 * x1) + a2 * x2;
+                    next[j] = ((next[j] + b0 * x0) + b1 * x1) + b2 * x2;
+                }
+                next[i + 1U] = ((next[i + 1U] + b0 * r0[i + 1U]) + b1 * r1[i + 1U]) +
+                               b2 * r2[i + 1U];
+                ++i;
+                continue;
+            }
             for (size_t j = 0U; j <= i; ++j) {
-                out[j] = ((out[j] + w0 * r0[j]) + w1 * r1[j]) + w2 * r2[j];
+                out[j] = ((out[j] + a0 * r0[j]) + a1 * r1[j]) + a2 * r2[j];
             }
             for (size_t j = i + 1U; j < n && !mirror_by_copy; ++j) {
-                out[j] = ((out[j] + (we[0] * row[0][j]) * ji[0]) + (we[1] * row[1][j]) * ji[1]) +
-                         (we[2] * row[2][j]) * ji[2];
+                out[j] = ((out[j] + (we[0] * r0[j]) * r0[i]) + (we[1] * r1[j]) * r1[i]) +
+                         (we[2] * r2[j]) * r2[i];
             }
         }
     }
