@@ -57,6 +57,7 @@ void dhc_calib_default_options(dhc_calib_options *opt)
     opt->structural_seed = 12345U;
     memset(&opt->noise, 0, sizeof opt->noise);
     opt->joint_sincos = NULL;
+    opt->sample_error2 = NULL;
 }
 
 /* The caller's trigonometry of sample i, or NULL (dhc_calib_options.joint_sincos). */
@@ -213,6 +214,7 @@ typedef struct {
     data_traits traits;
     double max_e2;     /* largest squared sample error, as sample_error2 defines it ... */
     int own_weights;   /* ... when 1: each sample whitened at the model itself */
+    int errors_kept;   /* 1: the pass left each sample's error in opt->sample_error2 */
 } pass_totals;
 
 static void note_traits(data_traits *t, const dhc_sample *s, size_t n_joints, int first)
@@ -265,6 +267,10 @@ static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *mod
     const double w = fc->opt->orientation_weight_mm_per_rad;
     memset(tot, 0, sizeof *tot);
     tot->own_weights = weights == model;
+    /* only errors at the model itself are the screens' (a trial judged with its start's
+     * weights leaves the start's errors in place) */
+    double *const kept = tot->own_weights ? fc->opt->sample_error2 : NULL;
+    tot->errors_kept = kept != NULL;
     dhc_arm_prepare(&model->arm, &ws->trig);
     if (accumulate) {
         const dhc_status st = dhc_normal_eq_init(&ws->ne, p);
@@ -356,6 +362,9 @@ static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *mod
             screened += sq(rw[k]);
         }
         tot->max_e2 = fmax(tot->max_e2, screened);
+        if (kept != NULL) {
+            kept[i] = screened;
+        }
         tot->samples++;
         tot->rows += rows;
     }
@@ -439,10 +448,17 @@ static dhc_status structural_rank(const fit_context *fc, const dhc_model *model,
     return DHC_OK;
 }
 
-/* Sample error (all rows, mm-equivalent) squared; used for outlier screening. */
-static dhc_status sample_error2(const fit_context *fc, const dhc_model *model, size_t i,
-                                double *e2, size_t *rows)
+/* Sample error (all rows, mm-equivalent) squared; used for outlier screening. at: NULL, or
+ * the totals of the last pass at the model, whose kept errors are then read (*rows = 0:
+ * not known). */
+static dhc_status sample_error2(const fit_context *fc, const dhc_model *model,
+                                const pass_totals *at, size_t i, double *e2, size_t *rows)
 {
+    if (at != NULL && at->errors_kept) {
+        *e2 = fc->opt->sample_error2[i];
+        *rows = 0U;
+        return DHC_OK;
+    }
     dhc_status st = fc->read(fc->ctx, i, &fc->ws->sample);
     if (st != DHC_OK) {
         return st;
@@ -471,15 +487,16 @@ static dhc_status sample_error2(const fit_context *fc, const dhc_model *model, s
 /* What one scan of the used samples' squared errors e2 found. */
 typedef struct {
     size_t used;
-    size_t pose;      /* pose samples among them */
+    size_t pose;      /* pose samples among them (not counted from kept errors) */
     size_t at_most;   /* samples with e2 <= the scan's limit */
     double max_e2;
 } error_scan;
 
 /* One pass over the used samples; with mark other than DHC_SAMPLE_USED, samples with e2
- * above limit2 are flagged with it. */
-static dhc_status scan_errors(const fit_context *fc, const dhc_model *model, double limit2,
-                              uint8_t mark, error_scan *out)
+ * above limit2 are flagged with it. at as sample_error2's. */
+static dhc_status scan_errors(const fit_context *fc, const dhc_model *model,
+                              const pass_totals *at, double limit2, uint8_t mark,
+                              error_scan *out)
 {
     memset(out, 0, sizeof *out);
     dhc_arm_prepare(&model->arm, &fc->ws->trig);
@@ -489,7 +506,7 @@ static dhc_status scan_errors(const fit_context *fc, const dhc_model *model, dou
         }
         double e2;
         size_t rows;
-        const dhc_status st = sample_error2(fc, model, i, &e2, &rows);
+        const dhc_status st = sample_error2(fc, model, at, i, &e2, &rows);
         if (st != DHC_OK) {
             return st;
         }
@@ -515,7 +532,8 @@ static dhc_status scan_errors(const fit_context *fc, const dhc_model *model, dou
  * the library keeps no per-sample storage, so no sort. The same steps, midpoints and result
  * as one pass per step, in a fifth of the passes. */
 static dhc_status quantile_error2(const fit_context *fc, const dhc_model *model,
-                                  const error_scan *all, double share, double *median)
+                                  const pass_totals *at, const error_scan *all, double share,
+                                  double *median)
 {
     double lo = 0.0;
     double hi = all->max_e2;
@@ -542,7 +560,7 @@ static dhc_status quantile_error2(const fit_context *fc, const dhc_model *model,
             }
             double e2;
             size_t rows;
-            const dhc_status st = sample_error2(fc, model, i, &e2, &rows);
+            const dhc_status st = sample_error2(fc, model, at, i, &e2, &rows);
             if (st != DHC_OK) {
                 return st;
             }
@@ -593,7 +611,7 @@ static dhc_status scan_all(const fit_context *fc, const dhc_model *model,
                            const pass_totals *tot, error_scan *out)
 {
     if (tot == NULL || !tot->own_weights) {
-        return scan_errors(fc, model, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, out);
+        return scan_errors(fc, model, NULL, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, out);
     }
     out->used = tot->samples;
     out->pose = tot->pose_samples;
@@ -611,7 +629,7 @@ static dhc_status robust_sigma(const fit_context *fc, const dhc_model *model,
     dhc_status st = scan_all(fc, model, tot, &all);
     double median = 0.0;
     if (st == DHC_OK && all.used > 0U) {
-        st = quantile_error2(fc, model, &all, 0.5, &median);
+        st = quantile_error2(fc, model, tot, &all, 0.5, &median);
     }
     const double chi2_median = 2U * all.pose > all.used ? CHI2_MEDIAN_6DOF : CHI2_MEDIAN_3DOF;
     *sigma = fmax(sqrt(median / chi2_median), fc->opt->outlier_floor_mm);
@@ -635,7 +653,7 @@ static dhc_status flag_outliers(const fit_context *fc, const dhc_model *model,
         return st;
     }
     error_scan kept;
-    st = scan_errors(fc, model, sq(fc->opt->outlier_threshold * sigma),
+    st = scan_errors(fc, model, tot, sq(fc->opt->outlier_threshold * sigma),
                      (uint8_t)DHC_SAMPLE_OUTLIER, &kept);
     *flagged = kept.used - kept.at_most;
     return st;
@@ -1087,19 +1105,19 @@ static dhc_status robust_start(const fit_context *fc, dhc_calib_report *rep, pas
     double level = 0.0;
     dhc_status st = scan_all(fc, &ws->current, tot, &scan);
     if (st == DHC_OK && scan.used >= 4U) {
-        st = quantile_error2(fc, &ws->current, &scan, 0.5, &level);
+        st = quantile_error2(fc, &ws->current, tot, &scan, 0.5, &level);
     }
     if (st != DHC_OK || scan.used < 4U || !(scan.max_e2 > sq(ROBUST_TRIGGER) * level)) {
         return st;
     }
     /* ws->current is still the caller's model (fc->input): no copy, the M4 stack is small */
     for (size_t step = 0U; step < ROBUST_CSTEPS && st == DHC_OK; ++step) {
-        st = scan_errors(fc, &ws->current, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, &scan);
+        st = scan_errors(fc, &ws->current, NULL, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, &scan);
         if (st == DHC_OK) {
-            st = quantile_error2(fc, &ws->current, &scan, ROBUST_KEEP, &level);
+            st = quantile_error2(fc, &ws->current, NULL, &scan, ROBUST_KEEP, &level);
         }
         if (st == DHC_OK) {
-            st = scan_errors(fc, &ws->current, level, (uint8_t)DHC_SAMPLE_ROBUST, &scan);
+            st = scan_errors(fc, &ws->current, NULL, level, (uint8_t)DHC_SAMPLE_ROBUST, &scan);
         }
         int converged = 0;
         if (st == DHC_OK) {
@@ -1113,7 +1131,7 @@ static dhc_status robust_start(const fit_context *fc, dhc_calib_report *rep, pas
     }
     size_t used;
     st = robust_sigma(fc, &ws->current, NULL, &level, &used);
-    return st == DHC_OK ? scan_errors(fc, &ws->current, sq(ROBUST_K * level),
+    return st == DHC_OK ? scan_errors(fc, &ws->current, NULL, sq(ROBUST_K * level),
                                       (uint8_t)DHC_SAMPLE_ROBUST, &scan)
                         : st;
 }

@@ -91,10 +91,21 @@ static void test_noise_estimate_and_residual_match_the_noise_level(void)
     TEST_ASSERT_TRUE(max_mm < 0.05);
 }
 
-/* The caller's table of the samples' joint trigonometry (dhc_calib_options.joint_sincos)
- * stands for the sines and cosines each pass would compute: the same fit to the bit, with
- * gross rows in the data so that the outlier screens read it too. */
-static void test_joint_sincos_table_gives_the_same_fit(void)
+static void assert_same_fit(const dhc_calib_report *a, const dhc_calib_report *b)
+{
+    TEST_ASSERT_EQUAL(a->outliers, b->outliers);
+    TEST_ASSERT_EQUAL(a->iterations, b->iterations);
+    TEST_ASSERT_EQUAL_MEMORY(a->value, b->value, sizeof a->value);
+    TEST_ASSERT_EQUAL_MEMORY(a->std_err, b->std_err, sizeof a->std_err);
+    TEST_ASSERT_EQUAL_MEMORY(&a->sigma, &b->sigma, sizeof a->sigma);
+}
+
+/* The caller's tables (dhc_calib_options.joint_sincos, the samples' joint trigonometry;
+ * sample_error2, the errors each pass keeps for the outlier screens) stand for what the
+ * passes would compute again: the same fit to the bit, with gross rows in the data so that
+ * the screens run, unweighted and under the noise model (whose trials are judged with
+ * other weights than their own). */
+static void test_caller_tables_give_the_same_fit(void)
 {
     dhc_arm truth;
     dhc_arm nominal;
@@ -120,16 +131,26 @@ static void test_joint_sincos_table_gives_the_same_fit(void)
     TEST_ASSERT_EQUAL(DHC_OK, fit(&plain, &opt));
     static dhc_calib_report plain_rep;
     plain_rep = rep;
-    memcpy(data.flags, flags0, sizeof flags0);
-    opt.joint_sincos = table;
-    dhc_arm tabled = nominal;
-    TEST_ASSERT_EQUAL(DHC_OK, fit(&tabled, &opt));
-    TEST_ASSERT_EQUAL(2U, rep.outliers);
-    TEST_ASSERT_EQUAL(plain_rep.outliers, rep.outliers);
-    TEST_ASSERT_EQUAL(plain_rep.iterations, rep.iterations);
-    TEST_ASSERT_EQUAL_MEMORY(plain_rep.value, rep.value, sizeof rep.value);
-    TEST_ASSERT_EQUAL_MEMORY(plain_rep.std_err, rep.std_err, sizeof rep.std_err);
-    TEST_ASSERT_EQUAL_MEMORY(&plain_rep.sigma, &rep.sigma, sizeof rep.sigma);
+    TEST_ASSERT_NULL(opt.sample_error2);
+    TEST_ASSERT_EQUAL(2U, plain_rep.outliers);
+    static double kept[TEST_MAX_SAMPLES];
+    for (int noise = 0; noise <= 1; ++noise) {
+        opt.noise.meas_mm = noise ? 0.05 : 0.0;
+        opt.joint_sincos = NULL;
+        opt.sample_error2 = NULL;
+        memcpy(data.flags, flags0, sizeof flags0);
+        dhc_arm arm = nominal;
+        TEST_ASSERT_EQUAL(DHC_OK, fit(&arm, &opt));
+        plain_rep = rep;
+        for (int variant = 1; variant <= 3; ++variant) {
+            opt.joint_sincos = (variant & 1) != 0 ? table : NULL;
+            opt.sample_error2 = (variant & 2) != 0 ? kept : NULL;
+            memcpy(data.flags, flags0, sizeof flags0);
+            arm = nominal;
+            TEST_ASSERT_EQUAL(DHC_OK, fit(&arm, &opt));
+            assert_same_fit(&plain_rep, &rep);
+        }
+    }
 }
 
 static void test_standard_errors_match_the_spread_of_repeated_fits(void)
@@ -404,7 +425,7 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_noise_estimate_and_residual_match_the_noise_level);
-    RUN_TEST(test_joint_sincos_table_gives_the_same_fit);
+    RUN_TEST(test_caller_tables_give_the_same_fit);
     RUN_TEST(test_standard_errors_match_the_spread_of_repeated_fits);
     RUN_TEST(test_gross_errors_are_flagged_left_out_and_the_fit_repeated);
     RUN_TEST(test_poses_outside_the_joint_ranges_are_outliers);

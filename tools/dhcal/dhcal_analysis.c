@@ -201,8 +201,11 @@ int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhcal
     dhc_calib_options opt;
     dhcal_calib_options_for(start, &out->noise, &opt);
     opt.joint_sincos = dhcal_samples_sincos(s, start->arm.n_joints);
+    /* optional: without it the outlier screens evaluate the model again */
+    opt.sample_error2 = malloc((s->n + 1U) * sizeof *opt.sample_error2);
     out->status = dhc_calib_fit(&out->model, &out->set, dhcal_samples_read, s, s->n, s->flags,
                                 &opt, &calib_ws, &out->rep);
+    free(opt.sample_error2);
     if (out->status == DHC_ERR_UNDERDETERMINED) {
         snprintf(err->msg, sizeof err->msg,
                  "the data under-determine the model: %zu equations from %zu rows identify %zu "

@@ -105,6 +105,11 @@ typedef struct {
      * the reader hands out (not checked). Each pass over the data then computes no sine or
      * cosine of its own; the memory is the caller's, the library's stays O(P^2). */
     const double *joint_sincos;
+    /* NULL (the default), or n doubles of the caller's, scratch during the fit: each pass
+     * keeps every sample's squared error there, and the outlier screens (medians by
+     * bisection, the marks) read them instead of evaluating the model again, pass after
+     * pass. The same fit; the memory is the caller's, the library's stays O(P^2). */
+    double *sample_error2;
 } dhc_calib_options;
 
 typedef struct {
