@@ -31,24 +31,12 @@ typedef struct {
     size_t cap;
     size_t len;
     size_t line_no; /* of the line in buf, 1-based */
-    /* the file in blocks: a locked getc per byte cost more than parsing the numbers */
+    /* the file in blocks, lines cut by memchr: a locked getc per byte cost more than
+     * parsing the numbers */
     unsigned char block[1U << 16];
     size_t block_pos;
     size_t block_len;
 } csv_reader;
-
-/* The next byte of the file, or EOF (at its end or on a read error: ferror tells). */
-static int next_byte(csv_reader *r)
-{
-    if (r->block_pos == r->block_len) {
-        r->block_len = fread(r->block, 1U, sizeof r->block, r->f);
-        r->block_pos = 0U;
-        if (r->block_len == 0U) {
-            return EOF;
-        }
-    }
-    return r->block[r->block_pos++];
-}
 
 /* Reads the next line (newline and a CR before it removed, NUL-terminated) and rejects NUL
  * and control bytes. *got = 0 at the end of the file. */
@@ -57,18 +45,29 @@ static int next_line(csv_reader *r, int *got)
     *got = 0;
     r->len = 0U;
     int any = 0;
-    int c;
-    while ((c = next_byte(r)) != EOF) {
-        any = 1;
-        if (c == '\n') {
-            break;
+    /* whole runs up to the newline, not byte by byte */
+    for (;;) {
+        if (r->block_pos == r->block_len) {
+            r->block_len = fread(r->block, 1U, sizeof r->block, r->f);
+            r->block_pos = 0U;
+            if (r->block_len == 0U) {
+                break;
+            }
         }
-        if (r->len >= DHCAL_CSV_MAX_LINE) {
+        const unsigned char *const start = r->block + r->block_pos;
+        const size_t avail = r->block_len - r->block_pos;
+        const unsigned char *const nl = memchr(start, '\n', avail);
+        const size_t take = nl != NULL ? (size_t)(nl - start) : avail;
+        any = 1;
+        if (r->len + take > DHCAL_CSV_MAX_LINE) {
             return dhcal_error_set(r->err, DHCAL_IO_BAD_INPUT, "%s:%zu: line longer than %u bytes",
                              r->path, r->line_no + 1U, DHCAL_CSV_MAX_LINE);
         }
-        if (r->len + 1U >= r->cap) {
-            size_t cap = r->cap * 2U;
+        if (r->len + take + 1U > r->cap) {
+            size_t cap = r->cap;
+            while (cap < r->len + take + 1U) {
+                cap *= 2U;
+            }
             if (cap > DHCAL_CSV_MAX_LINE + 1U) {
                 cap = DHCAL_CSV_MAX_LINE + 1U;
             }
@@ -80,7 +79,12 @@ static int next_line(csv_reader *r, int *got)
             r->buf = grown;
             r->cap = cap;
         }
-        r->buf[r->len++] = (char)c;
+        memcpy(r->buf + r->len, start, take);
+        r->len += take;
+        r->block_pos += take + (nl != NULL ? 1U : 0U);
+        if (nl != NULL) {
+            break;
+        }
     }
     if (ferror(r->f)) {
         return dhcal_error_set(r->err, DHCAL_IO_BAD_INPUT, "%s:%zu: read error: %s", r->path,
