@@ -93,7 +93,7 @@ dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double
         }
         bound += (w != NULL ? w[e] : 1.0) * m * m;
     }
-    if (!(poison >= 0.0 || poison <= 0.0)) {
+    if (isnan(poison)) {
         return DHC_ERR_NONFINITE;
     }
     if (!dhc_is_finite(2.0 * bound)) {
@@ -108,13 +108,15 @@ dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double
      * matrix at once: each equation's entry is loaded once for both (loads, not
      * arithmetic, bound this loop) */
     for (size_t e = 0U; e < k; e += 3U) {
-        const size_t m = k - e < 3U ? k - e : 3U;
         double we[3];
+        double rr[3];
         const double *row[3];
         for (size_t t = 0U; t < 3U; ++t) {
-            /* a missing third row is the first again with weight 0: adds exact zeros */
-            const size_t et = t < m ? e + t : e;
-            we[t] = t < m ? (w != NULL ? w[et] : 1.0) : 0.0;
+            /* a missing row is the first again with weight and residual 0: adds zeros */
+            const int live = e + t < k;
+            const size_t et = live ? e + t : e;
+            we[t] = live ? (w != NULL ? w[et] : 1.0) : 0.0;
+            rr[t] = live ? r[et] : 0.0;
             row[t] = &DHC_MAT_AT(jac, et, 0U);
         }
         const double *const r0 = row[0];
@@ -124,25 +126,13 @@ dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double
             const double a0 = we[0] * r0[i];
             const double a1 = we[1] * r1[i];
             const double a2 = we[2] * r2[i];
-            ne->jtr[i] += a0 * r[e];
-            if (m > 1U) {
-                ne->jtr[i] += a1 * r[e + 1U];
-            }
-            if (m > 2U) {
-                ne->jtr[i] += a2 * r[e + 2U];
-            }
+            ne->jtr[i] = ((ne->jtr[i] + a0 * rr[0]) + a1 * rr[1]) + a2 * rr[2];
             double *const out = &ne->jtj[i * n];
             if (mirror_by_copy && i + 1U < n) {
                 const double b0 = we[0] * r0[i + 1U];
                 const double b1 = we[1] * r1[i + 1U];
                 const double b2 = we[2] * r2[i + 1U];
-                ne->jtr[i + 1U] += b0 * r[e];
-                if (m > 1U) {
-                    ne->jtr[i + 1U] += b1 * r[e + 1U];
-                }
-                if (m > 2U) {
-                    ne->jtr[i + 1U] += b2 * r[e + 2U];
-                }
+                ne->jtr[i + 1U] = ((ne->jtr[i + 1U] + b0 * rr[0]) + b1 * rr[1]) + b2 * rr[2];
                 double *const next = out + n;
                 for (size_t j = 0U; j <= i; ++j) {
                     const double x0 = r0[j];

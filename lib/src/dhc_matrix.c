@@ -18,7 +18,7 @@ int dhc_all_finite(const double *x, size_t n)
     for (size_t i = 0U; i < n; ++i) {
         poison += x[i] * 0.0;
     }
-    return poison >= 0.0 || poison <= 0.0;
+    return !isnan(poison);
 }
 
 static int mat_valid(const dhc_mat *m)
