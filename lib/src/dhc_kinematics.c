@@ -127,8 +127,6 @@ void dhc_arm_prepare(const dhc_arm *arm, dhc_arm_trig *trig)
         dhc_mat3 ry;
         t->cos_theta = cos(j->theta_offset_rad);
         t->sin_theta = sin(j->theta_offset_rad);
-        t->cos_alpha = cos(j->alpha_rad);
-        t->sin_alpha = sin(j->alpha_rad);
         dhc_rot_x(j->alpha_rad, &rx);
         dhc_rot_y(j->beta_rad, &ry);
         dhc_rot_mul(&rx, &ry, &t->twist);
@@ -159,7 +157,7 @@ void dhc_forward_frames_trig(const dhc_arm *arm, const dhc_arm_trig *trig, doubl
             frames[i + 1U].pos[k] = frames[i].pos[k] + a * m.m[k][0] + d * m.m[k][2];
             if (axes != NULL) {
                 axes[i][0][k] = m.m[k][0];
-                axes[i][1][k] = t->cos_alpha * m.m[k][1] + t->sin_alpha * m.m[k][2];
+                axes[i][1][k] = t->twist.m[1][1] * m.m[k][1] + t->twist.m[2][1] * m.m[k][2];
             }
         }
         dhc_rot_mul(&m, &t->twist, &frames[i + 1U].rot);

@@ -67,9 +67,7 @@ double dhc_arm_reach(const dhc_arm *arm);
 typedef struct {
     double cos_theta;
     double sin_theta;
-    double cos_alpha;
-    double sin_alpha;
-    dhc_mat3 twist; /* Rx(alpha) Ry(beta) */
+    dhc_mat3 twist; /* Rx(alpha) Ry(beta); its middle column is (0, cos alpha, sin alpha) */
 } dhc_joint_trig;
 
 typedef struct {
