@@ -103,10 +103,6 @@ dhc_status dhcal_samples_read(void *ctx, size_t index, dhc_sample *out)
 int dhcal_samples_errors(const dhc_model *model, const dhcal_samples *s, double *resid,
                          double *err_mm, dhcal_error_stats *stats)
 {
-    double ss = 0.0;
-    double sum = 0.0;
-    double mx = 0.0;
-    size_t used = 0U;
     if (model->arm.n_joints == 0U || model->arm.n_joints > DHC_MAX_JOINTS) {
         return DHCAL_IO_FAILED;
     }
@@ -126,6 +122,18 @@ int dhcal_samples_errors(const dhc_model *model, const dhcal_samples *s, double 
             memcpy(resid + 3U * i, r, 3U * sizeof r[0]);
         }
         err_mm[i] = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+    }
+    dhcal_error_stats_of(s, err_mm, stats);
+    return DHCAL_IO_OK;
+}
+
+void dhcal_error_stats_of(const dhcal_samples *s, const double *err_mm, dhcal_error_stats *stats)
+{
+    double ss = 0.0;
+    double sum = 0.0;
+    double mx = 0.0;
+    size_t used = 0U;
+    for (size_t i = 0U; i < s->n; ++i) {
         if (s->flags[i] == (uint8_t)DHC_SAMPLE_USED) {
             ss += err_mm[i] * err_mm[i];
             sum += err_mm[i];
@@ -137,5 +145,4 @@ int dhcal_samples_errors(const dhc_model *model, const dhcal_samples *s, double 
     stats->mean_mm = used > 0U ? sum / (double)used : 0.0;
     stats->max_mm = mx;
     stats->used = used;
-    return DHCAL_IO_OK;
 }

@@ -52,4 +52,7 @@ typedef struct {
 int dhcal_samples_errors(const dhc_model *model, const dhcal_samples *s, double *resid,
                          double *err_mm, dhcal_error_stats *stats);
 
+/* The statistics of dhcal_samples_errors from the errors err_mm (n entries). */
+void dhcal_error_stats_of(const dhcal_samples *s, const double *err_mm, dhcal_error_stats *stats);
+
 #endif /* DHCAL_DATA_H */

@@ -178,6 +178,49 @@ void dhcal_calib_options_for(const dhc_model *model, const dhcal_noise *noise,
     }
 }
 
+/* The rows of the last model dhcal_fit_errors evaluated: the fit, its row report and its
+ * adequacy test read the same errors of the same model (three passes, now one). */
+static struct {
+    dhc_model model;
+    const dhc_sample *samples;
+    size_t n;
+    double *resid;
+    double *err;
+} fit_rows;
+
+int dhcal_fit_errors(const dhc_model *model, const dhcal_samples *s, double *resid,
+                     double *err_mm, dhcal_error_stats *stats)
+{
+    const int known = fit_rows.err != NULL && fit_rows.samples == s->samples &&
+                      fit_rows.n == s->n && memcmp(&fit_rows.model, model, sizeof *model) == 0;
+    if (!known) {
+        free(fit_rows.resid);
+        free(fit_rows.err);
+        fit_rows.samples = NULL;
+        fit_rows.resid = malloc((3U * s->n + 1U) * sizeof *fit_rows.resid);
+        fit_rows.err = malloc((s->n + 1U) * sizeof *fit_rows.err);
+        dhcal_error_stats unused;
+        if (fit_rows.resid == NULL || fit_rows.err == NULL ||
+            dhcal_samples_errors(model, s, fit_rows.resid, fit_rows.err, &unused) !=
+                DHCAL_IO_OK) {
+            free(fit_rows.resid);
+            free(fit_rows.err);
+            fit_rows.resid = NULL;
+            fit_rows.err = NULL;
+            return DHCAL_IO_FAILED;
+        }
+        fit_rows.model = *model;
+        fit_rows.samples = s->samples;
+        fit_rows.n = s->n;
+    }
+    if (resid != NULL) {
+        memcpy(resid, fit_rows.resid, 3U * s->n * sizeof *resid);
+    }
+    memcpy(err_mm, fit_rows.err, s->n * sizeof *err_mm);
+    dhcal_error_stats_of(s, err_mm, stats); /* the flags may have changed */
+    return DHCAL_IO_OK;
+}
+
 int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhcal_noise *noise,
                    dhcal_samples *s, const dhcal_samples *held, dhcal_fit *out,
                    dhcal_error *err)
@@ -219,7 +262,7 @@ int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhcal
         return DHCAL_IO_FAILED;
     }
     double *e = calloc(s->n > 0U ? s->n : 1U, sizeof *e);
-    int rc = e != NULL ? dhcal_samples_errors(&out->model, s, NULL, e, &out->train)
+    int rc = e != NULL ? dhcal_fit_errors(&out->model, s, NULL, e, &out->train)
                        : DHCAL_IO_FAILED;
     free(e);
     if (rc == DHCAL_IO_OK && held != NULL) {
@@ -584,7 +627,7 @@ int dhcal_assess(const dhcal_fit *fit, const dhcal_samples *s, dhcal_adequacy *o
     double *err = calloc(s->n > 0U ? s->n : 1U, sizeof *err);
     dhcal_error_stats es;
     if (resid == NULL || err == NULL ||
-        dhcal_samples_errors(&fit->model, s, resid, err, &es) != DHCAL_IO_OK || es.used == 0U) {
+        dhcal_fit_errors(&fit->model, s, resid, err, &es) != DHCAL_IO_OK || es.used == 0U) {
         free(resid);
         free(err);
         return DHCAL_IO_FAILED;
