@@ -704,13 +704,18 @@ static int outside_joint_range(const fit_context *fc, const dhc_arm *arm, const 
  * ranges, then points beyond the arm's reach. The reach flags go on in a second pass, and
  * only when fewer than half of the samples in range are beyond reach: when most are, the
  * model's base is off, not the rows. */
-static dhc_status screen_physical(const fit_context *fc, const dhc_model *model)
+static dhc_status screen_physical(const fit_context *fc, const dhc_model *model,
+                                  data_traits *traits)
 {
     const int reach_on = fc->opt->reach_margin > 0.0;
     const double limit = (1.0 + fc->opt->reach_margin) * dhc_arm_reach(&model->arm);
     size_t used = 0U;
     size_t beyond = 0U;
     for (int apply_reach = 0; apply_reach <= 1; ++apply_reach) {
+        /* the traits of the samples left in (those the data's first pass would note; a
+         * sample that fails its check stops that pass) */
+        size_t noted = 0U;
+        memset(traits, 0, sizeof *traits);
         for (size_t i = 0U; i < fc->n; ++i) {
             if (fc->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
                 continue;
@@ -724,13 +729,18 @@ static dhc_status screen_physical(const fit_context *fc, const dhc_model *model)
                 fc->flags[i] = (uint8_t)DHC_SAMPLE_JOINT_RANGE;
                 continue;
             }
-            const int far = reach_on && dhc_sample_check(model, s) == DHC_OK &&
-                            beyond_reach(model, s, limit);
+            const int valid = dhc_sample_check(model, s) == DHC_OK;
+            const int far = reach_on && valid && beyond_reach(model, s, limit);
             if (!apply_reach) {
                 used++;
                 beyond += far ? 1U : 0U;
             } else if (far) {
                 fc->flags[i] = (uint8_t)DHC_SAMPLE_BEYOND_REACH;
+                continue;
+            }
+            if (valid) {
+                note_traits(traits, s, model->arm.n_joints, noted == 0U);
+                noted++;
             }
         }
         if (beyond == 0U || 2U * beyond >= used) {
@@ -1041,11 +1051,10 @@ static dhc_status hold_unsupported(const fit_context *fc, const pass_totals *tot
  * parameters, at most max_identifiability_checks times), then the worst unsupported link
  * parameter held and the fit repeated (at most MAX_HOLDS times). */
 static dhc_status fit_to_convergence(const fit_context *fc, dhc_calib_report *rep,
-                                     pass_totals *tot, int *converged)
+                                     pass_totals *tot, int accumulated, int *converged)
 {
     size_t checks = 0U;
     size_t holds = 0U;
-    int accumulated = 0;
     for (;;) {
         dhc_status st = levenberg_marquardt(fc, rep, tot, accumulated, converged);
         if (st != DHC_OK || !*converged) {
@@ -1094,9 +1103,11 @@ static void unmark(const fit_context *fc, uint8_t mark)
  * closest to the model, twice (least trimmed squares' concentration steps), and leave out
  * the samples beyond ROBUST_K robust sigmas of that fit (DHC_SAMPLE_ROBUST). The fit then
  * starts from it. A trimmed fit that fails leaves everything as it was. */
-static dhc_status robust_start(const fit_context *fc, dhc_calib_report *rep, pass_totals *tot)
+static dhc_status robust_start(const fit_context *fc, dhc_calib_report *rep, pass_totals *tot,
+                               int *moved)
 {
     dhc_calib_workspace *const ws = fc->ws;
+    *moved = 0;
     if (!fc->opt->robust_start || !redundant(tot, rep)) {
         return DHC_OK;
     }
@@ -1111,6 +1122,7 @@ static dhc_status robust_start(const fit_context *fc, dhc_calib_report *rep, pas
         return st;
     }
     /* ws->current is still the caller's model (fc->input): no copy, the M4 stack is small */
+    *moved = 1;
     for (size_t step = 0U; step < ROBUST_CSTEPS && st == DHC_OK; ++step) {
         st = scan_errors(fc, &ws->current, NULL, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, &scan);
         if (st == DHC_OK) {
@@ -1121,7 +1133,7 @@ static dhc_status robust_start(const fit_context *fc, dhc_calib_report *rep, pas
         }
         int converged = 0;
         if (st == DHC_OK) {
-            st = fit_to_convergence(fc, rep, tot, &converged);
+            st = fit_to_convergence(fc, rep, tot, 0, &converged);
         }
         unmark(fc, (uint8_t)DHC_SAMPLE_ROBUST);
     }
@@ -1190,29 +1202,39 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
     const fit_context fc = {set, read, ctx, n, flags, opt, ws, whiten, model};
     ws->current = *model;
 
-    dhc_status st = screen_physical(&fc, model);
+    data_traits traits;
+    dhc_status st = screen_physical(&fc, model, &traits);
+    /* The structural rank before the data's first pass: it borrows ws->ne, which that pass
+     * then fills at the input model, LM's first accumulation unless the robust start moves
+     * the model. */
+    if (st == DHC_OK) {
+        st = structural_rank(&fc, model, &traits, rep);
+    }
     if (st != DHC_OK) {
         return st;
     }
     pass_totals tot;
-    st = data_pass(&fc, model, 0, &tot);
+    st = data_pass(&fc, model, 1, &tot);
+    const int accumulated = st == DHC_OK;
+    if (st != DHC_OK) {
+        st = data_pass(&fc, model, 0, &tot); /* slopes can fail where residuals do not */
+    }
     if (st != DHC_OK) {
         return st;
     }
     if (tot.samples == 0U) {
         return DHC_ERR_NO_DATA;
     }
-    st = structural_rank(&fc, model, &tot.traits, rep);
-    if (st == DHC_OK) {
-        st = robust_start(&fc, rep, &tot);
-    }
+    int moved = 0;
+    st = robust_start(&fc, rep, &tot, &moved);
     if (st != DHC_OK) {
         return st;
     }
 
     int converged = 0;
     for (size_t round = 0U; round <= opt->max_outlier_rounds; ++round) {
-        st = fit_to_convergence(&fc, rep, &tot, &converged);
+        st = fit_to_convergence(&fc, rep, &tot, round == 0U && accumulated && !moved,
+                                &converged);
         if (st != DHC_OK) {
             return st;
         }
