@@ -179,44 +179,43 @@ void dhcal_calib_options_for(const dhc_model *model, const dhcal_noise *noise,
 }
 
 /* The rows of the last model dhcal_fit_errors evaluated: the fit, its row report and its
- * adequacy test read the same errors of the same model (three passes, now one). */
+ * adequacy test read the same errors of the same model (three passes, now one). One block:
+ * 3 n residuals, then n errors. */
 static struct {
     dhc_model model;
     const dhc_sample *samples;
     size_t n;
-    double *resid;
-    double *err;
+    double *rows;
 } fit_rows;
 
 int dhcal_fit_errors(const dhc_model *model, const dhcal_samples *s, double *resid,
                      double *err_mm, dhcal_error_stats *stats)
 {
-    const int known = fit_rows.err != NULL && fit_rows.samples == s->samples &&
-                      fit_rows.n == s->n && memcmp(&fit_rows.model, model, sizeof *model) == 0;
-    if (!known) {
-        free(fit_rows.resid);
-        free(fit_rows.err);
+    /* Bytes, not values: a model that differs only in padding or in the sign of a zero is
+     * evaluated again, which costs a pass and changes nothing. */
+    // NOLINTNEXTLINE(bugprone-suspicious-memory-comparison,cert-exp42-c,cert-flp37-c)
+    const int same_model = memcmp(&fit_rows.model, model, sizeof *model) == 0;
+    double *rows = fit_rows.rows;
+    if (rows == NULL || fit_rows.samples != s->samples || fit_rows.n != s->n || !same_model) {
+        fit_rows.rows = NULL;
         fit_rows.samples = NULL;
-        fit_rows.resid = malloc((3U * s->n + 1U) * sizeof *fit_rows.resid);
-        fit_rows.err = malloc((s->n + 1U) * sizeof *fit_rows.err);
+        free(rows);
+        rows = malloc((4U * s->n + 1U) * sizeof *rows);
         dhcal_error_stats unused;
-        if (fit_rows.resid == NULL || fit_rows.err == NULL ||
-            dhcal_samples_errors(model, s, fit_rows.resid, fit_rows.err, &unused) !=
-                DHCAL_IO_OK) {
-            free(fit_rows.resid);
-            free(fit_rows.err);
-            fit_rows.resid = NULL;
-            fit_rows.err = NULL;
+        if (rows == NULL ||
+            dhcal_samples_errors(model, s, rows, rows + 3U * s->n, &unused) != DHCAL_IO_OK) {
+            free(rows);
             return DHCAL_IO_FAILED;
         }
+        fit_rows.rows = rows;
         fit_rows.model = *model;
         fit_rows.samples = s->samples;
         fit_rows.n = s->n;
     }
     if (resid != NULL) {
-        memcpy(resid, fit_rows.resid, 3U * s->n * sizeof *resid);
+        memcpy(resid, rows, 3U * s->n * sizeof *resid);
     }
-    memcpy(err_mm, fit_rows.err, s->n * sizeof *err_mm);
+    memcpy(err_mm, rows + 3U * s->n, s->n * sizeof *err_mm);
     dhcal_error_stats_of(s, err_mm, stats); /* the flags may have changed */
     return DHCAL_IO_OK;
 }
