@@ -57,6 +57,19 @@ int dhcal_samples_build(const dhc_model *model, const dhcal_dataset *data, const
         }
         out->flags[i] = (uint8_t)DHC_SAMPLE_USED;
     }
+    /* Without the table every pass of a fit computes these again (optional: no memory, no
+     * table, the same results). */
+    const size_t nj = model->arm.n_joints;
+    out->joint_sincos = nj <= DHC_MAX_JOINTS ? malloc(cap * 2U * nj * sizeof(double) + 1U) : NULL;
+    if (out->joint_sincos != NULL) {
+        out->sincos_joints = nj;
+        for (size_t i = 0U; i < out->n; ++i) {
+            for (size_t j = 0U; j < nj; ++j) {
+                out->joint_sincos[2U * (nj * i + j)] = sin(out->samples[i].q_rad[j]);
+                out->joint_sincos[2U * (nj * i + j) + 1U] = cos(out->samples[i].q_rad[j]);
+            }
+        }
+    }
     return DHCAL_IO_OK;
 }
 
@@ -64,9 +77,17 @@ void dhcal_samples_free(dhcal_samples *s)
 {
     free(s->samples);
     free(s->flags);
+    free(s->joint_sincos);
     s->samples = NULL;
     s->flags = NULL;
+    s->joint_sincos = NULL;
+    s->sincos_joints = 0U;
     s->n = 0U;
+}
+
+const double *dhcal_samples_sincos(const dhcal_samples *s, size_t n_joints)
+{
+    return s->joint_sincos != NULL && s->sincos_joints == n_joints ? s->joint_sincos : NULL;
 }
 
 dhc_status dhcal_samples_read(void *ctx, size_t index, dhc_sample *out)
@@ -82,21 +103,37 @@ dhc_status dhcal_samples_read(void *ctx, size_t index, dhc_sample *out)
 int dhcal_samples_errors(const dhc_model *model, const dhcal_samples *s, double *resid,
                          double *err_mm, dhcal_error_stats *stats)
 {
-    double ss = 0.0;
-    double sum = 0.0;
-    double mx = 0.0;
-    size_t used = 0U;
+    if (model->arm.n_joints == 0U || model->arm.n_joints > DHC_MAX_JOINTS) {
+        return DHCAL_IO_FAILED;
+    }
+    dhc_arm_trig trig; /* one model for every row */
+    dhc_arm_prepare(&model->arm, &trig);
+    const size_t nj = model->arm.n_joints;
+    const double *const sincos = dhcal_samples_sincos(s, nj);
     for (size_t i = 0U; i < s->n; ++i) {
         double r[DHC_MAX_ROWS_PER_SAMPLE];
         size_t rows;
-        if (dhc_model_residual(model, &s->samples[i], DHC_ORIENTATION_WEIGHT_MM_PER_RAD, r,
-                               &rows) != DHC_OK) {
+        if (dhc_model_residual_prepared(model, &trig, &s->samples[i],
+                                        sincos != NULL ? sincos + 2U * nj * i : NULL,
+                                        DHC_ORIENTATION_WEIGHT_MM_PER_RAD, r, &rows) != DHC_OK) {
             return DHCAL_IO_FAILED;
         }
         if (resid != NULL) {
             memcpy(resid + 3U * i, r, 3U * sizeof r[0]);
         }
         err_mm[i] = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
+    }
+    dhcal_error_stats_of(s, err_mm, stats);
+    return DHCAL_IO_OK;
+}
+
+void dhcal_error_stats_of(const dhcal_samples *s, const double *err_mm, dhcal_error_stats *stats)
+{
+    double ss = 0.0;
+    double sum = 0.0;
+    double mx = 0.0;
+    size_t used = 0U;
+    for (size_t i = 0U; i < s->n; ++i) {
         if (s->flags[i] == (uint8_t)DHC_SAMPLE_USED) {
             ss += err_mm[i] * err_mm[i];
             sum += err_mm[i];
@@ -108,5 +145,4 @@ int dhcal_samples_errors(const dhc_model *model, const dhcal_samples *s, double 
     stats->mean_mm = used > 0U ? sum / (double)used : 0.0;
     stats->max_mm = mx;
     stats->used = used;
-    return DHCAL_IO_OK;
 }

@@ -16,7 +16,14 @@ typedef struct {
     const dhcal_dataset *source; /* rows, for line numbers in reports */
     const char *path;
     int wires; /* samples are raw wire lengths (fit in wire-length space) */
+    /* NULL, or each sample's sin(q_j), cos(q_j) for sincos_joints joints (the model's), the
+     * layout of dhc_calib_options.joint_sincos: computed once, read by every pass */
+    double *joint_sincos;
+    size_t sincos_joints;
 } dhcal_samples;
+
+/* The table for a model of n_joints joints, or NULL when s has none that fits it. */
+const double *dhcal_samples_sincos(const dhcal_samples *s, size_t n_joints);
 
 /* Builds samples. Raw wire lengths L1..L3 are used as they are (residuals in wire-length
  * space, where noise is independent and equal) whenever the model has a measurer;
@@ -44,5 +51,8 @@ typedef struct {
  * flag is DHC_SAMPLE_USED into *stats. */
 int dhcal_samples_errors(const dhc_model *model, const dhcal_samples *s, double *resid,
                          double *err_mm, dhcal_error_stats *stats);
+
+/* The statistics of dhcal_samples_errors from the errors err_mm (n entries). */
+void dhcal_error_stats_of(const dhcal_samples *s, const double *err_mm, dhcal_error_stats *stats);
 
 #endif /* DHCAL_DATA_H */

@@ -56,6 +56,14 @@ void dhc_calib_default_options(dhc_calib_options *opt)
     opt->max_outlier_rounds = 3U;
     opt->structural_seed = 12345U;
     memset(&opt->noise, 0, sizeof opt->noise);
+    opt->joint_sincos = NULL;
+    opt->sample_error2 = NULL;
+}
+
+/* The caller's trigonometry of sample i, or NULL (dhc_calib_options.joint_sincos). */
+static const double *sample_sincos(const dhc_calib_options *opt, size_t n_joints, size_t i)
+{
+    return opt->joint_sincos != NULL ? opt->joint_sincos + 2U * n_joints * i : NULL;
 }
 
 dhc_status dhc_noise_model_check(const dhc_noise_model *noise, size_t n_joints, int *on)
@@ -204,6 +212,9 @@ typedef struct {
     size_t pose_samples;
     size_t rows;
     data_traits traits;
+    double max_e2;     /* largest squared sample error, as sample_error2 defines it ... */
+    int own_weights;   /* ... when 1: each sample whitened at the model itself */
+    int errors_kept;   /* 1: the pass left each sample's error in opt->sample_error2 */
 } pass_totals;
 
 static void note_traits(data_traits *t, const dhc_sample *s, size_t n_joints, int first)
@@ -228,6 +239,21 @@ static dhc_status data_pass(const fit_context *fc, const dhc_model *model, int a
     return data_pass_weighted(fc, model, model, accumulate, tot);
 }
 
+/* Rows of equations gathered in one pass before they go to the accumulator. */
+#define BATCH_ROWS 24U
+
+/* The batch's rows: the first `rows` of jac_buf (set->count columns) and residuals r. */
+static dhc_status add_batch(dhc_calib_workspace *ws, const double *r, size_t rows)
+{
+    dhc_mat jac;
+    dhc_status st = dhc_mat_init(&jac, rows, ws->ne.n, ws->jac_buf,
+                                 sizeof ws->jac_buf / sizeof ws->jac_buf[0]);
+    if (st == DHC_OK) {
+        st = dhc_normal_eq_add(&ws->ne, &jac, r, NULL, rows);
+    }
+    return st;
+}
+
 /* One pass whose samples are whitened with the covariance at `weights` (with the noise
  * model on): a trial step is judged with the weights of the estimate it starts from, so LM
  * minimises the objective whose gradient it steps along and stops where that gradient
@@ -240,38 +266,57 @@ static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *mod
     const size_t p = fc->set->count;
     const double w = fc->opt->orientation_weight_mm_per_rad;
     memset(tot, 0, sizeof *tot);
+    tot->own_weights = weights == model;
+    /* only errors at the model itself are the screens' (a trial judged with its start's
+     * weights leaves the start's errors in place) */
+    double *const kept = tot->own_weights ? fc->opt->sample_error2 : NULL;
+    tot->errors_kept = kept != NULL;
+    dhc_arm_prepare(&model->arm, &ws->trig);
     if (accumulate) {
         const dhc_status st = dhc_normal_eq_init(&ws->ne, p);
         if (st != DHC_OK) {
             return st;
         }
     }
-    for (size_t i = 0U; i < fc->n; ++i) {
+    /* Several samples' rows go to the accumulator at once (as many as jac_buf holds, at
+     * most BATCH_ROWS): the same sums, fewer sweeps of the normal matrix. */
+    const size_t jac_len = sizeof ws->jac_buf / sizeof ws->jac_buf[0];
+    const size_t batch_cap = jac_len / p < BATCH_ROWS ? jac_len / p : BATCH_ROWS;
+    double batch_r[BATCH_ROWS];
+    size_t batch = 0U;
+    for (size_t i = 0U; i <= fc->n; ++i) {
+        if (accumulate && batch > 0U &&
+            (i == fc->n || batch + DHC_MAX_ROWS_PER_SAMPLE > batch_cap)) {
+            const dhc_status st = add_batch(ws, batch_r, batch);
+            if (st != DHC_OK) {
+                return st;
+            }
+            batch = 0U;
+        }
+        if (i == fc->n) {
+            break;
+        }
         if (fc->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
             continue;
         }
+        /* the sample is checked by its evaluation */
         dhc_status st = fc->read(fc->ctx, i, &ws->sample);
-        if (st == DHC_OK) {
-            st = dhc_sample_check(model, &ws->sample);
-        }
-        if (st != DHC_OK) {
-            return st;
-        }
         const dhc_sample *const s = &ws->sample;
+        const double *const sincos = sample_sincos(fc->opt, model->arm.n_joints, i);
         const size_t rows = dhc_sample_rows(s);
         double r[DHC_MAX_ROWS_PER_SAMPLE];
         double rw[DHC_MAX_ROWS_PER_SAMPLE]; /* whitened (a copy of r with the model off) */
         size_t got_rows;
         dhc_mat jac;
-        if (accumulate) {
+        if (st == DHC_OK && accumulate) {
             /* residual and slope from one evaluation of the model */
-            st = dhc_mat_init(&jac, rows, p, ws->jac_buf,
-                              sizeof ws->jac_buf / sizeof ws->jac_buf[0]);
+            st = dhc_mat_init(&jac, rows, p, ws->jac_buf + batch * p, jac_len - batch * p);
             if (st == DHC_OK) {
-                st = dhc_model_linearize(model, fc->set, s, w, r, &got_rows, &jac);
+                st = dhc_model_linearize_prepared(model, &ws->trig, fc->set, s, sincos, w, r,
+                                                  &got_rows, &jac);
             }
-        } else {
-            st = dhc_model_residual(model, s, w, r, &got_rows);
+        } else if (st == DHC_OK) {
+            st = dhc_model_residual_prepared(model, &ws->trig, s, sincos, w, r, &got_rows);
         }
         if (st == DHC_OK) {
             memcpy(rw, r, sizeof r);
@@ -290,11 +335,15 @@ static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *mod
                                r_weights, rw, accumulate ? &jac : NULL);
             }
         }
-        if (st == DHC_OK && accumulate) {
-            st = dhc_normal_eq_add(&ws->ne, &jac, rw, NULL, rows);
-        }
         if (st != DHC_OK) {
-            return st;
+            /* the rows before it first, as one sample at a time would have */
+            const dhc_status before = accumulate && batch > 0U ? add_batch(ws, batch_r, batch)
+                                                               : DHC_OK;
+            return before != DHC_OK ? before : st;
+        }
+        if (accumulate) {
+            memcpy(batch_r + batch, rw, rows * sizeof rw[0]);
+            batch += rows;
         }
         note_traits(&tot->traits, s, model->arm.n_joints, tot->samples == 0U);
         /* the error totals stay physical (mm, rad); the SSR is what the fit minimises */
@@ -307,6 +356,14 @@ static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *mod
             tot->ssr += fc->whiten ? sq(rw[3]) + sq(rw[4]) + sq(rw[5]) : o2;
             tot->rot_ss += o2 / (w * w);
             tot->pose_samples++;
+        }
+        double screened = 0.0; /* the outlier screen's error: sample_error2's sum */
+        for (size_t k = 0U; k < rows; ++k) {
+            screened += sq(rw[k]);
+        }
+        tot->max_e2 = fmax(tot->max_e2, screened);
+        if (kept != NULL) {
+            kept[i] = screened;
         }
         tot->samples++;
         tot->rows += rows;
@@ -391,17 +448,25 @@ static dhc_status structural_rank(const fit_context *fc, const dhc_model *model,
     return DHC_OK;
 }
 
-/* Sample error (all rows, mm-equivalent) squared; used for outlier screening. */
-static dhc_status sample_error2(const fit_context *fc, const dhc_model *model, size_t i,
-                                double *e2, size_t *rows)
+/* Sample error (all rows, mm-equivalent) squared; used for outlier screening. at: NULL, or
+ * the totals of the last pass at the model, whose kept errors are then read (*rows = 0:
+ * not known). */
+static dhc_status sample_error2(const fit_context *fc, const dhc_model *model,
+                                const pass_totals *at, size_t i, double *e2, size_t *rows)
 {
+    if (at != NULL && at->errors_kept) {
+        *e2 = fc->opt->sample_error2[i];
+        *rows = 0U;
+        return DHC_OK;
+    }
     dhc_status st = fc->read(fc->ctx, i, &fc->ws->sample);
     if (st != DHC_OK) {
         return st;
     }
     double r[DHC_MAX_ROWS_PER_SAMPLE];
-    st = dhc_model_residual(model, &fc->ws->sample, fc->opt->orientation_weight_mm_per_rad, r,
-                            rows);
+    st = dhc_model_residual_prepared(model, &fc->ws->trig, &fc->ws->sample,
+                                     sample_sincos(fc->opt, model->arm.n_joints, i),
+                                     fc->opt->orientation_weight_mm_per_rad, r, rows);
     if (st == DHC_OK && fc->whiten) {
         /* screened in units of each sample's own noise: a sample at a pose where the joint
          * noise maps large is not an outlier for being larger */
@@ -422,24 +487,26 @@ static dhc_status sample_error2(const fit_context *fc, const dhc_model *model, s
 /* What one scan of the used samples' squared errors e2 found. */
 typedef struct {
     size_t used;
-    size_t pose;      /* pose samples among them */
+    size_t pose;      /* pose samples among them (not counted from kept errors) */
     size_t at_most;   /* samples with e2 <= the scan's limit */
     double max_e2;
 } error_scan;
 
 /* One pass over the used samples; with mark other than DHC_SAMPLE_USED, samples with e2
- * above limit2 are flagged with it. */
-static dhc_status scan_errors(const fit_context *fc, const dhc_model *model, double limit2,
-                              uint8_t mark, error_scan *out)
+ * above limit2 are flagged with it. at as sample_error2's. */
+static dhc_status scan_errors(const fit_context *fc, const dhc_model *model,
+                              const pass_totals *at, double limit2, uint8_t mark,
+                              error_scan *out)
 {
     memset(out, 0, sizeof *out);
+    dhc_arm_prepare(&model->arm, &fc->ws->trig);
     for (size_t i = 0U; i < fc->n; ++i) {
         if (fc->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
             continue;
         }
         double e2;
         size_t rows;
-        const dhc_status st = sample_error2(fc, model, i, &e2, &rows);
+        const dhc_status st = sample_error2(fc, model, at, i, &e2, &rows);
         if (st != DHC_OK) {
             return st;
         }
@@ -455,25 +522,75 @@ static dhc_status scan_errors(const fit_context *fc, const dhc_model *model, dou
     return DHC_OK;
 }
 
-/* A quantile (share 0.5: the median) of the squared sample errors by bisection on the value
- * (each step one pass over the data): the library keeps no per-sample storage, so no sort. */
+/* Bisection steps that one pass over the data decides: the pass counts the errors below
+ * every midpoint the next QUANTILE_LEVELS steps could visit (2^QUANTILE_LEVELS - 1 of them),
+ * and the steps then follow their path through those counts. */
+#define QUANTILE_LEVELS 5U
+#define QUANTILE_POINTS ((1U << QUANTILE_LEVELS) - 1U)
+
+/* A quantile (share 0.5: the median) of the squared sample errors by bisection on the value:
+ * the library keeps no per-sample storage, so no sort. The same steps, midpoints and result
+ * as one pass per step, in a fifth of the passes. */
 static dhc_status quantile_error2(const fit_context *fc, const dhc_model *model,
-                                  const error_scan *all, double share, double *median)
+                                  const pass_totals *at, const error_scan *all, double share,
+                                  double *median)
 {
     double lo = 0.0;
     double hi = all->max_e2;
     const size_t half = (size_t)ceil(share * (double)all->used);
-    for (size_t it = 0U; it < MEDIAN_BISECTIONS && hi - lo > MEDIAN_REL_PRECISION * hi; ++it) {
-        const double mid = 0.5 * (lo + hi);
-        error_scan scan;
-        const dhc_status st = scan_errors(fc, model, mid, (uint8_t)DHC_SAMPLE_USED, &scan);
-        if (st != DHC_OK) {
-            return st;
+    size_t it = 0U;
+    while (it < MEDIAN_BISECTIONS && hi - lo > MEDIAN_REL_PRECISION * hi) {
+        /* the midpoints in increasing order: point m at depth d (2^(L-1-d) from its
+         * interval's ends, which are points of lower depth, lo or hi) */
+        double mid[QUANTILE_POINTS];
+        for (size_t d = 0U; d < QUANTILE_LEVELS; ++d) {
+            const size_t half_width = (size_t)1U << (QUANTILE_LEVELS - 1U - d);
+            for (size_t m = half_width - 1U; m < QUANTILE_POINTS; m += 2U * half_width) {
+                const double a = m + 1U > half_width ? mid[m - half_width] : lo;
+                const double b = m + half_width < QUANTILE_POINTS ? mid[m + half_width] : hi;
+                mid[m] = 0.5 * (a + b);
+            }
         }
-        if (scan.at_most >= half) {
-            hi = mid;
-        } else {
-            lo = mid;
+        size_t below[QUANTILE_POINTS + 1U]; /* errors in (mid[m-1], mid[m]] */
+        memset(below, 0, sizeof below);
+        dhc_arm_prepare(&model->arm, &fc->ws->trig);
+        for (size_t i = 0U; i < fc->n; ++i) {
+            if (fc->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
+                continue;
+            }
+            double e2;
+            size_t rows;
+            const dhc_status st = sample_error2(fc, model, at, i, &e2, &rows);
+            if (st != DHC_OK) {
+                return st;
+            }
+            size_t first = 0U; /* the first midpoint at or above e2 */
+            size_t last = QUANTILE_POINTS;
+            while (first < last) {
+                const size_t m = (first + last) / 2U;
+                if (e2 <= mid[m]) {
+                    last = m;
+                } else {
+                    first = m + 1U;
+                }
+            }
+            below[first]++;
+        }
+        for (size_t m = 1U; m <= QUANTILE_POINTS; ++m) {
+            below[m] += below[m - 1U]; /* now: errors at or below mid[m] */
+        }
+        size_t m = (QUANTILE_POINTS - 1U) / 2U;
+        for (size_t d = 0U; d < QUANTILE_LEVELS && it < MEDIAN_BISECTIONS &&
+                            hi - lo > MEDIAN_REL_PRECISION * hi;
+             ++d, ++it) {
+            const size_t step = ((size_t)1U << (QUANTILE_LEVELS - 1U - d)) / 2U;
+            if (below[m] >= half) {
+                hi = mid[m];
+                m -= step;
+            } else {
+                lo = mid[m];
+                m += step;
+            }
         }
     }
     *median = hi;
@@ -488,16 +605,31 @@ static int redundant(const pass_totals *tot, const dhc_calib_report *rep)
     return tot->rows >= 2U * rep->structural_rank;
 }
 
+/* The scan of all used samples at the model: from the totals of a pass at it when they
+ * hold it (tot not NULL, each sample whitened at the model itself), else a pass. */
+static dhc_status scan_all(const fit_context *fc, const dhc_model *model,
+                           const pass_totals *tot, error_scan *out)
+{
+    if (tot == NULL || !tot->own_weights) {
+        return scan_errors(fc, model, NULL, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, out);
+    }
+    out->used = tot->samples;
+    out->pose = tot->pose_samples;
+    out->at_most = tot->samples;
+    out->max_e2 = tot->max_e2;
+    return DHC_OK;
+}
+
 /* Robust sigma of the used samples at the model, from their median squared error; *used
- * counts them. */
-static dhc_status robust_sigma(const fit_context *fc, const dhc_model *model, double *sigma,
-                               size_t *used)
+ * counts them. tot: NULL, or the totals of a pass at the model over the same samples. */
+static dhc_status robust_sigma(const fit_context *fc, const dhc_model *model,
+                               const pass_totals *tot, double *sigma, size_t *used)
 {
     error_scan all;
-    dhc_status st = scan_errors(fc, model, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, &all);
+    dhc_status st = scan_all(fc, model, tot, &all);
     double median = 0.0;
     if (st == DHC_OK && all.used > 0U) {
-        st = quantile_error2(fc, model, &all, 0.5, &median);
+        st = quantile_error2(fc, model, tot, &all, 0.5, &median);
     }
     const double chi2_median = 2U * all.pose > all.used ? CHI2_MEDIAN_6DOF : CHI2_MEDIAN_3DOF;
     *sigma = fmax(sqrt(median / chi2_median), fc->opt->outlier_floor_mm);
@@ -505,8 +637,10 @@ static dhc_status robust_sigma(const fit_context *fc, const dhc_model *model, do
     return st;
 }
 
-/* Flags samples whose error is many robust sigmas; returns how many were newly flagged. */
-static dhc_status flag_outliers(const fit_context *fc, const dhc_model *model, size_t *flagged)
+/* Flags samples whose error is many robust sigmas; returns how many were newly flagged.
+ * tot as robust_sigma's. */
+static dhc_status flag_outliers(const fit_context *fc, const dhc_model *model,
+                                const pass_totals *tot, size_t *flagged)
 {
     *flagged = 0U;
     if (fc->opt->outlier_threshold <= 0.0) {
@@ -514,12 +648,12 @@ static dhc_status flag_outliers(const fit_context *fc, const dhc_model *model, s
     }
     double sigma;
     size_t used;
-    dhc_status st = robust_sigma(fc, model, &sigma, &used);
+    dhc_status st = robust_sigma(fc, model, tot, &sigma, &used);
     if (st != DHC_OK || used < 3U) {
         return st;
     }
     error_scan kept;
-    st = scan_errors(fc, model, sq(fc->opt->outlier_threshold * sigma),
+    st = scan_errors(fc, model, tot, sq(fc->opt->outlier_threshold * sigma),
                      (uint8_t)DHC_SAMPLE_OUTLIER, &kept);
     *flagged = kept.used - kept.at_most;
     return st;
@@ -570,13 +704,18 @@ static int outside_joint_range(const fit_context *fc, const dhc_arm *arm, const 
  * ranges, then points beyond the arm's reach. The reach flags go on in a second pass, and
  * only when fewer than half of the samples in range are beyond reach: when most are, the
  * model's base is off, not the rows. */
-static dhc_status screen_physical(const fit_context *fc, const dhc_model *model)
+static dhc_status screen_physical(const fit_context *fc, const dhc_model *model,
+                                  data_traits *traits)
 {
     const int reach_on = fc->opt->reach_margin > 0.0;
     const double limit = (1.0 + fc->opt->reach_margin) * dhc_arm_reach(&model->arm);
     size_t used = 0U;
     size_t beyond = 0U;
     for (int apply_reach = 0; apply_reach <= 1; ++apply_reach) {
+        /* the traits of the samples left in (those the data's first pass would note; a
+         * sample that fails its check stops that pass) */
+        size_t noted = 0U;
+        memset(traits, 0, sizeof *traits);
         for (size_t i = 0U; i < fc->n; ++i) {
             if (fc->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
                 continue;
@@ -590,13 +729,18 @@ static dhc_status screen_physical(const fit_context *fc, const dhc_model *model)
                 fc->flags[i] = (uint8_t)DHC_SAMPLE_JOINT_RANGE;
                 continue;
             }
-            const int far = reach_on && dhc_sample_check(model, s) == DHC_OK &&
-                            beyond_reach(model, s, limit);
+            const int valid = dhc_sample_check(model, s) == DHC_OK;
+            const int far = reach_on && valid && beyond_reach(model, s, limit);
             if (!apply_reach) {
                 used++;
                 beyond += far ? 1U : 0U;
             } else if (far) {
                 fc->flags[i] = (uint8_t)DHC_SAMPLE_BEYOND_REACH;
+                continue;
+            }
+            if (valid) {
+                note_traits(traits, s, model->arm.n_joints, noted == 0U);
+                noted++;
             }
         }
         if (beyond == 0U || 2U * beyond >= used) {
@@ -725,7 +869,7 @@ static double predicted_decrease(const dhc_normal_eq *ne, const double *delta)
  * gradually, a rejected step doubles the growth. A fixed x10 / /10 schedule oscillates in
  * the curved valleys of real arms' barely determined parameters and creeps along them. */
 static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *rep,
-                                      pass_totals *tot, int *converged)
+                                      pass_totals *tot, int accumulated, int *converged)
 {
     dhc_calib_workspace *const ws = fc->ws;
     const size_t p = fc->set->count;
@@ -733,7 +877,8 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
     double nu = 2.0;
     double previous_gain = 0.0;
     *converged = 0;
-    dhc_status st = data_pass(fc, &ws->current, 1, tot);
+    /* accumulated: ws->ne and *tot already hold the pass at ws->current */
+    dhc_status st = accumulated ? DHC_OK : data_pass(fc, &ws->current, 1, tot);
     if (st == DHC_OK) {
         st = analyse_keeping_set(fc, rep);
     }
@@ -752,8 +897,23 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
         }
         ws->trial = ws->current;
         st = dhc_params_apply(fc->set, &ws->trial, ws->delta, p);
+        /* from the accumulation at the current estimate, before a trial overwrites it */
+        const double predicted = predicted_decrease(&ws->ne, ws->delta);
+        /* Most steps are accepted: the trial's pass accumulates its normal equations too,
+         * and an accepted step needs no pass of its own (a rejected one pays a pass to
+         * accumulate the current estimate again). Not with the noise model on: a trial is
+         * judged with its start's weights, but accumulated with its own. */
+        const int speculate = !fc->whiten;
+        int ne_at_trial = 0;
         pass_totals trial_tot;
-        if (st == DHC_OK) {
+        if (st == DHC_OK && speculate) {
+            st = data_pass(fc, &ws->trial, 1, &trial_tot);
+            ne_at_trial = st == DHC_OK;
+            if (st != DHC_OK) {
+                /* slopes can fail where residuals do not: judge the trial as before */
+                st = data_pass_weighted(fc, &ws->trial, &ws->current, 0, &trial_tot);
+            }
+        } else if (st == DHC_OK) {
             st = data_pass_weighted(fc, &ws->trial, &ws->current, 0, &trial_tot);
         }
         if (st != DHC_OK) {
@@ -762,13 +922,16 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
         if (trial_tot.ssr < tot->ssr) {
             const double gain = tot->ssr - trial_tot.ssr;
             const double step = scaled_step_norm(&ws->fac, ws->delta, p);
-            const double predicted = predicted_decrease(&ws->ne, ws->delta);
             const double rho = predicted > 0.0 ? gain / predicted : 0.0;
             const double t = 2.0 * rho - 1.0;
             ws->current = ws->trial;
             lambda = fmax(lambda * fmax(0.1, 1.0 - t * t * t), 1e-12);
             nu = 2.0;
-            st = data_pass(fc, &ws->current, 1, tot);
+            if (ne_at_trial) {
+                *tot = trial_tot;
+            } else {
+                st = data_pass(fc, &ws->current, 1, tot);
+            }
             if (st == DHC_OK) {
                 st = analyse_keeping_set(fc, rep);
             }
@@ -782,6 +945,14 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
             }
             previous_gain = gain;
         } else {
+            if (speculate) {
+                /* the same accumulation again: ws->fac is still its analysis */
+                pass_totals again;
+                st = data_pass(fc, &ws->current, 1, &again);
+                if (st != DHC_OK) {
+                    break;
+                }
+            }
             lambda *= nu;
             nu *= 2.0;
             if (lambda > LAMBDA_MAX) {
@@ -880,15 +1051,17 @@ static dhc_status hold_unsupported(const fit_context *fc, const pass_totals *tot
  * parameters, at most max_identifiability_checks times), then the worst unsupported link
  * parameter held and the fit repeated (at most MAX_HOLDS times). */
 static dhc_status fit_to_convergence(const fit_context *fc, dhc_calib_report *rep,
-                                     pass_totals *tot, int *converged)
+                                     pass_totals *tot, int accumulated, int *converged)
 {
     size_t checks = 0U;
     size_t holds = 0U;
     for (;;) {
-        dhc_status st = levenberg_marquardt(fc, rep, tot, converged);
+        dhc_status st = levenberg_marquardt(fc, rep, tot, accumulated, converged);
         if (st != DHC_OK || !*converged) {
             return st;
         }
+        /* LM ends with ws->ne and *tot at its estimate, which freeing parameters keeps */
+        accumulated = 1;
         size_t freed = 0U;
         if (checks < fc->opt->max_identifiability_checks) {
             st = free_identifiable(fc, rep, &freed);
@@ -911,6 +1084,7 @@ static dhc_status fit_to_convergence(const fit_context *fc, dhc_calib_report *re
         if (!held) {
             return DHC_OK;
         }
+        accumulated = 0; /* a held parameter moved the estimate */
         holds++;
     }
 }
@@ -929,34 +1103,37 @@ static void unmark(const fit_context *fc, uint8_t mark)
  * closest to the model, twice (least trimmed squares' concentration steps), and leave out
  * the samples beyond ROBUST_K robust sigmas of that fit (DHC_SAMPLE_ROBUST). The fit then
  * starts from it. A trimmed fit that fails leaves everything as it was. */
-static dhc_status robust_start(const fit_context *fc, dhc_calib_report *rep, pass_totals *tot)
+static dhc_status robust_start(const fit_context *fc, dhc_calib_report *rep, pass_totals *tot,
+                               int *moved)
 {
     dhc_calib_workspace *const ws = fc->ws;
+    *moved = 0;
     if (!fc->opt->robust_start || !redundant(tot, rep)) {
         return DHC_OK;
     }
     /* one scan and one level reused throughout: this is on the M4's deepest call chain */
     error_scan scan;
     double level = 0.0;
-    dhc_status st = scan_errors(fc, &ws->current, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, &scan);
+    dhc_status st = scan_all(fc, &ws->current, tot, &scan);
     if (st == DHC_OK && scan.used >= 4U) {
-        st = quantile_error2(fc, &ws->current, &scan, 0.5, &level);
+        st = quantile_error2(fc, &ws->current, tot, &scan, 0.5, &level);
     }
     if (st != DHC_OK || scan.used < 4U || !(scan.max_e2 > sq(ROBUST_TRIGGER) * level)) {
         return st;
     }
     /* ws->current is still the caller's model (fc->input): no copy, the M4 stack is small */
+    *moved = 1;
     for (size_t step = 0U; step < ROBUST_CSTEPS && st == DHC_OK; ++step) {
-        st = scan_errors(fc, &ws->current, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, &scan);
+        st = scan_errors(fc, &ws->current, NULL, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, &scan);
         if (st == DHC_OK) {
-            st = quantile_error2(fc, &ws->current, &scan, ROBUST_KEEP, &level);
+            st = quantile_error2(fc, &ws->current, NULL, &scan, ROBUST_KEEP, &level);
         }
         if (st == DHC_OK) {
-            st = scan_errors(fc, &ws->current, level, (uint8_t)DHC_SAMPLE_ROBUST, &scan);
+            st = scan_errors(fc, &ws->current, NULL, level, (uint8_t)DHC_SAMPLE_ROBUST, &scan);
         }
         int converged = 0;
         if (st == DHC_OK) {
-            st = fit_to_convergence(fc, rep, tot, &converged);
+            st = fit_to_convergence(fc, rep, tot, 0, &converged);
         }
         unmark(fc, (uint8_t)DHC_SAMPLE_ROBUST);
     }
@@ -965,8 +1142,8 @@ static dhc_status robust_start(const fit_context *fc, dhc_calib_report *rep, pas
         return st == DHC_ERR_NONFINITE || st == DHC_ERR_ARGUMENT ? st : DHC_OK;
     }
     size_t used;
-    st = robust_sigma(fc, &ws->current, &level, &used);
-    return st == DHC_OK ? scan_errors(fc, &ws->current, sq(ROBUST_K * level),
+    st = robust_sigma(fc, &ws->current, NULL, &level, &used);
+    return st == DHC_OK ? scan_errors(fc, &ws->current, NULL, sq(ROBUST_K * level),
                                       (uint8_t)DHC_SAMPLE_ROBUST, &scan)
                         : st;
 }
@@ -1025,29 +1202,39 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
     const fit_context fc = {set, read, ctx, n, flags, opt, ws, whiten, model};
     ws->current = *model;
 
-    dhc_status st = screen_physical(&fc, model);
+    data_traits traits;
+    dhc_status st = screen_physical(&fc, model, &traits);
+    /* The structural rank before the data's first pass: it borrows ws->ne, which that pass
+     * then fills at the input model, LM's first accumulation unless the robust start moves
+     * the model. */
+    if (st == DHC_OK) {
+        st = structural_rank(&fc, model, &traits, rep);
+    }
     if (st != DHC_OK) {
         return st;
     }
     pass_totals tot;
-    st = data_pass(&fc, model, 0, &tot);
+    st = data_pass(&fc, model, 1, &tot);
+    const int accumulated = st == DHC_OK;
+    if (st != DHC_OK) {
+        st = data_pass(&fc, model, 0, &tot); /* slopes can fail where residuals do not */
+    }
     if (st != DHC_OK) {
         return st;
     }
     if (tot.samples == 0U) {
         return DHC_ERR_NO_DATA;
     }
-    st = structural_rank(&fc, model, &tot.traits, rep);
-    if (st == DHC_OK) {
-        st = robust_start(&fc, rep, &tot);
-    }
+    int moved = 0;
+    st = robust_start(&fc, rep, &tot, &moved);
     if (st != DHC_OK) {
         return st;
     }
 
     int converged = 0;
     for (size_t round = 0U; round <= opt->max_outlier_rounds; ++round) {
-        st = fit_to_convergence(&fc, rep, &tot, &converged);
+        st = fit_to_convergence(&fc, rep, &tot, round == 0U && accumulated && !moved,
+                                &converged);
         if (st != DHC_OK) {
             return st;
         }
@@ -1057,7 +1244,7 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
         }
         size_t flagged = 0U;
         if (round < opt->max_outlier_rounds && redundant(&tot, rep)) {
-            st = flag_outliers(&fc, &ws->current, &flagged);
+            st = flag_outliers(&fc, &ws->current, &tot, &flagged);
             if (st != DHC_OK) {
                 return st;
             }

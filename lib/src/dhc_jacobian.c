@@ -19,64 +19,47 @@ static void rotation_column(const double axis[3], const double through[3], const
     dhc_vec3_cross(axis, lever, dp);
 }
 
-/* Axes of joint i's intermediate frames, in the world:
- *   z: joint axis (z of frame i-1), through origin of frame i-1
- *   u: x after Rz(q + theta): direction of a, axis of alpha, through origin of frame i
- *   v: y after Rz Rx(alpha): axis of beta, through origin of frame i */
-typedef struct {
-    double z[3];
-    double u[3];
-    double v[3];
-} joint_axes;
-
-static void compute_joint_axes(const dhc_frame *prev, const dhc_joint *j, double q_rad,
-                               joint_axes *ax)
-{
-    const double phi = q_rad + j->theta_offset_rad;
-    const double c = cos(phi);
-    const double s = sin(phi);
-    const double ca = cos(j->alpha_rad);
-    const double sa = sin(j->alpha_rad);
-    const double u_local[3] = {c, s, 0.0};
-    const double v_local[3] = {-s * ca, c * ca, sa};
-    dhc_rot_column(&prev->rot, 2U, ax->z);
-    dhc_rot_apply(&prev->rot, u_local, ax->u);
-    dhc_rot_apply(&prev->rot, v_local, ax->v);
-}
-
 static int is_geometric(uint8_t kind)
 {
     return kind <= (uint8_t)DHC_P_TOOL_Z;
 }
 
 /* Position and rotation derivative of the tool for one geometric parameter; f are the
- * chain's frames at q, p the tool point. */
-static void geometric_column(const dhc_arm *arm, const dhc_frame *f, const double *q_rad,
-                             const double p[3], const dhc_param_id *id, double dp[3],
-                             double dw[3])
+ * chain's frames at q and axes their intermediate axes (dhc_forward_frames_trig), p the tool
+ * point. Joint i's axes in the world:
+ *   z: joint axis (z of frame i-1), through origin of frame i-1
+ *   u: x after Rz(q + theta): direction of a, axis of alpha, through origin of frame i
+ *   v: y after Rz Rx(alpha): axis of beta, through origin of frame i */
+/* inline: returned through memory, its 3-vectors are read back as pairs, and the stores
+ * cannot forward to those loads (a stall per column) */
+static inline void geometric_column(const dhc_arm *arm, const dhc_frame *f,
+                                    double axes[][2][3], const double p[3],
+                                    const dhc_param_id *id, double dp[3], double dw[3])
 {
     dhc_vec3_set(dp, 0.0, 0.0, 0.0);
     dhc_vec3_set(dw, 0.0, 0.0, 0.0);
     if (id->kind <= (uint8_t)DHC_P_BETA) {
-        joint_axes ax;
-        compute_joint_axes(&f[id->joint], &arm->joint[id->joint], q_rad[id->joint], &ax);
+        double z[3];
+        dhc_rot_column(&f[id->joint].rot, 2U, z);
+        const double *const u = axes[id->joint][0];
+        const double *const v = axes[id->joint][1];
         const double *const o_prev = f[id->joint].pos;
         const double *const o_next = f[id->joint + 1U].pos;
         switch ((dhc_param_kind)id->kind) {
         case DHC_P_THETA:
-            rotation_column(ax.z, o_prev, p, dp);
-            dhc_vec3_copy(ax.z, dw);
+            rotation_column(z, o_prev, p, dp);
+            dhc_vec3_copy(z, dw);
             break;
-        case DHC_P_D: dhc_vec3_copy(ax.z, dp); break;
-        case DHC_P_A: dhc_vec3_copy(ax.u, dp); break;
+        case DHC_P_D: dhc_vec3_copy(z, dp); break;
+        case DHC_P_A: dhc_vec3_copy(u, dp); break;
         case DHC_P_ALPHA:
-            rotation_column(ax.u, o_next, p, dp);
-            dhc_vec3_copy(ax.u, dw);
+            rotation_column(u, o_next, p, dp);
+            dhc_vec3_copy(u, dw);
             break;
         case DHC_P_BETA:
         default:
-            rotation_column(ax.v, o_next, p, dp);
-            dhc_vec3_copy(ax.v, dw);
+            rotation_column(v, o_next, p, dp);
+            dhc_vec3_copy(v, dw);
             break;
         }
     } else if (id->kind <= (uint8_t)DHC_P_BASE_Z) {
@@ -98,6 +81,26 @@ static void put_column(dhc_mat *jac, size_t col, const double dp[3], const doubl
             DHC_MAT_AT(jac, r + 3U, col) = w_scale * dw[r];
         }
     }
+}
+
+/* The chain's frames and intermediate axes at q (n_joints entries, checked by the caller's
+ * check_arm), and the tool point. */
+static dhc_status frames_with_axes(const dhc_arm *arm, const double *q_rad, dhc_frame *f,
+                                   double axes[][2][3], double p[3])
+{
+    double sin_q[DHC_MAX_JOINTS];
+    double cos_q[DHC_MAX_JOINTS];
+    for (size_t i = 0U; i < arm->n_joints; ++i) {
+        if (!dhc_is_finite(q_rad[i])) {
+            return DHC_ERR_NONFINITE;
+        }
+        sin_q[i] = sin(q_rad[i]);
+        cos_q[i] = cos(q_rad[i]);
+    }
+    dhc_arm_trig trig;
+    dhc_arm_prepare(arm, &trig);
+    dhc_forward_frames_trig(arm, &trig, 1.0, sin_q, cos_q, f, axes, p);
+    return DHC_OK;
 }
 
 static dhc_status check_arm(const dhc_arm *arm)
@@ -150,15 +153,16 @@ dhc_status dhc_identification_jacobian(const dhc_arm *arm, const dhc_param_set *
         }
     }
     dhc_frame f[DHC_MAX_JOINTS + 1U];
+    double axes[DHC_MAX_JOINTS][2][3];
     double p[3];
-    st = dhc_forward_frames(arm, q_rad, q_len, f, DHC_MAX_JOINTS + 1U, p);
+    st = frames_with_axes(arm, q_rad, f, axes, p);
     if (st != DHC_OK) {
         return st;
     }
     for (size_t k = 0U; k < set->count; ++k) {
         double dp[3];
         double dw[3];
-        geometric_column(arm, f, q_rad, p, &set->id[k], dp, dw);
+        geometric_column(arm, f, axes, p, &set->id[k], dp, dw);
         put_column(jac, k, dp, dw, with_orientation, 1.0);
     }
     /* Finite angles on non-finite or overflowing geometry (found by fuzzing). */
@@ -235,6 +239,11 @@ static void wire_rows(const dhc_model *model, const dhc_param_id *id, const doub
     }
 }
 
+static dhc_status jacobian_prepared(const dhc_model *model, const dhc_arm_trig *trig,
+                                    const dhc_param_set *set, const dhc_sample *s,
+                                    const double *sincos_q, double weight_mm_per_rad,
+                                    dhc_mat *jac, dhc_prediction *pr);
+
 dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set,
                               const dhc_sample *s, double weight_mm_per_rad, dhc_mat *jac,
                               dhc_prediction *pred)
@@ -243,14 +252,29 @@ dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set,
         return DHC_ERR_ARGUMENT;
     }
     dhc_status st = check_jac(jac, dhc_sample_rows(s), set->count);
+    if (st == DHC_OK) {
+        st = check_arm(&model->arm);
+    }
     if (st != DHC_OK) {
         return st;
     }
     dhc_prediction local;
     memset(&local, 0, sizeof local); /* written before read; zeroed so no tool has to see it */
-    dhc_prediction *const pr = pred != NULL ? pred : &local;
+    dhc_arm_trig trig;
+    dhc_arm_prepare(&model->arm, &trig);
+    return jacobian_prepared(model, &trig, set, s, NULL, weight_mm_per_rad, jac,
+                             pred != NULL ? pred : &local);
+}
+
+/* dhc_model_jacobian after its argument checks, at the caller's trigonometry. */
+static dhc_status jacobian_prepared(const dhc_model *model, const dhc_arm_trig *trig,
+                                    const dhc_param_set *set, const dhc_sample *s,
+                                    const double *sincos_q, double weight_mm_per_rad,
+                                    dhc_mat *jac, dhc_prediction *pr)
+{
     dhc_model_eval ev;
-    st = dhc_model_evaluate(model, s, set_has_compliance(set), &ev, pr);
+    const dhc_status st =
+        dhc_model_evaluate_prepared(model, trig, s, sincos_q, set_has_compliance(set), &ev, pr);
     if (st != DHC_OK) {
         return st;
     }
@@ -268,7 +292,7 @@ dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set,
         double dw[3] = {0.0, 0.0, 0.0};
         double dp_scale = drift;
         if (is_geometric(id->kind)) {
-            geometric_column(arm, ev.frames, pr->q_eff_rad, p_arm, id, dp, dw);
+            geometric_column(arm, ev.frames, ev.axes, p_arm, id, dp, dw);
             if (id->kind >= (uint8_t)DHC_P_BASE_X && id->kind <= (uint8_t)DHC_P_BASE_Z) {
                 dp_scale = 1.0;
             }
@@ -280,7 +304,7 @@ dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set,
         } else if (id->kind <= (uint8_t)DHC_P_COMPLIANCE) {
             const dhc_param_id joint_theta = {(uint8_t)DHC_P_THETA, id->joint, 0U};
             const double factor = joint_effect_factor(id, s, ev.tau[id->joint]);
-            geometric_column(arm, ev.frames, pr->q_eff_rad, p_arm, &joint_theta, dp, dw);
+            geometric_column(arm, ev.frames, ev.axes, p_arm, &joint_theta, dp, dw);
             dhc_vec3_scale(dp, factor, dp);
             dhc_vec3_scale(dw, factor, dw);
         } else if (id->kind == (uint8_t)DHC_P_THERMAL) {
@@ -332,8 +356,9 @@ dhc_status dhc_joint_jacobian(const dhc_arm *arm, const double *q_rad, size_t q_
         return DHC_ERR_DIMENSION;
     }
     dhc_frame f[DHC_MAX_JOINTS + 1U];
+    double axes[DHC_MAX_JOINTS][2][3];
     double p[3];
-    st = dhc_forward_frames(arm, q_rad, q_len, f, DHC_MAX_JOINTS + 1U, p);
+    st = frames_with_axes(arm, q_rad, f, axes, p);
     if (st != DHC_OK) {
         return st;
     }
@@ -341,10 +366,34 @@ dhc_status dhc_joint_jacobian(const dhc_arm *arm, const double *q_rad, size_t q_
         const dhc_param_id theta = {(uint8_t)DHC_P_THETA, (uint8_t)i, 0U};
         double dp[3];
         double dw[3];
-        geometric_column(arm, f, q_rad, p, &theta, dp, dw);
+        geometric_column(arm, f, axes, p, &theta, dp, dw);
         put_column(jac, i, dp, dw, with_orientation, 1.0);
     }
     return DHC_OK;
+}
+
+dhc_status dhc_model_linearize_prepared(const dhc_model *model, const dhc_arm_trig *trig,
+                                       const dhc_param_set *set, const dhc_sample *s,
+                                       const double *sincos_q, double weight_mm_per_rad,
+                                       double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows,
+                                       dhc_mat *jac)
+{
+    if (model == NULL || trig == NULL || set == NULL || s == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    dhc_prediction pred;
+    memset(&pred, 0, sizeof pred);
+    dhc_status st = check_jac(jac, dhc_sample_rows(s), set->count);
+    if (st == DHC_OK) {
+        st = jacobian_prepared(model, trig, set, s, sincos_q, weight_mm_per_rad, jac, &pred);
+    }
+    if (st == DHC_OK) {
+        st = dhc_model_residual_of(s, &pred, weight_mm_per_rad, r, rows);
+    }
+    if (st == DHC_OK) {
+        dhc_model_residual_slope(s, r, weight_mm_per_rad, jac);
+    }
+    return st;
 }
 
 dhc_status dhc_model_linearize(const dhc_model *model, const dhc_param_set *set,

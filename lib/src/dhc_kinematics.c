@@ -105,18 +105,68 @@ dhc_status dhc_forward_frames_scaled(const dhc_arm *arm, double length_scale,
             return DHC_ERR_NONFINITE;
         }
     }
+    dhc_arm_trig trig;
+    double sin_q[DHC_MAX_JOINTS];
+    double cos_q[DHC_MAX_JOINTS];
+    dhc_arm_prepare(arm, &trig);
+    for (size_t i = 0U; i < n; ++i) {
+        sin_q[i] = sin(q_rad[i]);
+        cos_q[i] = cos(q_rad[i]);
+    }
+    dhc_forward_frames_trig(arm, &trig, length_scale, sin_q, cos_q, frames, NULL, tool_world_mm);
+    return DHC_OK;
+}
+
+void dhc_arm_prepare(const dhc_arm *arm, dhc_arm_trig *trig)
+{
+    trig->n_joints = arm->n_joints;
+    for (size_t i = 0U; i < arm->n_joints; ++i) {
+        const dhc_joint *const j = &arm->joint[i];
+        dhc_joint_trig *const t = &trig->joint[i];
+        dhc_mat3 rx;
+        dhc_mat3 ry;
+        t->cos_theta = cos(j->theta_offset_rad);
+        t->sin_theta = sin(j->theta_offset_rad);
+        dhc_rot_x(j->alpha_rad, &rx);
+        dhc_rot_y(j->beta_rad, &ry);
+        dhc_rot_mul(&rx, &ry, &t->twist);
+    }
+}
+
+void dhc_forward_frames_trig(const dhc_arm *arm, const dhc_arm_trig *trig, double length_scale,
+                             const double *sin_q, const double *cos_q, dhc_frame *frames,
+                             double axes[][2][3], double tool_world_mm[3])
+{
+    const size_t n = arm->n_joints;
     frames[0] = arm->base;
     for (size_t i = 0U; i < n; ++i) {
-        dhc_frame a;
-        joint_transform(&arm->joint[i], q_rad[i], length_scale, &a);
-        dhc_frame_mul(&frames[i], &a, &frames[i + 1U]);
+        const dhc_joint_trig *const t = &trig->joint[i];
+        const dhc_mat3 *const r = &frames[i].rot;
+        const double c = cos_q[i] * t->cos_theta - sin_q[i] * t->sin_theta;
+        const double s = sin_q[i] * t->cos_theta + cos_q[i] * t->sin_theta;
+        /* m = R_{i-1} Rz(q + theta): its columns are the rotated x, y and the joint axis */
+        dhc_mat3 m;
+        for (size_t k = 0U; k < 3U; ++k) {
+            m.m[k][0] = c * r->m[k][0] + s * r->m[k][1];
+            m.m[k][1] = c * r->m[k][1] - s * r->m[k][0];
+            m.m[k][2] = r->m[k][2];
+        }
+        const double a = length_scale * arm->joint[i].a_mm;
+        const double d = length_scale * arm->joint[i].d_mm;
+        for (size_t k = 0U; k < 3U; ++k) {
+            frames[i + 1U].pos[k] = frames[i].pos[k] + a * m.m[k][0] + d * m.m[k][2];
+            if (axes != NULL) {
+                axes[i][0][k] = m.m[k][0];
+                axes[i][1][k] = t->twist.m[1][1] * m.m[k][1] + t->twist.m[2][1] * m.m[k][2];
+            }
+        }
+        dhc_rot_mul(&m, &t->twist, &frames[i + 1U].rot);
     }
     if (tool_world_mm != NULL) {
         double tool[3];
         dhc_vec3_scale(arm->tool_mm, length_scale, tool);
         dhc_frame_apply(&frames[n], tool, tool_world_mm);
     }
-    return DHC_OK;
 }
 
 dhc_status dhc_forward(const dhc_arm *arm, const double *q_rad, size_t q_len, dhc_frame *tool)

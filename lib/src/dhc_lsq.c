@@ -60,54 +60,108 @@ dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double
     if (jac->rows != k || jac->cols != n) {
         return DHC_ERR_DIMENSION;
     }
-    if (!dhc_all_finite(jac->data, k * n) || !dhc_all_finite(r, k)) {
-        return DHC_ERR_NONFINITE;
-    }
     if (w != NULL) {
         for (size_t e = 0U; e < k; ++e) {
             if (!(w[e] > 0.0) || !dhc_is_finite(w[e])) {
-                return DHC_ERR_ARGUMENT;
+                /* a NaN or infinite entry elsewhere is reported first, as it always was */
+                return dhc_all_finite(jac->data, k * n) && dhc_all_finite(r, k)
+                           ? DHC_ERR_ARGUMENT
+                           : DHC_ERR_NONFINITE;
             }
         }
     }
     /* Finite rows can still overflow the sums (entries above ~1e154), which would poison
      * every later analysis. Every entry of J^T W J and J^T W r is at most the largest of the
      * diagonal and the SSR (Cauchy-Schwarz), and each row adds at most w max(|J|, |r|)^2
-     * to any of them: a finite bound, with room for rounding, means finite sums. */
+     * to any of them: a finite bound, with room for rounding, means finite sums.
+     * The same sweep finds a non-finite entry: x * 0 is NaN for NaN and infinities, and the
+     * sum keeps it (the comparisons of the maximum skip NaN). */
     double bound = ne->ssr;
     for (size_t i = 0U; i < n; ++i) {
-        bound = fmax(bound, ne->jtj[i * n + i]);
+        const double d = ne->jtj[i * n + i];
+        bound = d > bound ? d : bound;
     }
+    double poison = 0.0;
     for (size_t e = 0U; e < k; ++e) {
+        const double *const row = &DHC_MAT_AT(jac, e, 0U);
         double m = fabs(r[e]);
+        poison += r[e] * 0.0;
         for (size_t i = 0U; i < n; ++i) {
-            m = fmax(m, fabs(DHC_MAT_AT(jac, e, i)));
+            const double a = fabs(row[i]);
+            poison += row[i] * 0.0;
+            m = a > m ? a : m;
         }
         bound += (w != NULL ? w[e] : 1.0) * m * m;
+    }
+    if (isnan(poison)) {
+        return DHC_ERR_NONFINITE;
     }
     if (!dhc_is_finite(2.0 * bound)) {
         return DHC_ERR_NONFINITE;
     }
-    for (size_t e = 0U; e < k; ++e) {
-        const double we = w != NULL ? w[e] : 1.0;
-        const double *const row = &DHC_MAT_AT(jac, e, 0U);
+    /* Row by row of the matrix, each equation's term in turn (every sum in the equations'
+     * order): the lower triangle from (w_e J_ei) J_ej; the upper from the very products of
+     * its mirror, (w_e J_ej) J_ei, for a sample's few rows, or for many rows (a batch),
+     * where that costs more than a transposed copy, by the copy. Exactly symmetric. */
+    const int mirror_by_copy = k > 3U;
+    /* three equations per sweep (a sample's tool point) and, for a batch, two rows of the
+     * matrix at once: each equation's entry is loaded once for both (loads, not
+     * arithmetic, bound this loop) */
+    for (size_t e = 0U; e < k; e += 3U) {
+        double we[3];
+        double rr[3];
+        const double *row[3];
+        for (size_t t = 0U; t < 3U; ++t) {
+            /* a missing row is the first again with weight and residual 0: adds zeros */
+            const int live = e + t < k;
+            const size_t et = live ? e + t : e;
+            we[t] = live ? (w != NULL ? w[et] : 1.0) : 0.0;
+            rr[t] = live ? r[et] : 0.0;
+            row[t] = &DHC_MAT_AT(jac, et, 0U);
+        }
+        const double *const r0 = row[0];
+        const double *const r1 = row[1];
+        const double *const r2 = row[2];
         for (size_t i = 0U; i < n; ++i) {
-            const double wji = we * row[i];
-            if (!(fabs(wji) > 0.0)) {
-                continue; /* identification Jacobians are sparse; skipping is exact */
+            const double a0 = we[0] * r0[i];
+            const double a1 = we[1] * r1[i];
+            const double a2 = we[2] * r2[i];
+            ne->jtr[i] = ((ne->jtr[i] + a0 * rr[0]) + a1 * rr[1]) + a2 * rr[2];
+            double *const out = &ne->jtj[i * n];
+            if (mirror_by_copy && i + 1U < n) {
+                const double b0 = we[0] * r0[i + 1U];
+                const double b1 = we[1] * r1[i + 1U];
+                const double b2 = we[2] * r2[i + 1U];
+                ne->jtr[i + 1U] = ((ne->jtr[i + 1U] + b0 * rr[0]) + b1 * rr[1]) + b2 * rr[2];
+                double *const next = out + n;
+                for (size_t j = 0U; j <= i; ++j) {
+                    const double x0 = r0[j];
+                    const double x1 = r1[j];
+                    const double x2 = r2[j];
+                    out[j] = ((out[j] + a0 * x0) + a1 * x1) + a2 * x2;
+                    next[j] = ((next[j] + b0 * x0) + b1 * x1) + b2 * x2;
+                }
+                next[i + 1U] = ((next[i + 1U] + b0 * r0[i + 1U]) + b1 * r1[i + 1U]) +
+                               b2 * r2[i + 1U];
+                ++i;
+                continue;
             }
             for (size_t j = 0U; j <= i; ++j) {
-                ne->jtj[i * n + j] += wji * row[j];
+                out[j] = ((out[j] + a0 * r0[j]) + a1 * r1[j]) + a2 * r2[j];
             }
-            ne->jtr[i] += wji * r[e];
+            for (size_t j = i + 1U; j < n && !mirror_by_copy; ++j) {
+                out[j] = ((out[j] + (we[0] * r0[j]) * r0[i]) + (we[1] * r1[j]) * r1[i]) +
+                         (we[2] * r2[j]) * r2[i];
+            }
         }
-        ne->ssr += we * r[e] * r[e];
     }
-    /* Accumulate one triangle, keep the stored matrix full and exactly symmetric. */
-    for (size_t i = 0U; i < n; ++i) {
+    for (size_t i = 0U; i < n && mirror_by_copy; ++i) {
         for (size_t j = 0U; j < i; ++j) {
             ne->jtj[j * n + i] = ne->jtj[i * n + j];
         }
+    }
+    for (size_t e = 0U; e < k; ++e) {
+        ne->ssr += (w != NULL ? w[e] : 1.0) * r[e] * r[e];
     }
     ne->rows += k;
     return DHC_OK;

@@ -12,12 +12,13 @@ int dhc_is_finite(double x)
 
 int dhc_all_finite(const double *x, size_t n)
 {
+    /* x * 0 is a zero for every finite x and NaN for NaN and infinities; the sum keeps a
+     * NaN. No branch per element (this runs on every sample's Jacobian in a fit). */
+    double poison = 0.0;
     for (size_t i = 0U; i < n; ++i) {
-        if (!dhc_is_finite(x[i])) {
-            return 0;
-        }
+        poison += x[i] * 0.0;
     }
-    return 1;
+    return !isnan(poison);
 }
 
 static int mat_valid(const dhc_mat *m)

@@ -147,7 +147,23 @@ void dhc_measurer_anchor_world(const dhc_measurer_model *m, size_t k, double out
 dhc_status dhc_model_evaluate(const dhc_model *model, const dhc_sample *s, int need_moments,
                               dhc_model_eval *ev, dhc_prediction *out)
 {
-    if (ev == NULL || out == NULL) {
+    if (model == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    if (model->arm.n_joints == 0U || model->arm.n_joints > DHC_MAX_JOINTS) {
+        return DHC_ERR_CAPACITY;
+    }
+    dhc_arm_trig trig;
+    dhc_arm_prepare(&model->arm, &trig);
+    return dhc_model_evaluate_prepared(model, &trig, s, NULL, need_moments, ev, out);
+}
+
+dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_trig *trig,
+                                       const dhc_sample *s, const double *sincos_q,
+                                       int need_moments, dhc_model_eval *ev,
+                                       dhc_prediction *out)
+{
+    if (ev == NULL || out == NULL || trig == NULL) {
         return DHC_ERR_ARGUMENT;
     }
     dhc_status st = dhc_sample_check(model, s);
@@ -155,15 +171,25 @@ dhc_status dhc_model_evaluate(const dhc_model *model, const dhc_sample *s, int n
         return st;
     }
     const size_t n = model->arm.n_joints;
+    if (n == 0U || n > DHC_MAX_JOINTS) {
+        return DHC_ERR_CAPACITY;
+    }
+    if (trig->n_joints != n) {
+        return DHC_ERR_ARGUMENT;
+    }
     ev->length_scale = dhc_model_length_scale(model, s->temp_c);
     const int compliant = has_compliance(model);
     ev->has_moments = compliant || need_moments;
+    /* one sine and cosine per joint and sample: the effects and both chains share them */
+    double sin_q[DHC_MAX_JOINTS];
+    double cos_q[DHC_MAX_JOINTS];
+    for (size_t i = 0U; i < n; ++i) {
+        sin_q[i] = sincos_q != NULL ? sincos_q[2U * i] : sin(s->q_rad[i]);
+        cos_q[i] = sincos_q != NULL ? sincos_q[2U * i + 1U] : cos(s->q_rad[i]);
+    }
     if (ev->has_moments) {
-        st = dhc_forward_frames_scaled(&model->arm, ev->length_scale, s->q_rad, DHC_MAX_JOINTS,
-                                       ev->frames, DHC_MAX_JOINTS + 1U, NULL);
-        if (st != DHC_OK) {
-            return st;
-        }
+        dhc_forward_frames_trig(&model->arm, trig, ev->length_scale, sin_q, cos_q, ev->frames,
+                                NULL, NULL);
         moments_from_frames(model, ev->frames, ev->tau);
     }
     for (size_t i = 0U; i < DHC_MAX_JOINTS; ++i) {
@@ -172,8 +198,10 @@ dhc_status dhc_model_evaluate(const dhc_model *model, const dhc_sample *s, int n
     for (size_t i = 0U; i < n; ++i) {
         const dhc_joint_effects *fx = &model->effect[i];
         const double q = s->q_rad[i];
-        double dq = fx->scale * q + fx->harmonic_sin_rad * sin(q) +
-                    fx->harmonic_cos_rad * cos(q) + 0.5 * fx->backlash_rad * (double)s->dir[i];
+        double dq = fx->scale * q + 0.5 * fx->backlash_rad * (double)s->dir[i];
+        if (fabs(fx->harmonic_sin_rad) > 0.0 || fabs(fx->harmonic_cos_rad) > 0.0) {
+            dq += fx->harmonic_sin_rad * sin_q[i] + fx->harmonic_cos_rad * cos_q[i];
+        }
         for (size_t k = 0U; k + 1U < DHC_HARMONIC_MAX_ORDER; ++k) {
             const double a = fx->harmonic_hi_sin_rad[k];
             const double b = fx->harmonic_hi_cos_rad[k];
@@ -186,12 +214,17 @@ dhc_status dhc_model_evaluate(const dhc_model *model, const dhc_sample *s, int n
             dq += fx->compliance[j] * ev->tau[i][j];
         }
         out->q_eff_rad[i] = q + dq;
+        if (!dhc_is_finite(out->q_eff_rad[i])) {
+            return DHC_ERR_NONFINITE;
+        }
+        /* Without effects q_eff is q to the bit, and so are its sine and cosine. */
+        if (fabs(dq) > 0.0) {
+            sin_q[i] = sin(out->q_eff_rad[i]);
+            cos_q[i] = cos(out->q_eff_rad[i]);
+        }
     }
-    st = dhc_forward_frames_scaled(&model->arm, ev->length_scale, out->q_eff_rad, DHC_MAX_JOINTS,
-                                   ev->frames, DHC_MAX_JOINTS + 1U, out->p_mm);
-    if (st != DHC_OK) {
-        return st;
-    }
+    dhc_forward_frames_trig(&model->arm, trig, ev->length_scale, sin_q, cos_q, ev->frames,
+                            ev->axes, out->p_mm);
     out->rot = ev->frames[n].rot;
     dhc_vec3_copy(out->p_mm, out->p_arm_mm);
     dhc_model_drift(model, s->t_s, out->p_arm_mm, out->p_mm);
@@ -261,6 +294,21 @@ dhc_status dhc_model_residual(const dhc_model *model, const dhc_sample *s,
     dhc_prediction pred;
     memset(&pred, 0, sizeof pred);
     const dhc_status st = dhc_model_predict(model, s, &pred);
+    return st == DHC_OK ? dhc_model_residual_of(s, &pred, weight_mm_per_rad, r, rows) : st;
+}
+
+dhc_status dhc_model_residual_prepared(const dhc_model *model, const dhc_arm_trig *trig,
+                                       const dhc_sample *s, const double *sincos_q,
+                                       double weight_mm_per_rad,
+                                       double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows)
+{
+    if (r == NULL || rows == NULL || model == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    dhc_prediction pred;
+    dhc_model_eval ev;
+    memset(&pred, 0, sizeof pred);
+    const dhc_status st = dhc_model_evaluate_prepared(model, trig, s, sincos_q, 0, &ev, &pred);
     return st == DHC_OK ? dhc_model_residual_of(s, &pred, weight_mm_per_rad, r, rows) : st;
 }
 

@@ -123,6 +123,49 @@ static void csv_ok(const char *text, size_t n_joints)
 
 /* ------------------------------------------------------------------ CSV: file level */
 
+/* Every number the reader takes is the double strtod makes of its text, whichever path
+ * reads it (the short decimals of a logger, long ones, exponents, signs, leading and
+ * trailing points and zeros): compared bit for bit. */
+static void test_csv_numbers_are_strtods_to_the_bit(void)
+{
+    static char text[1U << 18];
+    static char fields[600][3][40];
+    const char *const formats[] = {"%.12f", "%.9f", "%.3f", "%+.6f", "%.17g", "%.0f.",
+                                   "%.15g", "%.16f", "%.6e", "%.2f"};
+    size_t len = (size_t)snprintf(text, sizeof text, "q1,x,y,z\n");
+    uint64_t state = 0x9E3779B97F4A7C15ULL;
+    for (size_t row = 0U; row < 600U; ++row) {
+        len += (size_t)snprintf(text + len, sizeof text - len, "%zu", row % 90U);
+        for (size_t k = 0U; k < 3U; ++k) {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            const double u = (double)(state >> 11) / 9007199254740992.0;
+            /* magnitudes from 1e-7 to 1e5 mm, both signs */
+            const double v = (u < 0.5 ? -1.0 : 1.0) * pow(10.0, -7.0 + 12.0 * fmod(u * 7.3, 1.0));
+            const char *const fmt = formats[(row + k) % (sizeof formats / sizeof formats[0])];
+            (void)snprintf(fields[row][k], sizeof fields[row][k], fmt, v);
+            if (row % 7U == 0U && fields[row][k][0] == '0' && fields[row][k][1] == '.' &&
+                fields[row][k][2] >= '0' && fields[row][k][2] <= '9') {
+                memmove(fields[row][k], fields[row][k] + 1, strlen(fields[row][k])); /* ".5" */
+            }
+            len += (size_t)snprintf(text + len, sizeof text - len, ",%s", fields[row][k]);
+        }
+        len += (size_t)snprintf(text + len, sizeof text - len, "\n");
+    }
+    csv_ok(text, 1U);
+    TEST_ASSERT_EQUAL_size_t(600U, g_data.n_rows);
+    for (size_t row = 0U; row < 600U; ++row) {
+        for (size_t k = 0U; k < 3U; ++k) {
+            const double expect = strtod(fields[row][k], NULL);
+            char why[160];
+            (void)snprintf(why, sizeof why, "row %zu: \"%s\"", row, fields[row][k]);
+            TEST_ASSERT_EQUAL_MEMORY_MESSAGE(&expect, &g_data.rows[row].xyz_mm[k],
+                                             sizeof expect, why);
+        }
+    }
+}
+
 static void test_csv_missing_file_is_bad_input_naming_it(void)
 {
     const char *const p = path_of("nope.csv");
@@ -1253,6 +1296,7 @@ int main(void)
 {
     UNITY_BEGIN();
     /* CSV */
+    RUN_TEST(test_csv_numbers_are_strtods_to_the_bit);
     RUN_TEST(test_csv_missing_file_is_bad_input_naming_it);
     RUN_TEST(test_csv_directory_is_bad_input);
     RUN_TEST(test_csv_empty_file);

@@ -83,6 +83,68 @@ static void test_noise_estimate_and_residual_match_the_noise_level(void)
     TEST_ASSERT_TRUE(max_mm < 0.05);
 }
 
+static void assert_same_fit(const dhc_calib_report *a, const dhc_calib_report *b)
+{
+    TEST_ASSERT_EQUAL(a->outliers, b->outliers);
+    TEST_ASSERT_EQUAL(a->iterations, b->iterations);
+    TEST_ASSERT_EQUAL_MEMORY(a->value, b->value, sizeof a->value);
+    TEST_ASSERT_EQUAL_MEMORY(a->std_err, b->std_err, sizeof a->std_err);
+    TEST_ASSERT_EQUAL_MEMORY(&a->sigma, &b->sigma, sizeof a->sigma);
+}
+
+/* The caller's tables (dhc_calib_options.joint_sincos, the samples' joint trigonometry;
+ * sample_error2, the errors each pass keeps for the outlier screens) stand for what the
+ * passes would compute again: the same fit to the bit, with gross rows in the data so that
+ * the screens run, unweighted and under the noise model (whose trials are judged with
+ * other weights than their own). */
+static void test_caller_tables_give_the_same_fit(void)
+{
+    dhc_arm truth;
+    dhc_arm nominal;
+    table3_arms(&truth, &nominal);
+    test_rng rng = {31ULL};
+    test_measure(&data, &truth, 120U, DHC_MEAS_POSITION, &rng);
+    add_noise(&data, 0.05, &rng);
+    data.s[7].p_mm[0] += 40.0;
+    data.s[50].p_mm[2] -= 25.0;
+    static double table[2U * 3U * TEST_MAX_SAMPLES];
+    for (size_t i = 0U; i < data.n; ++i) {
+        for (size_t j = 0U; j < 3U; ++j) {
+            table[2U * (3U * i + j)] = sin(data.s[i].q_rad[j]);
+            table[2U * (3U * i + j) + 1U] = cos(data.s[i].q_rad[j]);
+        }
+    }
+    dhc_calib_options opt;
+    dhc_calib_default_options(&opt);
+    TEST_ASSERT_NULL(opt.joint_sincos);
+    static uint8_t flags0[TEST_MAX_SAMPLES];
+    memcpy(flags0, data.flags, sizeof flags0);
+    dhc_arm plain = nominal;
+    TEST_ASSERT_EQUAL(DHC_OK, fit(&plain, &opt));
+    static dhc_calib_report plain_rep;
+    plain_rep = rep;
+    TEST_ASSERT_NULL(opt.sample_error2);
+    TEST_ASSERT_EQUAL(2U, plain_rep.outliers);
+    static double kept[TEST_MAX_SAMPLES];
+    for (int noise = 0; noise <= 1; ++noise) {
+        opt.noise.meas_mm = noise ? 0.05 : 0.0;
+        opt.joint_sincos = NULL;
+        opt.sample_error2 = NULL;
+        memcpy(data.flags, flags0, sizeof flags0);
+        dhc_arm arm = nominal;
+        TEST_ASSERT_EQUAL(DHC_OK, fit(&arm, &opt));
+        plain_rep = rep;
+        for (int variant = 1; variant <= 3; ++variant) {
+            opt.joint_sincos = (variant & 1) != 0 ? table : NULL;
+            opt.sample_error2 = (variant & 2) != 0 ? kept : NULL;
+            memcpy(data.flags, flags0, sizeof flags0);
+            arm = nominal;
+            TEST_ASSERT_EQUAL(DHC_OK, fit(&arm, &opt));
+            assert_same_fit(&plain_rep, &rep);
+        }
+    }
+}
+
 static void test_standard_errors_match_the_spread_of_repeated_fits(void)
 {
     dhc_arm truth;
@@ -355,6 +417,7 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_noise_estimate_and_residual_match_the_noise_level);
+    RUN_TEST(test_caller_tables_give_the_same_fit);
     RUN_TEST(test_standard_errors_match_the_spread_of_repeated_fits);
     RUN_TEST(test_gross_errors_are_flagged_left_out_and_the_fit_repeated);
     RUN_TEST(test_poses_outside_the_joint_ranges_are_outliers);

@@ -98,6 +98,77 @@ static void test_forward_matches_paper_matrix_product(void)
     }
 }
 
+/* The per-sample path: the arm's trigonometry prepared once, each angle by its sine and
+ * cosine (angle addition inside), against eq. (1) with sin and cos of q + theta directly;
+ * the intermediate axes against the paper's Rz(q + theta) and Rz Rx(alpha) columns. */
+static void test_forward_frames_trig_matches_paper_per_frame(void)
+{
+    for (size_t trial = 0U; trial < 50U; ++trial) {
+        dhc_arm arm;
+        const size_t n = 1U + trial % DHC_MAX_JOINTS;
+        random_arm(&arm, n);
+        double q[DHC_MAX_JOINTS] = {0.0};
+        double sq[DHC_MAX_JOINTS] = {0.0};
+        double cq[DHC_MAX_JOINTS] = {0.0};
+        for (size_t i = 0U; i < n; ++i) {
+            q[i] = test_range(&rng, -20.0, 20.0); /* beyond +-pi: the addition must wrap */
+            sq[i] = sin(q[i]);
+            cq[i] = cos(q[i]);
+        }
+        const double scale = test_range(&rng, 0.99, 1.01);
+        dhc_arm_trig trig;
+        dhc_arm_prepare(&arm, &trig);
+        dhc_frame f[DHC_MAX_JOINTS + 1U];
+        double axes[DHC_MAX_JOINTS][2][3];
+        double p[3];
+        dhc_forward_frames_trig(&arm, &trig, scale, sq, cq, f, axes, p);
+
+        mat4 t = {{{0}}};
+        for (size_t r = 0U; r < 3U; ++r) {
+            for (size_t c = 0U; c < 3U; ++c) {
+                t.m[r][c] = arm.base.rot.m[r][c];
+            }
+            t.m[r][3] = arm.base.pos[r];
+        }
+        t.m[3][3] = 1.0;
+        for (size_t i = 0U; i < n; ++i) {
+            const dhc_joint *j = &arm.joint[i];
+            const double phi = q[i] + j->theta_offset_rad;
+            const double u_local[3] = {cos(phi), sin(phi), 0.0};
+            const double v_local[3] = {-sin(phi) * cos(j->alpha_rad),
+                                       cos(phi) * cos(j->alpha_rad), sin(j->alpha_rad)};
+            for (size_t r = 0U; r < 3U; ++r) {
+                double u = 0.0;
+                double v = 0.0;
+                for (size_t c = 0U; c < 3U; ++c) {
+                    u += t.m[r][c] * u_local[c];
+                    v += t.m[r][c] * v_local[c];
+                }
+                TEST_ASSERT_DOUBLE_WITHIN(1e-12, u, axes[i][0][r]);
+                TEST_ASSERT_DOUBLE_WITHIN(1e-12, v, axes[i][1][r]);
+            }
+            mat4 a;
+            mat4 next;
+            paper_link_matrix(phi, scale * j->d_mm, scale * j->a_mm, j->alpha_rad, j->beta_rad,
+                              &a);
+            mat4_mul(&t, &a, &next);
+            t = next;
+            for (size_t r = 0U; r < 3U; ++r) {
+                TEST_ASSERT_DOUBLE_WITHIN(1e-9, t.m[r][3], f[i + 1U].pos[r]);
+                for (size_t c = 0U; c < 3U; ++c) {
+                    TEST_ASSERT_DOUBLE_WITHIN(1e-12, t.m[r][c], f[i + 1U].rot.m[r][c]);
+                }
+            }
+        }
+        for (size_t r = 0U; r < 3U; ++r) {
+            const double expect = scale * (t.m[r][0] * arm.tool_mm[0] +
+                                           t.m[r][1] * arm.tool_mm[1] +
+                                           t.m[r][2] * arm.tool_mm[2]) + t.m[r][3];
+            TEST_ASSERT_DOUBLE_WITHIN(1e-9, expect, p[r]);
+        }
+    }
+}
+
 static void test_planar_two_link_closed_form(void)
 {
     dhc_arm arm;
@@ -246,6 +317,7 @@ int main(void)
     RUN_TEST(test_planar_two_link_closed_form);
     RUN_TEST(test_paper_3dof_home_pose);
     RUN_TEST(test_forward_frames_lists_every_link_frame);
+    RUN_TEST(test_forward_frames_trig_matches_paper_per_frame);
     RUN_TEST(test_conventions_follow_nominal_parallel_axes);
     RUN_TEST(test_standard_dh_of_a_dh_arm_is_itself);
     RUN_TEST(test_standard_dh_keeps_every_pose_of_a_hayati_arm);

@@ -459,6 +459,59 @@ static void test_weighted_step_is_the_weighted_solution(void)
     TEST_ASSERT_TRUE_MESSAGE(diff > 1e-3, "weights made no difference: test is vacuous");
 }
 
+/* The accumulator's row-by-row update (several equations per sweep, the upper triangle
+ * from the mirrored products) against the plain sums written here: every entry of
+ * sum_e w_e J_ei J_ej, of J^T W r and the SSR, any number of rows per call (1 to 7: the
+ * sweep takes three at a time), with and without weights, with sparse columns; the stored
+ * matrix exactly symmetric. */
+static void test_accumulation_matches_plain_sums(void)
+{
+    static double plain[MAXP * MAXP];
+    for (size_t trial = 0U; trial < 40U; ++trial) {
+        const size_t n = 1U + trial % MAXP;
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_normal_eq_init(&ne, n));
+        double g[MAXP] = {0.0};
+        double ssr = 0.0;
+        memset(plain, 0, sizeof plain);
+        for (size_t call = 0U; call < 5U; ++call) {
+            const size_t k = 1U + (trial + call) % 7U;
+            const int weighted = (trial + call) % 2U == 0U;
+            double jac_data[7U * MAXP];
+            double r[7];
+            double wt[7];
+            for (size_t e = 0U; e < k; ++e) {
+                for (size_t j = 0U; j < n; ++j) {
+                    /* every third column empty in some rows: the skipped terms are zeros */
+                    jac_data[e * n + j] = (j + e) % 3U == 0U ? 0.0 : uniform(-5.0, 5.0);
+                }
+                r[e] = uniform(-1.0, 1.0);
+                wt[e] = weighted ? uniform(0.1, 3.0) : 1.0;
+            }
+            dhc_mat jac;
+            TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&jac, k, n, jac_data, 7U * MAXP));
+            TEST_ASSERT_EQUAL(DHC_OK, dhc_normal_eq_add(&ne, &jac, r, weighted ? wt : NULL, k));
+            for (size_t e = 0U; e < k; ++e) {
+                for (size_t i = 0U; i < n; ++i) {
+                    for (size_t j = 0U; j < n; ++j) {
+                        plain[i * n + j] += wt[e] * jac_data[e * n + i] * jac_data[e * n + j];
+                    }
+                    g[i] += wt[e] * jac_data[e * n + i] * r[e];
+                }
+                ssr += wt[e] * r[e] * r[e];
+            }
+        }
+        for (size_t i = 0U; i < n; ++i) {
+            for (size_t j = 0U; j < n; ++j) {
+                TEST_ASSERT_DOUBLE_WITHIN(1e-12 * (1.0 + fabs(plain[i * n + j])),
+                                          plain[i * n + j], ne.jtj[i * n + j]);
+                TEST_ASSERT_TRUE(same_bits(ne.jtj[i * n + j], ne.jtj[j * n + i]));
+            }
+            TEST_ASSERT_DOUBLE_WITHIN(1e-12 * (1.0 + fabs(g[i])), g[i], ne.jtr[i]);
+        }
+        TEST_ASSERT_DOUBLE_WITHIN(1e-12 * (1.0 + ssr), ssr, ne.ssr);
+    }
+}
+
 static void test_streaming_result_is_independent_of_chunking(void)
 {
     const size_t m = 42U;
@@ -1007,6 +1060,7 @@ int main(void)
     RUN_TEST(test_decrement_is_the_ssr_the_solution_removes);
     RUN_TEST(test_prediction_variance_is_j_ninv_j);
     RUN_TEST(test_weighted_step_is_the_weighted_solution);
+    RUN_TEST(test_accumulation_matches_plain_sums);
     RUN_TEST(test_streaming_result_is_independent_of_chunking);
     RUN_TEST(test_duplicate_and_zero_columns_are_unidentifiable);
     RUN_TEST(test_linear_combination_names_all_its_members);

@@ -177,6 +177,48 @@ void dhcal_calib_options_for(const dhc_model *model, const dhcal_noise *noise,
     }
 }
 
+/* The rows of the last model dhcal_fit_errors evaluated: the fit, its row report and its
+ * adequacy test read the same errors of the same model (three passes, now one). One block:
+ * 3 n residuals, then n errors. */
+static struct {
+    dhc_model model;
+    const dhc_sample *samples;
+    size_t n;
+    double *rows;
+} fit_rows;
+
+int dhcal_fit_errors(const dhc_model *model, const dhcal_samples *s, double *resid,
+                     double *err_mm, dhcal_error_stats *stats)
+{
+    /* Bytes, not values: a model that differs only in padding or in the sign of a zero is
+     * evaluated again, which costs a pass and changes nothing. */
+    // NOLINTNEXTLINE(bugprone-suspicious-memory-comparison,cert-exp42-c,cert-flp37-c)
+    const int same_model = memcmp(&fit_rows.model, model, sizeof *model) == 0;
+    double *rows = fit_rows.rows;
+    if (rows == NULL || fit_rows.samples != s->samples || fit_rows.n != s->n || !same_model) {
+        fit_rows.rows = NULL;
+        fit_rows.samples = NULL;
+        free(rows);
+        rows = malloc((4U * s->n + 1U) * sizeof *rows);
+        dhcal_error_stats unused;
+        if (rows == NULL ||
+            dhcal_samples_errors(model, s, rows, rows + 3U * s->n, &unused) != DHCAL_IO_OK) {
+            free(rows);
+            return DHCAL_IO_FAILED;
+        }
+        fit_rows.rows = rows;
+        fit_rows.model = *model;
+        fit_rows.samples = s->samples;
+        fit_rows.n = s->n;
+    }
+    if (resid != NULL) {
+        memcpy(resid, rows, 3U * s->n * sizeof *resid);
+    }
+    memcpy(err_mm, rows + 3U * s->n, s->n * sizeof *err_mm);
+    dhcal_error_stats_of(s, err_mm, stats); /* the flags may have changed */
+    return DHCAL_IO_OK;
+}
+
 int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhcal_noise *noise,
                    dhcal_samples *s, const dhcal_samples *held, dhcal_fit *out,
                    dhcal_error *err)
@@ -199,8 +241,12 @@ int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhcal
     set_drift_reference(&out->model, s);
     dhc_calib_options opt;
     dhcal_calib_options_for(start, &out->noise, &opt);
+    opt.joint_sincos = dhcal_samples_sincos(s, start->arm.n_joints);
+    /* optional: without it the outlier screens evaluate the model again */
+    opt.sample_error2 = malloc((s->n + 1U) * sizeof *opt.sample_error2);
     out->status = dhc_calib_fit(&out->model, &out->set, dhcal_samples_read, s, s->n, s->flags,
                                 &opt, &calib_ws, &out->rep);
+    free(opt.sample_error2);
     if (out->status == DHC_ERR_UNDERDETERMINED) {
         snprintf(err->msg, sizeof err->msg,
                  "the data under-determine the model: %zu equations from %zu rows identify %zu "
@@ -214,7 +260,7 @@ int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhcal
         return DHCAL_IO_FAILED;
     }
     double *e = calloc(s->n > 0U ? s->n : 1U, sizeof *e);
-    int rc = e != NULL ? dhcal_samples_errors(&out->model, s, NULL, e, &out->train)
+    int rc = e != NULL ? dhcal_fit_errors(&out->model, s, NULL, e, &out->train)
                        : DHCAL_IO_FAILED;
     free(e);
     if (rc == DHCAL_IO_OK && held != NULL) {
@@ -579,7 +625,7 @@ int dhcal_assess(const dhcal_fit *fit, const dhcal_samples *s, dhcal_adequacy *o
     double *err = calloc(s->n > 0U ? s->n : 1U, sizeof *err);
     dhcal_error_stats es;
     if (resid == NULL || err == NULL ||
-        dhcal_samples_errors(&fit->model, s, resid, err, &es) != DHCAL_IO_OK || es.used == 0U) {
+        dhcal_fit_errors(&fit->model, s, resid, err, &es) != DHCAL_IO_OK || es.used == 0U) {
         free(resid);
         free(err);
         return DHCAL_IO_FAILED;

@@ -46,6 +46,8 @@ int dhcal_cross_validate(const dhc_model *start, const dhc_param_set *set,
     /* each fold starts at the fit on all rows and moves a little: where it creeps, a few
      * dozen steps hold its prediction to far below the noise */
     opt.max_iterations = DHCAL_CV_MAX_ITERATIONS;
+    opt.joint_sincos = dhcal_samples_sincos(s, start->arm.n_joints);
+    opt.sample_error2 = malloc((s->n + 1U) * sizeof *opt.sample_error2); /* optional */
     dhcal_samples fold_samples = *s;
     fold_samples.flags = flags;
     double ss = 0.0;
@@ -85,6 +87,7 @@ int dhcal_cross_validate(const dhc_model *start, const dhc_param_set *set,
         }
     }
     free(fold_of);
+    free(opt.sample_error2);
     free(flags);
     if (rc == DHCAL_IO_OK) {
         out->rms_mm = sqrt(ss / (double)rows);

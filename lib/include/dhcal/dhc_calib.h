@@ -1,8 +1,12 @@
 /* dhc_calib.h - kinematic calibration: Levenberg-Marquardt on streamed measurements.
  *
  * The caller owns the measurements and hands out one at a time through a reader callback,
- * so the library never stores them (memory O(P^2)); each LM iteration reads them all twice
- * (one pass to accumulate, one to evaluate the trial step).
+ * so the library never stores them (memory O(P^2)); each LM iteration reads them all once:
+ * the pass that evaluates the trial step accumulates its normal equations too, ready for the
+ * next step when the trial is accepted (with the noise model on, or after a rejected trial,
+ * one more pass). A caller that keeps its samples can hand the fit their joint trigonometry
+ * and a buffer for their errors (dhc_calib_options: joint_sincos, sample_error2): the passes
+ * then compute no sine, and the outlier screens no pass of their own.
  *
  * Usage:
  *     static dhc_calib_workspace ws;                 // large: keep off small stacks
@@ -99,6 +103,17 @@ typedef struct {
      * When on, the fit is generalized least squares and the report's sigma is unit-free
      * (see below). */
     dhc_noise_model noise;
+    /* NULL (the default), or the samples' joint trigonometry, kept by a caller that holds
+     * its samples: sample i's sin(q_j), cos(q_j) pairs at joint_sincos[2 N i + 2 j] and
+     * [2 N i + 2 j + 1], N = n_joints, exactly what sin() and cos() give for the angles
+     * the reader hands out (not checked). Each pass over the data then computes no sine or
+     * cosine of its own; the memory is the caller's, the library's stays O(P^2). */
+    const double *joint_sincos;
+    /* NULL (the default), or n doubles of the caller's, scratch during the fit: each pass
+     * keeps every sample's squared error there, and the outlier screens (medians by
+     * bisection, the marks) read them instead of evaluating the model again, pass after
+     * pass. The same fit; the memory is the caller's, the library's stays O(P^2). */
+    double *sample_error2;
 } dhc_calib_options;
 
 typedef struct {
@@ -143,6 +158,7 @@ typedef struct {
     dhc_model current;
     dhc_model trial;
     dhc_sample sample;
+    dhc_arm_trig trig; /* of the model the current pass evaluates */
     double delta[DHC_MAX_PARAMS];
     double scratch[DHC_MAX_PARAMS];
     double weights_residual[DHC_MAX_ROWS_PER_SAMPLE];
@@ -194,7 +210,8 @@ dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_sample *s,
  * With the noise model on, the SSR minimised and the outlier screening use whitened
  * residuals (a sample's whitened squared error ~ sigma^2 chi^2(rows)); the structural rank
  * does not depend on it.
- * Cost per iteration: 2 passes over the data, O(n P^2) + O(P^3). */
+ * Cost per iteration: 1 pass over the data (2 with the noise model on or after a rejected
+ * step), O(n P^2) + O(P^3). */
 dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_reader read,
                          void *ctx, size_t n, uint8_t *flags, const dhc_calib_options *opt,
                          dhc_calib_workspace *ws, dhc_calib_report *rep);

@@ -66,6 +66,15 @@ dhc_status dhc_model_linearize(const dhc_model *model, const dhc_param_set *set,
                                const dhc_sample *s, double weight_mm_per_rad,
                                double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows, dhc_mat *jac);
 
+/* dhc_model_linearize at the arm's trigonometry from dhc_arm_prepare (model->arm's, unchanged
+ * since): a pass over many samples at one model prepares once. sincos_q as
+ * dhc_model_evaluate_prepared's. */
+dhc_status dhc_model_linearize_prepared(const dhc_model *model, const dhc_arm_trig *trig,
+                                       const dhc_param_set *set, const dhc_sample *s,
+                                       const double *sincos_q, double weight_mm_per_rad,
+                                       double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows,
+                                       dhc_mat *jac);
+
 #ifdef __cplusplus
 }
 #endif

@@ -60,6 +60,24 @@ void dhc_arm_choose_conventions(dhc_arm *arm, double parallel_tol);
  * bound of the tool point's distance from the base origin. */
 double dhc_arm_reach(const dhc_arm *arm);
 
+/* What the link transforms need of the arm's parameters, computed once per parameter set
+ * (a fit's iterate) instead of once per sample: the trigonometry of each joint's offset,
+ * twist and tilt and its constant rotation Rx(alpha_i) Ry(beta_i). A sample then needs only
+ * sin and cos of its joint angles: sin(q + theta) = sin q cos theta + cos q sin theta. */
+typedef struct {
+    double cos_theta;
+    double sin_theta;
+    dhc_mat3 twist; /* Rx(alpha) Ry(beta); its middle column is (0, cos alpha, sin alpha) */
+} dhc_joint_trig;
+
+typedef struct {
+    size_t n_joints;
+    dhc_joint_trig joint[DHC_MAX_JOINTS];
+} dhc_arm_trig;
+
+/* Fills trig for the arm's current parameters (valid until they change). O(N). */
+void dhc_arm_prepare(const dhc_arm *arm, dhc_arm_trig *trig);
+
 /* A_i for joint index i at joint angle q_rad. DHC_ERR_ARGUMENT when i >= n_joints. */
 dhc_status dhc_joint_transform(const dhc_arm *arm, size_t i, double q_rad, dhc_frame *out);
 
@@ -76,6 +94,16 @@ dhc_status dhc_forward_frames(const dhc_arm *arm, const double *q_rad, size_t q_
 dhc_status dhc_forward_frames_scaled(const dhc_arm *arm, double length_scale,
                                      const double *q_rad, size_t q_len, dhc_frame *frames,
                                      size_t frames_len, double tool_world_mm[3]);
+
+/* dhc_forward_frames_scaled with the arm's trigonometry from dhc_arm_prepare (trig must
+ * be the arm's) and the joint angles given by their sines and cosines (n_joints each, the
+ * angles finite). When axes is not NULL it receives, per joint, the world directions of the
+ * intermediate axes the identification Jacobian turns about: axes[i][0] x after
+ * Rz(q + theta) (a, alpha), axes[i][1] y after Rz Rx(alpha) (beta). No checks: the callers
+ * have made them. */
+void dhc_forward_frames_trig(const dhc_arm *arm, const dhc_arm_trig *trig, double length_scale,
+                             const double *sin_q, const double *cos_q, dhc_frame *frames,
+                             double axes[][2][3], double tool_world_mm[3]);
 
 /* Tool pose in the world: position of the tool point and orientation of the last link.
  * Same errors as dhc_forward_frames. */

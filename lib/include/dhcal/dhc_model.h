@@ -121,12 +121,13 @@ dhc_status dhc_model_gravity_moments(const dhc_model *model, double length_scale
                                      double tau[DHC_MAX_JOINTS][DHC_MAX_JOINTS]);
 
 /* Scratch of one evaluation, shared by prediction and Jacobian so neither copies the arm
- * (about 1.2 KiB: keep it off small stacks when calling in a loop). */
+ * (about 1.5 KiB: keep it off small stacks when calling in a loop). */
 typedef struct {
     double length_scale;
     int has_moments;
     double tau[DHC_MAX_JOINTS][DHC_MAX_JOINTS];
     dhc_frame frames[DHC_MAX_JOINTS + 1U]; /* at the effective angles on return */
+    double axes[DHC_MAX_JOINTS][2][3];     /* their intermediate axes (dhc_forward_frames_trig) */
 } dhc_model_eval;
 
 /* Prediction for one sample, leaving the frames (and, when need_moments or the model has
@@ -134,6 +135,16 @@ typedef struct {
  * dhc_model_predict. */
 dhc_status dhc_model_evaluate(const dhc_model *model, const dhc_sample *s, int need_moments,
                               dhc_model_eval *ev, dhc_prediction *out);
+
+/* dhc_model_evaluate with the arm's trigonometry prepared by the caller (dhc_arm_prepare on
+ * model->arm, unchanged since): what a pass over many samples at one model uses.
+ * sincos_q: NULL, or the sample's sin(q_i), cos(q_i) pairs (2 n_joints values, exactly what
+ * sin() and cos() give for s->q_rad: not checked), kept by a caller that evaluates the same
+ * samples again and again. */
+dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_trig *trig,
+                                       const dhc_sample *s, const double *sincos_q,
+                                       int need_moments, dhc_model_eval *ev,
+                                       dhc_prediction *out);
 
 /* World position of anchor k (0..2). */
 void dhc_measurer_anchor_world(const dhc_measurer_model *m, size_t k, double out[3]);
@@ -167,6 +178,14 @@ dhc_status dhc_model_tool_point(const dhc_model *model, const double *q_rad, con
 dhc_status dhc_model_residual(const dhc_model *model, const dhc_sample *s,
                               double weight_mm_per_rad, double r[DHC_MAX_ROWS_PER_SAMPLE],
                               size_t *rows);
+
+/* dhc_model_residual at the arm's trigonometry from dhc_arm_prepare (model->arm's,
+ * unchanged since): for passes over many samples at one model. sincos_q as
+ * dhc_model_evaluate_prepared's. */
+dhc_status dhc_model_residual_prepared(const dhc_model *model, const dhc_arm_trig *trig,
+                                       const dhc_sample *s, const double *sincos_q,
+                                       double weight_mm_per_rad,
+                                       double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows);
 
 /* The residual of a sample from a prediction already made (dhc_model_predict, or the one
  * dhc_model_jacobian returns): as dhc_model_residual without evaluating the model again. */
