@@ -59,6 +59,20 @@ static void random_arm(dhc_arm *arm, size_t n)
     dhc_vec3_set(arm->tool_mm, 10.0, -20.0, 55.0);
 }
 
+/* The arm's base frame as a homogeneous matrix: where the paper's product starts. */
+static mat4 base_matrix(const dhc_arm *arm)
+{
+    mat4 t = {{{0}}};
+    for (size_t r = 0U; r < 3U; ++r) {
+        for (size_t c = 0U; c < 3U; ++c) {
+            t.m[r][c] = arm->base.rot.m[r][c];
+        }
+        t.m[r][3] = arm->base.pos[r];
+    }
+    t.m[3][3] = 1.0;
+    return t;
+}
+
 static void test_forward_matches_paper_matrix_product(void)
 {
     for (size_t trial = 0U; trial < 50U; ++trial) {
@@ -68,14 +82,7 @@ static void test_forward_matches_paper_matrix_product(void)
         double q[DHC_MAX_JOINTS] = {0.0};
         test_random_q(&rng, &arm, q);
 
-        mat4 t = {{{0}}};
-        for (size_t r = 0U; r < 3U; ++r) {
-            for (size_t c = 0U; c < 3U; ++c) {
-                t.m[r][c] = arm.base.rot.m[r][c];
-            }
-            t.m[r][3] = arm.base.pos[r];
-        }
-        t.m[3][3] = 1.0;
+        mat4 t = base_matrix(&arm);
         for (size_t i = 0U; i < n; ++i) {
             const dhc_joint *j = &arm.joint[i];
             mat4 a;
@@ -123,14 +130,7 @@ static void test_forward_frames_trig_matches_paper_per_frame(void)
         double p[3];
         dhc_forward_frames_trig(&arm, &trig, scale, sq, cq, f, axes, p);
 
-        mat4 t = {{{0}}};
-        for (size_t r = 0U; r < 3U; ++r) {
-            for (size_t c = 0U; c < 3U; ++c) {
-                t.m[r][c] = arm.base.rot.m[r][c];
-            }
-            t.m[r][3] = arm.base.pos[r];
-        }
-        t.m[3][3] = 1.0;
+        mat4 t = base_matrix(&arm);
         for (size_t i = 0U; i < n; ++i) {
             const dhc_joint *j = &arm.joint[i];
             const double phi = q[i] + j->theta_offset_rad;
