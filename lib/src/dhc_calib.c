@@ -492,6 +492,21 @@ typedef struct {
     double max_e2;
 } error_scan;
 
+/* The walk every error scan makes: 1 with the next used sample from *i on and its squared
+ * error; 0 at the end, or on an error (*st). */
+static int next_used_error2(const fit_context *fc, const dhc_model *model, const pass_totals *at,
+                            size_t *i, double *e2, size_t *rows, dhc_status *st)
+{
+    while (*i < fc->n && fc->flags[*i] != (uint8_t)DHC_SAMPLE_USED) {
+        ++*i;
+    }
+    if (*i == fc->n) {
+        return 0;
+    }
+    *st = sample_error2(fc, model, at, *i, e2, rows);
+    return *st == DHC_OK;
+}
+
 /* One pass over the used samples; with mark other than DHC_SAMPLE_USED, samples with e2
  * above limit2 are flagged with it. at as sample_error2's. */
 static dhc_status scan_errors(const fit_context *fc, const dhc_model *model,
@@ -500,16 +515,10 @@ static dhc_status scan_errors(const fit_context *fc, const dhc_model *model,
 {
     memset(out, 0, sizeof *out);
     dhc_arm_prepare(&model->arm, &fc->ws->trig);
-    for (size_t i = 0U; i < fc->n; ++i) {
-        if (fc->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
-            continue;
-        }
-        double e2;
-        size_t rows;
-        const dhc_status st = sample_error2(fc, model, at, i, &e2, &rows);
-        if (st != DHC_OK) {
-            return st;
-        }
+    dhc_status st = DHC_OK;
+    double e2 = 0.0;
+    size_t rows = 0U;
+    for (size_t i = 0U; next_used_error2(fc, model, at, &i, &e2, &rows, &st); ++i) {
         out->used++;
         out->pose += rows == 6U ? 1U : 0U;
         out->max_e2 = fmax(out->max_e2, e2);
@@ -519,7 +528,7 @@ static dhc_status scan_errors(const fit_context *fc, const dhc_model *model,
             fc->flags[i] = mark;
         }
     }
-    return DHC_OK;
+    return st;
 }
 
 /* Bisection steps that one pass over the data decides: the pass counts the errors below
@@ -554,16 +563,10 @@ static dhc_status quantile_error2(const fit_context *fc, const dhc_model *model,
         size_t below[QUANTILE_POINTS + 1U]; /* errors in (mid[m-1], mid[m]] */
         memset(below, 0, sizeof below);
         dhc_arm_prepare(&model->arm, &fc->ws->trig);
-        for (size_t i = 0U; i < fc->n; ++i) {
-            if (fc->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
-                continue;
-            }
-            double e2;
-            size_t rows;
-            const dhc_status st = sample_error2(fc, model, at, i, &e2, &rows);
-            if (st != DHC_OK) {
-                return st;
-            }
+        dhc_status st = DHC_OK;
+        double e2 = 0.0;
+        size_t rows = 0U;
+        for (size_t i = 0U; next_used_error2(fc, model, at, &i, &e2, &rows, &st); ++i) {
             size_t first = 0U; /* the first midpoint at or above e2 */
             size_t last = QUANTILE_POINTS;
             while (first < last) {
@@ -575,6 +578,9 @@ static dhc_status quantile_error2(const fit_context *fc, const dhc_model *model,
                 }
             }
             below[first]++;
+        }
+        if (st != DHC_OK) {
+            return st;
         }
         for (size_t m = 1U; m <= QUANTILE_POINTS; ++m) {
             below[m] += below[m - 1U]; /* now: errors at or below mid[m] */
