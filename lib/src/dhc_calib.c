@@ -551,7 +551,7 @@ static dhc_status quantile_error2(const fit_context *fc, const dhc_model *model,
     while (it < MEDIAN_BISECTIONS && hi - lo > MEDIAN_REL_PRECISION * hi) {
         /* the midpoints in increasing order: point m at depth d (2^(L-1-d) from its
          * interval's ends, which are points of lower depth, lo or hi) */
-        double mid[QUANTILE_POINTS];
+        double mid[QUANTILE_POINTS] = {0.0};
         for (size_t d = 0U; d < QUANTILE_LEVELS; ++d) {
             const size_t half_width = (size_t)1U << (QUANTILE_LEVELS - 1U - d);
             for (size_t m = half_width - 1U; m < QUANTILE_POINTS; m += 2U * half_width) {
