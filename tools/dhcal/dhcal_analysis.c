@@ -55,7 +55,7 @@ int dhcal_parse_effects(const char *list, const dhc_model *model, dhc_param_set 
     return DHCAL_IO_OK;
 }
 
-int dhcal_parse_noise(const char *text, dhcal_noise *out, dhcal_error *err)
+int dhcal_parse_noise(const char *text, dhc_noise_model *out, dhcal_error *err)
 {
     memset(out, 0, sizeof *out);
     if (text == NULL) {
@@ -82,11 +82,10 @@ int dhcal_parse_noise(const char *text, dhcal_noise *out, dhcal_error *err)
                  text);
         return DHCAL_IO_BAD_INPUT;
     }
-    out->on = 1;
     for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
-        out->model.joint_rad[j] = joint_deg * DHC_PI / 180.0;
+        out->joint_rad[j] = joint_deg * DHC_PI / 180.0;
     }
-    out->model.meas_mm = meas_mm;
+    out->meas_mm = meas_mm;
     return DHCAL_IO_OK;
 }
 
@@ -165,15 +164,15 @@ int dhcal_geometry_set(const dhc_model *model, dhcal_geometry g, dhc_param_set *
     return DHCAL_IO_OK;
 }
 
-void dhcal_calib_options_for(const dhc_model *model, const dhcal_noise *noise,
+void dhcal_calib_options_for(const dhc_model *model, const dhc_noise_model *noise,
                              dhc_calib_options *opt)
 {
     dhc_calib_default_options(opt);
     /* a link parameter the data pin only to half its physical range or worse is held */
     opt->max_std_angle_rad = 0.5 * DHCAL_PLAUSIBLE_ANGLE_DEG * DHC_PI / 180.0;
     opt->max_std_length_mm = 0.5 * DHCAL_PLAUSIBLE_LENGTH_SHARE * dhc_arm_reach(&model->arm);
-    if (noise != NULL && noise->on) {
-        opt->noise = noise->model;
+    if (noise != NULL) {
+        opt->noise = *noise;
     }
 }
 
@@ -219,7 +218,7 @@ int dhcal_fit_errors(const dhc_model *model, const dhcal_samples *s, double *res
     return DHCAL_IO_OK;
 }
 
-int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhcal_noise *noise,
+int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhc_noise_model *noise,
                    dhcal_samples *s, const dhcal_samples *held, dhcal_fit *out,
                    dhcal_error *err)
 {
@@ -281,7 +280,7 @@ int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhcal
 }
 
 int dhcal_run_fit(const dhc_model *nominal, const char *effects, dhcal_geometry geometry,
-                  const dhcal_noise *noise, dhcal_samples *s, const dhcal_samples *held,
+                  const dhc_noise_model *noise, dhcal_samples *s, const dhcal_samples *held,
                   dhcal_fit *out, dhcal_error *err)
 {
     static dhc_param_set set;
@@ -352,9 +351,7 @@ int dhcal_run_diagnose(const dhcal_fit *fit, const dhcal_samples *s, dhc_diagnos
                                               DHC_MAX_CANDIDATES);
     dhc_diagnose_options opt;
     dhc_diagnose_default_options(&opt);
-    if (fit->noise.on) {
-        opt.noise = fit->noise.model;
-    }
+    opt.noise = fit->noise;
     const double sigma2 = fit->rep.sigma * fit->rep.sigma;
     if (!(sigma2 > 0.0)) {
         snprintf(err->msg, sizeof err->msg,
@@ -600,7 +597,7 @@ static double predicted_row_variance(const dhcal_fit *fit, const dhc_sample *smp
     }
     double buf[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_JOINTS];
     dhc_mat jq;
-    const double meas2 = fit->noise.model.meas_mm * fit->noise.model.meas_mm;
+    const double meas2 = fit->noise.meas_mm * fit->noise.meas_mm;
     if (dhc_mat_init(&jq, dhc_sample_rows(smp), n, buf, sizeof buf / sizeof buf[0]) != DHC_OK ||
         dhc_model_jacobian(&fit->model, &thetas, smp, DHC_ORIENTATION_WEIGHT_MM_PER_RAD, &jq,
                            NULL) != DHC_OK) {
@@ -612,7 +609,7 @@ static double predicted_row_variance(const dhcal_fit *fit, const dhc_sample *smp
             sum += DHC_MAT_AT(&jq, r, j) * DHC_MAT_AT(&jq, r, j);
         }
     }
-    const double joint_sd = fit->noise.model.joint_rad[0]; /* --noise: one for all joints */
+    const double joint_sd = fit->noise.joint_rad[0]; /* --noise: one for all joints */
     return meas2 + joint_sd * joint_sd * sum / 3.0;
 }
 
@@ -631,7 +628,7 @@ int dhcal_assess(const dhcal_fit *fit, const dhcal_samples *s, dhcal_adequacy *o
         return DHCAL_IO_FAILED;
     }
     const double ss = es.rms_mm * es.rms_mm * (double)es.used; /* sum of |e|^2 */
-    if (fit->noise.on) {
+    if (dhcal_noise_on(&fit->noise)) {
         out->source = "given";
         const size_t dof = fit->rep.rows > fit->rep.rank ? fit->rep.rows - fit->rep.rank : 0U;
         double var = 0.0;
@@ -744,7 +741,7 @@ int dhcal_extrapolate(const dhcal_fit *fit, const dhcal_samples *s, const dhcal_
                                 &got, &jac) != DHC_OK) {
             return DHCAL_IO_FAILED;
         }
-        if (fit->noise.on &&
+        if (dhcal_noise_on(&fit->noise) &&
             dhc_sample_whiten(&fit->model, smp, &opt.noise,
                               opt.orientation_weight_mm_per_rad, r, &jac) != DHC_OK) {
             return DHCAL_IO_FAILED;

@@ -7,17 +7,18 @@
 #include "dhcal_data.h"
 #include "dhcal_io.h"
 
-/* The samples' noise model (--noise): off, or the library's noise model with one standard
- * deviation for every joint angle and one for each measured row; on, every sample is weighted
- * by its covariance (dhc_noise_model). */
-typedef struct {
-    int on;
-    dhc_noise_model model; /* joint_rad: the same value for every joint */
-} dhcal_noise;
+/* 1 when the samples are weighted by a noise model (--noise given), by the library's rule. */
+static inline int dhcal_noise_on(const dhc_noise_model *noise)
+{
+    int on = 0;
+    return dhc_noise_model_check(noise, DHC_MAX_JOINTS, &on) == DHC_OK && on;
+}
 
-/* Parses "JOINT_DEG,MEAS_MM" (e.g. "0.0009,0.004"): joint angle sd in degrees (0..1), the
+/* The samples' noise model (--noise): all zero (off), or each joint angle's sd (one value for
+ * all joints) and each measured row's; then every sample is weighted by its covariance.
+ * Parses "JOINT_DEG,MEAS_MM" (e.g. "0.0009,0.004"): joint angle sd in degrees (0..1), the
  * measurement's sd in mm (greater than 0, up to 100). DHCAL_IO_BAD_INPUT with the reason. */
-int dhcal_parse_noise(const char *text, dhcal_noise *out, dhcal_error *err);
+int dhcal_parse_noise(const char *text, dhc_noise_model *out, dhcal_error *err);
 
 /* How much geometry a fit adjusts (--geometry): joint offsets; offsets plus a and d (beta
  * where Hayati's convention replaces d); every geometric parameter (the default). */
@@ -32,7 +33,7 @@ int dhcal_geometry_set(const dhc_model *model, dhcal_geometry g, dhc_param_set *
 typedef struct {
     dhc_model model;      /* calibrated (nominal when the fit failed) */
     dhcal_geometry geometry;
-    dhcal_noise noise;    /* what the fit weighted with (the diagnosis uses the same) */
+    dhc_noise_model noise;    /* what the fit weighted with (the diagnosis uses the same) */
     dhc_param_set set;    /* base model + effects */
     dhc_calib_report rep;
     dhc_status status;
@@ -53,7 +54,7 @@ int dhcal_parse_effects(const char *list, const dhc_model *model, dhc_param_set 
 /* The library's fit options for the model: the noise model (NULL or off: unweighted), and
  * link parameters held at their input values when the data determine them only to half
  * their physical range (DHCAL_PLAUSIBLE_*) or worse. */
-void dhcal_calib_options_for(const dhc_model *model, const dhcal_noise *noise,
+void dhcal_calib_options_for(const dhc_model *model, const dhc_noise_model *noise,
                              dhc_calib_options *opt);
 
 /* dhcal_samples_errors for the session's samples (which do not change once built): the
@@ -69,14 +70,14 @@ int dhcal_fit_errors(const dhc_model *model, const dhcal_samples *s, double *res
  * set it. DHCAL_IO_OK when the library returned DHC_OK or DHC_ERR_NOT_CONVERGED (see
  * out->status), DHCAL_IO_FAILED with a plain-words message otherwise (under-determined
  * data included). */
-int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhcal_noise *noise,
+int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhc_noise_model *noise,
                    dhcal_samples *s, const dhcal_samples *held, dhcal_fit *out,
                    dhcal_error *err);
 
 /* Fits the geometry level plus effects to s from nominal (dhcal_fit_from);
  * DHCAL_IO_BAD_INPUT for a bad effects list. */
 int dhcal_run_fit(const dhc_model *nominal, const char *effects, dhcal_geometry geometry,
-                  const dhcal_noise *noise, dhcal_samples *s, const dhcal_samples *held,
+                  const dhc_noise_model *noise, dhcal_samples *s, const dhcal_samples *held,
                   dhcal_fit *out, dhcal_error *err);
 
 /* Whether the session's covariates vary apart from the pose (dhc_covariate_pose_r2 over the

@@ -19,7 +19,7 @@ static size_t used_rows(const dhcal_samples *s)
 }
 
 int dhcal_cross_validate(const dhc_model *start, const dhc_param_set *set,
-                         const dhcal_noise *noise, const dhcal_samples *s, dhcal_cv *out,
+                         const dhc_noise_model *noise, const dhcal_samples *s, dhcal_cv *out,
                          dhcal_error *err)
 {
     memset(out, 0, sizeof *out);
@@ -166,7 +166,7 @@ static void record_step(dhcal_refine_result *out, const char *added, const char 
  * itself when they are not. Every level's fit starts from the same flags; s->flags end as
  * the chosen fit's. */
 static int fit_start(const dhc_model *nominal, const char *effects,
-                     const dhcal_geometry *geometry, const dhcal_noise *noise,
+                     const dhcal_geometry *geometry, const dhc_noise_model *noise,
                      dhcal_samples *s, const dhcal_samples *held, dhcal_refine_result *out,
                      dhcal_error *err)
 {
@@ -285,7 +285,7 @@ static int fit_start(const dhc_model *nominal, const char *effects,
 }
 
 int dhcal_try_candidates(const dhcal_fit *fit, const dhc_diagnosis *diag,
-                         const dhcal_noise *noise, dhcal_samples *s, const dhcal_samples *held,
+                         const dhc_noise_model *noise, dhcal_samples *s, const dhcal_samples *held,
                          dhcal_trials *out, dhcal_fit *best_fit, uint8_t *best_flags,
                          dhcal_error *err)
 {
@@ -351,7 +351,7 @@ int dhcal_try_candidates(const dhcal_fit *fit, const dhc_diagnosis *diag,
 }
 
 int dhcal_run_refine(const dhc_model *nominal, const char *start_effects,
-                     const dhcal_geometry *geometry, const dhcal_noise *noise,
+                     const dhcal_geometry *geometry, const dhc_noise_model *noise,
                      dhcal_samples *s, const dhcal_samples *held, dhcal_refine_result *out,
                      dhcal_error *err)
 {

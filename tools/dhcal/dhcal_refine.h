@@ -40,7 +40,7 @@ typedef struct {
  * each spans the session. DHCAL_IO_FAILED with the reason when a fold cannot be fitted
  * (fewer rows than parameters); s->flags is left as it was. */
 int dhcal_cross_validate(const dhc_model *start, const dhc_param_set *set,
-                         const dhcal_noise *noise, const dhcal_samples *s, dhcal_cv *out,
+                         const dhc_noise_model *noise, const dhcal_samples *s, dhcal_cv *out,
                          dhcal_error *err);
 
 /* A diagnosis candidate tried as refine tries it: added to the fit's set, refitted from the
@@ -63,7 +63,7 @@ typedef struct {
  * best_fit and best_flags (s->n entries; both may be NULL) receive the refit of out->best
  * and its flags; s->flags end as they started. DHCAL_IO_FAILED when memory runs out. */
 int dhcal_try_candidates(const dhcal_fit *fit, const dhc_diagnosis *diag,
-                         const dhcal_noise *noise, dhcal_samples *s, const dhcal_samples *held,
+                         const dhc_noise_model *noise, dhcal_samples *s, const dhcal_samples *held,
                          dhcal_trials *out, dhcal_fit *best_fit, uint8_t *best_flags,
                          dhcal_error *err);
 
@@ -103,7 +103,7 @@ typedef struct {
  * DHCAL_IO_BAD_INPUT for a bad effects list; DHCAL_IO_FAILED with the reason when the
  * start cannot be fitted. */
 int dhcal_run_refine(const dhc_model *nominal, const char *start_effects,
-                     const dhcal_geometry *geometry, const dhcal_noise *noise,
+                     const dhcal_geometry *geometry, const dhc_noise_model *noise,
                      dhcal_samples *s, const dhcal_samples *held, dhcal_refine_result *out,
                      dhcal_error *err);
 

@@ -244,7 +244,7 @@ static int parse_args(int argc, char **argv, options *o)
 typedef struct {
     dhcal_model file_model;
     dhc_model model;
-    dhcal_noise noise;
+    dhc_noise_model noise;
     dhcal_geometry geometry;
     dhcal_dataset data;
     dhcal_samples samples;
@@ -550,11 +550,11 @@ static void json_fit(cJSON *obj, const dhcal_fit *f, const session *s, const dou
     }
     cJSON_AddNumberToObject(obj, "iterations", (double)f->rep.iterations);
     cJSON_AddBoolToObject(obj, "converged", f->rep.converged);
-    if (f->noise.on) {
+    if (dhcal_noise_on(&f->noise)) {
         /* weighted rows: the residual's sd is in units of the noise model (1: it fits) */
         cJSON *nm = cJSON_AddObjectToObject(obj, "noise_model");
-        cJSON_AddNumberToObject(nm, "joint_deg", f->noise.model.joint_rad[0] * 180.0 / DHC_PI);
-        cJSON_AddNumberToObject(nm, "meas_mm", f->noise.model.meas_mm);
+        cJSON_AddNumberToObject(nm, "joint_deg", f->noise.joint_rad[0] * 180.0 / DHC_PI);
+        cJSON_AddNumberToObject(nm, "meas_mm", f->noise.meas_mm);
         cJSON_AddNumberToObject(nm, "whitened_sd", f->rep.sigma);
     } else {
         cJSON_AddNumberToObject(obj, "sigma_mm", f->rep.sigma);
@@ -844,11 +844,11 @@ static void text_diagnosis(const dhcal_fit *fit, const dhc_diagnosis *d, const c
                            const dhcal_trials *trials)
 {
     char label[64];
-    if (fit->noise.on) {
+    if (dhcal_noise_on(&fit->noise)) {
         printf("\ndiagnosis: %zu candidate effects scored against the remaining residual "
                "(rows weighted by the noise model: joint angles %.2g deg, measurements %.2g "
                "mm; whitened residual sd %.3f, 1 when the model fits to that noise)\n",
-               d->count, fit->noise.model.joint_rad[0] * 180.0 / DHC_PI, fit->noise.model.meas_mm, sqrt(d->sigma2));
+               d->count, fit->noise.joint_rad[0] * 180.0 / DHC_PI, fit->noise.meas_mm, sqrt(d->sigma2));
     } else {
         printf("\ndiagnosis: %zu candidate effects scored against the remaining residual "
                "(noise estimate %.4f mm per coordinate)\n",
