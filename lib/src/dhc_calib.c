@@ -874,8 +874,19 @@ static double predicted_decrease(const dhc_normal_eq *ne, const double *delta)
  * Nielsen and Tingleff's notes): a good model shrinks lambda, a poor one grows it
  * gradually, a rejected step doubles the growth. A fixed x10 / /10 schedule oscillates in
  * the curved valleys of real arms' barely determined parameters and creeps along them. */
+/* The identifiability checks of one fit: how many freed parameters, and whether LM may
+ * still free them between its steps (not after a roll-back, see roll_back_early). */
+typedef struct {
+    size_t checks;
+    int early;
+} freeing;
+
+static dhc_status free_identifiable(const fit_context *fc, dhc_calib_report *rep,
+                                    uint8_t *mark, size_t *freed);
+
 static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *rep,
-                                      pass_totals *tot, int accumulated, int *converged)
+                                      pass_totals *tot, int accumulated, freeing *fr,
+                                      int *converged)
 {
     dhc_calib_workspace *const ws = fc->ws;
     const size_t p = fc->set->count;
@@ -944,6 +955,22 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
             /* "the SSR stopped falling" judged by what an undamped step would still take,
              * not by the damped step just taken (damping makes that small long before) */
             decrement = st == DHC_OK ? current_decrement(fc) : HUGE_VAL;
+            /* Parameters that the input values could not identify join as soon as an
+             * estimate that has moved identifies them, not after a first convergence
+             * without them: the steps to come move them too (Gauss-Newton's quadratic
+             * convergence from here, instead of a second run of iterations). */
+            size_t freed = 0U;
+            if (st == DHC_OK && fr->early && fr->checks < fc->opt->max_identifiability_checks) {
+                st = free_identifiable(fc, rep, ws->freed_early, &freed);
+            }
+            if (st == DHC_OK && freed > 0U) {
+                fr->checks++;
+                rep->freed += freed;
+                st = analyse_keeping_set(fc, rep);
+                decrement = st == DHC_OK ? current_decrement(fc) : HUGE_VAL;
+                previous_gain = 0.0;
+                continue;
+            }
             if (decrement <= fc->opt->ssr_rel_tol * tot->ssr || step <= fc->opt->step_rel_tol ||
                 little_left_to_gain(fc, tot, gain, previous_gain)) {
                 *converged = 1;
@@ -972,11 +999,12 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
     return st;
 }
 
-/* Judges identifiability again at the converged estimate (ws->ne is its accumulation):
- * parameters kept out because the input values could not identify them, and that these
- * values do identify, join the fitted set. *freed counts them; with none, ws->fac is the
- * analysis of the kept set again. */
-static dhc_status free_identifiable(const fit_context *fc, dhc_calib_report *rep, size_t *freed)
+/* Judges identifiability again at the estimate (ws->ne is its accumulation): parameters
+ * kept out because the input values could not identify them, and that these values do
+ * identify, join the fitted set (and are marked in mark, when not NULL). *freed counts
+ * them; with none, ws->fac is the analysis of the kept set again. */
+static dhc_status free_identifiable(const fit_context *fc, dhc_calib_report *rep,
+                                    uint8_t *mark, size_t *freed)
 {
     dhc_calib_workspace *const ws = fc->ws;
     *freed = 0U;
@@ -988,8 +1016,18 @@ static dhc_status free_identifiable(const fit_context *fc, dhc_calib_report *rep
         return st;
     }
     for (size_t k = 0U; k < fc->set->count; ++k) {
+        const uint8_t kind = fc->set->id[k].kind;
+        /* a base rotation composes with the others: it cannot go back alone (roll_back_early) */
+        const int returnable = kind != (uint8_t)DHC_P_BASE_RX &&
+                               kind != (uint8_t)DHC_P_BASE_RY && kind != (uint8_t)DHC_P_BASE_RZ;
+        if (mark != NULL && !returnable) {
+            continue;
+        }
         if (ws->fac.identifiable[k] && !rep->identifiable[k] && !rep->unsupported[k]) {
             rep->identifiable[k] = 1U;
+            if (mark != NULL) {
+                mark[k] = 1U;
+            }
             ++*freed;
         }
     }
@@ -1039,12 +1077,8 @@ static dhc_status hold_unsupported(const fit_context *fc, const pass_totals *tot
     if (worst == p) {
         return DHC_OK;
     }
-    for (size_t k = 0U; k < p; ++k) {
-        ws->delta[k] = k == worst ? dhc_params_value(fc->set, fc->input, k) -
-                                        dhc_params_value(fc->set, &ws->current, k)
-                                  : 0.0;
-    }
-    dhc_status st = dhc_params_apply(fc->set, &ws->current, ws->delta, p);
+    const dhc_status st = dhc_params_set_value(fc->set, &ws->current, worst,
+                                               dhc_params_value(fc->set, fc->input, worst));
     if (st == DHC_OK) {
         rep->identifiable[worst] = 0U;
         rep->unsupported[worst] = 1U;
@@ -1053,28 +1087,72 @@ static dhc_status hold_unsupported(const fit_context *fc, const pass_totals *tot
     return st;
 }
 
-/* Levenberg-Marquardt, then identifiability judged at the estimate (again while that frees
- * parameters, at most max_identifiability_checks times), then the worst unsupported link
- * parameter held and the fit repeated (at most MAX_HOLDS times). */
+/* Parameters freed between LM's steps join on the evidence of an estimate on its way: where
+ * the truth itself is degenerate (exactly parallel axes), an iterate off it identifies what
+ * the converged estimate cannot, and a parameter would end reported unidentifiable, off its
+ * input value. When the converged estimate's analysis drops any of the fitted set, every
+ * parameter freed early goes back to its input value and out of the set (*rolled = 1); the
+ * fit repeats and judges them at its converged estimate only. */
+static dhc_status roll_back_early(const fit_context *fc, dhc_calib_report *rep, int *rolled)
+{
+    dhc_calib_workspace *const ws = fc->ws;
+    const size_t p = fc->set->count;
+    int dropped = 0;
+    int any_early = 0;
+    for (size_t k = 0U; k < p; ++k) {
+        dropped |= rep->identifiable[k] && !ws->fac.identifiable[k];
+        any_early |= ws->freed_early[k] != 0U;
+    }
+    *rolled = dropped && any_early;
+    if (!*rolled) {
+        return DHC_OK;
+    }
+    dhc_status st = DHC_OK;
+    for (size_t k = 0U; k < p && st == DHC_OK; ++k) {
+        if (ws->freed_early[k]) {
+            st = dhc_params_set_value(fc->set, &ws->current, k,
+                                      dhc_params_value(fc->set, fc->input, k));
+            rep->identifiable[k] = 0U;
+            rep->freed--;
+            ws->freed_early[k] = 0U;
+        }
+    }
+    return st;
+}
+
+/* Levenberg-Marquardt (freeing parameters between its steps), then identifiability judged
+ * at the converged estimate (again while that frees parameters, at most
+ * max_identifiability_checks times in all), then the worst unsupported link parameter held
+ * and the fit repeated (at most MAX_HOLDS times). */
 static dhc_status fit_to_convergence(const fit_context *fc, dhc_calib_report *rep,
                                      pass_totals *tot, int accumulated, int *converged)
 {
-    size_t checks = 0U;
+    freeing fr = {0U, 1};
     size_t holds = 0U;
     for (;;) {
-        dhc_status st = levenberg_marquardt(fc, rep, tot, accumulated, converged);
+        dhc_status st = levenberg_marquardt(fc, rep, tot, accumulated, &fr, converged);
         if (st != DHC_OK || !*converged) {
             return st;
+        }
+        int rolled = 0;
+        st = roll_back_early(fc, rep, &rolled);
+        if (st != DHC_OK) {
+            return st;
+        }
+        if (rolled) {
+            fr.early = 0;
+            accumulated = 0; /* the estimate moved */
+            continue;
         }
         /* LM ends with ws->ne and *tot at its estimate, which freeing parameters keeps */
         accumulated = 1;
         size_t freed = 0U;
-        if (checks < fc->opt->max_identifiability_checks) {
-            st = free_identifiable(fc, rep, &freed);
+        if (fr.checks < fc->opt->max_identifiability_checks) {
+            st = free_identifiable(fc, rep, NULL, &freed);
             if (st != DHC_OK) {
                 return st;
             }
-            checks += freed > 0U ? 1U : 0U;
+            fr.checks += freed > 0U ? 1U : 0U;
             rep->freed += freed;
         }
         if (freed > 0U) {
@@ -1207,6 +1285,7 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
     rep->n_params = set->count;
     const fit_context fc = {set, read, ctx, n, flags, opt, ws, whiten, model};
     ws->current = *model;
+    memset(ws->freed_early, 0, sizeof ws->freed_early);
 
     data_traits traits;
     dhc_status st = screen_physical(&fc, model, &traits);

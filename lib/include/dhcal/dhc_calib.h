@@ -162,6 +162,7 @@ typedef struct {
     double delta[DHC_MAX_PARAMS];
     double scratch[DHC_MAX_PARAMS];
     double weights_residual[DHC_MAX_ROWS_PER_SAMPLE];
+    uint8_t freed_early[DHC_MAX_PARAMS]; /* freed between LM's steps (may be rolled back) */
     double jac_buf[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS];
 } dhc_calib_workspace;
 
