@@ -1338,22 +1338,16 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
             break;
         }
     }
+    fill_report(&fc, &tot, rep);
     if (rep->freed > 0U) {
         /* What rich data identify changed with the estimate as well (the same point moved
-         * off the same axis): the report's structural rank is the estimate's. The structural
-         * poses borrow ws->ne, so the data are accumulated and analysed again after them. */
+         * off the same axis): the report's structural rank is the estimate's. The
+         * structural poses borrow ws->ne and ws->fac, which the report has read. */
         st = structural_rank(&fc, &ws->current, &tot.traits, rep);
-        if (st == DHC_OK) {
-            st = data_pass(&fc, &ws->current, 1, &tot);
-        }
-        if (st == DHC_OK) {
-            st = analyse_keeping_set(&fc, rep);
-        }
         if (st != DHC_OK) {
             return st;
         }
     }
-    fill_report(&fc, &tot, rep);
     rep->converged = converged;
     *model = ws->current;
     return converged ? DHC_OK : DHC_ERR_NOT_CONVERGED;
