@@ -50,6 +50,106 @@ dhc_status dhc_normal_eq_init(dhc_normal_eq *ne, size_t n)
     return DHC_OK;
 }
 
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(DHC_PORTABLE_ONLY)
+#define DHC_LSQ_AVX2 1
+#include <immintrin.h>
+/* The batch kernels for x86-64 processors with AVX2, chosen at run time; the portable
+ * loops in dhc_normal_eq_add serve every other processor. Unit weights. The same products
+ * and sums in the same order as those loops (no fused multiply-adds): the same bits. */
+#define DHC_AVX2 __attribute__((target("avx2")))
+
+/* sum over the k equations of r_e^2 + |J_e|^2 (four lanes at a time) */
+DHC_AVX2 static double square_sum_avx2(const dhc_mat *jac, const double *r, size_t k)
+{
+    const size_t n = jac->cols;
+    __m256d lanes = _mm256_setzero_pd();
+    double rest = 0.0;
+    for (size_t e = 0U; e < k; ++e) {
+        const double *const row = &DHC_MAT_AT(jac, e, 0U);
+        size_t i = 0U;
+        for (; i + 4U <= n; i += 4U) {
+            const __m256d x = _mm256_loadu_pd(row + i);
+            lanes = _mm256_add_pd(lanes, _mm256_mul_pd(x, x));
+        }
+        for (; i < n; ++i) {
+            rest += row[i] * row[i];
+        }
+        rest += r[e] * r[e];
+    }
+    double four[4];
+    _mm256_storeu_pd(four, lanes);
+    return ((four[0] + four[1]) + (four[2] + four[3])) + rest;
+}
+
+/* J^T J and J^T r of the k equations added; the whole matrix in blocks of 4 x 8 entries
+ * held in registers over all k equations: each entry is loaded and stored once per batch
+ * and each equation's entries feed 32 products. Entries (i, j) and (j, i) are the same
+ * products summed in the same (the equations') order: the matrix stays exactly symmetric
+ * without a transposed copy. */
+DHC_AVX2 static void add_unweighted_avx2(dhc_normal_eq *ne, const dhc_mat *jac,
+                                         const double *r, size_t k)
+{
+    const size_t n = ne->n;
+    double *const jtj = ne->jtj;
+    for (size_t e = 0U; e < k; ++e) {
+        const double *const row = &DHC_MAT_AT(jac, e, 0U);
+        for (size_t i = 0U; i < n; ++i) {
+            ne->jtr[i] += row[i] * r[e];
+        }
+    }
+    const size_t whole_i = n - n % 4U;
+    const size_t whole_j = n - n % 8U;
+    for (size_t i0 = 0U; i0 < whole_i; i0 += 4U) {
+        double *const out = jtj + i0 * n;
+        for (size_t j0 = 0U; j0 < whole_j; j0 += 8U) {
+            __m256d c00 = _mm256_loadu_pd(out + j0);
+            __m256d c01 = _mm256_loadu_pd(out + j0 + 4U);
+            __m256d c10 = _mm256_loadu_pd(out + n + j0);
+            __m256d c11 = _mm256_loadu_pd(out + n + j0 + 4U);
+            __m256d c20 = _mm256_loadu_pd(out + 2U * n + j0);
+            __m256d c21 = _mm256_loadu_pd(out + 2U * n + j0 + 4U);
+            __m256d c30 = _mm256_loadu_pd(out + 3U * n + j0);
+            __m256d c31 = _mm256_loadu_pd(out + 3U * n + j0 + 4U);
+            for (size_t e = 0U; e < k; ++e) {
+                const double *const row = &DHC_MAT_AT(jac, e, 0U);
+                const __m256d y0 = _mm256_loadu_pd(row + j0);
+                const __m256d y1 = _mm256_loadu_pd(row + j0 + 4U);
+                __m256d x = _mm256_broadcast_sd(row + i0);
+                c00 = _mm256_add_pd(c00, _mm256_mul_pd(x, y0));
+                c01 = _mm256_add_pd(c01, _mm256_mul_pd(x, y1));
+                x = _mm256_broadcast_sd(row + i0 + 1U);
+                c10 = _mm256_add_pd(c10, _mm256_mul_pd(x, y0));
+                c11 = _mm256_add_pd(c11, _mm256_mul_pd(x, y1));
+                x = _mm256_broadcast_sd(row + i0 + 2U);
+                c20 = _mm256_add_pd(c20, _mm256_mul_pd(x, y0));
+                c21 = _mm256_add_pd(c21, _mm256_mul_pd(x, y1));
+                x = _mm256_broadcast_sd(row + i0 + 3U);
+                c30 = _mm256_add_pd(c30, _mm256_mul_pd(x, y0));
+                c31 = _mm256_add_pd(c31, _mm256_mul_pd(x, y1));
+            }
+            _mm256_storeu_pd(out + j0, c00);
+            _mm256_storeu_pd(out + j0 + 4U, c01);
+            _mm256_storeu_pd(out + n + j0, c10);
+            _mm256_storeu_pd(out + n + j0 + 4U, c11);
+            _mm256_storeu_pd(out + 2U * n + j0, c20);
+            _mm256_storeu_pd(out + 2U * n + j0 + 4U, c21);
+            _mm256_storeu_pd(out + 3U * n + j0, c30);
+            _mm256_storeu_pd(out + 3U * n + j0 + 4U, c31);
+        }
+    }
+    /* the entries outside the whole blocks: the last rows, and the last columns */
+    for (size_t i = 0U; i < n; ++i) {
+        for (size_t j = i < whole_i ? whole_j : 0U; j < n; ++j) {
+            double sum = jtj[i * n + j];
+            for (size_t e = 0U; e < k; ++e) {
+                sum += DHC_MAT_AT(jac, e, i) * DHC_MAT_AT(jac, e, j);
+            }
+            jtj[i * n + j] = sum;
+        }
+    }
+}
+#endif
+
 dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double *r,
                              const double *w, size_t k)
 {
@@ -72,42 +172,50 @@ dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double
     }
     /* Finite rows can still overflow the sums (entries above ~1e154), which would poison
      * every later analysis. Every entry of J^T W J and J^T W r is at most the largest of the
-     * diagonal and the SSR (Cauchy-Schwarz), and each row adds at most w max(|J|, |r|)^2
-     * to any of them: a finite bound, with room for rounding, means finite sums.
-     * The same sweep finds a non-finite entry: x * 0 is NaN for NaN and infinities, and the
-     * sum keeps it (the comparisons of the maximum skip NaN). */
+     * diagonal and the SSR (Cauchy-Schwarz), and each row adds at most w (r^2 + |J|^2) to
+     * any of them: a finite bound, with room for rounding, means finite sums. A non-finite
+     * entry makes the bound non-finite too. */
     double bound = ne->ssr;
     for (size_t i = 0U; i < n; ++i) {
         const double d = ne->jtj[i * n + i];
         bound = d > bound ? d : bound;
     }
-    double poison = 0.0;
-    for (size_t e = 0U; e < k; ++e) {
+    const int mirror_by_copy = k > 3U;
+#ifdef DHC_LSQ_AVX2
+    const int fast = w == NULL && mirror_by_copy && __builtin_cpu_supports("avx2");
+#else
+    const int fast = 0;
+#endif
+    double added = 0.0;
+#ifdef DHC_LSQ_AVX2
+    if (fast) {
+        added = square_sum_avx2(jac, r, k);
+    }
+#endif
+    for (size_t e = 0U; e < k && !fast; ++e) {
         const double *const row = &DHC_MAT_AT(jac, e, 0U);
-        double m = fabs(r[e]);
-        poison += r[e] * 0.0;
+        double s2 = r[e] * r[e];
         for (size_t i = 0U; i < n; ++i) {
-            const double a = fabs(row[i]);
-            poison += row[i] * 0.0;
-            m = a > m ? a : m;
+            s2 += row[i] * row[i];
         }
-        bound += (w != NULL ? w[e] : 1.0) * m * m;
+        added += (w != NULL ? w[e] : 1.0) * s2;
     }
-    if (isnan(poison)) {
-        return DHC_ERR_NONFINITE;
-    }
-    if (!dhc_is_finite(2.0 * bound)) {
+    if (!dhc_is_finite(2.0 * (bound + added))) {
         return DHC_ERR_NONFINITE;
     }
     /* Row by row of the matrix, each equation's term in turn (every sum in the equations'
      * order): the lower triangle from (w_e J_ei) J_ej; the upper from the very products of
      * its mirror, (w_e J_ej) J_ei, for a sample's few rows, or for many rows (a batch),
      * where that costs more than a transposed copy, by the copy. Exactly symmetric. */
-    const int mirror_by_copy = k > 3U;
+#ifdef DHC_LSQ_AVX2
+    if (fast) {
+        add_unweighted_avx2(ne, jac, r, k);
+    }
+#endif
     /* three equations per sweep (a sample's tool point) and, for a batch, two rows of the
      * matrix at once: each equation's entry is loaded once for both (loads, not
      * arithmetic, bound this loop) */
-    for (size_t e = 0U; e < k; e += 3U) {
+    for (size_t e = 0U; e < k && !fast; e += 3U) {
         double we[3];
         double rr[3];
         const double *row[3];
@@ -155,7 +263,7 @@ dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double
             }
         }
     }
-    for (size_t i = 0U; i < n && mirror_by_copy; ++i) {
+    for (size_t i = 0U; i < n && mirror_by_copy && !fast; ++i) {
         for (size_t j = 0U; j < i; ++j) {
             ne->jtj[j * n + i] = ne->jtj[i * n + j];
         }
