@@ -102,7 +102,14 @@ static int next_line(csv_reader *r, int *got)
         r->len -= 3U;
         memmove(r->buf, r->buf + 3U, r->len + 1U);
     }
+    /* one test of the whole line (no early exit: the compiler vectorises it), and the
+     * byte's position only for the message */
+    unsigned bad = 0U;
     for (size_t k = 0U; k < r->len; ++k) {
+        const unsigned char b = (unsigned char)r->buf[k];
+        bad |= (unsigned)((b < 0x20U && b != '\t') || b == 0x7fU);
+    }
+    for (size_t k = 0U; k < r->len && bad; ++k) {
         const unsigned char b = (unsigned char)r->buf[k];
         if (b == 0U) {
             return dhcal_error_set(r->err, DHCAL_IO_BAD_INPUT,
@@ -155,25 +162,24 @@ typedef struct {
 static size_t split_fields(char *line, size_t len, span **spans, size_t *cap)
 {
     size_t count = 0U;
-    const char *start = line;
-    for (size_t k = 0U; k <= len; ++k) {
-        if (k == len || line[k] == ',') {
-            if (count == *cap) {
-                const size_t grown_cap = *cap == 0U ? 32U : *cap * 2U;
-                span *const grown = realloc(*spans, grown_cap * sizeof **spans);
-                if (grown == NULL) {
-                    return 0U;
-                }
-                *spans = grown;
-                *cap = grown_cap;
+    for (size_t start = 0U; start <= len;) {
+        const char *const comma = memchr(line + start, ',', len - start);
+        const size_t end = comma != NULL ? (size_t)(comma - line) : len;
+        if (count == *cap) {
+            const size_t grown_cap = *cap == 0U ? 32U : *cap * 2U;
+            span *const grown = realloc(*spans, grown_cap * sizeof **spans);
+            if (grown == NULL) {
+                return 0U;
             }
-            span f = {start, (size_t)(line + k - start)};
-            trim(&f.s, &f.n);
-            /* Trimming only moves the end left: the terminator lands inside this field. */
-            line[(size_t)(f.s - line) + f.n] = '\0';
-            (*spans)[count++] = f;
-            start = line + k + 1U;
+            *spans = grown;
+            *cap = grown_cap;
         }
+        span f = {line + start, end - start};
+        trim(&f.s, &f.n);
+        /* Trimming only moves the end left: the terminator lands inside this field. */
+        line[(size_t)(f.s - line) + f.n] = '\0';
+        (*spans)[count++] = f;
+        start = end + 1U;
     }
     return count;
 }
@@ -458,39 +464,34 @@ static const double EXACT_POW10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6, 
                                        1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
                                        1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 
-/* The common field, [+-] digits [. digits] with at most 15 significant digits, as strtod
- * reads it, without strtod's general (slow) path: the digits form an integer m < 2^53 and
- * the value is m / 10^k with k <= 22, a quotient of two exact doubles, which IEEE division
- * rounds correctly, as strtod must (Clinger's fast path). 0 when the field is not of that
- * form: strtod then decides. */
+/* The common field, [+-] digits [. digits], as strtod reads it, without strtod's general
+ * (slow) path: when its digits form an integer m <= 2^53 and it has k <= 22 decimals, the
+ * value is m / 10^k, a quotient of two exact doubles, which IEEE division rounds
+ * correctly, as strtod must (Clinger's fast path). 0 when the field is not of that form:
+ * strtod then decides. */
 static int parse_plain_decimal(const char *s, size_t n, double *out)
 {
-    size_t i = 0U;
-    const int negative = n > 0U && s[0] == '-';
-    if (n > 0U && (s[0] == '-' || s[0] == '+')) {
-        i = 1U;
-    }
+    const int negative = s[0] == '-';
+    size_t i = s[0] == '-' || s[0] == '+' ? 1U : 0U;
     uint64_t m = 0U;
-    size_t digits = 0U;
+    size_t digits = 0U; /* at most 19: m cannot overflow */
     size_t frac = 0U;
-    int point = 0;
+    size_t point = 0U;
     for (; i < n; ++i) {
-        const char ch = s[i];
-        if (ch >= '0' && ch <= '9') {
-            if (digits == 15U) {
+        const unsigned d = (unsigned)(unsigned char)s[i] - (unsigned)'0';
+        if (d <= 9U) {
+            if (++digits > 19U) {
                 return 0;
             }
-            m = m * 10U + (uint64_t)(ch - '0');
-            digits += m > 0U ? 1U : 0U; /* leading zeros are not significant */
-            frac += point ? 1U : 0U;
-        } else if (ch == '.' && !point) {
-            point = 1;
+            m = m * 10U + d;
+            frac += point;
+        } else if (s[i] == '.' && point == 0U) {
+            point = 1U;
         } else {
             return 0;
         }
     }
-    const size_t before = n - frac - (point ? 1U : 0U) - (s[0] == '-' || s[0] == '+' ? 1U : 0U);
-    if (frac > 22U || (before == 0U && frac == 0U)) {
+    if (digits == 0U || frac > 22U || m > ((uint64_t)1U << 53U)) {
         return 0;
     }
     const double v = (double)m / EXACT_POW10[frac];
