@@ -77,8 +77,8 @@ typedef struct {
                                     step moved no parameter by more than tol of its standard
                                     error and lowered the SSR by under 2 tol sigma^2. The
                                     test real data meet; 0 turns it off */
-    size_t max_identifiability_checks; /* re-analyses at the converged estimate that may
-                                    free parameters found unidentifiable at the start (3) */
+    size_t max_identifiability_checks; /* re-analyses at an estimate that free parameters
+                                    found unidentifiable at the start, at most (3) */
     double max_std_angle_rad;    /* a joint offset or twist whose standard error exceeds this
                                     is held at its input value (0: no bound, the default) */
     double max_std_length_mm;    /* ... a length (a, d) likewise (0: no bound) */
@@ -193,9 +193,12 @@ dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_sample *s,
  * naming its reason) and refits without them.
  * Identifiability is judged on the data at the input values (the set is kept fixed through
  * the iterations: which of two nearly dependent columns pivoting drops would otherwise
- * change with the iterate) and judged again at the converged estimate: parameters that
+ * change with the iterate) and judged again at each accepted estimate: parameters that
  * became identifiable there (a tool point that the fit moved off an axis it sat on
  * nominally) are freed and the fit goes on, up to max_identifiability_checks times.
+ * Parameters freed on the way that the converged estimate cannot identify after all (a
+ * degenerate truth the iterates passed by) go back to their input values and are judged
+ * at the converged estimate only; base rotations are always judged there.
  * Convergence: relative to the noise the fit estimates (noise_rel_tol), or the SSR or the
  * scaled step stop changing (noise-free data), or no damped step lowers the SSR.
  * Returns DHC_OK (converged), DHC_ERR_NOT_CONVERGED (model holds the best iterate, report
