@@ -88,26 +88,13 @@ dhc_status dhc_noise_model_check(const dhc_noise_model *noise, size_t n_joints, 
     return DHC_OK;
 }
 
-/* dhc_sample_whiten with the covariance of the sample at `model`, whose residual there is
- * r_model (for the orientation rows' slope; may alias r, read first), applied to r and jac
- * (which may belong to another estimate: a trial step judged with its start's weights). */
-static dhc_status whiten_at(const dhc_model *model, const dhc_sample *s,
-                            const dhc_noise_model *noise, double weight_mm_per_rad,
-                            const double *r_model, double *r, dhc_mat *jac);
-
-dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_sample *s,
-                             const dhc_noise_model *noise, double weight_mm_per_rad, double *r,
-                             dhc_mat *jac)
+dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_arm_trig *trig,
+                             dhc_model_eval *ev, const dhc_sample *s,
+                             const dhc_noise_model *noise, double weight_mm_per_rad,
+                             const double *r_model, double *r, dhc_mat *jac)
 {
-    /* r_model may alias r: it is read before r is whitened */
-    return whiten_at(model, s, noise, weight_mm_per_rad, r, r, jac);
-}
-
-static dhc_status whiten_at(const dhc_model *model, const dhc_sample *s,
-                            const dhc_noise_model *noise, double weight_mm_per_rad,
-                            const double *r_model, double *r, dhc_mat *jac)
-{
-    if (model == NULL || s == NULL || r == NULL || noise == NULL) {
+    if (model == NULL || trig == NULL || ev == NULL || s == NULL || r == NULL ||
+        r_model == NULL || noise == NULL) {
         return DHC_ERR_ARGUMENT;
     }
     const double *const joint_noise_rad = noise->joint_rad;
@@ -136,8 +123,10 @@ static dhc_status whiten_at(const dhc_model *model, const dhc_sample *s,
     double jq_buf[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_JOINTS];
     dhc_mat jq;
     st = dhc_mat_init(&jq, rows, n, jq_buf, sizeof jq_buf / sizeof jq_buf[0]);
+    dhc_prediction pred;
     if (st == DHC_OK) {
-        st = dhc_model_jacobian(model, &thetas, s, weight_mm_per_rad, &jq, NULL);
+        st = dhc_model_jacobian_prepared(model, trig, &thetas, s, NULL, weight_mm_per_rad, &jq,
+                                         &pred, ev);
     }
     if (st != DHC_OK) {
         return st;
@@ -272,6 +261,10 @@ static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *mod
     double *const kept = tot->own_weights ? fc->opt->sample_error2 : NULL;
     tot->errors_kept = kept != NULL;
     dhc_arm_prepare(&model->arm, &ws->trig);
+    if (fc->whiten && weights != model) {
+        dhc_arm_prepare(&weights->arm, &ws->weights_trig);
+    }
+    const dhc_arm_trig *const weights_trig = weights != model ? &ws->weights_trig : &ws->trig;
     if (accumulate) {
         const dhc_status st = dhc_normal_eq_init(&ws->ne, p);
         if (st != DHC_OK) {
@@ -313,7 +306,7 @@ static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *mod
             st = dhc_mat_init(&jac, rows, p, ws->jac_buf + batch * p, jac_len - batch * p);
             if (st == DHC_OK) {
                 st = dhc_model_linearize_prepared(model, &ws->trig, fc->set, s, sincos, w, r,
-                                                  &got_rows, &jac);
+                                                  &got_rows, &jac, &ws->eval);
             }
         } else if (st == DHC_OK) {
             st = dhc_model_residual_prepared(model, &ws->trig, s, sincos, w, r, &got_rows);
@@ -328,11 +321,13 @@ static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *mod
             size_t weights_rows = rows;
             memcpy(r_weights, r, sizeof ws->weights_residual);
             if (weights != model && s->kind == (uint8_t)DHC_MEAS_POSE) {
-                st = dhc_model_residual(weights, s, w, r_weights, &weights_rows);
+                st = dhc_model_residual_prepared(weights, weights_trig, s,
+                                                 sample_sincos(fc->opt, model->arm.n_joints, i),
+                                                 w, r_weights, &weights_rows);
             }
             if (st == DHC_OK) {
-                st = whiten_at(weights, s, &fc->opt->noise, w,
-                               r_weights, rw, accumulate ? &jac : NULL);
+                st = dhc_sample_whiten(weights, weights_trig, &ws->eval, s, &fc->opt->noise,
+                                       w, r_weights, rw, accumulate ? &jac : NULL);
             }
         }
         if (st != DHC_OK) {
@@ -414,6 +409,7 @@ static dhc_status structural_rank(const fit_context *fc, const dhc_model *model,
     if (st != DHC_OK) {
         return st;
     }
+    dhc_arm_prepare(&model->arm, &ws->trig);
     for (size_t k = 0U; k < poses; ++k) {
         for (size_t i = 0U; i < model->arm.n_joints; ++i) {
             const dhc_joint *const j = &model->arm.joint[i];
@@ -425,8 +421,10 @@ static dhc_status structural_rank(const fit_context *fc, const dhc_model *model,
         dhc_mat jac;
         st = dhc_mat_init(&jac, rows, p, ws->jac_buf,
                           sizeof ws->jac_buf / sizeof ws->jac_buf[0]);
+        dhc_prediction pred;
         if (st == DHC_OK) {
-            st = dhc_model_jacobian(model, fc->set, s, w, &jac, NULL);
+            st = dhc_model_jacobian_prepared(model, &ws->trig, fc->set, s, NULL, w, &jac, &pred,
+                                             &ws->eval);
         }
         if (st != DHC_OK) {
             return st;
@@ -470,7 +468,8 @@ static dhc_status sample_error2(const fit_context *fc, const dhc_model *model,
     if (st == DHC_OK && fc->whiten) {
         /* screened in units of each sample's own noise: a sample at a pose where the joint
          * noise maps large is not an outlier for being larger */
-        st = dhc_sample_whiten(model, &fc->ws->sample, &fc->opt->noise, fc->opt->orientation_weight_mm_per_rad, r,
+        st = dhc_sample_whiten(model, &fc->ws->trig, &fc->ws->eval, &fc->ws->sample,
+                               &fc->opt->noise, fc->opt->orientation_weight_mm_per_rad, r, r,
                                NULL);
     }
     if (st != DHC_OK) {

@@ -423,6 +423,7 @@ static dhc_status accumulate(const dhc_model *model, dhc_sample_reader read, voi
     dhc_status st = dhc_normal_eq_init(&ws->ne, p);
     *ssr = 0.0;
     *rows = 0U;
+    dhc_arm_prepare(&model->arm, &ws->trig);
     for (size_t i = 0U; st == DHC_OK && i < n; ++i) {
         if (flags[i] != (uint8_t)DHC_SAMPLE_USED) {
             continue;
@@ -437,13 +438,14 @@ static dhc_status accumulate(const dhc_model *model, dhc_sample_reader read, voi
         }
         if (st == DHC_OK) {
             /* residual and slope from one evaluation, as the fit linearises them */
-            st = dhc_model_linearize(model, &ws->set, &ws->sample,
-                                     opt->orientation_weight_mm_per_rad, r, &k, &jac);
+            st = dhc_model_linearize_prepared(model, &ws->trig, &ws->set, &ws->sample, NULL,
+                                              opt->orientation_weight_mm_per_rad, r, &k, &jac,
+                                              &ws->eval);
         }
         if (st == DHC_OK) {
             /* off: returns at once, r and jac untouched */
-            st = dhc_sample_whiten(model, &ws->sample, &opt->noise,
-                                   opt->orientation_weight_mm_per_rad, r, &jac);
+            st = dhc_sample_whiten(model, &ws->trig, &ws->eval, &ws->sample, &opt->noise,
+                                   opt->orientation_weight_mm_per_rad, r, r, &jac);
         }
         if (st == DHC_OK) {
             st = dhc_normal_eq_add(&ws->ne, &jac, r, NULL, k);

@@ -242,7 +242,7 @@ static void wire_rows(const dhc_model *model, const dhc_param_id *id, const doub
 static dhc_status jacobian_prepared(const dhc_model *model, const dhc_arm_trig *trig,
                                     const dhc_param_set *set, const dhc_sample *s,
                                     const double *sincos_q, double weight_mm_per_rad,
-                                    dhc_mat *jac, dhc_prediction *pr);
+                                    dhc_mat *jac, dhc_prediction *pr, dhc_model_eval *ev);
 
 dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set,
                               const dhc_sample *s, double weight_mm_per_rad, dhc_mat *jac,
@@ -262,19 +262,34 @@ dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set,
     memset(&local, 0, sizeof local); /* written before read; zeroed so no tool has to see it */
     dhc_arm_trig trig;
     dhc_arm_prepare(&model->arm, &trig);
+    dhc_model_eval ev;
     return jacobian_prepared(model, &trig, set, s, NULL, weight_mm_per_rad, jac,
-                             pred != NULL ? pred : &local);
+                             pred != NULL ? pred : &local, &ev);
+}
+
+dhc_status dhc_model_jacobian_prepared(const dhc_model *model, const dhc_arm_trig *trig,
+                                       const dhc_param_set *set, const dhc_sample *s,
+                                       const double *sincos_q, double weight_mm_per_rad,
+                                       dhc_mat *jac, dhc_prediction *pred, dhc_model_eval *ev)
+{
+    if (model == NULL || trig == NULL || set == NULL || s == NULL || pred == NULL ||
+        ev == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    const dhc_status st = check_jac(jac, dhc_sample_rows(s), set->count);
+    return st == DHC_OK ? jacobian_prepared(model, trig, set, s, sincos_q, weight_mm_per_rad,
+                                            jac, pred, ev)
+                        : st;
 }
 
 /* dhc_model_jacobian after its argument checks, at the caller's trigonometry. */
 static dhc_status jacobian_prepared(const dhc_model *model, const dhc_arm_trig *trig,
                                     const dhc_param_set *set, const dhc_sample *s,
                                     const double *sincos_q, double weight_mm_per_rad,
-                                    dhc_mat *jac, dhc_prediction *pr)
+                                    dhc_mat *jac, dhc_prediction *pr, dhc_model_eval *ev)
 {
-    dhc_model_eval ev;
     const dhc_status st =
-        dhc_model_evaluate_prepared(model, trig, s, sincos_q, set_has_compliance(set), &ev, pr);
+        dhc_model_evaluate_prepared(model, trig, s, sincos_q, set_has_compliance(set), ev, pr);
     if (st != DHC_OK) {
         return st;
     }
@@ -292,25 +307,25 @@ static dhc_status jacobian_prepared(const dhc_model *model, const dhc_arm_trig *
         double dw[3] = {0.0, 0.0, 0.0};
         double dp_scale = drift;
         if (is_geometric(id->kind)) {
-            geometric_column(arm, ev.frames, ev.axes, p_arm, id, dp, dw);
+            geometric_column(arm, ev->frames, ev->axes, p_arm, id, dp, dw);
             if (id->kind >= (uint8_t)DHC_P_BASE_X && id->kind <= (uint8_t)DHC_P_BASE_Z) {
                 dp_scale = 1.0;
             }
             /* lengths are stored unscaled; the chain used them times the thermal factor */
             if (id->kind == (uint8_t)DHC_P_D || id->kind == (uint8_t)DHC_P_A ||
                 id->kind >= (uint8_t)DHC_P_TOOL_X) {
-                dhc_vec3_scale(dp, ev.length_scale, dp);
+                dhc_vec3_scale(dp, ev->length_scale, dp);
             }
         } else if (id->kind <= (uint8_t)DHC_P_COMPLIANCE) {
             const dhc_param_id joint_theta = {(uint8_t)DHC_P_THETA, id->joint, 0U};
-            const double factor = joint_effect_factor(id, s, ev.tau[id->joint]);
-            geometric_column(arm, ev.frames, ev.axes, p_arm, &joint_theta, dp, dw);
+            const double factor = joint_effect_factor(id, s, ev->tau[id->joint]);
+            geometric_column(arm, ev->frames, ev->axes, p_arm, &joint_theta, dp, dw);
             dhc_vec3_scale(dp, factor, dp);
             dhc_vec3_scale(dw, factor, dw);
         } else if (id->kind == (uint8_t)DHC_P_THERMAL) {
             /* scaling every length scales the tool point about the base origin */
             dhc_vec3_sub(p_arm, arm->base.pos, dp);
-            dhc_vec3_scale(dp, dtemp / ev.length_scale, dp);
+            dhc_vec3_scale(dp, dtemp / ev->length_scale, dp);
         } else if (id->kind == (uint8_t)DHC_P_DRIFT_SCALE) {
             dhc_vec3_sub(p_arm, arm->base.pos, dp);
             dhc_vec3_scale(dp, dt, dp);
@@ -376,16 +391,16 @@ dhc_status dhc_model_linearize_prepared(const dhc_model *model, const dhc_arm_tr
                                        const dhc_param_set *set, const dhc_sample *s,
                                        const double *sincos_q, double weight_mm_per_rad,
                                        double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows,
-                                       dhc_mat *jac)
+                                       dhc_mat *jac, dhc_model_eval *ev)
 {
-    if (model == NULL || trig == NULL || set == NULL || s == NULL) {
+    if (model == NULL || trig == NULL || set == NULL || s == NULL || ev == NULL) {
         return DHC_ERR_ARGUMENT;
     }
     dhc_prediction pred;
     memset(&pred, 0, sizeof pred);
     dhc_status st = check_jac(jac, dhc_sample_rows(s), set->count);
     if (st == DHC_OK) {
-        st = jacobian_prepared(model, trig, set, s, sincos_q, weight_mm_per_rad, jac, &pred);
+        st = jacobian_prepared(model, trig, set, s, sincos_q, weight_mm_per_rad, jac, &pred, ev);
     }
     if (st == DHC_OK) {
         st = dhc_model_residual_of(s, &pred, weight_mm_per_rad, r, rows);

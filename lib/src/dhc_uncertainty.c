@@ -35,6 +35,7 @@ dhc_status dhc_uncertainty_from_samples(dhc_uncertainty *u, const dhc_model *mod
     u->sigma2 = sigma * sigma;
     double *const jac_buf = u->jac;
     double *const r = u->r;
+    dhc_arm_prepare(&model->arm, &u->trig);
     for (size_t i = 0U; i < n && st == DHC_OK; ++i) {
         st = read(ctx, i, &u->sample);
         const size_t rows = dhc_sample_rows(&u->sample);
@@ -43,7 +44,8 @@ dhc_status dhc_uncertainty_from_samples(dhc_uncertainty *u, const dhc_model *mod
             st = dhc_mat_init(&jac, rows, p, jac_buf, sizeof u->jac / sizeof u->jac[0]);
         }
         if (st == DHC_OK) {
-            st = dhc_model_jacobian(model, set, &u->sample, weight_mm_per_rad, &jac, NULL);
+            st = dhc_model_jacobian_prepared(model, &u->trig, set, &u->sample, NULL,
+                                             weight_mm_per_rad, &jac, &u->pred, &u->eval);
         }
         /* a parameter held at its value has no variance: its column carries nothing */
         for (size_t k = 0U; k < p && st == DHC_OK && use != NULL; ++k) {
@@ -55,7 +57,8 @@ dhc_status dhc_uncertainty_from_samples(dhc_uncertainty *u, const dhc_model *mod
         }
         if (st == DHC_OK && noise_on) {
             memset(r, 0, sizeof u->r); /* the rows only: the residual is not needed */
-            st = dhc_sample_whiten(model, &u->sample, used, weight_mm_per_rad, r, &jac);
+            st = dhc_sample_whiten(model, &u->trig, &u->eval, &u->sample, used,
+                                   weight_mm_per_rad, r, r, &jac);
         }
         if (st == DHC_OK) {
             memset(r, 0, sizeof u->r);

@@ -727,6 +727,9 @@ int dhcal_extrapolate(const dhcal_fit *fit, const dhcal_samples *s, const dhcal_
     dhc_calib_options opt;
     dhcal_calib_options_for(&fit->model, &fit->noise, &opt);
     static double buf[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS];
+    static dhc_arm_trig trig;
+    static dhc_model_eval ev;
+    dhc_arm_prepare(&fit->model.arm, &trig);
     for (size_t i = 0U; i < s->n; ++i) {
         if (s->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
             continue;
@@ -742,8 +745,8 @@ int dhcal_extrapolate(const dhcal_fit *fit, const dhcal_samples *s, const dhcal_
             return DHCAL_IO_FAILED;
         }
         if (dhcal_noise_on(&fit->noise) &&
-            dhc_sample_whiten(&fit->model, smp, &opt.noise,
-                              opt.orientation_weight_mm_per_rad, r, &jac) != DHC_OK) {
+            dhc_sample_whiten(&fit->model, &trig, &ev, smp, &opt.noise,
+                              opt.orientation_weight_mm_per_rad, r, r, &jac) != DHC_OK) {
             return DHCAL_IO_FAILED;
         }
         if (dhc_normal_eq_add(&extrapolation_ne, &jac, r, NULL, rows) != DHC_OK) {

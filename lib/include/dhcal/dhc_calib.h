@@ -159,6 +159,8 @@ typedef struct {
     dhc_model trial;
     dhc_sample sample;
     dhc_arm_trig trig; /* of the model the current pass evaluates */
+    dhc_arm_trig weights_trig; /* of the model whose covariance whitens the pass */
+    dhc_model_eval eval; /* one evaluation's scratch: off the stack */
     double delta[DHC_MAX_PARAMS];
     double scratch[DHC_MAX_PARAMS];
     double weights_residual[DHC_MAX_ROWS_PER_SAMPLE];
@@ -173,20 +175,27 @@ void dhc_calib_default_options(dhc_calib_options *opt);
  * non-finite value, or joint noise without a positive meas_noise_mm. */
 dhc_status dhc_noise_model_check(const dhc_noise_model *noise, size_t n_joints, int *on);
 
-/* Whitens one sample under the noise model (see dhc_calib_options): r (dhc_sample_rows(s)
- * entries, as dhc_model_residual with the same weight) and, when jac is not NULL, its rows
- * (rows x any columns) are replaced by L^-1 r and L^-1 jac. J_q is the model Jacobian's
- * joint-offset columns (d prediction / d q_eff) times dq_eff/dq = 1 + s_i + A_i cos q_i -
- * B_i sin q_i (joint scale and harmonic: the chain rule of dhc_model.h); compliance's
- * dependence on q (c dtau/dq, ~1e-3 of the diagonal for mm-level compliance) is left out,
- * a per-mil change of the covariance, like the Jacobian's second-order terms.
- * DHC_ERR_ARGUMENT for a negative or non-finite noise value, or joint noise without a
- * positive meas_noise_mm (a pose sample's 6 x 6 covariance from 3 joints is singular);
+/* Whitens one sample under the noise model (see dhc_calib_options) with the sample's
+ * covariance at `model`: r (dhc_sample_rows(s) entries, as dhc_model_residual with the same
+ * weight) and, when jac is not NULL, its rows (rows x any columns) are replaced by L^-1 r and
+ * L^-1 jac; they may belong to another estimate (a trial step judged with the weights of
+ * the estimate it starts from). r_model is the sample's residual at model (its orientation
+ * rows turn the joint noise; may alias r, it is read first). trig: model->arm's
+ * dhc_arm_prepare; ev: one evaluation's scratch (about 1.5 KiB: a workspace's, so that a
+ * pass over many samples stays within a small stack).
+ * J_q is the model Jacobian's joint-offset columns (d prediction / d q_eff) times
+ * dq_eff/dq = 1 + s_i + A_i cos q_i - B_i sin q_i (joint scale and harmonic: the chain rule
+ * of dhc_model.h); compliance's dependence on q (c dtau/dq, ~1e-3 of the diagonal for
+ * mm-level compliance) is left out, a per-mil change of the covariance, like the Jacobian's
+ * second-order terms.
+ * DHC_ERR_ARGUMENT for a NULL, a negative or non-finite noise value, or joint noise without
+ * a positive meas_noise_mm (a pose sample's 6 x 6 covariance from 3 joints is singular);
  * errors of dhc_model_jacobian; DHC_ERR_DIMENSION for a jac of the wrong row count. With the
  * noise model off, nothing is changed. O(rows^2 (n_joints + cols)). */
-dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_sample *s,
-                             const dhc_noise_model *noise, double weight_mm_per_rad, double *r,
-                             dhc_mat *jac);
+dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_arm_trig *trig,
+                             dhc_model_eval *ev, const dhc_sample *s,
+                             const dhc_noise_model *noise, double weight_mm_per_rad,
+                             const double *r_model, double *r, dhc_mat *jac);
 
 /* Fits the parameters of set to the samples. flags (n bytes) marks samples the caller
  * excludes; the fit adds outlier marks (DHC_SAMPLE_OUTLIER and the kinds after it, each

@@ -100,6 +100,8 @@ typedef struct {
     size_t range_count[DHC_MAX_CANDIDATES];
     size_t rival[DHC_MAX_CANDIDATES];
     dhc_sample sample;
+    dhc_arm_trig trig;    /* of the model diagnosed */
+    dhc_model_eval eval;  /* one evaluation's scratch */
     double jac_buf[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS];
 } dhc_diagnose_workspace;
 

@@ -68,12 +68,20 @@ dhc_status dhc_model_linearize(const dhc_model *model, const dhc_param_set *set,
 
 /* dhc_model_linearize at the arm's trigonometry from dhc_arm_prepare (model->arm's, unchanged
  * since): a pass over many samples at one model prepares once. sincos_q as
- * dhc_model_evaluate_prepared's. */
+ * dhc_model_evaluate_prepared's; ev is the evaluation's scratch (about 1.5 KiB: a
+ * workspace's, so that the pass stays within a small stack). */
 dhc_status dhc_model_linearize_prepared(const dhc_model *model, const dhc_arm_trig *trig,
                                        const dhc_param_set *set, const dhc_sample *s,
                                        const double *sincos_q, double weight_mm_per_rad,
                                        double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows,
-                                       dhc_mat *jac);
+                                       dhc_mat *jac, dhc_model_eval *ev);
+
+/* dhc_model_jacobian at the prepared trigonometry, with the scratch ev, as
+ * dhc_model_linearize_prepared's; pred receives the prediction (not NULL). */
+dhc_status dhc_model_jacobian_prepared(const dhc_model *model, const dhc_arm_trig *trig,
+                                       const dhc_param_set *set, const dhc_sample *s,
+                                       const double *sincos_q, double weight_mm_per_rad,
+                                       dhc_mat *jac, dhc_prediction *pred, dhc_model_eval *ev);
 
 #ifdef __cplusplus
 }
