@@ -516,26 +516,26 @@ int dhcal_implausible(const dhc_model *nominal, const dhcal_fit *fit, char *why,
 
 /* Joint angles, lexicographically, equal within DHCAL_REPEAT_TOL_RAD: the order that groups
  * repeats, and the test of one. */
-static int pose_order(const dhc_sample *sa, const dhc_sample *sb)
+static int pose_order(const double *qa, const double *qb)
 {
     for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
-        if (sa->q_rad[j] < sb->q_rad[j] - DHCAL_REPEAT_TOL_RAD) {
+        if (qa[j] < qb[j] - DHCAL_REPEAT_TOL_RAD) {
             return -1;
         }
-        if (sa->q_rad[j] > sb->q_rad[j] + DHCAL_REPEAT_TOL_RAD) {
+        if (qa[j] > qb[j] + DHCAL_REPEAT_TOL_RAD) {
             return 1;
         }
     }
     return 0;
 }
 
-/* qsort of row indices has no context: the samples sorted are held here */
-static const dhcal_samples *repeat_sort_samples;
+/* qsort of row indices has no context: the angles sorted are held here, copied out of the
+ * samples into one compact block (the sort's reads stay in cache) */
+static const double (*repeat_sort_q)[DHC_MAX_JOINTS];
 
 static int compare_poses(const void *a, const void *b)
 {
-    return pose_order(&repeat_sort_samples->samples[*(const size_t *)a],
-                      &repeat_sort_samples->samples[*(const size_t *)b]);
+    return pose_order(repeat_sort_q[*(const size_t *)a], repeat_sort_q[*(const size_t *)b]);
 }
 
 /* Pure-error sum of squares of the position (or wire) residuals over groups of repeated
@@ -548,20 +548,24 @@ static void pure_error(const dhcal_samples *s, const double *resid, double *ss, 
     *groups = 0U;
     *rows = 0U;
     size_t *idx = malloc((s->n > 0U ? s->n : 1U) * sizeof *idx);
-    if (idx == NULL) {
+    double (*q)[DHC_MAX_JOINTS] = malloc((s->n > 0U ? s->n : 1U) * sizeof *q);
+    if (idx == NULL || q == NULL) {
+        free(idx);
+        free(q);
         return;
     }
     size_t m = 0U;
     for (size_t i = 0U; i < s->n; ++i) {
+        memcpy(q[i], s->samples[i].q_rad, sizeof q[i]);
         if (s->flags[i] == (uint8_t)DHC_SAMPLE_USED) {
             idx[m++] = i;
         }
     }
-    repeat_sort_samples = s;
+    repeat_sort_q = (const double (*)[DHC_MAX_JOINTS])q;
     qsort(idx, m, sizeof *idx, compare_poses);
     for (size_t a = 0U; a < m;) {
         size_t b = a + 1U;
-        while (b < m && pose_order(&s->samples[idx[a]], &s->samples[idx[b]]) == 0) {
+        while (b < m && pose_order(q[idx[a]], q[idx[b]]) == 0) {
             ++b;
         }
         if (b - a >= 2U) {
@@ -584,6 +588,7 @@ static void pure_error(const dhcal_samples *s, const double *resid, double *ss, 
         a = b;
     }
     free(idx);
+    free(q);
 }
 
 /* Per-coordinate variance the noise model predicts for the position rows of sample i. */
