@@ -58,6 +58,7 @@ void dhc_calib_default_options(dhc_calib_options *opt)
     memset(&opt->noise, 0, sizeof opt->noise);
     opt->joint_sincos = NULL;
     opt->sample_error2 = NULL;
+    opt->sample_residual = NULL;
 }
 
 /* The caller's trigonometry of sample i, or NULL (dhc_calib_options.joint_sincos). */
@@ -204,6 +205,7 @@ typedef struct {
     double max_e2;     /* largest squared sample error, as sample_error2 defines it ... */
     int own_weights;   /* ... when 1: each sample whitened at the model itself */
     int errors_kept;   /* 1: the pass left each sample's error in opt->sample_error2 */
+    int residuals_kept; /* ... and its residual in opt->sample_residual */
 } pass_totals;
 
 static void note_traits(data_traits *t, const dhc_sample *s, size_t n_joints, int first)
@@ -260,6 +262,8 @@ static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *mod
      * weights leaves the start's errors in place) */
     double *const kept = tot->own_weights ? fc->opt->sample_error2 : NULL;
     tot->errors_kept = kept != NULL;
+    double *const kept_residual = tot->own_weights ? fc->opt->sample_residual : NULL;
+    tot->residuals_kept = kept_residual != NULL;
     dhc_arm_prepare(&model->arm, &ws->trig);
     if (fc->whiten && weights != model) {
         dhc_arm_prepare(&weights->arm, &ws->weights_trig);
@@ -359,6 +363,9 @@ static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *mod
         tot->max_e2 = fmax(tot->max_e2, screened);
         if (kept != NULL) {
             kept[i] = screened;
+        }
+        if (kept_residual != NULL) {
+            memcpy(kept_residual + 3U * i, r, 3U * sizeof r[0]);
         }
         tot->samples++;
         tot->rows += rows;
@@ -1236,6 +1243,7 @@ static void fill_report(const fit_context *fc, const pass_totals *tot, dhc_calib
     const dhc_calib_workspace *const ws = fc->ws;
     const size_t p = fc->set->count;
     rep->samples_used = tot->samples;
+    rep->residuals_kept = tot->residuals_kept;
     rep->rows = tot->rows;
     rep->rank = ws->fac.rank;
     rep->condition = ws->fac.condition;

@@ -126,6 +126,8 @@ static void test_caller_tables_give_the_same_fit(void)
     TEST_ASSERT_NULL(opt.sample_error2);
     TEST_ASSERT_EQUAL(2U, plain_rep.outliers);
     static double kept[TEST_MAX_SAMPLES];
+    static double residuals[3U * TEST_MAX_SAMPLES];
+    TEST_ASSERT_NULL(opt.sample_residual);
     for (int noise = 0; noise <= 1; ++noise) {
         opt.noise.meas_mm = noise ? 0.05 : 0.0;
         opt.joint_sincos = NULL;
@@ -134,14 +136,31 @@ static void test_caller_tables_give_the_same_fit(void)
         dhc_arm arm = nominal;
         TEST_ASSERT_EQUAL(DHC_OK, fit(&arm, &opt));
         plain_rep = rep;
-        for (int variant = 1; variant <= 3; ++variant) {
+        TEST_ASSERT_FALSE(rep.residuals_kept);
+        for (int variant = 1; variant <= 7; ++variant) {
             opt.joint_sincos = (variant & 1) != 0 ? table : NULL;
             opt.sample_error2 = (variant & 2) != 0 ? kept : NULL;
+            opt.sample_residual = (variant & 4) != 0 ? residuals : NULL;
             memcpy(data.flags, flags0, sizeof flags0);
             arm = nominal;
             TEST_ASSERT_EQUAL(DHC_OK, fit(&arm, &opt));
             assert_same_fit(&plain_rep, &rep);
+            TEST_ASSERT_EQUAL((variant & 4) != 0, rep.residuals_kept);
+            /* the residuals kept are the fitted model's, to the bit, for every sample used */
+            const dhc_model fitted = test_model_of(&arm);
+            for (size_t i = 0U; i < data.n && rep.residuals_kept; ++i) {
+                double r[DHC_MAX_ROWS_PER_SAMPLE];
+                size_t rows;
+                if (data.flags[i] != (uint8_t)DHC_SAMPLE_USED) {
+                    continue;
+                }
+                TEST_ASSERT_EQUAL(DHC_OK, dhc_model_residual(&fitted, &data.s[i],
+                                                             opt.orientation_weight_mm_per_rad,
+                                                             r, &rows));
+                TEST_ASSERT_EQUAL_MEMORY(r, &residuals[3U * i], 3U * sizeof r[0]);
+            }
         }
+        opt.sample_residual = NULL;
     }
 }
 

@@ -186,8 +186,9 @@ static struct {
     double *rows;
 } fit_rows;
 
-int dhcal_fit_errors(const dhc_model *model, const dhcal_samples *s, double *resid,
-                     double *err_mm, dhcal_error_stats *stats)
+/* dhcal_fit_errors with the residuals of the used samples known (NULL: not known). */
+static int fit_errors(const dhc_model *model, const dhcal_samples *s, const double *known,
+                      double *resid, double *err_mm, dhcal_error_stats *stats)
 {
     /* Bytes, not values: a model that differs only in padding or in the sign of a zero is
      * evaluated again, which costs a pass and changes nothing. */
@@ -201,7 +202,8 @@ int dhcal_fit_errors(const dhc_model *model, const dhcal_samples *s, double *res
         rows = malloc((4U * s->n + 1U) * sizeof *rows);
         dhcal_error_stats unused;
         if (rows == NULL ||
-            dhcal_samples_errors(model, s, rows, rows + 3U * s->n, &unused) != DHCAL_IO_OK) {
+            dhcal_samples_errors_known(model, s, known, rows, rows + 3U * s->n, &unused) !=
+                DHCAL_IO_OK) {
             free(rows);
             return DHCAL_IO_FAILED;
         }
@@ -216,6 +218,12 @@ int dhcal_fit_errors(const dhc_model *model, const dhcal_samples *s, double *res
     memcpy(err_mm, rows + 3U * s->n, s->n * sizeof *err_mm);
     dhcal_error_stats_of(s, err_mm, stats); /* the flags may have changed */
     return DHCAL_IO_OK;
+}
+
+int dhcal_fit_errors(const dhc_model *model, const dhcal_samples *s, double *resid,
+                     double *err_mm, dhcal_error_stats *stats)
+{
+    return fit_errors(model, s, NULL, resid, err_mm, stats);
 }
 
 int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhc_noise_model *noise,
@@ -243,10 +251,13 @@ int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhc_n
     opt.joint_sincos = dhcal_samples_sincos(s, start->arm.n_joints);
     /* optional: without it the outlier screens evaluate the model again */
     opt.sample_error2 = malloc((s->n + 1U) * sizeof *opt.sample_error2);
+    /* optional: the fit's residuals spare the row report a pass */
+    opt.sample_residual = malloc((3U * s->n + 1U) * sizeof *opt.sample_residual);
     out->status = dhc_calib_fit(&out->model, &out->set, dhcal_samples_read, s, s->n, s->flags,
                                 &opt, &calib_ws, &out->rep);
     free(opt.sample_error2);
     if (out->status == DHC_ERR_UNDERDETERMINED) {
+        free(opt.sample_residual);
         snprintf(err->msg, sizeof err->msg,
                  "the data under-determine the model: %zu equations from %zu rows identify %zu "
                  "of the %zu parameters the model could identify from rich data; measure more "
@@ -255,13 +266,16 @@ int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhc_n
         return DHCAL_IO_FAILED;
     }
     if (out->status != DHC_OK && out->status != DHC_ERR_NOT_CONVERGED) {
+        free(opt.sample_residual);
         snprintf(err->msg, sizeof err->msg, "fit failed: %s", dhc_status_str(out->status));
         return DHCAL_IO_FAILED;
     }
     double *e = calloc(s->n > 0U ? s->n : 1U, sizeof *e);
-    int rc = e != NULL ? dhcal_fit_errors(&out->model, s, NULL, e, &out->train)
+    const double *known = out->rep.residuals_kept ? opt.sample_residual : NULL;
+    int rc = e != NULL ? fit_errors(&out->model, s, known, NULL, e, &out->train)
                        : DHCAL_IO_FAILED;
     free(e);
+    free(opt.sample_residual);
     if (rc == DHCAL_IO_OK && held != NULL) {
         e = calloc(held->n > 0U ? held->n : 1U, sizeof *e);
         /* held-out rows come from another session: the calibration session's drift is not

@@ -114,11 +114,19 @@ typedef struct {
      * bisection, the marks) read them instead of evaluating the model again, pass after
      * pass. The same fit; the memory is the caller's, the library's stays O(P^2). */
     double *sample_error2;
+    /* NULL (the default), or 3 n doubles of the caller's: each pass at an estimate keeps
+     * sample i's first three residual rows (dhc_model_residual's: position or wire lengths,
+     * unwhitened) at [3 i]; with the report's residuals_kept they are the fitted model's
+     * for every sample the fit used (the others' entries are not defined), so the caller
+     * need not evaluate the model again for them. */
+    double *sample_residual;
 } dhc_calib_options;
 
 typedef struct {
     size_t iterations;      /* LM iterations, all rounds */
     int converged;          /* 1 when the last round met its tolerance */
+    int residuals_kept;     /* 1: opt->sample_residual holds the fitted model's residuals
+                               of the samples used */
     size_t samples_used;
     size_t rows;            /* equations in the final fit */
     size_t n_params;
