@@ -465,10 +465,10 @@ static const double EXACT_POW10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6, 
                                        1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 
 /* The common field, [+-] digits [. digits], as strtod reads it, without strtod's general
- * (slow) path: when its digits form an integer m <= 2^53 and it has k <= 22 decimals, the
- * value is m / 10^k, a quotient of two exact doubles, which IEEE division rounds
- * correctly, as strtod must (Clinger's fast path). 0 when the field is not of that form:
- * strtod then decides. */
+ * (slow) path: when its (at most 19) digits form an integer m <= 2^53 and it has k
+ * decimals, the value is m / 10^k, a quotient of two exact doubles (10^k is exact up to
+ * k = 22), which IEEE division rounds correctly, as strtod must (Clinger's fast path). 0
+ * when the field is not of that form: strtod then decides. */
 static int parse_plain_decimal(const char *s, size_t n, double *out)
 {
     const int negative = s[0] == '-';

@@ -875,13 +875,10 @@ static double predicted_decrease(const dhc_normal_eq *ne, const double *delta)
     return 2.0 * lin - quad;
 }
 
-/* Levenberg-Marquardt from ws->current until the SSR stops falling. The damping follows
- * the gain ratio rho (actual over predicted decrease; Nielsen's update, as in Madsen,
- * Nielsen and Tingleff's notes): a good model shrinks lambda, a poor one grows it
- * gradually, a rejected step doubles the growth. A fixed x10 / /10 schedule oscillates in
- * the curved valleys of real arms' barely determined parameters and creeps along them. */
-/* The identifiability checks of one fit: how many freed parameters, and whether LM may
- * still free them between its steps (not after a roll-back, see roll_back_early). */
+/* The identifiability checks of one fit_to_convergence: how many at a converged estimate
+ * freed parameters, and whether LM may still free them between its steps (when any check
+ * is allowed; not after a roll-back, see roll_back_early). Freeing between steps counts no
+ * check: each parameter is freed there once at most. */
 typedef struct {
     size_t checks;
     int early;
@@ -890,6 +887,11 @@ typedef struct {
 static dhc_status free_identifiable(const fit_context *fc, dhc_calib_report *rep,
                                     uint8_t *mark, size_t *freed);
 
+/* Levenberg-Marquardt from ws->current until the SSR stops falling. The damping follows
+ * the gain ratio rho (actual over predicted decrease; Nielsen's update, as in Madsen,
+ * Nielsen and Tingleff's notes): a good model shrinks lambda, a poor one grows it
+ * gradually, a rejected step doubles the growth. A fixed x10 / /10 schedule oscillates in
+ * the curved valleys of real arms' barely determined parameters and creeps along them. */
 static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *rep,
                                       pass_totals *tot, int accumulated, freeing *fr,
                                       int *converged)
@@ -966,11 +968,10 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
              * without them: the steps to come move them too (Gauss-Newton's quadratic
              * convergence from here, instead of a second run of iterations). */
             size_t freed = 0U;
-            if (st == DHC_OK && fr->early && fr->checks < fc->opt->max_identifiability_checks) {
+            if (st == DHC_OK && fr->early && fc->opt->max_identifiability_checks > 0U) {
                 st = free_identifiable(fc, rep, ws->freed_early, &freed);
             }
             if (st == DHC_OK && freed > 0U) {
-                fr->checks++;
                 rep->freed += freed;
                 st = analyse_keeping_set(fc, rep);
                 decrement = st == DHC_OK ? current_decrement(fc) : HUGE_VAL;
@@ -1088,6 +1089,7 @@ static dhc_status hold_unsupported(const fit_context *fc, const pass_totals *tot
     if (st == DHC_OK) {
         rep->identifiable[worst] = 0U;
         rep->unsupported[worst] = 1U;
+        ws->freed_early[worst] = 0U; /* held, not freed: nothing to roll back */
         *held = 1;
     }
     return st;
@@ -1111,6 +1113,8 @@ static dhc_status roll_back_early(const fit_context *fc, dhc_calib_report *rep, 
     }
     *rolled = dropped && any_early;
     if (!*rolled) {
+        /* the estimate identifies them: freed for good, nothing left to roll back */
+        memset(ws->freed_early, 0, sizeof ws->freed_early);
         return DHC_OK;
     }
     dhc_status st = DHC_OK;
@@ -1128,8 +1132,8 @@ static dhc_status roll_back_early(const fit_context *fc, dhc_calib_report *rep, 
 
 /* Levenberg-Marquardt (freeing parameters between its steps), then identifiability judged
  * at the converged estimate (again while that frees parameters, at most
- * max_identifiability_checks times in all), then the worst unsupported link parameter held
- * and the fit repeated (at most MAX_HOLDS times). */
+ * max_identifiability_checks times), then the worst unsupported link parameter held and the
+ * fit repeated (at most MAX_HOLDS times). */
 static dhc_status fit_to_convergence(const fit_context *fc, dhc_calib_report *rep,
                                      pass_totals *tot, int accumulated, int *converged)
 {
@@ -1137,12 +1141,19 @@ static dhc_status fit_to_convergence(const fit_context *fc, dhc_calib_report *re
     size_t holds = 0U;
     for (;;) {
         dhc_status st = levenberg_marquardt(fc, rep, tot, accumulated, &fr, converged);
-        if (st != DHC_OK || !*converged) {
+        if (st != DHC_OK) {
             return st;
         }
         int rolled = 0;
         st = roll_back_early(fc, rep, &rolled);
-        if (st != DHC_OK) {
+        if (st == DHC_OK && rolled && !*converged) {
+            /* no iterations left to refit: the report describes the estimate as it is */
+            st = data_pass(fc, &fc->ws->current, 1, tot);
+            if (st == DHC_OK) {
+                st = analyse_keeping_set(fc, rep);
+            }
+        }
+        if (st != DHC_OK || !*converged) {
             return st;
         }
         if (rolled) {

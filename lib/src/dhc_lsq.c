@@ -58,7 +58,9 @@ dhc_status dhc_normal_eq_init(dhc_normal_eq *ne, size_t n)
 /* glibc's answer, from the processor and the kernel's state saving, already at hand: no
  * start-up constructor of its own (libgcc's for __builtin_cpu_supports costs 0.1 ms) */
 #include <sys/platform/x86.h>
+#ifdef CPU_FEATURE_ACTIVE /* glibc 2.33; 2.32's header has CPU_FEATURE_USABLE only */
 #define DHC_HAS_AVX2() CPU_FEATURE_ACTIVE(AVX2)
+#endif
 #endif
 #endif
 #ifndef DHC_HAS_AVX2

@@ -166,6 +166,30 @@ static void test_csv_numbers_are_strtods_to_the_bit(void)
     }
 }
 
+/* The fast path's edges, to the bit against strtod: a mantissa of exactly 2^53 (the fast
+ * path's last) and 2^53 + 1 (strtod's), 19 digits with leading zeros, 20 digits, signed
+ * zeros, a leading sign before the point, a trailing point. */
+static void test_csv_fast_path_edges_are_strtods_to_the_bit(void)
+{
+    static const char *const fields[] = {
+        "90071.99254740992", "90071.99254740993", "-90071.99254740993",
+        "0.000000000000000001", "00000000000000000001.5", "0.0000000000000000001",
+        "-0", "-0.0", "+.5", "5.", "-.25", "99999.99999999999999"};
+    const size_t n = sizeof fields / sizeof fields[0];
+    static char text[2048];
+    size_t len = (size_t)snprintf(text, sizeof text, "q1,x,y,z\n");
+    for (size_t i = 0U; i < n; ++i) {
+        len += (size_t)snprintf(text + len, sizeof text - len, "1,%s,0,0\n", fields[i]);
+    }
+    csv_ok(text, 1U);
+    TEST_ASSERT_EQUAL_size_t(n, g_data.n_rows);
+    for (size_t i = 0U; i < n; ++i) {
+        const double expect = strtod(fields[i], NULL);
+        TEST_ASSERT_EQUAL_MEMORY_MESSAGE(&expect, &g_data.rows[i].xyz_mm[0], sizeof expect,
+                                         fields[i]);
+    }
+}
+
 static void test_csv_missing_file_is_bad_input_naming_it(void)
 {
     const char *const p = path_of("nope.csv");
@@ -1297,6 +1321,7 @@ int main(void)
     UNITY_BEGIN();
     /* CSV */
     RUN_TEST(test_csv_numbers_are_strtods_to_the_bit);
+    RUN_TEST(test_csv_fast_path_edges_are_strtods_to_the_bit);
     RUN_TEST(test_csv_missing_file_is_bad_input_naming_it);
     RUN_TEST(test_csv_directory_is_bad_input);
     RUN_TEST(test_csv_empty_file);

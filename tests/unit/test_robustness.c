@@ -27,8 +27,6 @@
 #include "dhcal/dhc_params.h"
 #include "unity.h"
 
-void setUp(void) {}
-void tearDown(void) {}
 
 #if defined(__arm__) && !defined(__linux__)
 #define ROBUST_SCALE 4U /* bare-metal Cortex-M4 under QEMU: a quarter of the cases */
@@ -570,10 +568,22 @@ static void measure(const dhc_model *truth, size_t count, dhc_meas_kind kind, te
  * default 1000 mm/rad suits L ~ 1 m; at L = 1e-3 mm it makes the position rows 1e-6 of the
  * orientation rows, and parallel-axis offsets drop below the rank tolerance), and the robust
  * sigma floor is 1e-6 L. With both scaled, a problem scaled by s is the same problem. */
+/* 0, or the iteration limit of the fits (a fit stopped on its way) */
+static size_t iteration_limit;
+
+void setUp(void)
+{
+    iteration_limit = 0U; /* also after a test that failed with a limit set */
+}
+void tearDown(void) {}
+
 static dhc_status fit(dhc_model *model, double L)
 {
     dhc_calib_options opt;
     dhc_calib_default_options(&opt);
+    if (iteration_limit > 0U) {
+        opt.max_iterations = iteration_limit;
+    }
     opt.orientation_weight_mm_per_rad = L;
     opt.outlier_floor_mm = 1e-6 * L;
     return dhc_calib_fit(model, &set, test_read_sample, &data, data.n, data.flags, &opt, &ws,
@@ -657,6 +667,45 @@ static size_t index_of(dhc_param_kind kind, size_t joint)
     const size_t k = test_param_index(&set, kind, joint);
     TEST_ASSERT_TRUE(k < set.count);
     return k;
+}
+
+/* A fit stopped after a few iterations, where parameters freed on the way may not be
+ * identifiable by the estimate it stops at (exactly parallel axes of the truth, plain DH):
+ * every parameter it reports unidentifiable is still at its input value. */
+static void test_fits_stopped_on_their_way_leave_unidentifiable_parameters_untouched(void)
+{
+    test_rng g = {0x5709ULL};
+    static dhc_model nominal;
+    static dhc_model model;
+    for (size_t c = 0U; c < CASES(12U); ++c) {
+        const size_t n = 3U + c % 4U;
+        const size_t i = c % (n - 1U);
+        int parallel[DHC_MAX_JOINTS] = {0};
+        parallel[i] = 1;
+        dhc_arm arm;
+        random_arm(&g, &arm, n, 1.0, parallel);
+        arm.joint[i].convention = DHC_CONV_DH;
+        arm.joint[i + 1U].convention = DHC_CONV_DH;
+        nominal = test_model_of(&arm);
+        dhc_arm t;
+        add_errors(&g, &arm, NULL, 1.0, &t);
+        t.joint[i].alpha_rad = arm.joint[i].alpha_rad;
+        const dhc_model truth = test_model_of(&t);
+        measure(&truth, 40U, c % 2U == 0U ? DHC_MEAS_POSE : DHC_MEAS_POSITION, &g,
+                DHC_MAX_JOINTS, 0.0, 0);
+        for (size_t limit = 1U; limit <= 4U; ++limit) {
+            iteration_limit = limit;
+            model = nominal;
+            TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &model));
+            for (size_t k = 0U; k < data.n; ++k) {
+                data.flags[k] = (uint8_t)DHC_SAMPLE_USED;
+            }
+            const dhc_status st = fit(&model, 1.0);
+            assert_report_sane(st);
+            assert_unidentifiable_untouched(&nominal);
+        }
+        iteration_limit = 0U;
+    }
 }
 
 /* ------------------------------------------------------------------ rich data, any scale */
@@ -1412,6 +1461,7 @@ int main(void)
     RUN_TEST(test_identical_poses_identify_no_more_than_one_pose_does);
     RUN_TEST(test_a_joint_never_moved_confounds_its_offset_and_effects);
     RUN_TEST(test_parallel_axes_without_beta_confound_the_two_offsets_along_them);
+    RUN_TEST(test_fits_stopped_on_their_way_leave_unidentifiable_parameters_untouched);
     RUN_TEST(test_nearly_parallel_axes_stay_finite_and_lose_rank_at_the_tolerance);
     RUN_TEST(test_columns_of_zeros_are_unidentifiable_without_partners);
     RUN_TEST(test_duplicated_columns_name_each_other);

@@ -77,8 +77,9 @@ typedef struct {
                                     step moved no parameter by more than tol of its standard
                                     error and lowered the SSR by under 2 tol sigma^2. The
                                     test real data meet; 0 turns it off */
-    size_t max_identifiability_checks; /* re-analyses at an estimate that free parameters
-                                    found unidentifiable at the start, at most (3) */
+    size_t max_identifiability_checks; /* re-analyses at a converged estimate that free
+                                    parameters found unidentifiable at the start, at most
+                                    (3); 0 also keeps them out between LM's steps */
     double max_std_angle_rad;    /* a joint offset or twist whose standard error exceeds this
                                     is held at its input value (0: no bound, the default) */
     double max_std_length_mm;    /* ... a length (a, d) likewise (0: no bound) */
