@@ -1010,11 +1010,30 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
  * kept out because the input values could not identify them, and that these values do
  * identify, join the fitted set (and are marked in mark, when not NULL). *freed counts
  * them; with none, ws->fac is the analysis of the kept set again. */
+/* A parameter free_identifiable may free: held out since the start, not for want of
+ * support, and (between LM's steps, mark not NULL) not a base rotation, which composes with
+ * the others and cannot go back alone (roll_back_early). */
+static int may_free(const fit_context *fc, const dhc_calib_report *rep, const uint8_t *mark,
+                    size_t k)
+{
+    const uint8_t kind = fc->set->id[k].kind;
+    const int rotation = kind == (uint8_t)DHC_P_BASE_RX || kind == (uint8_t)DHC_P_BASE_RY ||
+                         kind == (uint8_t)DHC_P_BASE_RZ;
+    return !rep->identifiable[k] && !rep->unsupported[k] && (mark == NULL || !rotation);
+}
+
 static dhc_status free_identifiable(const fit_context *fc, dhc_calib_report *rep,
                                     uint8_t *mark, size_t *freed)
 {
     dhc_calib_workspace *const ws = fc->ws;
     *freed = 0U;
+    int candidates = 0;
+    for (size_t k = 0U; k < fc->set->count; ++k) {
+        candidates |= may_free(fc, rep, mark, k);
+    }
+    if (!candidates) {
+        return DHC_OK; /* ws->fac is still the kept set's analysis: no analysis to repeat */
+    }
     /* Freed only with a clear margin: an exact dependence (d1 and the base along axis 1)
      * leaves a rounding-level pivot that the plain tolerance can take at another estimate. */
     dhc_status st = dhc_lsq_analyse(&ws->ne, fmin(fc->opt->rank_rel_tol * FREE_TOL_FACTOR, 0.5),
@@ -1023,14 +1042,7 @@ static dhc_status free_identifiable(const fit_context *fc, dhc_calib_report *rep
         return st;
     }
     for (size_t k = 0U; k < fc->set->count; ++k) {
-        const uint8_t kind = fc->set->id[k].kind;
-        /* a base rotation composes with the others: it cannot go back alone (roll_back_early) */
-        const int returnable = kind != (uint8_t)DHC_P_BASE_RX &&
-                               kind != (uint8_t)DHC_P_BASE_RY && kind != (uint8_t)DHC_P_BASE_RZ;
-        if (mark != NULL && !returnable) {
-            continue;
-        }
-        if (ws->fac.identifiable[k] && !rep->identifiable[k] && !rep->unsupported[k]) {
+        if (ws->fac.identifiable[k] && may_free(fc, rep, mark, k)) {
             rep->identifiable[k] = 1U;
             if (mark != NULL) {
                 mark[k] = 1U;

@@ -60,8 +60,10 @@ dhc_status dhc_normal_eq_init(dhc_normal_eq *ne, size_t n);
 
 /* Adds k equations: rows of jac (k x n), residuals r (k, measured - model) and weights w
  * (k, each > 0; NULL means 1). DHC_ERR_DIMENSION for a shape mismatch,
- * DHC_ERR_NONFINITE for a non-finite entry, DHC_ERR_ARGUMENT for a weight <= 0 or
- * non-finite; the accumulator is unchanged on error. O(k n^2). */
+ * DHC_ERR_NONFINITE for a non-finite entry, or for finite rows whose sums could overflow
+ * (twice the largest diagonal or SSR plus every row's w (r^2 + |J|^2) is not finite:
+ * entries beyond ~1e153), DHC_ERR_ARGUMENT for a weight <= 0 or non-finite; the
+ * accumulator is unchanged on error. O(k n^2). */
 dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double *r,
                              const double *w, size_t k);
 
