@@ -251,6 +251,7 @@ void dhc_rot_from_rpy(const double rpy_rad[3], dhc_mat3 *r)
     dhc_rot_mul(&zy, &rx, r);
 }
 
+#if DHC_WITH_CONVERSIONS
 void dhc_rot_to_rpy(const dhc_mat3 *r, double rpy_rad[3])
 {
     const double cp = sqrt(r->m[0][0] * r->m[0][0] + r->m[1][0] * r->m[1][0]);
@@ -305,6 +306,7 @@ void dhc_quat_from_rot(const dhc_mat3 *r, double q[4])
     q[2] = s * w[1];
     q[3] = s * w[2];
 }
+#endif /* DHC_WITH_CONVERSIONS */
 
 /* ---------------------------------------------------------------- frames */
 
