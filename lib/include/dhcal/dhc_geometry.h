@@ -66,8 +66,10 @@ void dhc_rot_apply_t(const dhc_mat3 *r, const double v[3], double out[3]);
 void dhc_rot_column(const dhc_mat3 *r, size_t c, double out[3]);
 /* Rotation by the vector w (axis w/|w|, angle |w|), Rodrigues' formula; exact for any size. */
 void dhc_rot_exp(const double w_rad[3], dhc_mat3 *r);
+#if DHC_WITH_POSE_SAMPLES || DHC_WITH_CONVERSIONS
 /* Rotation vector of r (inverse of dhc_rot_exp, angle in [0, pi]); accurate near 0 and pi. */
 void dhc_rot_log(const dhc_mat3 *r, double w_rad[3]);
+#endif
 /* R = Rz(yaw) Ry(pitch) Rx(roll), rpy_rad = {roll, pitch, yaw} (docs/formats.md, section 2). */
 void dhc_rot_from_rpy(const double rpy_rad[3], dhc_mat3 *r);
 #if DHC_WITH_CONVERSIONS
