@@ -52,7 +52,7 @@ void dhc_calib_default_options(dhc_calib_options *opt)
     opt->outlier_floor_mm = 1e-6;
     opt->joint_margin_rad = 0.1;
     opt->reach_margin = 0.1;
-    opt->robust_start = 1;
+    opt->robust_start = DHC_WITH_ROBUST_START;
     opt->max_outlier_rounds = 3U;
     opt->structural_seed = 12345U;
     memset(&opt->noise, 0, sizeof opt->noise);
@@ -85,10 +85,16 @@ dhc_status dhc_noise_model_check(const dhc_noise_model *noise, size_t n_joints, 
     if (!ok || (joints_on && !(meas_noise_mm > 0.0))) {
         return DHC_ERR_ARGUMENT;
     }
+#if !DHC_WITH_EIV
+    if (joints_on || meas_noise_mm > 0.0) {
+        return DHC_ERR_ARGUMENT; /* left out of this build (DHC_WITH_EIV 0): only "off" */
+    }
+#endif
     *on = joints_on || meas_noise_mm > 0.0;
     return DHC_OK;
 }
 
+#if DHC_WITH_EIV
 dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_arm_trig *trig,
                              dhc_model_eval *ev, const dhc_sample *s,
                              const dhc_noise_model *noise, double weight_mm_per_rad,
@@ -172,6 +178,24 @@ dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_arm_trig *trig,
     }
     return DHC_OK;
 }
+#else
+dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_arm_trig *trig,
+                             dhc_model_eval *ev, const dhc_sample *s,
+                             const dhc_noise_model *noise, double weight_mm_per_rad,
+                             const double *r_model, double *r, dhc_mat *jac)
+{
+    (void)trig; (void)ev; (void)s; (void)weight_mm_per_rad; (void)r_model; (void)r; (void)jac;
+    if (model == NULL || noise == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    /* the noise model can only be off in this build (DHC_WITH_EIV 0): nothing to change */
+    int on = 0;
+    return dhc_noise_model_check(noise, model->arm.n_joints, &on);
+}
+#endif /* DHC_WITH_EIV */
+
+/* The noise model is on (always off in a build without it: the whitening drops out). */
+#define WHITEN(fc) (DHC_WITH_EIV && (fc)->whiten)
 
 /* Everything one pass over the samples needs; kept together to keep signatures short. */
 typedef struct {
@@ -265,7 +289,7 @@ static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *mod
     double *const kept_residual = tot->own_weights ? fc->opt->sample_residual : NULL;
     tot->residuals_kept = kept_residual != NULL;
     dhc_arm_prepare(&model->arm, &ws->trig);
-    if (fc->whiten && weights != model) {
+    if (WHITEN(fc) && weights != model) {
         dhc_arm_prepare(&weights->arm, &ws->weights_trig);
     }
     const dhc_arm_trig *const weights_trig = weights != model ? &ws->weights_trig : &ws->trig;
@@ -318,7 +342,7 @@ static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *mod
         if (st == DHC_OK) {
             memcpy(rw, r, sizeof r);
         }
-        if (st == DHC_OK && fc->whiten) {
+        if (st == DHC_OK && WHITEN(fc)) {
             /* the covariance at `weights`: its own residual gives the orientation slope (in
              * the workspace: this is the library's deepest call chain) */
             double *const r_weights = ws->weights_residual;
@@ -349,10 +373,10 @@ static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *mod
         const double e2 = sq(r[0]) + sq(r[1]) + sq(r[2]);
         tot->pos_ss += e2;
         tot->max_pos = fmax(tot->max_pos, sqrt(e2));
-        tot->ssr += fc->whiten ? sq(rw[0]) + sq(rw[1]) + sq(rw[2]) : e2;
+        tot->ssr += WHITEN(fc) ? sq(rw[0]) + sq(rw[1]) + sq(rw[2]) : e2;
         if (rows == 6U) {
             const double o2 = sq(r[3]) + sq(r[4]) + sq(r[5]);
-            tot->ssr += fc->whiten ? sq(rw[3]) + sq(rw[4]) + sq(rw[5]) : o2;
+            tot->ssr += WHITEN(fc) ? sq(rw[3]) + sq(rw[4]) + sq(rw[5]) : o2;
             tot->rot_ss += o2 / (w * w);
             tot->pose_samples++;
         }
@@ -472,7 +496,7 @@ static dhc_status sample_error2(const fit_context *fc, const dhc_model *model,
     st = dhc_model_residual_prepared(model, &fc->ws->trig, &fc->ws->sample,
                                      sample_sincos(fc->opt, model->arm.n_joints, i),
                                      fc->opt->orientation_weight_mm_per_rad, r, rows);
-    if (st == DHC_OK && fc->whiten) {
+    if (st == DHC_OK && WHITEN(fc)) {
         /* screened in units of each sample's own noise: a sample at a pose where the joint
          * noise maps large is not an outlier for being larger */
         st = dhc_sample_whiten(model, &fc->ws->trig, &fc->ws->eval, &fc->ws->sample,
@@ -928,7 +952,7 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
          * and an accepted step needs no pass of its own (a rejected one pays a pass to
          * accumulate the current estimate again). Not with the noise model on: a trial is
          * judged with its start's weights, but accumulated with its own. */
-        const int speculate = !fc->whiten;
+        const int speculate = !WHITEN(fc);
         int ne_at_trial = 0;
         pass_totals trial_tot;
         if (st == DHC_OK && speculate) {
@@ -1202,6 +1226,7 @@ static dhc_status fit_to_convergence(const fit_context *fc, dhc_calib_report *re
     }
 }
 
+#if DHC_WITH_ROBUST_START
 static void unmark(const fit_context *fc, uint8_t mark)
 {
     for (size_t i = 0U; i < fc->n; ++i) {
@@ -1260,6 +1285,7 @@ static dhc_status robust_start(const fit_context *fc, dhc_calib_report *rep, pas
                                       (uint8_t)DHC_SAMPLE_ROBUST, &scan)
                         : st;
 }
+#endif /* DHC_WITH_ROBUST_START */
 
 static void fill_report(const fit_context *fc, const pass_totals *tot, dhc_calib_report *rep)
 {
@@ -1310,6 +1336,9 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
                               &whiten) != DHC_OK) {
         return DHC_ERR_ARGUMENT;
     }
+    if (!DHC_WITH_ROBUST_START && opt->robust_start) {
+        return DHC_ERR_ARGUMENT; /* left out of this build (DHC_WITH_ROBUST_START 0) */
+    }
     /* memset, not a compound literal: the report is ~5 KiB and M4 stacks are small. */
     memset(rep, 0, sizeof *rep);
     rep->n_params = set->count;
@@ -1341,10 +1370,12 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
         return DHC_ERR_NO_DATA;
     }
     int moved = 0;
+#if DHC_WITH_ROBUST_START
     st = robust_start(&fc, rep, &tot, &moved);
     if (st != DHC_OK) {
         return st;
     }
+#endif
 
     int converged = 0;
     for (size_t round = 0U; round <= opt->max_outlier_rounds; ++round) {

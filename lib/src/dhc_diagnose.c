@@ -24,6 +24,7 @@ void dhc_diagnose_default_options(dhc_diagnose_options *opt)
     memset(&opt->noise, 0, sizeof opt->noise);
 }
 
+#if DHC_WITH_DIAGNOSE || DHC_WITH_SESSION_TESTS
 /* ln Gamma(dof / 2), exact sums: chi-square only needs integer and half-integer arguments,
  * and libm's lgamma writes the global signgam. */
 static double ln_gamma_half(size_t dof)
@@ -54,7 +55,9 @@ static double lentz_step(double an, double bn, double *c, double *d)
     *d = 1.0 / *d;
     return *d * *c;
 }
+#endif /* DHC_WITH_DIAGNOSE || DHC_WITH_SESSION_TESTS */
 
+#if DHC_WITH_DIAGNOSE
 double dhc_chi2_log10_sf(double chi2, size_t dof)
 {
     if (dof == 0U || !(chi2 > 0.0)) {
@@ -98,7 +101,9 @@ double dhc_chi2_log10_sf(double chi2, size_t dof)
     }
     return (log_prefix + log(h)) / LN10;
 }
+#endif /* DHC_WITH_DIAGNOSE */
 
+#if DHC_WITH_SESSION_TESTS
 /* ln of the continued fraction of the regularized incomplete beta I_x(a, b), valid for
  * x < (a + 1) / (a + b + 2) (modified Lentz). */
 static double ln_beta_fraction(double a, double b, double x)
@@ -150,19 +155,9 @@ double dhc_f_log10_sf(double f, size_t d1, size_t d2)
     const double x = (double)d2 / ((double)d2 + (double)d1 * f);
     return ln_incomplete_beta(d2, d1, x) / LN10;
 }
+#endif /* DHC_WITH_SESSION_TESTS */
 
-static int base_has_effect(const dhc_param_set *base, dhc_effect e, size_t joint)
-{
-    for (size_t k = 0U; k < base->count; ++k) {
-        const dhc_param_id *id = &base->id[k];
-        if (dhc_params_effect_of(id) == e &&
-            (!dhc_effect_is_per_joint(e) || (size_t)id->joint == joint)) {
-            return 1;
-        }
-    }
-    return 0;
-}
-
+#if DHC_WITH_SESSION_TESTS
 static double covariate_of(const dhc_sample *smp, dhc_covariate which)
 {
     return which == DHC_COVARIATE_TIME ? smp->t_s : smp->temp_c;
@@ -240,6 +235,29 @@ dhc_status dhc_covariate_pose_r2(size_t n_joints, dhc_covariate which, dhc_sampl
     const double dof = (double)(used - fac->rank);
     *r2 = dof > 0.0 ? fmax(1.0 - (1.0 - plain) * (double)(used - 1U) / dof, 0.0) : 1.0;
     return DHC_OK;
+}
+#else
+dhc_status dhc_covariate_pose_r2(size_t n_joints, dhc_covariate which, dhc_sample_reader read,
+                                 void *ctx, size_t n, const uint8_t *flags, dhc_normal_eq *ne,
+                                 dhc_lsq_factor *fac, double *r2)
+{
+    (void)n_joints; (void)which; (void)read; (void)ctx; (void)n; (void)flags; (void)ne;
+    (void)fac; (void)r2;
+    return DHC_ERR_ARGUMENT; /* left out of this build (DHC_WITH_SESSION_TESTS 0) */
+}
+#endif /* DHC_WITH_SESSION_TESTS */
+
+#if DHC_WITH_DIAGNOSE
+static int base_has_effect(const dhc_param_set *base, dhc_effect e, size_t joint)
+{
+    for (size_t k = 0U; k < base->count; ++k) {
+        const dhc_param_id *id = &base->id[k];
+        if (dhc_params_effect_of(id) == e &&
+            (!dhc_effect_is_per_joint(e) || (size_t)id->joint == joint)) {
+            return 1;
+        }
+    }
+    return 0;
 }
 
 size_t dhc_diagnose_candidates(const dhc_model *model, const dhc_param_set *base,
@@ -664,3 +682,29 @@ dhc_status dhc_diagnose(const dhc_model *model, const dhc_param_set *base,
     mark_significant(out, opt->alpha);
     return find_lookalikes(model, base, identifiable, read, ctx, n, flags, opt, ws, out);
 }
+#else
+/* Left out of this build (DHC_WITH_DIAGNOSE 0): no candidates, and a diagnosis asked for
+ * all the same is refused. */
+size_t dhc_diagnose_candidates(const dhc_model *model, const dhc_param_set *base,
+                               const dhc_candidate_scope *scope, dhc_candidate *out,
+                               size_t cap)
+{
+    (void)model; (void)base; (void)scope; (void)out; (void)cap;
+    return 0U;
+}
+
+dhc_status dhc_diagnose(const dhc_model *model, const dhc_param_set *base,
+                        const uint8_t *identifiable, double sigma2,
+                        const dhc_candidate *candidates, size_t n_candidates,
+                        dhc_sample_reader read, void *ctx, size_t n, const uint8_t *flags,
+                        const dhc_diagnose_options *opt, dhc_diagnose_workspace *ws,
+                        dhc_diagnosis *out)
+{
+    (void)model; (void)base; (void)identifiable; (void)sigma2; (void)candidates;
+    (void)n_candidates; (void)read; (void)ctx; (void)n; (void)flags; (void)opt; (void)ws;
+    if (out != NULL) {
+        out->count = 0U;
+    }
+    return DHC_ERR_ARGUMENT;
+}
+#endif /* DHC_WITH_DIAGNOSE */

@@ -7,58 +7,64 @@
 
 #define KINDS(first, last) (uint8_t)(first), (uint8_t)((unsigned)(last) - (unsigned)(first) + 1U)
 
+#if DHC_WITH_EFFECT_SUMMARIES
+#define SUMMARY(text) text
+#else
+#define SUMMARY(text) "" /* left out of this build (DHC_WITH_EFFECT_SUMMARIES 0) */
+#endif
+
 /* In the order of docs/effects.md; the summaries are what a diagnosis says of a candidate. */
 static const dhc_effect_info catalogue[DHC_EFFECT_COUNT] = {
     {"base_frame",
-     "a constant shift and a rotation growing with distance (robot or measurer placement)",
+     SUMMARY("a constant shift and a rotation growing with distance (robot or measurer placement)"),
      DHC_EFFECT_BASE_FRAME, 0U, KINDS(DHC_P_BASE_X, DHC_P_BASE_RZ), 0U, 1U, 0U,
      DHC_EFFECT_REF_NONE, 1U},
-    {"tool_offset", "an error vector that turns with the last link (tool point unknown)",
+    {"tool_offset", SUMMARY("an error vector that turns with the last link (tool point unknown)"),
      DHC_EFFECT_TOOL_OFFSET, 0U, KINDS(DHC_P_TOOL_X, DHC_P_TOOL_Z), 0U, 1U, 0U,
      DHC_EFFECT_REF_NONE, 1U},
     {"joint_scale",
-     "a joint error growing in proportion to the joint angle (gear ratio or encoder "
-     "resolution)",
+     SUMMARY("a joint error growing in proportion to the joint angle (gear ratio or encoder "
+     "resolution)"),
      DHC_EFFECT_JOINT_SCALE, 1U, KINDS(DHC_P_JOINT_SCALE, DHC_P_JOINT_SCALE), 0U, 1U,
      DHC_NEEDS_ANGLE_RANGE, DHC_EFFECT_REF_NONE, 0U},
-    {"joint_harmonic", "a joint error periodic in the joint angle (encoder or gear eccentricity)",
+    {"joint_harmonic", SUMMARY("a joint error periodic in the joint angle (encoder or gear eccentricity)"),
      DHC_EFFECT_JOINT_HARMONIC, 1U, KINDS(DHC_P_HARMONIC_SIN, DHC_P_HARMONIC_COS), 0U, 1U,
      DHC_NEEDS_ANGLE_RANGE, DHC_EFFECT_REF_NONE, 0U},
     {"joint_harmonic2",
-     "a joint error repeating twice per turn (encoder ellipticity, gear harmonic)",
+     SUMMARY("a joint error repeating twice per turn (encoder ellipticity, gear harmonic)"),
      DHC_EFFECT_JOINT_HARMONIC2, 1U, KINDS(DHC_P_HARMONIC_SIN, DHC_P_HARMONIC_COS), 1U, 1U,
      DHC_NEEDS_ANGLE_RANGE, DHC_EFFECT_REF_NONE, 0U},
-    {"joint_harmonic3", "a joint error repeating three times per turn (gear harmonic)",
+    {"joint_harmonic3", SUMMARY("a joint error repeating three times per turn (gear harmonic)"),
      DHC_EFFECT_JOINT_HARMONIC3, 1U, KINDS(DHC_P_HARMONIC_SIN, DHC_P_HARMONIC_COS), 2U, 1U,
      DHC_NEEDS_ANGLE_RANGE, DHC_EFFECT_REF_NONE, 0U},
-    {"joint_harmonic4", "a joint error repeating four times per turn (gear harmonic)",
+    {"joint_harmonic4", SUMMARY("a joint error repeating four times per turn (gear harmonic)"),
      DHC_EFFECT_JOINT_HARMONIC4, 1U, KINDS(DHC_P_HARMONIC_SIN, DHC_P_HARMONIC_COS), 3U, 1U,
      DHC_NEEDS_ANGLE_RANGE, DHC_EFFECT_REF_NONE, 0U},
-    {"joint_backlash", "a joint error that splits by approach direction (gear backlash)",
+    {"joint_backlash", SUMMARY("a joint error that splits by approach direction (gear backlash)"),
      DHC_EFFECT_JOINT_BACKLASH, 1U, KINDS(DHC_P_BACKLASH, DHC_P_BACKLASH), 0U, 1U,
      DHC_NEEDS_BOTH_DIRECTIONS, DHC_EFFECT_REF_NONE, 0U},
-    {"joint_compliance", "a joint error that follows the gravity torque (joint stiffness)",
+    {"joint_compliance", SUMMARY("a joint error that follows the gravity torque (joint stiffness)"),
      DHC_EFFECT_JOINT_COMPLIANCE, 1U, KINDS(DHC_P_COMPLIANCE, DHC_P_COMPLIANCE), 0U, 0U,
      DHC_NEEDS_GRAVITY, DHC_EFFECT_REF_NONE, 0U},
-    {"measurer_scale", "wire errors growing with wire length (friction-wheel radius)",
+    {"measurer_scale", SUMMARY("wire errors growing with wire length (friction-wheel radius)"),
      DHC_EFFECT_MEASURER_SCALE, 0U, KINDS(DHC_P_MEAS_SCALE, DHC_P_MEAS_SCALE), 0U, 1U,
      DHC_NEEDS_WIRES, DHC_EFFECT_REF_NONE, 0U},
-    {"measurer_offset", "a constant error on each wire (wire zero reference)",
+    {"measurer_offset", SUMMARY("a constant error on each wire (wire zero reference)"),
      DHC_EFFECT_MEASURER_OFFSET, 0U, KINDS(DHC_P_MEAS_OFFSET, DHC_P_MEAS_OFFSET), 0U, 3U,
      DHC_NEEDS_WIRES, DHC_EFFECT_REF_NONE, 0U},
     {"measurer_anchors",
-     "errors pointing at the measurer's anchors (measurer built off its drawing)",
+     SUMMARY("errors pointing at the measurer's anchors (measurer built off its drawing)"),
      DHC_EFFECT_MEASURER_ANCHORS, 0U, KINDS(DHC_P_MEAS_ANCHOR, DHC_P_MEAS_ANCHOR), 0U, 9U,
      DHC_NEEDS_WIRES, DHC_EFFECT_REF_NONE, 1U},
-    {"thermal_scale", "lengths growing with temperature (thermal expansion)",
+    {"thermal_scale", SUMMARY("lengths growing with temperature (thermal expansion)"),
      DHC_EFFECT_THERMAL_SCALE, 0U, KINDS(DHC_P_THERMAL, DHC_P_THERMAL), 0U, 1U,
      DHC_NEEDS_TEMPERATURE, DHC_EFFECT_REF_TEMPERATURE, 0U},
     {"drift_scale",
-     "errors growing over the session in proportion to the distance from the base (warming "
-     "arm)",
+     SUMMARY("errors growing over the session in proportion to the distance from the base (warming "
+     "arm)"),
      DHC_EFFECT_DRIFT_SCALE, 0U, KINDS(DHC_P_DRIFT_SCALE, DHC_P_DRIFT_SCALE), 0U, 1U,
      DHC_NEEDS_TIME, DHC_EFFECT_REF_TIME, 0U},
-    {"drift_offset", "a constant error growing over the session (measurer or base moving)",
+    {"drift_offset", SUMMARY("a constant error growing over the session (measurer or base moving)"),
      DHC_EFFECT_DRIFT_OFFSET, 0U, KINDS(DHC_P_DRIFT_OFFSET, DHC_P_DRIFT_OFFSET), 0U, 3U,
      DHC_NEEDS_TIME, DHC_EFFECT_REF_TIME, 0U},
 };

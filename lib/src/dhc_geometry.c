@@ -200,6 +200,7 @@ void dhc_rot_exp(const double w_rad[3], dhc_mat3 *r)
     r->m[2][1] += a * w_rad[0];
 }
 
+#if DHC_WITH_POSE_SAMPLES || DHC_WITH_CONVERSIONS
 void dhc_rot_log(const dhc_mat3 *r, double w_rad[3])
 {
     /* v = sin(t) * axis from the skew part; cos(t) from the trace. atan2 keeps t accurate over
@@ -235,6 +236,7 @@ void dhc_rot_log(const dhc_mat3 *r, double w_rad[3])
     const double sign = dhc_vec3_dot(u, v) < 0.0 ? -1.0 : 1.0;
     dhc_vec3_scale(u, sign * t / dhc_vec3_norm(u), w_rad);
 }
+#endif /* DHC_WITH_POSE_SAMPLES || DHC_WITH_CONVERSIONS */
 
 void dhc_rot_from_rpy(const double rpy_rad[3], dhc_mat3 *r)
 {
@@ -251,6 +253,7 @@ void dhc_rot_from_rpy(const double rpy_rad[3], dhc_mat3 *r)
     dhc_rot_mul(&zy, &rx, r);
 }
 
+#if DHC_WITH_CONVERSIONS
 void dhc_rot_to_rpy(const dhc_mat3 *r, double rpy_rad[3])
 {
     const double cp = sqrt(r->m[0][0] * r->m[0][0] + r->m[1][0] * r->m[1][0]);
@@ -305,6 +308,7 @@ void dhc_quat_from_rot(const dhc_mat3 *r, double q[4])
     q[2] = s * w[1];
     q[3] = s * w[2];
 }
+#endif /* DHC_WITH_CONVERSIONS */
 
 /* ---------------------------------------------------------------- frames */
 

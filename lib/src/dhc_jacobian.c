@@ -300,7 +300,7 @@ static dhc_status jacobian_prepared(const dhc_model *model, const dhc_arm_trig *
      * move of the base origin itself moves the measured point one to one */
     const double drift = dhc_model_drift_factor(model, s->t_s);
     const double *const p_arm = pr->p_arm_mm;
-    const int with_orientation = s->kind == (uint8_t)DHC_MEAS_POSE;
+    const int with_orientation = DHC_WITH_POSE_SAMPLES && s->kind == (uint8_t)DHC_MEAS_POSE;
     for (size_t k = 0U; k < set->count; ++k) {
         const dhc_param_id *id = &set->id[k];
         double dp[3] = {0.0, 0.0, 0.0};

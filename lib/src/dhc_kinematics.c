@@ -185,6 +185,7 @@ dhc_status dhc_forward(const dhc_arm *arm, const double *q_rad, size_t q_len, dh
     return DHC_OK;
 }
 
+#if DHC_WITH_CONVERSIONS
 static void frame_axis(const dhc_frame *f, size_t col, double out[3])
 {
     dhc_rot_column(&f->rot, col, out);
@@ -292,3 +293,10 @@ dhc_status dhc_arm_to_standard_dh(const dhc_arm *arm, dhc_arm *out)
     }
     return DHC_OK;
 }
+#else
+dhc_status dhc_arm_to_standard_dh(const dhc_arm *arm, dhc_arm *out)
+{
+    (void)arm; (void)out;
+    return DHC_ERR_ARGUMENT; /* left out of this build (DHC_WITH_CONVERSIONS 0) */
+}
+#endif /* DHC_WITH_CONVERSIONS */

@@ -225,6 +225,26 @@ dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double
         add_unweighted_avx2(ne, jac, r, k);
     }
 #endif
+#if DHC_SMALL_CODE
+    /* Size-optimised builds: one equation at a time. Each entry receives the same products
+     * in the same (the equations') order as the unrolled loops below, so the same bits. */
+    for (size_t e = 0U; e < k && !fast; ++e) {
+        const double we = w != NULL ? w[e] : 1.0;
+        const double *const row = &DHC_MAT_AT(jac, e, 0U);
+        for (size_t i = 0U; i < n; ++i) {
+            const double a = we * row[i];
+            double *const out = &ne->jtj[i * n];
+            ne->jtr[i] += a * r[e];
+            for (size_t j = 0U; j < n; ++j) {
+                if (j <= i) {
+                    out[j] += a * row[j];
+                } else if (!mirror_by_copy) {
+                    out[j] += (we * row[j]) * row[i];
+                }
+            }
+        }
+    }
+#else
     /* three equations per sweep (a sample's tool point) and, for a batch, two rows of the
      * matrix at once: each equation's entry is loaded once for both (loads, not
      * arithmetic, bound this loop) */
@@ -276,6 +296,7 @@ dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double
             }
         }
     }
+#endif
     for (size_t i = 0U; i < n && mirror_by_copy && !fast; ++i) {
         for (size_t j = 0U; j < i; ++j) {
             ne->jtj[j * n + i] = ne->jtj[i * n + j];
@@ -467,6 +488,7 @@ dhc_status dhc_lsq_std_errors(const dhc_lsq_factor *fac, double sigma2, double *
     return DHC_OK;
 }
 
+#if DHC_WITH_UNCERTAINTY
 dhc_status dhc_lsq_prediction_variance(const dhc_lsq_factor *fac, double sigma2,
                                        const double *row, size_t len, double *variance)
 {
@@ -497,6 +519,14 @@ dhc_status dhc_lsq_prediction_variance(const dhc_lsq_factor *fac, double sigma2,
     *variance = sigma2 * sum;
     return dhc_is_finite(*variance) ? DHC_OK : DHC_ERR_NONFINITE;
 }
+#else
+dhc_status dhc_lsq_prediction_variance(const dhc_lsq_factor *fac, double sigma2,
+                                       const double *row, size_t len, double *variance)
+{
+    (void)fac; (void)sigma2; (void)row; (void)len; (void)variance;
+    return DHC_ERR_ARGUMENT; /* left out of this build (DHC_WITH_UNCERTAINTY 0) */
+}
+#endif /* DHC_WITH_UNCERTAINTY */
 
 dhc_status dhc_lsq_confounded(const dhc_normal_eq *ne, const dhc_lsq_factor *fac, size_t j,
                               uint8_t *partner, size_t len, size_t *count)

@@ -33,6 +33,7 @@ dhc_status dhc_sample_check(const dhc_model *model, const dhc_sample *s)
         return DHC_ERR_ARGUMENT;
     }
     if (s->kind > (uint8_t)DHC_MEAS_WIRES ||
+        (!DHC_WITH_POSE_SAMPLES && s->kind == (uint8_t)DHC_MEAS_POSE) ||
         (s->kind == (uint8_t)DHC_MEAS_WIRES && !model->measurer.present)) {
         return DHC_ERR_ARGUMENT;
     }
@@ -319,6 +320,12 @@ dhc_status dhc_model_residual_of(const dhc_sample *s, const dhc_prediction *pred
     if (s == NULL || pred == NULL || r == NULL || rows == NULL) {
         return DHC_ERR_ARGUMENT;
     }
+#if !DHC_WITH_POSE_SAMPLES
+    if (s->kind == (uint8_t)DHC_MEAS_POSE) {
+        return DHC_ERR_ARGUMENT; /* left out of this build (DHC_WITH_POSE_SAMPLES 0) */
+    }
+    (void)weight_mm_per_rad;
+#endif
     double out[DHC_MAX_ROWS_PER_SAMPLE];
     if (s->kind == (uint8_t)DHC_MEAS_WIRES) {
         dhc_vec3_sub(s->wire_mm, pred->wire_mm, out);
@@ -326,6 +333,7 @@ dhc_status dhc_model_residual_of(const dhc_sample *s, const dhc_prediction *pred
         dhc_vec3_sub(s->p_mm, pred->p_mm, out);
     }
     const size_t n = dhc_sample_rows(s);
+#if DHC_WITH_POSE_SAMPLES
     if (s->kind == (uint8_t)DHC_MEAS_POSE) {
         /* R_meas = exp([w]) R_model  =>  w = log(R_meas R_model^T) */
         dhc_mat3 err;
@@ -336,6 +344,7 @@ dhc_status dhc_model_residual_of(const dhc_sample *s, const dhc_prediction *pred
             out[3U + k] = weight_mm_per_rad * w[k];
         }
     }
+#endif
     /* Finite predictions, but a difference or a weight can still overflow (fuzzing). */
     for (size_t k = 0U; k < n; ++k) {
         if (!dhc_is_finite(out[k])) {
@@ -352,6 +361,13 @@ dhc_status dhc_model_residual_of(const dhc_sample *s, const dhc_prediction *pred
 void dhc_model_residual_slope(const dhc_sample *s, const double *r, double weight_mm_per_rad,
                               dhc_mat *jac)
 {
+#if !DHC_WITH_POSE_SAMPLES
+    /* no pose samples in this build (DHC_WITH_POSE_SAMPLES 0): nothing to turn */
+    (void)s;
+    (void)r;
+    (void)weight_mm_per_rad;
+    (void)jac;
+#else
     if (s == NULL || r == NULL || jac == NULL || jac->data == NULL ||
         s->kind != (uint8_t)DHC_MEAS_POSE || jac->rows != 6U || !(weight_mm_per_rad > 0.0)) {
         return;
@@ -382,4 +398,5 @@ void dhc_model_residual_slope(const dhc_sample *s, const double *r, double weigh
             DHC_MAT_AT(jac, 3U + a, col) = m[a][0] * v[0] + m[a][1] * v[1] + m[a][2] * v[2];
         }
     }
+#endif
 }

@@ -5,6 +5,7 @@
 
 #include "dhcal/dhc_jacobian.h"
 
+#if DHC_WITH_UNCERTAINTY
 /* the fit's own pivot tolerance (dhc_calib_options.rank_rel_tol's default) */
 #define UNCERTAINTY_RANK_TOL 1e-10
 
@@ -138,3 +139,29 @@ dhc_status dhc_uncertainty_tool_point(dhc_uncertainty *u, const dhc_model *model
     }
     return st;
 }
+#else
+/* Left out of this build (DHC_WITH_UNCERTAINTY 0): every call is refused. */
+dhc_status dhc_uncertainty_from_samples(dhc_uncertainty *u, const dhc_model *model,
+                                        const dhc_param_set *set, const uint8_t *use,
+                                        dhc_sample_reader read, void *ctx, size_t n,
+                                        const dhc_noise_model *noise, double weight_mm_per_rad,
+                                        double sigma)
+{
+    (void)model; (void)set; (void)use; (void)read; (void)ctx; (void)n; (void)noise;
+    (void)weight_mm_per_rad; (void)sigma;
+    if (u != NULL) {
+        u->fac.n = 0U;
+    }
+    return DHC_ERR_ARGUMENT;
+}
+
+dhc_status dhc_uncertainty_tool_point(dhc_uncertainty *u, const dhc_model *model,
+                                      const dhc_param_set *set, const double *q_rad,
+                                      const int8_t *dir, const double *joint_sd_rad,
+                                      double *variance_mm2)
+{
+    (void)u; (void)model; (void)set; (void)q_rad; (void)dir; (void)joint_sd_rad;
+    (void)variance_mm2;
+    return DHC_ERR_ARGUMENT;
+}
+#endif /* DHC_WITH_UNCERTAINTY */

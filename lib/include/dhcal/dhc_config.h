@@ -31,6 +31,51 @@ DHC_STATIC_ASSERT(DHC_MAX_JOINTS >= 1U && DHC_MAX_JOINTS <= 16U, "DHC_MAX_JOINTS
 DHC_STATIC_ASSERT(DHC_MAX_PARAMS >= 4U * DHC_MAX_JOINTS, "DHC_MAX_PARAMS must hold the base model");
 DHC_STATIC_ASSERT(DHC_MAX_PARAMS <= 256U, "DHC_MAX_PARAMS too large for the index types");
 
+/* Features (1: built, the default; 0: left out of the build, for a controller's flash).
+ * The whole build, callers included, must agree. A feature left out answers with a
+ * status, never with a silently different result: its entry points return
+ * DHC_ERR_ARGUMENT (or find nothing: dhc_diagnose_candidates returns 0), model files and
+ * samples that need it are refused (dhc_params_add, dhc_sample_check), and functions
+ * that return a value rather than a status (dhc_f_log10_sf, the rotation conversions) are
+ * not defined at all: a caller fails to link. scripts/target-report lists each one's
+ * bytes on the Cortex-M4. */
+#ifndef DHC_WITH_DIAGNOSE        /* dhc_diagnose.h: the score test of missing effects */
+#define DHC_WITH_DIAGNOSE 1
+#endif
+#ifndef DHC_WITH_SESSION_TESTS   /* dhc_f_log10_sf (lack of fit against replicates),
+                                    dhc_covariate_pose_r2 (time, temperature vs the pose) */
+#define DHC_WITH_SESSION_TESTS 1
+#endif
+#ifndef DHC_WITH_UNCERTAINTY     /* dhc_uncertainty.h, dhc_lsq_prediction_variance */
+#define DHC_WITH_UNCERTAINTY 1
+#endif
+#ifndef DHC_WITH_EIV             /* the noise model: errors in variables, dhc_sample_whiten */
+#define DHC_WITH_EIV 1
+#endif
+#ifndef DHC_WITH_POSE_SAMPLES    /* DHC_MEAS_POSE samples (orientation rows) */
+#define DHC_WITH_POSE_SAMPLES 1
+#endif
+#ifndef DHC_WITH_ROBUST_START    /* dhc_calib_options.robust_start */
+#define DHC_WITH_ROBUST_START 1
+#endif
+#ifndef DHC_WITH_EFFECT_SUMMARIES /* dhc_effect_info.summary text ("" when 0) */
+#define DHC_WITH_EFFECT_SUMMARIES 1
+#endif
+#ifndef DHC_WITH_CONVERSIONS     /* dhc_arm_to_standard_dh, quaternions, roll-pitch-yaw */
+#define DHC_WITH_CONVERSIONS 1
+#endif
+
+/* DHC_SMALL_CODE: 1 chooses the compact form of a few loops that faster builds unroll
+ * (the same arithmetic in the same order: the same results). Default: on where the
+ * compiler optimises for size (-Os, -Oz). */
+#ifndef DHC_SMALL_CODE
+#if defined(__OPTIMIZE_SIZE__)
+#define DHC_SMALL_CODE 1
+#else
+#define DHC_SMALL_CODE 0
+#endif
+#endif
+
 /* Programmer errors (NULL where a pointer is required, broken invariants). Data-dependent
  * conditions never go through this: they return a dhc_status. The build defines
  * DHC_ASSERT_TRAPS=1 for hosted and test builds, so a broken invariant stops the program

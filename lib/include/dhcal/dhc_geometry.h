@@ -66,10 +66,13 @@ void dhc_rot_apply_t(const dhc_mat3 *r, const double v[3], double out[3]);
 void dhc_rot_column(const dhc_mat3 *r, size_t c, double out[3]);
 /* Rotation by the vector w (axis w/|w|, angle |w|), Rodrigues' formula; exact for any size. */
 void dhc_rot_exp(const double w_rad[3], dhc_mat3 *r);
+#if DHC_WITH_POSE_SAMPLES || DHC_WITH_CONVERSIONS
 /* Rotation vector of r (inverse of dhc_rot_exp, angle in [0, pi]); accurate near 0 and pi. */
 void dhc_rot_log(const dhc_mat3 *r, double w_rad[3]);
+#endif
 /* R = Rz(yaw) Ry(pitch) Rx(roll), rpy_rad = {roll, pitch, yaw} (docs/formats.md, section 2). */
 void dhc_rot_from_rpy(const double rpy_rad[3], dhc_mat3 *r);
+#if DHC_WITH_CONVERSIONS
 /* Inverse of dhc_rot_from_rpy, pitch in [-pi/2, pi/2]. */
 void dhc_rot_to_rpy(const dhc_mat3 *r, double rpy_rad[3]);
 /* Unit quaternion q = {w, x, y, z} to rotation; q is normalised first. Returns DHC_ERR_NONFINITE
@@ -77,6 +80,7 @@ void dhc_rot_to_rpy(const dhc_mat3 *r, double rpy_rad[3]);
 dhc_status dhc_rot_from_quat(const double q[4], dhc_mat3 *r);
 /* Rotation to unit quaternion {w, x, y, z} with w >= 0. */
 void dhc_quat_from_rot(const dhc_mat3 *r, double q[4]);
+#endif
 
 void dhc_frame_identity(dhc_frame *f);
 /* out = a b (apply b, then a); out may alias neither input. */
