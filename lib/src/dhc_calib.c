@@ -292,7 +292,6 @@ static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *mod
     if (WHITEN(fc) && weights != model) {
         dhc_arm_prepare(&weights->arm, &ws->weights_trig);
     }
-    const dhc_arm_trig *const weights_trig = weights != model ? &ws->weights_trig : &ws->trig;
     if (accumulate) {
         const dhc_status st = dhc_normal_eq_init(&ws->ne, p);
         if (st != DHC_OK) {
@@ -345,6 +344,8 @@ static dhc_status data_pass_weighted(const fit_context *fc, const dhc_model *mod
         if (st == DHC_OK && WHITEN(fc)) {
             /* the covariance at `weights`: its own residual gives the orientation slope (in
              * the workspace: this is the library's deepest call chain) */
+            const dhc_arm_trig *const weights_trig =
+                weights != model ? &ws->weights_trig : &ws->trig;
             double *const r_weights = ws->weights_residual;
             size_t weights_rows = rows;
             memcpy(r_weights, r, sizeof ws->weights_residual);

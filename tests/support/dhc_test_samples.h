@@ -87,11 +87,14 @@ static inline void test_compare_arms(const dhc_arm *a, const dhc_arm *b, size_t 
         double d[3];
         dhc_vec3_sub(pa.pos, pb.pos, d);
         *max_mm = fmax(*max_mm, dhc_vec3_norm(d));
+        /* the angle of pb^T pa from its own sine and cosine (not the library's rotation
+         * log, which a build may leave out, and which this compares) */
         dhc_mat3 rel;
         dhc_rot_tmul(&pb.rot, &pa.rot, &rel);
-        double w[3];
-        dhc_rot_log(&rel, w);
-        *max_rad = fmax(*max_rad, dhc_vec3_norm(w));
+        const double axis[3] = {rel.m[2][1] - rel.m[1][2], rel.m[0][2] - rel.m[2][0],
+                                rel.m[1][0] - rel.m[0][1]};
+        const double cosine = 0.5 * (rel.m[0][0] + rel.m[1][1] + rel.m[2][2] - 1.0);
+        *max_rad = fmax(*max_rad, atan2(0.5 * dhc_vec3_norm(axis), cosine));
     }
 }
 

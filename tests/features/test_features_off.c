@@ -1,0 +1,134 @@
+/* test_features_off.c - the library built with every optional feature left out
+ * (dhc_config.h's DHC_WITH_* all 0, as a controller's build may choose): what is left still
+ * calibrates, and what is out answers with a status, never with a different result. */
+#include <string.h>
+
+#include "dhc_test_arms.h"
+#include "dhc_test_paper.h"
+#include "dhc_test_samples.h"
+#include "dhcal/dhc_calib.h"
+#include "dhcal/dhc_diagnose.h"
+#include "dhcal/dhc_effects.h"
+#include "dhcal/dhc_uncertainty.h"
+#include "unity.h"
+
+#if DHC_WITH_DIAGNOSE || DHC_WITH_SESSION_TESTS || DHC_WITH_UNCERTAINTY || DHC_WITH_EIV ||   \
+    DHC_WITH_POSE_SAMPLES || DHC_WITH_ROBUST_START || DHC_WITH_EFFECT_SUMMARIES ||              \
+    DHC_WITH_CONVERSIONS
+#error "this test is built with every DHC_WITH_* feature 0"
+#endif
+
+void setUp(void) {}
+void tearDown(void) {}
+
+static test_paper_fit paper;
+static dhc_diagnose_workspace dws;
+static dhc_diagnosis diagnosis;
+static dhc_uncertainty unc;
+
+/* The paper's 6-DOF calibration from tool positions: the core is all there. */
+static void test_the_core_fit_reaches_the_true_arm(void)
+{
+    dhc_arm cal;
+    TEST_ASSERT_EQUAL(DHC_OK, test_paper_calibrate(&paper, 6U, DHC_MEAS_POSITION, 30U, 0xFEA7ULL,
+                                                   &cal));
+    TEST_ASSERT_TRUE(paper.rep.converged);
+    TEST_ASSERT_TRUE(paper.rep.rms_mm < 1e-6);
+    dhc_arm truth;
+    dhc_arm nominal;
+    test_paper_arms(6U, &truth, &nominal);
+    test_rng fresh = {7ULL};
+    double max_mm;
+    double max_rad;
+    test_compare_arms(&cal, &truth, 50U, &fresh, &max_mm, &max_rad);
+    TEST_ASSERT_TRUE(max_mm < 1e-5);
+}
+
+static void test_a_noise_model_or_a_robust_start_is_refused(void)
+{
+    dhc_arm cal;
+    (void)test_paper_calibrate(&paper, 3U, DHC_MEAS_POSITION, 20U, 3ULL, &cal);
+    dhc_calib_options opt;
+    dhc_calib_default_options(&opt);
+    TEST_ASSERT_EQUAL(0, opt.robust_start); /* the default follows the build */
+    int on = 1;
+    dhc_noise_model noise;
+    memset(&noise, 0, sizeof noise);
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_noise_model_check(&noise, 3U, &on));
+    TEST_ASSERT_EQUAL(0, on);
+    noise.meas_mm = 0.02;
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_noise_model_check(&noise, 3U, &on));
+    dhc_model model = test_paper3_model();
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&paper.set, &model));
+    const dhc_model before = model;
+    opt.noise = noise;
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
+                      dhc_calib_fit(&model, &paper.set, test_read_sample, &paper.data,
+                                    paper.data.n, paper.data.flags, &opt, &paper.ws, &paper.rep));
+    dhc_calib_default_options(&opt);
+    opt.robust_start = 1;
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
+                      dhc_calib_fit(&model, &paper.set, test_read_sample, &paper.data,
+                                    paper.data.n, paper.data.flags, &opt, &paper.ws, &paper.rep));
+    TEST_ASSERT_EQUAL_MEMORY(&before, &model, sizeof model);
+}
+
+static void test_a_pose_sample_is_refused(void)
+{
+    dhc_model model = test_paper3_model();
+    dhc_sample s;
+    memset(&s, 0, sizeof s);
+    s.kind = (uint8_t)DHC_MEAS_POSE;
+    s.rot.m[0][0] = 1.0;
+    s.rot.m[1][1] = 1.0;
+    s.rot.m[2][2] = 1.0;
+    double r[DHC_MAX_ROWS_PER_SAMPLE];
+    size_t rows = 0U;
+    TEST_ASSERT_NOT_EQUAL(DHC_OK, dhc_model_residual(&model, &s, 1000.0, r, &rows));
+    s.kind = (uint8_t)DHC_MEAS_POSITION;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_model_residual(&model, &s, 1000.0, r, &rows));
+    TEST_ASSERT_EQUAL_size_t(3U, rows);
+}
+
+static void test_the_diagnosis_and_the_uncertainty_are_refused(void)
+{
+    dhc_arm cal;
+    TEST_ASSERT_EQUAL(DHC_OK, test_paper_calibrate(&paper, 3U, DHC_MEAS_POSITION, 20U, 5ULL,
+                                                   &cal));
+    dhc_model model = test_paper3_model();
+    dhc_candidate candidates[4];
+    const dhc_candidate_scope scope = {1, 0, 0};
+    TEST_ASSERT_EQUAL_size_t(0U, dhc_diagnose_candidates(&model, &paper.set, &scope, candidates,
+                                                         4U));
+    dhc_diagnose_options dopt;
+    memset(&dopt, 0, sizeof dopt);
+    diagnosis.count = 7U;
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
+                      dhc_diagnose(&model, &paper.set, paper.rep.identifiable, 1.0, candidates,
+                                   0U, test_read_sample, &paper.data, paper.data.n,
+                                   paper.data.flags, &dopt, &dws, &diagnosis));
+    TEST_ASSERT_EQUAL_size_t(0U, diagnosis.count);
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
+                      dhc_uncertainty_from_samples(&unc, &model, &paper.set, NULL,
+                                                   test_read_sample, &paper.data, paper.data.n,
+                                                   NULL, 1000.0, 0.01));
+}
+
+static void test_effects_keep_their_names_without_summaries(void)
+{
+    const dhc_effect_info *info = dhc_effect_at(0U);
+    TEST_ASSERT_NOT_NULL(info);
+    TEST_ASSERT_TRUE(strlen(info->name) > 0U);
+    TEST_ASSERT_EQUAL_STRING("", info->summary);
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_the_core_fit_reaches_the_true_arm);
+    RUN_TEST(test_a_noise_model_or_a_robust_start_is_refused);
+    RUN_TEST(test_a_pose_sample_is_refused);
+    RUN_TEST(test_the_diagnosis_and_the_uncertainty_are_refused);
+    RUN_TEST(test_effects_keep_their_names_without_summaries);
+    return UNITY_END();
+}
