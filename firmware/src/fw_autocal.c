@@ -185,10 +185,17 @@ fw_fault fw_autocal_configured(const fw_autocal_config *cfg, dhc_model *model,
     if (geo_out != NULL) {
         *geo_out = ws->geo;
     }
+#if DHC_WITH_DIAGNOSE
     const size_t nc = cfg->diagnose != 0
                           ? dhc_diagnose_candidates(&ws->geo, &set, &fw_autocal_scope, ws->cands,
                                                     DHC_MAX_CANDIDATES)
                           : 0U;
+#else
+    if (cfg->diagnose != 0) {
+        return FW_FAULT_ARGUMENT; /* the library of this build has no diagnosis */
+    }
+    const size_t nc = 0U;
+#endif
     if (nc > 0U &&
         dhc_diagnose(&ws->geo, &set, res->geo.identifiable, res->geo.sigma * res->geo.sigma,
                      ws->cands, nc, read_sample, &buf, n, ws->flags, &dopt, &ws->diag_ws,

@@ -52,7 +52,7 @@ void dhc_calib_default_options(dhc_calib_options *opt)
     opt->outlier_floor_mm = 1e-6;
     opt->joint_margin_rad = 0.1;
     opt->reach_margin = 0.1;
-    opt->robust_start = DHC_WITH_ROBUST_START;
+    opt->robust_start = 1; /* a build without it refuses: its callers turn it off, visibly */
     opt->max_outlier_rounds = 3U;
     opt->structural_seed = 12345U;
     memset(&opt->noise, 0, sizeof opt->noise);

@@ -683,15 +683,8 @@ dhc_status dhc_diagnose(const dhc_model *model, const dhc_param_set *base,
     return find_lookalikes(model, base, identifiable, read, ctx, n, flags, opt, ws, out);
 }
 #else
-/* Left out of this build (DHC_WITH_DIAGNOSE 0): no candidates, and a diagnosis asked for
- * all the same is refused. */
-size_t dhc_diagnose_candidates(const dhc_model *model, const dhc_param_set *base,
-                               const dhc_candidate_scope *scope, dhc_candidate *out,
-                               size_t cap)
-{
-    (void)model; (void)base; (void)scope; (void)out; (void)cap;
-    return 0U;
-}
+/* Left out of this build (DHC_WITH_DIAGNOSE 0): a diagnosis is refused (the candidates'
+ * list is not defined: "none" would read as "nothing found"). */
 
 dhc_status dhc_diagnose(const dhc_model *model, const dhc_param_set *base,
                         const uint8_t *identifiable, double sigma2,

@@ -34,10 +34,12 @@ DHC_STATIC_ASSERT(DHC_MAX_PARAMS <= 256U, "DHC_MAX_PARAMS too large for the inde
 /* Features (1: built, the default; 0: left out of the build, for a controller's flash).
  * The whole build, callers included, must agree. A feature left out answers with a
  * status, never with a silently different result: its entry points return
- * DHC_ERR_ARGUMENT (or find nothing: dhc_diagnose_candidates returns 0), model files and
- * samples that need it are refused (dhc_params_add, dhc_sample_check), and functions
- * that return a value rather than a status (dhc_f_log10_sf, the rotation conversions) are
- * not defined at all: a caller fails to link. scripts/target-report lists each one's
+ * DHC_ERR_ARGUMENT (dhc_diagnose, dhc_uncertainty_*, dhc_lsq_prediction_variance,
+ * dhc_arm_to_standard_dh), options and samples that need it are refused (a noise model
+ * that is on, robust_start, pose samples: dhc_calib_fit, dhc_sample_check), and functions
+ * that return a value rather than a status (dhc_diagnose_candidates, dhc_chi2_log10_sf,
+ * dhc_f_log10_sf, dhc_rot_log, the quaternion and roll-pitch-yaw conversions) are not
+ * declared: a caller fails to compile. scripts/target-report --features lists each one's
  * bytes on the Cortex-M4. */
 #ifndef DHC_WITH_DIAGNOSE        /* dhc_diagnose.h: the score test of missing effects */
 #define DHC_WITH_DIAGNOSE 1

@@ -139,11 +139,14 @@ dhc_status dhc_covariate_pose_r2(size_t n_joints, dhc_covariate which, dhc_sampl
  * every joint, base_frame, tool_offset, and the effects scope admits (thermal_scale, drift,
  * measurer effects when the model also has a measurer). Returns the number written (at most
  * cap). */
+#if DHC_WITH_DIAGNOSE /* not defined without the diagnosis: "none" would mean "none found" */
 size_t dhc_diagnose_candidates(const dhc_model *model, const dhc_param_set *base,
                                const dhc_candidate_scope *scope, dhc_candidate *out,
                                size_t cap);
+#endif
 
-/* Scores the candidates against the fitted model. base and identifiable are the fit's
+/* Scores the candidates against the fitted model (DHC_ERR_ARGUMENT in a build without the
+ * diagnosis, DHC_WITH_DIAGNOSE 0). base and identifiable are the fit's
  * parameter set and its identifiable flags (dhc_calib_report), sigma2 its noise variance per
  * row and flags its sample flags (only DHC_SAMPLE_USED rows count).
  * DHC_ERR_CAPACITY when base alone leaves no room for a candidate's columns;
@@ -159,12 +162,16 @@ dhc_status dhc_diagnose(const dhc_model *model, const dhc_param_set *base,
 
 /* log10 of the upper tail P(X > chi2) of chi-square with dof degrees of freedom, accurate
  * far into the tail (no underflow to -inf before ~1e300). dof >= 1, chi2 >= 0. */
+#if DHC_WITH_DIAGNOSE
 double dhc_chi2_log10_sf(double chi2, size_t dof);
+#endif
 
 /* log10 of the upper tail P(X > f) of Fisher's F with (d1, d2) degrees of freedom: the
  * lack-of-fit test against replicated measurements (regularized incomplete beta by its
  * continued fraction, in logs). d1, d2 >= 1, f >= 0; 0 for f <= 0. */
+#if DHC_WITH_SESSION_TESTS
 double dhc_f_log10_sf(double f, size_t d1, size_t d2);
+#endif
 
 #ifdef __cplusplus
 }
