@@ -142,6 +142,15 @@ fw_fault fw_autocal_configured(const fw_autocal_config *cfg, dhc_model *model,
     sample_buf buf = {samples, n};
     dhc_calib_options opt;
     dhc_calib_default_options(&opt);
+    const size_t nj = model->arm.n_joints;
+    for (size_t i = 0U; i < n; ++i) {
+        for (size_t j = 0U; j < nj && j < DHC_MAX_JOINTS; ++j) {
+            ws->joint_sincos[2U * (nj * i + j)] = sin(samples[i].q_rad[j]);
+            ws->joint_sincos[2U * (nj * i + j) + 1U] = cos(samples[i].q_rad[j]);
+        }
+    }
+    opt.joint_sincos = ws->joint_sincos;
+    opt.sample_error2 = ws->err2;
     dhc_diagnose_options dopt;
     dhc_diagnose_default_options(&dopt);
     if (cfg->io != NULL) {

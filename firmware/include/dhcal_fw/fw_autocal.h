@@ -89,8 +89,11 @@ typedef struct {
 /* No configured effects; the diagnosis on; no noise model. */
 void fw_autocal_default_config(fw_autocal_config *cfg);
 
-/* Everything a calibration needs besides the caller's samples (about 175 KiB with the
- * default DHC_MAX_PARAMS of 64: static storage, not a stack); scratch between calls. */
+/* Everything a calibration needs besides the caller's samples (about 190 KiB with the
+ * default DHC_MAX_PARAMS of 64: static storage, not a stack); scratch between calls.
+ * joint_sincos and err2 hold what the fit would otherwise compute again on every pass over
+ * the samples (dhc_calib_options): with soft doubles a sine costs the M4 thousands of
+ * instructions. */
 typedef struct {
     dhc_calib_workspace cal;
     dhc_diagnose_workspace diag_ws;
@@ -101,6 +104,8 @@ typedef struct {
     dhc_model geo;
     double err_new[FW_ACQ_MAX_SAMPLES];
     double err_old[FW_ACQ_MAX_SAMPLES];
+    double joint_sincos[2U * DHC_MAX_JOINTS * FW_ACQ_MAX_SAMPLES];
+    double err2[FW_ACQ_MAX_SAMPLES];
 } fw_autocal_workspace;
 
 /* fw_autocal with a configuration: the "base" fit (res->geo, geo_out) is the geometry plus
