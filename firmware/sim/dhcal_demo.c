@@ -251,14 +251,18 @@ static int write_outputs(const char *dir, size_t n, const char *effect)
 static const char *const usage_text =
     "usage: dhcal-demo --scenario S.json [--json] [--out DIR] [--samples N] [--targets N]\n"
     "                  [--mixed-directions] [--effects LIST] [--no-diagnose] [--unweighted]\n"
-    "                  [--start-deg Q1,...,QN]\n"
+    "                  [--start-deg Q1,...,QN] [--plan-candidates K]\n"
     "  --start-deg LIST where the arm stands when the controller starts, one angle per joint\n"
     "                   (default for the paper's 3-joint arm: 0,60,-60)\n"
     "  --effects LIST   the controller's configured effects, fitted in every calibration\n"
     "                   (e.g. joint_compliance:2,measurer_scale)\n"
     "  --no-diagnose    fit only those; do not look for a missing one\n"
     "  --unweighted     no noise model (encoder quantisation, wire noise): plain least "
-    "squares\n";
+    "squares\n"
+    "  --plan-candidates K  measure the N poses of K random candidates that observe the\n"
+    "                   fitted parameters best (a D-optimal plan; K > N, at most "
+    "4 x 128); 0, the\n"
+    "                   default: N random poses\n";
 
 /* A count in 0..max, digits only. */
 static int parse_count(const char *s, size_t max, size_t *out)
@@ -285,7 +289,8 @@ enum {
     OPT_EFFECTS,
     OPT_NO_DIAGNOSE,
     OPT_UNWEIGHTED,
-    OPT_START
+    OPT_START,
+    OPT_PLAN
 };
 
 /* "a,b,c" into q_deg (at most DHC_MAX_JOINTS finite angles in [-720, 720]); the count, or 0
@@ -319,6 +324,7 @@ int main(int argc, char **argv)
         {"no-diagnose", no_argument, NULL, OPT_NO_DIAGNOSE},
         {"unweighted", no_argument, NULL, OPT_UNWEIGHTED},
         {"start-deg", required_argument, NULL, OPT_START},
+        {"plan-candidates", required_argument, NULL, OPT_PLAN},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
     const char *scenario = NULL;
@@ -327,6 +333,7 @@ int main(int argc, char **argv)
     int mixed_dirs = 0;
     size_t n_samples = 60U;
     size_t n_targets = 20U;
+    size_t n_candidates = 0U;
     fw_autocal_config autocal;
     fw_autocal_default_config(&autocal);
     const char *effects = NULL;
@@ -355,6 +362,13 @@ int main(int argc, char **argv)
             break;
         case OPT_TARGETS:
             bad = parse_count(optarg, MAX_TARGETS, &n_targets);
+            break;
+        case OPT_PLAN:
+            bad = parse_count(optarg, FW_PLAN_MAX_CANDIDATES, &n_candidates);
+            if (bad) {
+                fprintf(stderr, "dhcal-demo: --plan-candidates: '%s' is not a count in 0..%u\n",
+                        optarg, FW_PLAN_MAX_CANDIDATES);
+            }
             break;
         case OPT_EFFECTS:
             effects = optarg;
@@ -397,6 +411,11 @@ int main(int argc, char **argv)
     }
     if (optind < argc) {
         fprintf(stderr, "dhcal-demo: unexpected argument '%s'\n%s", argv[optind], usage_text);
+        return 2;
+    }
+    if (n_candidates != 0U && n_candidates <= n_samples) {
+        fprintf(stderr, "dhcal-demo: --plan-candidates %zu: need more candidates than the %zu "
+                        "samples\n", n_candidates, n_samples);
         return 2;
     }
     if (scenario == NULL || n_samples < 10U || n_samples > FW_ACQ_MAX_SAMPLES ||
@@ -453,6 +472,7 @@ int main(int argc, char **argv)
     memcpy(jc.q_start_rad, q_start, sizeof jc.q_start_rad);
     jc.n_samples = n_samples;
     jc.plan_seed = 4242U;
+    jc.plan_candidates = n_candidates;
     jc.mixed_dirs = mixed_dirs;
     jc.hold_ticks = 200U;
     /* the calibration's noise model: encoder quantisation from the io configuration, the
@@ -480,8 +500,10 @@ int main(int argc, char **argv)
     }
     const size_t n_done = job.n_samples;
     const double o1 = job.o1;
-    fprintf(log, "(b) %zu samples (plan of %zu poses, observability O1 %.4g over %zu of %zu "
-                 "parameters)\n", n_done, job.n_plan, o1, job.o1_rank, job.o1_params);
+    fprintf(log, "(b) %zu samples (%s plan of %zu poses%s, observability O1 %.4g over %zu of "
+                 "%zu parameters)\n", n_done, n_candidates > 0U ? "D-optimal" : "random",
+            job.n_plan, n_candidates > 0U ? " out of the candidates" : "", o1, job.o1_rank,
+            job.o1_params);
     if (fa != FW_FAULT_NONE) {
         fprintf(stderr, "dhcal-demo: fault %s (index %zu) during acquisition\n",
                 fw_fault_name(fa), job.ctrl.fault_index);

@@ -68,16 +68,38 @@ fw_fault fw_job_plan(fw_job *job)
     if (job->ctrl.fault != FW_FAULT_NONE) {
         return job->ctrl.fault;
     }
-    job->n_plan = fw_plan_poses(&job->nominal, job->cfg.n_samples, job->cfg.plan_seed,
-                                job->cfg.mixed_dirs, job->plan);
+    dhc_param_set base;
+    const int have_base = dhc_params_base_model(&base, &job->nominal) == DHC_OK;
+    if (job->cfg.plan_candidates > 0U) {
+        /* what the calibration will fit: the base model and the configured effects */
+        dhc_param_set fitted = base;
+        const fw_autocal_config *ac = &job->cfg.autocal;
+        int ok = have_base && ac->n_effects <= FW_AUTOCAL_MAX_EFFECTS;
+        for (size_t e = 0U; ok && e < ac->n_effects; ++e) {
+            ok = dhc_params_add_effect(&fitted, &job->nominal, ac->effect[e],
+                                       ac->effect_joint[e]) == DHC_OK;
+        }
+        if (!ok) {
+            return job_fault(job, FW_FAULT_ARGUMENT);
+        }
+#if DHC_WITH_PLAN
+        job->n_plan = fw_plan_select(&job->nominal, &fitted, job->cfg.n_samples,
+                                     job->cfg.plan_candidates, job->cfg.plan_seed,
+                                     job->cfg.mixed_dirs, &job->plan_ws, job->plan);
+#else
+        return job_fault(job, FW_FAULT_ARGUMENT); /* the library of this build plans not */
+#endif
+    } else {
+        job->n_plan = fw_plan_poses(&job->nominal, job->cfg.n_samples, job->cfg.plan_seed,
+                                    job->cfg.mixed_dirs, job->plan);
+    }
     if (job->n_plan == 0U) {
         return job_fault(job, FW_FAULT_UNDERDETERMINED);
     }
-    dhc_param_set base;
     job->o1 = 0.0;
     job->o1_rank = 0U;
     job->o1_params = 0U;
-    if (dhc_params_base_model(&base, &job->nominal) == DHC_OK) {
+    if (have_base) {
         job->o1_params = base.count;
         /* a score, not a gate: a plan the analysis cannot score still runs */
         (void)fw_plan_observability(&job->nominal, &base, job->plan, job->n_plan,

@@ -4,10 +4,6 @@
 #include <math.h>
 #include <string.h>
 
-#include "dhcal/dhc_jacobian.h"
-
-/* Below this the scaled normal matrix's pivot is no information (fw_plan.h). */
-#define OBSERVABILITY_PIVOT_TOL 1e-10
 
 static uint32_t rng_next(uint32_t *s)
 {
@@ -79,45 +75,49 @@ dhc_status fw_pose_wires(const dhc_model *model, const fw_pose *pose, double wir
     return st;
 }
 
+typedef struct {
+    const dhc_model *model;
+    const fw_pose *poses;
+} pose_list;
+
+static dhc_status read_pose(void *ctx, size_t index, dhc_sample *out)
+{
+    const pose_list *l = ctx;
+    pose_sample(l->model, &l->poses[index], out);
+    return DHC_OK;
+}
+
+#if DHC_WITH_PLAN
+size_t fw_plan_select(const dhc_model *model, const dhc_param_set *set, size_t n,
+                      size_t candidates, uint32_t seed, int mixed_dirs, fw_plan_workspace *ws,
+                      fw_pose *poses)
+{
+    if (model == NULL || set == NULL || ws == NULL || poses == NULL || n == 0U ||
+        n > FW_PLAN_MAX_POSES || candidates > FW_PLAN_MAX_CANDIDATES) {
+        return 0U;
+    }
+    const size_t k = fw_plan_poses(model, candidates, seed, mixed_dirs, ws->candidates);
+    pose_list list = {model, ws->candidates};
+    dhc_plan_report rep;
+    if (k < n || dhc_plan_select(model, set, read_pose, &list, k, n, NULL, &ws->lib,
+                                 ws->chosen, &rep) != DHC_OK) {
+        return 0U;
+    }
+    for (size_t i = 0U; i < n; ++i) {
+        poses[i] = ws->candidates[ws->chosen[i]];
+    }
+    return n;
+}
+#endif
+
 dhc_status fw_plan_observability(const dhc_model *model, const dhc_param_set *set,
                                  const fw_pose *poses, size_t n, fw_plan_workspace *ws,
                                  double *o1, size_t *rank)
 {
-    const size_t p = set != NULL ? set->count : 0U;
-    if (p == 0U || n == 0U || o1 == NULL || ws == NULL || poses == NULL || model == NULL) {
+    if (poses == NULL || ws == NULL || model == NULL) {
         return DHC_ERR_ARGUMENT;
     }
-    dhc_status st = dhc_normal_eq_init(&ws->ne, p);
-    double rows_buf[3U * DHC_MAX_PARAMS];
-    const double zero_residual[3] = {0.0, 0.0, 0.0};
-    for (size_t i = 0U; i < n && st == DHC_OK; ++i) {
-        dhc_sample s;
-        pose_sample(model, &poses[i], &s);
-        dhc_mat jac;
-        st = dhc_mat_init(&jac, 3U, p, rows_buf, sizeof rows_buf / sizeof rows_buf[0]);
-        if (st == DHC_OK) {
-            st = dhc_model_jacobian(model, set, &s, DHC_ORIENTATION_WEIGHT_MM_PER_RAD, &jac, NULL);
-        }
-        if (st == DHC_OK) {
-            st = dhc_normal_eq_add(&ws->ne, &jac, zero_residual, NULL, 3U);
-        }
-    }
-    if (st == DHC_OK) {
-        st = dhc_lsq_analyse(&ws->ne, OBSERVABILITY_PIVOT_TOL, &ws->fac);
-    }
-    if (st != DHC_OK) {
-        return st;
-    }
-    /* det of the scaled normal matrix over the kept pivots: prod L_kk^2 */
-    double log_det = 0.0;
-    const size_t kept = ws->fac.rank;
-    for (size_t k = 0U; k < kept; ++k) {
-        log_det += 2.0 * log(ws->fac.factor[k * p + k]);
-    }
-    if (rank != NULL) {
-        *rank = kept;
-    }
-    /* prod sigma = sqrt(det N) */
-    *o1 = kept > 0U ? exp(0.5 * log_det / (double)kept) / sqrt(3.0 * (double)n) : 0.0;
-    return DHC_OK;
+    pose_list list = {model, poses};
+    return dhc_plan_observability(model, set, read_pose, &list, NULL, n, &ws->lib, o1,
+                                  rank);
 }

@@ -10,6 +10,7 @@
 #include "dhcal/dhc_diagnose.h"
 #include "dhcal/dhc_effects.h"
 #include "dhcal/dhc_uncertainty.h"
+#include "dhcal/dhc_plan.h"
 #include "unity.h"
 
 #if DHC_WITH_DIAGNOSE || DHC_WITH_SESSION_TESTS || DHC_WITH_UNCERTAINTY || DHC_WITH_EIV ||   \
@@ -131,6 +132,27 @@ static void test_the_diagnosis_and_the_uncertainty_are_refused(void)
                                                    NULL, 1000.0, 0.01));
 }
 
+static dhc_plan_workspace plan_ws;
+
+/* The plan's selection is refused; the score of a plan stays. */
+static void test_pose_selection_is_refused_its_score_kept(void)
+{
+    dhc_arm cal;
+    TEST_ASSERT_EQUAL(DHC_OK, calibrate(3U, 20U, 5ULL, &cal));
+    const dhc_model model = test_paper3_model();
+    size_t chosen[5];
+    dhc_plan_report rep;
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
+                      dhc_plan_select(&model, &paper.set, test_read_sample, &paper.data,
+                                      paper.data.n, 5U, NULL, &plan_ws, chosen, &rep));
+    double o1 = 0.0;
+    size_t rank = 0U;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_observability(&model, &paper.set, test_read_sample,
+                                                     &paper.data, NULL, paper.data.n, &plan_ws,
+                                                     &o1, &rank));
+    TEST_ASSERT_TRUE(o1 > 0.0 && rank > 0U);
+}
+
 static void test_effects_keep_their_names_without_summaries(void)
 {
     const dhc_effect_info *info = dhc_effect_at(0U);
@@ -146,6 +168,7 @@ int main(void)
     RUN_TEST(test_a_noise_model_or_a_robust_start_is_refused);
     RUN_TEST(test_a_pose_sample_is_refused);
     RUN_TEST(test_the_diagnosis_and_the_uncertainty_are_refused);
+    RUN_TEST(test_pose_selection_is_refused_its_score_kept);
     RUN_TEST(test_effects_keep_their_names_without_summaries);
     return UNITY_END();
 }

@@ -38,7 +38,7 @@
 #include "dhcal_fw/fw_controller.h"
 #include "dhcal_fw/fw_plan.h"
 
-#define FW_ACQ_MAX_SAMPLES 128U
+#define FW_ACQ_MAX_SAMPLES FW_PLAN_MAX_POSES
 /* pair check of fw_acquire: |measured - predicted wire change| bound, mm and share */
 #define FW_ACQ_PAIR_TOL_MM 10.0
 #define FW_ACQ_PAIR_TOL_REL 0.25

@@ -31,6 +31,15 @@ typedef struct {
                                            homed there (the joints' n_joints first) */
     size_t n_samples;      /* poses in the plan, 1..FW_ACQ_MAX_SAMPLES */
     uint32_t plan_seed;
+    size_t plan_candidates; /* 0: the plan is n_samples random poses; else the n_samples
+                               of this many random candidates (at most
+                               FW_PLAN_MAX_CANDIDATES) that observe the base model and the
+                               configured effects best (fw_plan_select). Such a plan
+                               gathers the poses where those parameters show most: a
+                               diagnosis of effects not named needs the spread of random
+                               poses (measured: dhcal-demo's hidden joint_compliance:2 is
+                               told from joint_scale:2 with 30 random poses, not with 30
+                               planned ones) */
     int mixed_dirs;        /* approach directions drawn +-1 (fw_plan.h) */
     uint32_t hold_ticks;   /* ticks averaged per sample */
     int noise_model;       /* 1: the fits weight by the encoders' quantisation and the
@@ -75,7 +84,8 @@ void fw_job_default_config(fw_job_config *cfg, const dhc_model *nominal);
 fw_fault fw_job_boot(fw_job *job, const fw_job_config *cfg, const dhc_model *nominal,
                      const fw_port *port, const fw_io_config *io);
 
-/* Plan: the poses (fw_plan_poses) and their observability for the base model.
+/* Plan: the poses (fw_plan_poses, or fw_plan_select with plan_candidates) and their
+ * observability for the base model.
  * FW_FAULT_UNDERDETERMINED when the joint ranges leave no pose. */
 fw_fault fw_job_plan(fw_job *job);
 

@@ -35,7 +35,7 @@ DHC_STATIC_ASSERT(DHC_MAX_PARAMS <= 256U, "DHC_MAX_PARAMS too large for the inde
  * The whole build, callers included, must agree. A feature left out answers with a
  * status, never with a silently different result: its entry points return
  * DHC_ERR_ARGUMENT (dhc_diagnose, dhc_uncertainty_*, dhc_lsq_prediction_variance,
- * dhc_arm_to_standard_dh), options and samples that need it are refused (a noise model
+ * dhc_arm_to_standard_dh, dhc_plan_select), options and samples that need it are refused (a noise model
  * that is on, robust_start, pose samples: dhc_calib_fit, dhc_sample_check), and functions
  * that return a value rather than a status (dhc_diagnose_candidates, dhc_chi2_log10_sf,
  * dhc_f_log10_sf, dhc_rot_log, the quaternion and roll-pitch-yaw conversions) are not
@@ -65,6 +65,9 @@ DHC_STATIC_ASSERT(DHC_MAX_PARAMS <= 256U, "DHC_MAX_PARAMS too large for the inde
 #endif
 #ifndef DHC_WITH_CONVERSIONS     /* dhc_arm_to_standard_dh, quaternions, roll-pitch-yaw */
 #define DHC_WITH_CONVERSIONS 1
+#endif
+#ifndef DHC_WITH_PLAN            /* dhc_plan_select: D-optimal pose plans */
+#define DHC_WITH_PLAN 1
 #endif
 
 /* DHC_SMALL_CODE: 1 chooses the compact form of a few loops that faster builds unroll

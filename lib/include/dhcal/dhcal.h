@@ -19,6 +19,7 @@
 #include "dhc_matrix.h"
 #include "dhc_model.h"
 #include "dhc_params.h"
+#include "dhc_plan.h"
 #include "dhc_status.h"
 #include "dhc_trilat.h"
 #include "dhc_uncertainty.h"

@@ -97,6 +97,41 @@ static void test_samples_keep_encoder_angles_directions_and_raw_lengths(void)
     TEST_ASSERT_TRUE(rank >= set.count - 2U);
 }
 
+/* A planned plan: n of the candidates fw_plan_poses draws (so inside the workspace limits),
+ * distinct, and observing the parameters better than the first n of those candidates, the
+ * random plan of the same seed. */
+static void test_planned_poses_come_from_the_candidates_and_observe_better(void)
+{
+    dhc_param_set set;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &model));
+    static fw_pose candidates[120];
+    TEST_ASSERT_EQUAL_size_t(120U, fw_plan_poses(&model, 120U, 9U, 0, candidates));
+    fw_pose planned[20];
+    TEST_ASSERT_EQUAL_size_t(20U, fw_plan_select(&model, &set, 20U, 120U, 9U, 0, &plan_ws,
+                                                 planned));
+    for (size_t i = 0U; i < 20U; ++i) {
+        size_t found = 0U;
+        for (size_t c = 0U; c < 120U; ++c) {
+            found += memcmp(&planned[i], &candidates[c], sizeof planned[i]) == 0 ? 1U : 0U;
+        }
+        TEST_ASSERT_EQUAL_size_t(1U, found);
+        for (size_t j = 0U; j < i; ++j) {
+            TEST_ASSERT_NOT_EQUAL(0, memcmp(&planned[i], &planned[j], sizeof planned[i]));
+        }
+    }
+    double o1_planned = 0.0;
+    double o1_random = 0.0;
+    TEST_ASSERT_EQUAL(DHC_OK, fw_plan_observability(&model, &set, planned, 20U, &plan_ws,
+                                                    &o1_planned, NULL));
+    TEST_ASSERT_EQUAL(DHC_OK, fw_plan_observability(&model, &set, candidates, 20U, &plan_ws,
+                                                    &o1_random, NULL));
+    TEST_ASSERT_TRUE(o1_planned > 1.1 * o1_random);
+    /* more poses than candidates pass the limits, or than the workspace holds: none */
+    TEST_ASSERT_EQUAL_size_t(0U, fw_plan_select(&model, &set, 20U, 15U, 9U, 0, &plan_ws, planned));
+    TEST_ASSERT_EQUAL_size_t(0U, fw_plan_select(&model, &set, 20U, FW_PLAN_MAX_CANDIDATES + 1U,
+                                                9U, 0, &plan_ws, planned));
+}
+
 static void test_encoder_jump_stops_the_drives(void)
 {
     const double q[3] = {0.3, 1.2, -0.8};
@@ -191,6 +226,7 @@ int main(void)
     UNITY_BEGIN();
     RUN_TEST(test_move_settles_on_target_and_records_direction);
     RUN_TEST(test_samples_keep_encoder_angles_directions_and_raw_lengths);
+    RUN_TEST(test_planned_poses_come_from_the_candidates_and_observe_better);
     RUN_TEST(test_encoder_jump_stops_the_drives);
     RUN_TEST(test_tacho_disagreeing_with_the_encoder_stops_the_drives);
     RUN_TEST(test_drive_saturated_too_long_stops_the_drives);

@@ -1,0 +1,100 @@
+/* dhc_plan.h - calibration pose plans: which poses to measure so that few measurements
+ * identify the parameters well.
+ *
+ * dhc_plan_select chooses n poses out of k candidates (the caller's: random poses inside the
+ * joint ranges and its workspace limits, handed out by a dhc_sample_reader) that maximise
+ * the determinant of the plan's information matrix J^T J over the parameters of the set
+ * (D-optimality: the volume of the parameters' confidence ellipsoid shrinks as 1/sqrt(det)).
+ * First every candidate's Jacobian is accumulated: the parameters that no plan drawn from
+ * these candidates can identify (a pivot of the candidates' joint information below 1e-10,
+ * dhc_lsq_analyse) are left out of the criterion, and the columns are scaled so that one
+ * pose contributes about 1 to each diagonal entry (the criterion does not depend on the
+ * scaling; the arithmetic does). Then a greedy start adds, n times, the candidate that
+ * raises log det the most (a small ridge, 1e-6 of one pose, keeps the first steps defined),
+ * and Fedorov's exchange swaps a chosen pose for an unchosen one while that raises log det,
+ * until no swap does or DHC_PLAN_MAX_EXCHANGE_PASSES passes over the plan. Ties go to the
+ * lower candidate index: the same candidates give the same plan.
+ *
+ * dhc_plan_observability scores any plan with the observability index O1 of Borm and Menq,
+ *     O1 = (prod_k sigma_k)^(1/r) / sqrt(m),
+ * sigma_k the singular values of the plan's identification Jacobian (m rows, its columns
+ * scaled to unit norm), over the r parameters the plan identifies (pivot >= 1e-10), computed
+ * as sqrt(det) of the scaled normal matrix from its pivoted Cholesky factor.
+ *
+ * Both read each candidate through the model's analytic Jacobian (dhc_model_jacobian):
+ * nothing is measured, a plan is scored before it runs. No heap; the scratch is the
+ * workspace's (about 32 DHC_MAX_PARAMS^2 bytes: static storage, not a stack). Optional
+ * storage of the caller's for the candidates' Jacobian rows spares evaluating the model
+ * again on every pass (the same plan either way). A build with DHC_WITH_PLAN 0 leaves the
+ * selection out (dhc_plan_select answers DHC_ERR_ARGUMENT); the score stays.
+ */
+#ifndef DHC_PLAN_H
+#define DHC_PLAN_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "dhc_calib.h"
+#include "dhc_config.h"
+#include "dhc_lsq.h"
+#include "dhc_model.h"
+#include "dhc_params.h"
+#include "dhc_status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Passes of Fedorov's exchange over the plan, at most. */
+#define DHC_PLAN_MAX_EXCHANGE_PASSES 20U
+
+typedef struct {
+    dhc_normal_eq ne;   /* the candidates' (or the plan's) information, unscaled */
+    dhc_lsq_factor fac; /* its analysis */
+    double info[DHC_MAX_PARAMS * DHC_MAX_PARAMS];   /* the plan's, scaled, kept parameters */
+    double chol[DHC_MAX_PARAMS * DHC_MAX_PARAMS];   /* its Cholesky factor (lower) */
+    double jac[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS];
+    double rows[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS]; /* a candidate's scaled rows */
+    double solved[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS];
+    double scale[DHC_MAX_PARAMS];
+    size_t kept[DHC_MAX_PARAMS]; /* the parameters the criterion uses (set indices) */
+    size_t n_kept;
+    size_t rows_per_pose;
+    dhc_sample sample;
+} dhc_plan_workspace;
+
+typedef struct {
+    size_t usable;       /* candidates whose Jacobian could be evaluated */
+    size_t identifiable; /* parameters some plan from the candidates identifies: the
+                            criterion's; the set's others are left out */
+    double log_det;      /* ln det of the plan's scaled information over them */
+    size_t exchanges;    /* swaps the exchange made after the greedy start */
+    double o1;           /* the plan's observability index (dhc_plan_observability) */
+    size_t rank;         /* parameters the plan identifies */
+} dhc_plan_report;
+
+/* Chooses n of the k candidates read(ctx, 0 .. k-1, ...) (samples of one kind: position,
+ * wires or pose; their measured values are not read) into chosen[0 .. n-1] (indices, in
+ * the order chosen). rows_store: NULL, or k R set->count doubles of the caller's (R = the
+ * candidates' rows per sample, 3 or 6) that keep the Jacobians between passes.
+ * Errors: DHC_ERR_ARGUMENT (NULL, n = 0, n above the usable candidates, candidates of
+ * different row counts), DHC_ERR_CAPACITY (set larger than DHC_MAX_PARAMS), the reader's
+ * error, DHC_ERR_UNDERDETERMINED (no parameter identifiable from all candidates). A
+ * candidate whose Jacobian is not finite is never chosen. */
+dhc_status dhc_plan_select(const dhc_model *model, const dhc_param_set *set,
+                           dhc_sample_reader read, void *ctx, size_t k, size_t n,
+                           double *rows_store, dhc_plan_workspace *ws, size_t *chosen,
+                           dhc_plan_report *rep);
+
+/* O1 of the plan made of read(ctx, index[i]) for i < n (index NULL: 0 .. n-1) for the
+ * set, and in *rank (may be NULL) the parameters it identifies. Errors of the reader and of
+ * dhc_model_jacobian; DHC_ERR_ARGUMENT for NULL or n = 0. */
+dhc_status dhc_plan_observability(const dhc_model *model, const dhc_param_set *set,
+                                  dhc_sample_reader read, void *ctx, const size_t *index,
+                                  size_t n, dhc_plan_workspace *ws, double *o1, size_t *rank);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* DHC_PLAN_H */
