@@ -12,7 +12,7 @@
 /* The ridge that keeps a plan of fewer poses than parameters factorable, in units of one
  * pose's average information (the columns' scale). */
 #define PLAN_RIDGE 1e-6
-/* A swap must raise ln det by more than this (relative): rounding is no improvement. */
+/* A swap must lower the criterion by more than this (relative): rounding is no gain. */
 #define PLAN_MIN_GAIN 1e-10
 
 static double sq(double x)
@@ -71,6 +71,15 @@ static void info_add(dhc_plan_workspace *ws, double sign)
     }
 }
 
+/* The ridge alone: an empty plan. */
+static void clear_info(dhc_plan_workspace *ws)
+{
+    memset(ws->info, 0, sizeof ws->info);
+    for (size_t i = 0U; i < ws->n_kept; ++i) {
+        ws->info[i * (DHC_MAX_PARAMS + 1U)] = PLAN_RIDGE;
+    }
+}
+
 /* Cholesky of ws->info into ws->chol (lower triangles, row stride DHC_MAX_PARAMS). */
 static dhc_status factor_info(dhc_plan_workspace *ws)
 {
@@ -83,42 +92,91 @@ static dhc_status factor_info(dhc_plan_workspace *ws)
     return dhc_chol_in_place(&t, r, 0.0, PLAN_RIDGE * 1e-6);
 }
 
-/* ln det(I + Y L^-T L^-1 Y^T) for the candidate's scaled rows Y (ws->rows): by how much ln
- * det of the information the factor L belongs to rises when the candidate joins it. */
-static double gain(dhc_plan_workspace *ws)
+/* Cholesky of the small symmetric g (rows x rows, row stride DHC_MAX_ROWS_PER_SAMPLE) in
+ * place; 0 when it is not positive definite. */
+static int small_chol(double g[DHC_MAX_ROWS_PER_SAMPLE][DHC_MAX_ROWS_PER_SAMPLE], size_t rows)
 {
-    const size_t r = ws->n_kept;
-    const size_t rows = ws->rows_per_pose;
-    const dhc_tri t = chol_tri(ws);
-    for (size_t row = 0U; row < rows; ++row) {
-        memcpy(ws->solved + row * r, ws->rows + row * r, r * sizeof ws->solved[0]);
-        dhc_tri_forward(&t, r, ws->solved + row * r);
-    }
-    /* G = I + Z^T Z (rows x rows, Z = L^-1 Y^T), ln det by its own small Cholesky */
-    double g[DHC_MAX_ROWS_PER_SAMPLE][DHC_MAX_ROWS_PER_SAMPLE];
-    double log_det = 0.0;
     for (size_t a = 0U; a < rows; ++a) {
         for (size_t b = 0U; b <= a; ++b) {
-            double v = a == b ? 1.0 : 0.0;
-            for (size_t i = 0U; i < r; ++i) {
-                v += ws->solved[a * r + i] * ws->solved[b * r + i];
-            }
+            double v = g[a][b];
             for (size_t m = 0U; m < b; ++m) {
                 v -= g[a][m] * g[b][m];
             }
             if (a == b) {
-                g[a][a] = sqrt(v); /* v >= 1 in exact arithmetic: I + a Gram matrix */
-                log_det += 2.0 * log(g[a][a]);
+                if (!(v > 0.0)) {
+                    return 0;
+                }
+                g[a][a] = sqrt(v);
             } else {
                 g[a][b] = v / g[b][b];
             }
         }
     }
-    return dhc_is_finite(log_det) ? log_det : -HUGE_VAL;
+    return 1;
 }
 
-/* The candidate's scaled rows over the kept parameters into ws->rows; -HUGE_VAL gain
- * (never chosen) for a candidate whose Jacobian is not finite, *st for other errors. */
+/* By how much the candidate (its transformed rows Y in ws->rows) lowers trace(M^-1), M the
+ * plan's transformed information that the factor L belongs to:
+ *     trace((I + Y M^-1 Y^T)^-1 Y M^-2 Y^T)
+ * (Sherman-Morrison-Woodbury), from Z = L^-1 Y^T and G = L^-T Z. -HUGE_VAL when that is
+ * not finite. */
+static double gain(dhc_plan_workspace *ws)
+{
+    const size_t r = ws->n_kept;
+    const size_t rows = ws->rows_per_pose;
+    const dhc_tri t = chol_tri(ws);
+    double u[DHC_MAX_ROWS_PER_SAMPLE][DHC_MAX_ROWS_PER_SAMPLE];
+    double v[DHC_MAX_ROWS_PER_SAMPLE][DHC_MAX_ROWS_PER_SAMPLE];
+    for (size_t row = 0U; row < rows; ++row) {
+        double *z = ws->solved + row * r;
+        double *g = ws->back + row * r;
+        memcpy(z, ws->rows + row * r, r * sizeof z[0]);
+        dhc_tri_forward(&t, r, z);
+        memcpy(g, z, r * sizeof g[0]);
+        dhc_tri_backward(&t, r, g);
+    }
+    for (size_t a = 0U; a < rows; ++a) {
+        for (size_t b = 0U; b <= a; ++b) {
+            double zz = a == b ? 1.0 : 0.0;
+            double gg = 0.0;
+            for (size_t i = 0U; i < r; ++i) {
+                zz += ws->solved[a * r + i] * ws->solved[b * r + i];
+                gg += ws->back[a * r + i] * ws->back[b * r + i];
+            }
+            u[a][b] = zz;
+            v[a][b] = gg;
+            v[b][a] = gg;
+        }
+    }
+    if (!small_chol(u, rows)) {
+        return -HUGE_VAL;
+    }
+    /* trace(U^-1 V) = sum over V's columns c of c^T U^-1 c... as |C^-1 V^(1/2)|: here
+     * trace(U^-1 V) = sum_k (U^-1 V)_kk, column by column through U's factor */
+    double tr = 0.0;
+    for (size_t col = 0U; col < rows; ++col) {
+        double x[DHC_MAX_ROWS_PER_SAMPLE];
+        for (size_t a = 0U; a < rows; ++a) {
+            x[a] = v[a][col];
+            for (size_t m = 0U; m < a; ++m) {
+                x[a] -= u[a][m] * x[m];
+            }
+            x[a] /= u[a][a];
+        }
+        for (size_t a = rows; a-- > 0U;) {
+            for (size_t m = a + 1U; m < rows; ++m) {
+                x[a] -= u[m][a] * x[m];
+            }
+            x[a] /= u[a][a];
+        }
+        tr += x[col];
+    }
+    return dhc_is_finite(tr) ? tr : -HUGE_VAL;
+}
+
+/* The candidate's rows over the kept parameters into ws->rows, scaled and transformed by
+ * C^-1 (W = C C^T the candidates' average information: trace(M^-1 W) becomes trace(M^-1));
+ * 0 (never chosen) for a candidate whose Jacobian is not finite, *st for other errors. */
 static int load_rows(const dhc_model *model, const dhc_param_set *set, dhc_sample_reader read,
                      void *ctx, size_t c, const double *store, dhc_plan_workspace *ws,
                      dhc_status *st)
@@ -132,11 +190,13 @@ static int load_rows(const dhc_model *model, const dhc_param_set *set, dhc_sampl
         return 0;
     }
     const size_t p = set->count;
+    const dhc_tri w = {ws->wchol, DHC_MAX_PARAMS, 1U, ws->wchol, DHC_MAX_PARAMS + 1U};
     for (size_t row = 0U; row < ws->rows_per_pose; ++row) {
+        double *y = ws->rows + row * ws->n_kept;
         for (size_t k = 0U; k < ws->n_kept; ++k) {
-            ws->rows[row * ws->n_kept + k] =
-                ws->jac[row * p + ws->kept[k]] * ws->scale[ws->kept[k]];
+            y[k] = ws->jac[row * p + ws->kept[k]] * ws->scale[ws->kept[k]];
         }
+        dhc_tri_forward(&w, ws->n_kept, y); /* the workspace's information becomes I */
     }
     return 1;
 }
@@ -237,14 +297,32 @@ static dhc_status survey(const dhc_model *model, const dhc_param_set *set,
             ws->kept[ws->n_kept++] = j;
         }
     }
-    return ws->n_kept > 0U ? DHC_OK : DHC_ERR_UNDERDETERMINED;
+    if (ws->n_kept == 0U) {
+        return DHC_ERR_UNDERDETERMINED;
+    }
+    /* W: one pose's average information over the kept parameters (unit diagonal) */
+    for (size_t a = 0U; a < ws->n_kept; ++a) {
+        for (size_t b = 0U; b <= a; ++b) {
+            const size_t i = ws->kept[a];
+            const size_t j = ws->kept[b];
+            ws->wchol[a * DHC_MAX_PARAMS + b] =
+                ws->ne.jtj[i * p + j] * ws->scale[i] * ws->scale[j] / (double)*usable;
+        }
+    }
+    const dhc_tri w = {ws->wchol, DHC_MAX_PARAMS, 1U, ws->wchol, DHC_MAX_PARAMS + 1U};
+    return dhc_chol_in_place(&w, ws->n_kept, 0.0, PLAN_PIVOT_TOL) == DHC_OK
+               ? DHC_OK
+               : DHC_ERR_UNDERDETERMINED;
 }
 
-static double log_det_of_factor(dhc_plan_workspace *ws)
+/* trace(M^-1) of the factored transformed information: the plan's prediction variance
+ * summed over the kept parameters' directions, averaged over the candidates' poses. */
+static double trace_of_inverse(dhc_plan_workspace *ws)
 {
+    const dhc_tri t = chol_tri(ws);
     double s = 0.0;
     for (size_t i = 0U; i < ws->n_kept; ++i) {
-        s += 2.0 * log(ws->chol[i * (DHC_MAX_PARAMS + 1U)]);
+        s += dhc_chol_inverse_diagonal(&t, ws->n_kept, i, ws->solved);
     }
     return s;
 }
@@ -314,10 +392,17 @@ dhc_status dhc_plan_select(const dhc_model *model, const dhc_param_set *set,
     if (n > rep->usable) {
         return DHC_ERR_ARGUMENT;
     }
-    memset(ws->info, 0, sizeof ws->info);
-    for (size_t i = 0U; i < ws->n_kept; ++i) {
-        ws->info[i * (DHC_MAX_PARAMS + 1U)] = PLAN_RIDGE;
+    /* the first n candidates: a random plan when the candidates are random */
+    clear_info(ws);
+    for (size_t c = 0U; c < n; ++c) {
+        if (load_rows(model, set, read, ctx, c, rows_store, ws, &st)) {
+            info_add(ws, 1.0);
+        } else if (st != DHC_OK) {
+            return st;
+        }
     }
+    rep->variance_first = factor_info(ws) == DHC_OK ? trace_of_inverse(ws) : HUGE_VAL;
+    clear_info(ws);
     for (size_t got = 0U; got < n; ++got) {
         st = factor_info(ws);
         size_t best = k;
@@ -340,7 +425,7 @@ dhc_status dhc_plan_select(const dhc_model *model, const dhc_param_set *set,
     if (st != DHC_OK) {
         return st;
     }
-    rep->log_det = log_det_of_factor(ws);
+    rep->variance = trace_of_inverse(ws);
     return dhc_plan_observability(model, set, read, ctx, chosen, n, ws, &rep->o1, &rep->rank);
 }
 

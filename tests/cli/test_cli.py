@@ -221,8 +221,67 @@ class Cli(unittest.TestCase):
         self.assertGreater(d['noise_model']['whitened_sd'], 0.5)
         self.assertLess(d['noise_model']['whitened_sd'], 2.0)
 
+    # ---- dhcal plan
+    def plan(self, *extra):
+        return self.run_dhcal('plan', '--model', self.model, '--out', self.out, *extra)
+
+    def test_plan_bad_input_exits_2_and_leaves_out_untouched(self):
+        cases = [(('--poses', '0'), '--poses'), (('--poses', 'x'), '--poses'),
+                 (('--poses', '10', '--candidates', '10'), '--candidates'),
+                 (('--poses', '10', '--min-z', 'nan'), '--min-z'),
+                 (('--poses', '10', '--min-z', '1e300'), '--min-z'),
+                 (('--poses', '10', '--effects', 'warp_drive'), 'warp_drive'),
+                 (('--poses', '10', '--bogus'), '--bogus'),
+                 (('--poses', '10', 'stray'), 'stray')]
+        for existing in (None, 'q1,q2,q3\n1,2,3\n'):
+            for args, word in cases:
+                if existing is None:
+                    if os.path.exists(self.out):
+                        os.remove(self.out)
+                else:
+                    self.write('calibrated.json', existing)
+                r = self.plan(*args)
+                self.assert_bad_input(r, word)
+                self.assert_out_untouched(existing)
+        r = self.run_dhcal('plan', '--model', self.write('m.json', '{"joints": ['),
+                           '--poses', '5', '--out', self.out)
+        self.assert_bad_input(r, 'm.json')
+        r = self.run_dhcal('plan', '--poses', '5', '--out', self.out)
+        self.assert_bad_input(r, '--model')
+
+    def test_plan_writes_the_poses_it_reports(self):
+        model = json.loads(GOOD_MODEL)
+        r = self.plan('--poses', '12', '--candidates', '150', '--seed', '3', '--json')
+        self.assertEqual(r.returncode, 0, r.stderr)
+        rep = json.loads(r.stdout)
+        for key in ('poses', 'candidates', 'measured', 'parameters', 'identifiable', 'left_out',
+                    'o1', 'rank', 'o1_random', 'rank_random', 'variance', 'variance_random',
+                    'exchanges', 'out'):
+            self.assertIn(key, rep)
+        self.assertEqual((rep['poses'], rep['candidates']), (12, 150))
+        self.assertGreater(rep['o1'], rep['o1_random'])
+        self.assertLess(rep['variance'], rep['variance_random'])
+        with open(self.out) as f:
+            rows = [l.strip() for l in f if l.strip() and not l.startswith('#')]
+        self.assertEqual(rows[0], 'q1,q2,q3')
+        poses = [tuple(float(v) for v in l.split(',')) for l in rows[1:]]
+        self.assertEqual(len(poses), 12)
+        self.assertEqual(len(set(poses)), 12)
+        for q in poses:
+            for j, v in enumerate(q):
+                lo = model['joints'][j].get('min_deg', -180.0)
+                hi = model['joints'][j].get('max_deg', 180.0)
+                self.assertTrue(lo <= v <= hi, (j, v, lo, hi))
+        # the same arguments give the same plan
+        with open(self.out) as f:
+            first = f.read()
+        self.assertEqual(self.plan('--poses', '12', '--candidates', '150', '--seed', '3')
+                         .returncode, 0)
+        with open(self.out) as f:
+            self.assertEqual(f.read(), first)
+
     def test_help_on_every_command(self):
-        for cmd in ('compare', 'fit', 'diagnose', 'plot'):
+        for cmd in ('compare', 'fit', 'diagnose', 'plot', 'plan'):
             r = self.run_dhcal(cmd, '--help')
             self.assertEqual(r.returncode, 0)
             self.assertIn('usage: dhcal ' + cmd, r.stdout)

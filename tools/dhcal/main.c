@@ -16,6 +16,7 @@
 #include "dhcal_data.h"
 #include "dhcal_io.h"
 #include "dhcal_model_map.h"
+#include "dhcal_plan_cmd.h"
 #include "dhcal_plot.h"
 #include "dhcal_refine.h"
 
@@ -62,6 +63,7 @@ static const char *const usage_text =
     "  diagnose   fit, then rank the physical effects the model still misses\n"
     "  refine     the loop compare -> diagnose -> add -> refit, chosen by cross-validation\n"
     "  plot       residual and error plots (SVG) of a fit and its diagnosis\n"
+    "  plan       the poses to measure: a D-optimal plan (dhcal plan --help)\n"
     "'dhcal <command> --help' describes each; 'dhcal --version' prints the version.\n"
     "exit codes: 0 success, 1 computation failed, 2 bad input or usage\n";
 
@@ -1208,6 +1210,9 @@ static int cmd_plot(const options *o, session *s)
 
 int main(int argc, char **argv)
 {
+    if (argc >= 2 && strcmp(argv[1], "plan") == 0) { /* no measurements: its own options */
+        return dhcal_plan_command(argc, argv);
+    }
     options o;
     int rc = parse_args(argc, argv, &o);
     if (rc != 0) {

@@ -2,18 +2,24 @@
  * identify the parameters well.
  *
  * dhc_plan_select chooses n poses out of k candidates (the caller's: random poses inside the
- * joint ranges and its workspace limits, handed out by a dhc_sample_reader) that maximise
- * the determinant of the plan's information matrix J^T J over the parameters of the set
- * (D-optimality: the volume of the parameters' confidence ellipsoid shrinks as 1/sqrt(det)).
+ * joint ranges and its workspace limits, handed out by a dhc_sample_reader) so that the
+ * calibration predicts the tool best where the arm works: it minimises
+ *     trace(M^-1 W),
+ * M the plan's information J^T J over the parameters of the set and W one candidate pose's
+ * average information, i.e. the variance of the predicted tool point (summed over a
+ * sample's rows, per unit measurement variance) averaged over the candidates' poses
+ * (I-optimality; a random plan of n poses has about r / n for r parameters). That is what a
+ * held-out error measures; the determinant of M (D-optimality) shrinks the parameters'
+ * confidence volume instead and measured worse there (tests/acceptance/test_plan_poses.py).
  * First every candidate's Jacobian is accumulated: the parameters that no plan drawn from
  * these candidates can identify (a pivot of the candidates' joint information below 1e-10,
- * dhc_lsq_analyse) are left out of the criterion, and the columns are scaled so that one
- * pose contributes about 1 to each diagonal entry (the criterion does not depend on the
- * scaling; the arithmetic does). Then a greedy start adds, n times, the candidate that
- * raises log det the most (a small ridge, 1e-6 of one pose, keeps the first steps defined),
- * and Fedorov's exchange swaps a chosen pose for an unchosen one while that raises log det,
- * until no swap does or DHC_PLAN_MAX_EXCHANGE_PASSES passes over the plan. Ties go to the
- * lower candidate index: the same candidates give the same plan.
+ * dhc_lsq_analyse) are left out, the columns are scaled so that one pose contributes about
+ * 1 to each diagonal entry, and W is factored (W = C C^T; rows transformed by C^-1 turn the
+ * criterion into trace(M^-1)). Then a greedy start adds, n times, the candidate that lowers
+ * the criterion most (a small ridge, 1e-6 of one pose, keeps the first steps defined), and
+ * Fedorov's exchange swaps a chosen pose for an unchosen one while that lowers it, until no
+ * swap does or DHC_PLAN_MAX_EXCHANGE_PASSES passes over the plan. Ties go to the lower
+ * candidate index: the same candidates give the same plan.
  *
  * dhc_plan_observability scores any plan with the observability index O1 of Borm and Menq,
  *     O1 = (prod_k sigma_k)^(1/r) / sqrt(m),
@@ -23,7 +29,7 @@
  *
  * Both read each candidate through the model's analytic Jacobian (dhc_model_jacobian):
  * nothing is measured, a plan is scored before it runs. No heap; the scratch is the
- * workspace's (about 32 DHC_MAX_PARAMS^2 bytes: static storage, not a stack). Optional
+ * workspace's (about 40 DHC_MAX_PARAMS^2 bytes: static storage, not a stack). Optional
  * storage of the caller's for the candidates' Jacobian rows spares evaluating the model
  * again on every pass (the same plan either way). A build with DHC_WITH_PLAN 0 leaves the
  * selection out (dhc_plan_select answers DHC_ERR_ARGUMENT); the score stays.
@@ -51,11 +57,13 @@ extern "C" {
 typedef struct {
     dhc_normal_eq ne;   /* the candidates' (or the plan's) information, unscaled */
     dhc_lsq_factor fac; /* its analysis */
-    double info[DHC_MAX_PARAMS * DHC_MAX_PARAMS];   /* the plan's, scaled, kept parameters */
+    double info[DHC_MAX_PARAMS * DHC_MAX_PARAMS];   /* the plan's: kept, scaled, by C^-1 */
     double chol[DHC_MAX_PARAMS * DHC_MAX_PARAMS];   /* its Cholesky factor (lower) */
+    double wchol[DHC_MAX_PARAMS * DHC_MAX_PARAMS];  /* C: W = C C^T (lower) */
     double jac[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS];
     double rows[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS]; /* a candidate's scaled rows */
     double solved[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS];
+    double back[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS];
     double scale[DHC_MAX_PARAMS];
     size_t kept[DHC_MAX_PARAMS]; /* the parameters the criterion uses (set indices) */
     size_t n_kept;
@@ -67,7 +75,10 @@ typedef struct {
     size_t usable;       /* candidates whose Jacobian could be evaluated */
     size_t identifiable; /* parameters some plan from the candidates identifies: the
                             criterion's; the set's others are left out */
-    double log_det;      /* ln det of the plan's scaled information over them */
+    double variance;     /* the criterion at the plan: trace(M^-1 W) (about r / n for a
+                            random plan of n poses) */
+    double variance_first; /* the criterion for candidates 0 .. n-1: the random plan of the
+                              same size when the candidates are random */
     size_t exchanges;    /* swaps the exchange made after the greedy start */
     double o1;           /* the plan's observability index (dhc_plan_observability) */
     size_t rank;         /* parameters the plan identifies */
