@@ -192,40 +192,30 @@ static void free_descent(const dhc_arm *arm, const double *q, const dhc_mat *jac
 }
 
 /* The damped Gauss-Newton step (J^T J + lambda I) dq = J^T r over the joints that are free
- * to move (a pinned joint's dq is 0). */
+ * to move (a pinned joint's row and column are lambda I alone, its g_i 0: its dq is 0). */
 static dhc_status damped_step(const dhc_arm *arm, const double *q, const dhc_mat *jac,
                               const double *r, double lambda, double *dq)
 {
     const size_t n = jac->cols;
     double a_buf[DHC_MAX_JOINTS * DHC_MAX_JOINTS];
-    double g[DHC_MAX_JOINTS];
     int pinned[DHC_MAX_JOINTS];
-    size_t perm[DHC_MAX_JOINTS];
-    size_t rank = 0U;
     dhc_mat a;
     (void)dhc_mat_init(&a, n, n, a_buf, DHC_MAX_JOINTS * DHC_MAX_JOINTS);
     free_descent(arm, q, jac, r, dq, pinned);
     for (size_t i = 0U; i < n; ++i) {
         for (size_t j = 0U; j <= i; ++j) {
-            double v = i == j ? lambda : 0.0;
+            double v = 0.0;
             for (size_t k = 0U; !pinned[i] && !pinned[j] && k < jac->rows; ++k) {
                 v += DHC_MAT_AT(jac, k, i) * DHC_MAT_AT(jac, k, j);
             }
             DHC_MAT_AT(&a, i, j) = v;
         }
     }
-    dhc_status st = dhc_chol_pivoted(&a, perm, DHC_MAX_JOINTS, 1e-15, &rank);
-    if (st == DHC_OK && rank < n) {
-        st = DHC_ERR_SINGULAR;
-    }
-    for (size_t k = 0U; k < n; ++k) {
-        g[k] = dq[perm[k]];
-    }
+    const dhc_tri l = dhc_tri_of_mat(&a);
+    const dhc_status st = dhc_chol_in_place(&l, n, lambda, 0.0);
     if (st == DHC_OK) {
-        st = dhc_chol_solve(&a, n, g, g, DHC_MAX_JOINTS);
-    }
-    for (size_t k = 0U; st == DHC_OK && k < n; ++k) {
-        dq[perm[k]] = g[k];
+        dhc_tri_forward(&l, n, dq);
+        dhc_tri_backward(&l, n, dq);
     }
     return st;
 }
@@ -233,6 +223,22 @@ static dhc_status damped_step(const dhc_arm *arm, const double *q, const dhc_mat
 static double clamp_to_range(const dhc_joint *j, double q)
 {
     return fmin(fmax(q, j->min_rad), j->max_rad);
+}
+
+/* |J|_F^2, and the largest squared column norm in *widest. */
+static double squared_norms(const dhc_mat *jac, double *widest)
+{
+    double total = 0.0;
+    *widest = 0.0;
+    for (size_t i = 0U; i < jac->cols; ++i) {
+        double c2 = 0.0;
+        for (size_t k = 0U; k < jac->rows; ++k) {
+            c2 += DHC_MAT_AT(jac, k, i) * DHC_MAT_AT(jac, k, i);
+        }
+        total += c2;
+        *widest = fmax(*widest, c2);
+    }
+    return total;
 }
 
 /* 1 when no direction the joint ranges allow lowers |r| to first order: the free gradient
@@ -244,14 +250,11 @@ static int at_rest(const dhc_arm *arm, const double *q, const dhc_mat *jac, cons
     int pinned[DHC_MAX_JOINTS];
     free_descent(arm, q, jac, r, g, pinned);
     double g2 = 0.0;
-    double j2 = 0.0;
     for (size_t i = 0U; i < jac->cols; ++i) {
         g2 += g[i] * g[i];
-        for (size_t k = 0U; k < jac->rows; ++k) {
-            j2 += DHC_MAT_AT(jac, k, i) * DHC_MAT_AT(jac, k, i);
-        }
     }
-    return g2 <= 1e-8 * j2 * err2;
+    double widest = 0.0;
+    return g2 <= 1e-8 * squared_norms(jac, &widest) * err2;
 }
 
 dhc_status dhc_model_inverse(const dhc_model *model, const dhc_sample *target,
@@ -297,13 +300,7 @@ dhc_status dhc_model_inverse(const dhc_model *model, const dhc_sample *target,
      * a tenth of a percent at first, Gauss-Newton once steps succeed, ever shorter steps
      * when they fail until no step of any length helps. */
     double scale = 0.0;
-    for (size_t i = 0U; i < n; ++i) {
-        double c2 = 0.0;
-        for (size_t k = 0U; k < jac.rows; ++k) {
-            c2 += DHC_MAT_AT(&jac, k, i) * DHC_MAT_AT(&jac, k, i);
-        }
-        scale = fmax(scale, c2);
-    }
+    (void)squared_norms(&jac, &scale);
     scale = fmax(scale, 1e-12);
     double lambda = 1e-3 * scale;
     const double tol2 = opt->tol_mm * opt->tol_mm;

@@ -31,7 +31,7 @@ fw_ik_status fw_ik_seed_3dof(const dhc_model *model, const double target_mm[3], 
  * predicted tool point is within tol_mm of the target, keeping every joint inside its
  * range. sample_template supplies the approach directions, temperature and time the
  * prediction should assume. FW_IK_NOT_CONVERGED when the target is out of reach from the
- * seed or max_iterations (>= 1) ran out; the solver's scratch (about 2.2 KiB) is on the stack. */
+ * seed or max_iterations (>= 1) ran out; the solver's scratch (about 2.1 KiB) is on the stack. */
 fw_ik_status fw_ik_solve(const dhc_model *model, const dhc_sample *sample_template,
                          const double target_mm[3], double tol_mm, size_t max_iterations,
                          double q_rad[DHC_MAX_JOINTS]);

@@ -24,8 +24,9 @@
  * iteration budget ran out while the error was still falling).
  *
  * No heap, no I/O. Cost per iteration: one model evaluation, O(N^3) for the chain rule
- * through compliance (O(N) without), an N x N Cholesky. The scratch (about 2.2 KiB) is the
- * caller's dhc_inverse_workspace; the functions' own frames stay below 1.2 KiB.
+ * through compliance (O(N) without), an N x N Cholesky. The scratch (2.1 KiB: the arm's
+ * trigonometry and a model evaluation) is the caller's dhc_inverse_workspace; the stack
+ * below dhc_model_inverse is about 3 KiB on the Cortex-M4 (scripts/target-report).
  * Built when DHC_WITH_INVERSE is 1 (dhc_config.h); otherwise not declared.
  */
 #ifndef DHC_INVERSE_H
