@@ -30,18 +30,6 @@ static double own_slope(const dhc_joint_effects *fx, double q)
     return d;
 }
 
-static int has_compliance(const dhc_model *model)
-{
-    for (size_t i = 0U; i < model->arm.n_joints; ++i) {
-        for (size_t j = i; j < model->arm.n_joints; ++j) {
-            if (fabs(model->effect[i].compliance[j]) > 0.0) {
-                return 1;
-            }
-        }
-    }
-    return 0;
-}
-
 /* slope[i][k] += d(sum_j c_ij tau_ij)/d(q_k), tau_ij = g . (z_i x (o_{j+1} - o_i)) on the
  * frames f at the commanded angles (where dhc_model_evaluate takes the moments). Joint k
  * turns everything beyond it about z_k: for k < i the axis z_i and the lever together,
@@ -109,7 +97,7 @@ static dhc_status command_jacobian(const dhc_model *model, const dhc_sample *s,
     for (size_t i = 0U; i < n; ++i) {
         slope[i * n + i] = own_slope(&model->effect[i], s->q_rad[i]);
     }
-    if (has_compliance(model)) {
+    if (dhc_model_has_compliance(model)) {
         double sin_q[DHC_MAX_JOINTS];
         double cos_q[DHC_MAX_JOINTS];
         for (size_t i = 0U; i < n; ++i) {

@@ -206,6 +206,28 @@ static void test_nominal_paper_arm_agrees_with_its_closed_form(void)
     TEST_ASSERT_GREATER_OR_EQUAL(35U, checked);
 }
 
+/* Makes s, at the true angles, a target: the model's own pose there; the start moved by up
+ * to +-spread rad per joint, as today's command for it would be. */
+static void aim_at_truth(const dhc_model *m, dhc_sample *s, double spread, dhc_prediction *truth)
+{
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_model_predict(m, s, truth));
+    dhc_vec3_copy(truth->p_mm, s->p_mm);
+    s->rot = truth->rot;
+    for (size_t i = 0U; i < m->arm.n_joints; ++i) {
+        s->q_rad[i] += test_range(&rng, -spread, spread);
+    }
+}
+
+/* An independent forward prediction at angles q under the target's conditions. */
+static dhc_prediction predicted_at(const dhc_model *m, const dhc_sample *target, const double *q)
+{
+    dhc_sample at = *target;
+    memcpy(at.q_rad, q, sizeof at.q_rad);
+    dhc_prediction got;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_model_predict(m, &at, &got));
+    return got;
+}
+
 /* The commanded angles that put the model with every effect on the target: an independent
  * forward prediction at them reaches it to 1e-9 mm, and they are the angles the target was
  * made from (one solution on the branch). */
@@ -226,18 +248,11 @@ static void test_effects_are_compensated_to_1e9_mm(void)
         s.t_s = 600.0;
         s.dir[0] = (int8_t)(k % 2U == 0U ? 1 : -1);
         dhc_prediction truth;
-        TEST_ASSERT_EQUAL(DHC_OK, dhc_model_predict(&m, &s, &truth));
-        dhc_vec3_copy(truth.p_mm, s.p_mm);
-        for (size_t i = 0U; i < 3U; ++i) {
-            s.q_rad[i] += test_range(&rng, -0.05, 0.05);
-        }
+        aim_at_truth(&m, &s, 0.05, &truth);
         double q[DHC_MAX_JOINTS];
         dhc_inverse_result res;
         TEST_ASSERT_EQUAL(DHC_OK, dhc_model_inverse(&m, &s, &opt, &ws, q, &res));
-        dhc_sample at = s;
-        memcpy(at.q_rad, q, sizeof q);
-        dhc_prediction reached;
-        TEST_ASSERT_EQUAL(DHC_OK, dhc_model_predict(&m, &at, &reached));
+        const dhc_prediction reached = predicted_at(&m, &s, q);
         TEST_ASSERT_TRUE(distance(reached.p_mm, truth.p_mm) <= 1e-9);
         TEST_ASSERT_TRUE(res.error_mm <= 1e-9);
         for (size_t i = 0U; i < 3U; ++i) {
@@ -260,21 +275,13 @@ static void test_six_joints_reach_a_pose(void)
         random_q_inside(&m, q_true, 0.3);
         dhc_sample s = sample_of(&m, q_true, DHC_MEAS_POSE);
         dhc_prediction truth;
-        TEST_ASSERT_EQUAL(DHC_OK, dhc_model_predict(&m, &s, &truth));
-        dhc_vec3_copy(truth.p_mm, s.p_mm);
-        s.rot = truth.rot;
-        for (size_t i = 0U; i < 6U; ++i) {
-            s.q_rad[i] += test_range(&rng, -0.05, 0.05);
-        }
+        aim_at_truth(&m, &s, 0.05, &truth);
         double q[DHC_MAX_JOINTS];
         dhc_inverse_result res;
         if (dhc_model_inverse(&m, &s, &opt, &ws, q, &res) != DHC_OK) {
             continue; /* near a wrist singularity 3 deg may be too far */
         }
-        dhc_sample at = s;
-        memcpy(at.q_rad, q, sizeof q);
-        dhc_prediction got;
-        TEST_ASSERT_EQUAL(DHC_OK, dhc_model_predict(&m, &at, &got));
+        const dhc_prediction got = predicted_at(&m, &s, q);
         TEST_ASSERT_TRUE(distance(got.p_mm, truth.p_mm) <= 1e-9);
         dhc_mat3 turn;
         double wv[3];
