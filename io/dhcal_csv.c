@@ -305,6 +305,7 @@ typedef struct {
     size_t header_line;
     int has_quat;
     int plan; /* a pose plan: q and dir columns only, each dir column on its own */
+    int targets; /* compensation targets: x,y,z; q1..qN, qw..qz, dir1..dirN optional */
     span *spans;
     size_t spans_cap;
 } csv_ctx;
@@ -326,7 +327,8 @@ static int check_group(csv_ctx *c, const size_t *seen, size_t n, col_kind kind, 
         return DHCAL_IO_OK;
     }
     char nb[16];
-    const char *group = kind == COL_XYZ    ? "x,y,z"
+    const char *group = kind == COL_Q      ? "q1..qN"
+                        : kind == COL_XYZ  ? "x,y,z"
                         : kind == COL_WIRE ? "L1,L2,L3"
                         : kind == COL_QUAT ? "qw,qx,qy,qz"
                                            : "dir1..dirN";
@@ -360,6 +362,13 @@ static int parse_header(csv_ctx *c, dhcal_dataset *data)
                              "%s:%zu: column '%s' is beyond the model's %zu joints", path, line,
                              dhcal_quote(f.s, f.n, sb), c->n_joints);
         }
+        if (c->targets && (cls == 0 || col.kind == COL_WIRE || col.kind == COL_TEMP ||
+                           col.kind == COL_TIME)) {
+            return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
+                             "%s:%zu: unknown column '%s' (targets have x,y,z and optionally "
+                             "qw,qx,qy,qz, q1..q%zu, dir1..dir%zu)",
+                             path, line, dhcal_quote(f.s, f.n, sb), c->n_joints, c->n_joints);
+        }
         if (cls == 0 && !c->plan) {
             return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
                              "%s:%zu: unknown column '%s' (known: q1..q%zu, x,y,z, L1,L2,L3, "
@@ -382,7 +391,8 @@ static int parse_header(csv_ctx *c, dhcal_dataset *data)
         /* Cannot overflow: every column is distinct, CSV_MAX_COLS counts them all. */
         c->cols[c->n_cols++] = col;
     }
-    for (size_t j = 0U; j < c->n_joints; ++j) {
+    data->has_q = 1;
+    for (size_t j = 0U; !c->targets && j < c->n_joints; ++j) {
         if (seen[COL_Q][j] == 0U) {
             return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
                              "%s:%zu: missing column 'q%zu' (the model has %zu joints)", path,
@@ -396,7 +406,11 @@ static int parse_header(csv_ctx *c, dhcal_dataset *data)
         }
         return DHCAL_IO_OK;
     }
-    int rc = check_group(c, seen[COL_XYZ], 3U, COL_XYZ, &data->has_xyz);
+    int rc = c->targets ? check_group(c, seen[COL_Q], c->n_joints, COL_Q, &data->has_q)
+                        : DHCAL_IO_OK;
+    if (rc == DHCAL_IO_OK) {
+        rc = check_group(c, seen[COL_XYZ], 3U, COL_XYZ, &data->has_xyz);
+    }
     if (rc == DHCAL_IO_OK) {
         rc = check_group(c, seen[COL_WIRE], 3U, COL_WIRE, &data->has_wires);
     }
@@ -408,6 +422,10 @@ static int parse_header(csv_ctx *c, dhcal_dataset *data)
     }
     if (rc != DHCAL_IO_OK) {
         return rc;
+    }
+    if (c->targets && !data->has_xyz) {
+        return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
+                         "%s:%zu: missing columns x,y,z (the target tool point, mm)", path, line);
     }
     if (!data->has_xyz && !data->has_wires) {
         return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
@@ -694,7 +712,9 @@ static int csv_read_all(csv_ctx *c, dhcal_dataset *data)
     return DHCAL_IO_OK;
 }
 
-static int load(const char *path, size_t n_joints, int plan, dhcal_dataset *data,
+enum { LOAD_MEASUREMENTS = 0, LOAD_PLAN, LOAD_TARGETS };
+
+static int load(const char *path, size_t n_joints, int what, dhcal_dataset *data,
                 dhcal_error *err)
 {
     memset(data, 0, sizeof *data);
@@ -709,7 +729,8 @@ static int load(const char *path, size_t n_joints, int plan, dhcal_dataset *data
     c->rd.path = path;
     c->rd.err = err;
     c->n_joints = n_joints;
-    c->plan = plan;
+    c->plan = what == LOAD_PLAN;
+    c->targets = what == LOAD_TARGETS;
     c->rd.f = fopen(path, "rb");
     const int open_errno = errno;
     /* The first line may be empty: the buffer must hold its terminator from the start. */
@@ -740,12 +761,18 @@ static int load(const char *path, size_t n_joints, int plan, dhcal_dataset *data
 
 int dhcal_csv_load(const char *path, size_t n_joints, dhcal_dataset *data, dhcal_error *err)
 {
-    return load(path, n_joints, 0, data, err);
+    return load(path, n_joints, LOAD_MEASUREMENTS, data, err);
 }
 
 int dhcal_csv_load_plan(const char *path, size_t n_joints, dhcal_dataset *plan, dhcal_error *err)
 {
-    return load(path, n_joints, 1, plan, err);
+    return load(path, n_joints, LOAD_PLAN, plan, err);
+}
+
+int dhcal_csv_load_targets(const char *path, size_t n_joints, dhcal_dataset *targets,
+                           dhcal_error *err)
+{
+    return load(path, n_joints, LOAD_TARGETS, targets, err);
 }
 
 void dhcal_dataset_free(dhcal_dataset *data)

@@ -34,6 +34,7 @@ typedef struct {
     size_t n_rows;
     size_t n_joints;
     int has_xyz, has_wires, has_quat, has_dir, has_temp, has_time;
+    int has_q; /* always 1 but for compensation targets (dhcal_csv_load_targets) */
     dhcal_row *rows; /* heap, n_rows entries */
 } dhcal_dataset;
 
@@ -61,6 +62,13 @@ int dhcal_csv_load(const char *path, size_t n_joints, dhcal_dataset *data, dhcal
  * 0 where dirj is absent (the caller chooses), has_dir when any is present. Everything else
  * (comments, numbers, ranges, messages, at least one row) as dhcal_csv_load. */
 int dhcal_csv_load_plan(const char *path, size_t n_joints, dhcal_dataset *plan, dhcal_error *err);
+/* Loads compensation targets (docs/formats.md, section 5): x,y,z (mm, required) and
+ * optionally qw,qx,qy,qz (target orientation), q1..qN (deg: today's commanded angles, the
+ * start) and dir1..dirN, each group all or nothing (has_q says whether q was given). No
+ * other column. Everything else (comments, numbers, ranges, messages, at least one row) as
+ * dhcal_csv_load. */
+int dhcal_csv_load_targets(const char *path, size_t n_joints, dhcal_dataset *targets,
+                           dhcal_error *err);
 /* Frees the rows and empties *data; NULL and already-empty datasets are fine. */
 void dhcal_dataset_free(dhcal_dataset *data);
 

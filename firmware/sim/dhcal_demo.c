@@ -260,7 +260,7 @@ static const char *const usage_text =
     "  --unweighted     no noise model (encoder quantisation, wire noise): plain least "
     "squares\n"
     "  --plan-candidates K  measure the N poses of K random candidates that observe the\n"
-    "                   fitted parameters best (a D-optimal plan; K > N, at most "
+    "                   fitted parameters best (an optimal plan; K > N, at most "
     "4 x 128); 0, the\n"
     "                   default: N random poses\n";
 
@@ -501,7 +501,7 @@ int main(int argc, char **argv)
     const size_t n_done = job.n_samples;
     const double o1 = job.o1;
     fprintf(log, "(b) %zu samples (%s plan of %zu poses%s, observability O1 %.4g over %zu of "
-                 "%zu parameters)\n", n_done, n_candidates > 0U ? "D-optimal" : "random",
+                 "%zu parameters)\n", n_done, n_candidates > 0U ? "optimal" : "random",
             job.n_plan, n_candidates > 0U ? " out of the candidates" : "", o1, job.o1_rank,
             job.o1_params);
     if (fa != FW_FAULT_NONE) {

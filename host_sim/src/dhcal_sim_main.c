@@ -35,7 +35,7 @@ static const char *const usage_text =
 
 static const char *const dataset_help =
     "usage: dhcal-sim dataset --scenario S.json (--poses N | --plan P.csv) --out D.csv\n"
-    "                         [--seed K] [--wires] [--model-out M.json]\n"
+    "                         [--seed K] [--wires | --exact] [--model-out M.json]\n"
     "Calibration samples of the scenario's arm at rest (kinematic mode: no motion is\n"
     "integrated). Per pose: a joint target (uniform over the model's joint ranges, or the\n"
     "next row of --plan), an approach direction per joint; the servo stops the motor on the\n"
@@ -48,6 +48,10 @@ static const char *const dataset_help =
     "  --out D.csv        the dataset, a measurement CSV: q1..qN (deg, from the encoder\n"
     "                     counts), dir1..dirN, and x,y,z (mm, true tool point + noise)\n"
     "  --wires            L1,L2,L3 instead of x,y,z: the measurer's wire counters (mm)\n"
+    "  --exact            with --plan: the true tool point at the commanded angles, to\n"
+    "                     judge commands: an ideal servo (the motor exactly at the plan's\n"
+    "                     angle, no count rounding; q reports the plan) and no noise on\n"
+    "                     x,y,z; the links still settle through stiffness and backlash\n"
     "  --seed K           run seed: poses, directions, noise (default: the scenario's seed;\n"
     "                     the arm itself depends only on the scenario)\n"
     "  --model-out M.json a copy of the nominal model, to pass to dhcal --model\n"
@@ -63,6 +67,7 @@ typedef struct {
     unsigned long long seed;
     int have_seed;
     int wires;
+    int exact;
 } options;
 
 static int usage_error(const char *fmt, ...)
@@ -102,7 +107,7 @@ static int next_option(int argc, char **argv, const struct option *longs, const 
 }
 
 enum { OPT_HELP = 'h', OPT_WIRES = 256, OPT_SCENARIO, OPT_OUT, OPT_PLAN, OPT_MODEL_OUT,
-       OPT_POSES, OPT_SEED };
+       OPT_POSES, OPT_SEED, OPT_EXACT };
 
 static int parse_options(int argc, char **argv, options *o)
 {
@@ -116,6 +121,7 @@ static int parse_options(int argc, char **argv, options *o)
         {"model-out", required_argument, NULL, OPT_MODEL_OUT},
         {"poses", required_argument, NULL, OPT_POSES},
         {"seed", required_argument, NULL, OPT_SEED},
+        {"exact", no_argument, NULL, OPT_EXACT},
         {NULL, 0, NULL, 0}};
     opterr = 0;
     optind = 1;
@@ -128,6 +134,7 @@ static int parse_options(int argc, char **argv, options *o)
             fputs(dataset_help, stdout);
             exit(0);
         case OPT_WIRES: o->wires = 1; continue;
+        case OPT_EXACT: o->exact = 1; continue;
         case OPT_SCENARIO: slot = &o->scenario; break;
         case OPT_OUT: slot = &o->out; break;
         case OPT_PLAN: slot = &o->plan; break;
@@ -178,6 +185,9 @@ static int parse_options(int argc, char **argv, options *o)
     if (o->have_poses == (o->plan != NULL)) {
         return usage_error("dataset needs exactly one of --poses and --plan");
     }
+    if (o->exact && (o->plan == NULL || o->wires)) {
+        return usage_error("--exact needs --plan and x,y,z (not --wires)");
+    }
     return 0;
 }
 
@@ -212,6 +222,7 @@ static int run_dataset(const options *o)
         dhcal_dataset_free(&pl);
         return EXIT_USAGE;
     }
+    ds.exact = o->exact;
     const size_t poses = o->plan != NULL ? pl.n_rows : (size_t)o->poses;
 
     dhcal_text b = {NULL, 0U, 0U, 0};
@@ -222,8 +233,9 @@ static int run_dataset(const options *o)
     if (o->wires) {
         dhcal_text_str(&b, "# L1,L2,L3: wire lengths from the measurer's counters (mm)\n");
     } else {
-        dhcal_text_printf(&b, "# x,y,z: tool point (mm, world), noise %.6g mm per coordinate\n",
-                          sc->noise_xyz_mm);
+        dhcal_text_printf(&b, "# x,y,z: tool point (mm, world), noise %.6g mm per coordinate%s\n",
+                          o->exact ? 0.0 : sc->noise_xyz_mm,
+                          o->exact ? " (--exact: the true point at the plan's angles)" : "");
     }
     dhcal_csv_columns cols;
     memset(&cols, 0, sizeof cols);

@@ -128,7 +128,7 @@ void dhc_model_drift(const dhc_model *model, double t_s, const double p_arm[3], 
     }
 }
 
-static int has_compliance(const dhc_model *model)
+int dhc_model_has_compliance(const dhc_model *model)
 {
     for (size_t i = 0U; i < model->arm.n_joints; ++i) {
         for (size_t j = i; j < model->arm.n_joints; ++j) {
@@ -179,7 +179,7 @@ dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_tri
         return DHC_ERR_ARGUMENT;
     }
     ev->length_scale = dhc_model_length_scale(model, s->temp_c);
-    const int compliant = has_compliance(model);
+    const int compliant = dhc_model_has_compliance(model);
     ev->has_moments = compliant || need_moments;
     /* one sine and cosine per joint and sample: the effects and both chains share them */
     double sin_q[DHC_MAX_JOINTS];

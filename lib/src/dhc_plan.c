@@ -1,4 +1,4 @@
-/* dhc_plan.c - D-optimal calibration pose plans (dhc_plan.h). */
+/* dhc_plan.c - optimal calibration pose plans (dhc_plan.h). */
 #include "dhcal/dhc_plan.h"
 
 #include <math.h>

@@ -309,6 +309,34 @@ class SimCli(unittest.TestCase):
         self.assertEqual(r.returncode, 2)
         self.assertIn("bad.csv:1: missing column 'q3'", r.stderr)
 
+    def test_exact_gives_the_true_point_at_the_plan(self):
+        # --exact, to judge commands: the plan's angles reported as they are (no count
+        # rounding), no noise: every run seed gives the same points; a measuring run is
+        # those points plus the scenario's 0.05 mm noise.
+        good = self.scenario(json.loads(read(os.path.join(SCENARIOS, 'joint_compliance_2.json'))))
+        # (directions given: the links' friction makes the rest pose depend on them)
+        plan = self.write('plan.csv', 'q1,q2,q3,dir1,dir2,dir3\n10.123456789,45,-30,1,1,1\n'
+                                      '-120.5,100.0000004,60,-1,1,-1\n')
+        runs = []
+        for seed in ('1', '2'):
+            r = self.sim('dataset', '--scenario', good, '--plan', plan, '--exact', '--seed', seed,
+                         '--out', self.out)
+            self.assertEqual(r.returncode, 0, r.stderr)
+            runs.append(self.read_csv(self.out)[1])
+        for a, b in zip(*runs):
+            self.assertEqual([a[k] for k in 'xyz'], [b[k] for k in 'xyz'])
+        self.assertEqual([runs[0][0]['q1'], runs[0][1]['q2']], [10.123456789, 100.0000004])
+        r = self.sim('dataset', '--scenario', good, '--plan', plan, '--out', self.out)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        measured = self.read_csv(self.out)[1]
+        for exact, noisy in zip(runs[0], measured):
+            d = [abs(exact[k] - noisy[k]) for k in 'xyz']
+            self.assertTrue(0.0 < max(d) < 0.3, d)  # noise (and the count), not another arm
+        for extra in (['--plan', plan, '--wires'], ['--poses', '3']):
+            r = self.sim('dataset', '--scenario', good, '--exact', '--out', self.out, *extra)
+            self.assertEqual(r.returncode, 2)
+            self.assertIn('--exact needs --plan', r.stderr)
+
     def test_model_out_loads_in_dhcal(self):
         good = self.scenario()
         model = os.path.join(self.dir, 'nominal.json')

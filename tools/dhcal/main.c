@@ -13,6 +13,7 @@
 
 #include "dhcal/dhc_version.h"
 #include "dhcal_analysis.h"
+#include "dhcal_compensate.h"
 #include "dhcal_data.h"
 #include "dhcal_io.h"
 #include "dhcal_model_map.h"
@@ -63,7 +64,9 @@ static const char *const usage_text =
     "  diagnose   fit, then rank the physical effects the model still misses\n"
     "  refine     the loop compare -> diagnose -> add -> refit, chosen by cross-validation\n"
     "  plot       residual and error plots (SVG) of a fit and its diagnosis\n"
-    "  plan       the poses to measure: a D-optimal plan (dhcal plan --help)\n"
+    "  compensate joint angles that put a calibrated model's tool on targets\n"
+    "             (--model C.json --targets T.csv --out J.csv: its own options)\n"
+    "  plan       the poses to measure: an optimal plan (dhcal plan --help)\n"
     "'dhcal <command> --help' describes each; 'dhcal --version' prints the version.\n"
     "exit codes: 0 success, 1 computation failed, 2 bad input or usage\n";
 
@@ -1212,6 +1215,9 @@ int main(int argc, char **argv)
 {
     if (argc >= 2 && strcmp(argv[1], "plan") == 0) { /* no measurements: its own options */
         return dhcal_plan_command(argc, argv);
+    }
+    if (argc >= 2 && strcmp(argv[1], "compensate") == 0) {
+        return dhcal_compensate_main(argc, argv); /* targets, not measurements */
     }
     options o;
     int rc = parse_args(argc, argv, &o);

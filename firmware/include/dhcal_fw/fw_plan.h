@@ -2,10 +2,9 @@
  *
  * Plan: n poses drawn uniformly (a fixed-seed generator) inside the joint ranges shrunk by
  * a margin, kept when the model puts the tool at least 250 mm from axis 1, above z = 100 mm
- * and at least 300 mm in front of the measurer's anchor plane. A planned plan (fw_plan_select)
- * draws more candidates that way and keeps the n that observe the parameters best
- * (dhc_plan_select: D-optimal, the parameters no candidate identifies left out). Approach directions: with
- * mixed_dirs each joint's is drawn +-1 (backlash-like effects become observable), else +1
+ * and at least 300 mm in front of the measurer's anchor plane. A planned plan
+ * (fw_plan_select) draws more candidates that way and keeps the n from which a fit predicts
+ * the tool best over them (dhc_plan_select). Approach directions: with mixed_dirs each joint's is drawn +-1 (backlash-like effects become observable), else +1
  * for all: direction-dependent offsets (backlash, the link bearing's friction holding a
  * compliant joint's spring) are then the same in every sample and are absorbed by the
  * joint offsets, which is exact as long as positioning approaches the same way.

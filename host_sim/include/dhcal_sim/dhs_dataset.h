@@ -57,6 +57,12 @@ typedef struct {
     int wires_ready;
     dhs_wires wires;
     size_t count;
+    /* 1: an ideal servo and no measurement noise, to evaluate commands: the motor rests
+     * exactly at the target times the controller's nominal counts per radian (no count
+     * rounding), q_rad reports the target itself and xyz_mm is the true tool point. The
+     * arm still settles through its stiffness, backlash and transmission error. Set after
+     * dhs_dataset_init; 0 there. */
+    int exact;
 } dhs_dataset;
 
 /* Starts a dataset of scenario sc (must pass dhs_scenario_check: else DHC_ERR_ARGUMENT). */

@@ -66,8 +66,12 @@ DHC_STATIC_ASSERT(DHC_MAX_PARAMS <= 256U, "DHC_MAX_PARAMS too large for the inde
 #ifndef DHC_WITH_CONVERSIONS     /* dhc_arm_to_standard_dh, quaternions, roll-pitch-yaw */
 #define DHC_WITH_CONVERSIONS 1
 #endif
-#ifndef DHC_WITH_PLAN            /* dhc_plan_select: D-optimal pose plans */
+#ifndef DHC_WITH_PLAN            /* dhc_plan_select: optimal pose plans */
 #define DHC_WITH_PLAN 1
+#endif
+#ifndef DHC_WITH_INVERSE         /* dhc_inverse.h: commanded angles for a target on the full
+                                    model (the controller's IK, dhcal compensate) */
+#define DHC_WITH_INVERSE 1
 #endif
 
 /* DHC_SMALL_CODE: 1 chooses the compact form of a few loops that faster builds unroll

@@ -114,6 +114,10 @@ double dhc_model_length_scale(const dhc_model *model, double temp_c);
 double dhc_model_drift_factor(const dhc_model *model, double t_s);
 void dhc_model_drift(const dhc_model *model, double t_s, const double p_arm[3], double p[3]);
 
+/* 1 when any compliance c_ij of the model is not zero (its predictions need the gravity
+ * moments). */
+int dhc_model_has_compliance(const dhc_model *model);
+
 /* Gravity moments tau_ij (row i, column j, j >= i; others 0) at joint angles q, with link
  * lengths scaled by length_scale. */
 dhc_status dhc_model_gravity_moments(const dhc_model *model, double length_scale,

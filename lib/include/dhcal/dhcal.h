@@ -12,6 +12,7 @@
 #include "dhc_effects.h"
 #include "dhc_factor.h"
 #include "dhc_geometry.h"
+#include "dhc_inverse.h"
 #include "dhc_jacobian.h"
 #include "dhc_kinematics.h"
 #include "dhc_linalg.h"
