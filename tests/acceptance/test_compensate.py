@@ -41,6 +41,10 @@ import subprocess
 import sys
 import tempfile
 
+sys.dont_write_bytecode = True
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import Checks  # noqa: E402
+
 NOISE_MM = 0.05
 FLOOR_MM = math.sqrt(3.0) * NOISE_MM
 N_TARGETS = 30
@@ -108,19 +112,6 @@ ARMS = {
         "margin_deg": [10, 10, 15, 10, 15, 10],
     },
 }
-
-
-class Checks:
-    def __init__(self):
-        self.passed = 0
-        self.failed = 0
-
-    def check(self, name, ok, detail=""):
-        print("%s  %s%s" % ("ok  " if ok else "FAIL", name, ": " + detail if detail else ""))
-        if ok:
-            self.passed += 1
-        else:
-            self.failed += 1
 
 
 def run(wrapper, args, expect=(0,)):

@@ -31,19 +31,7 @@ import tempfile
 sys.dont_write_bytecode = True
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import hidden_effects as he  # noqa: E402
-
-
-class Checks:
-    def __init__(self):
-        self.passed = 0
-        self.failed = 0
-
-    def check(self, name, ok, detail=""):
-        print("%s  %s%s" % ("ok  " if ok else "FAIL", name, ": " + detail if detail else ""))
-        if ok:
-            self.passed += 1
-        else:
-            self.failed += 1
+from checks import Checks  # noqa: E402
 
 
 def write_csv(path, rows):
