@@ -18,6 +18,7 @@
 #include "dhcal_model_map.h"
 #include "dhcal_plot.h"
 #include "dhcal_refine.h"
+#include "dhcal_urdf_cmd.h"
 
 #define EXIT_COMPUTE 1
 #define EXIT_USAGE 2
@@ -62,6 +63,8 @@ static const char *const usage_text =
     "  diagnose   fit, then rank the physical effects the model still misses\n"
     "  refine     the loop compare -> diagnose -> add -> refit, chosen by cross-validation\n"
     "  plot       residual and error plots (SVG) of a fit and its diagnosis\n"
+    "  import-urdf  a URDF's serial chain as a model file (dhcal import-urdf --help)\n"
+    "  export-urdf  a model file as a URDF (dhcal export-urdf --help)\n"
     "'dhcal <command> --help' describes each; 'dhcal --version' prints the version.\n"
     "exit codes: 0 success, 1 computation failed, 2 bad input or usage\n";
 
@@ -1208,6 +1211,9 @@ static int cmd_plot(const options *o, session *s)
 
 int main(int argc, char **argv)
 {
+    if (argc >= 2 && dhcal_urdf_is_command(argv[1])) {
+        return dhcal_urdf_command(argc, argv);
+    }
     options o;
     int rc = parse_args(argc, argv, &o);
     if (rc != 0) {
