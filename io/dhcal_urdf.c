@@ -601,20 +601,28 @@ static void put_comment_text(dhcal_text *t, const char *s)
     }
 }
 
-/* v, with -0 written as 0 (adding +0.0 turns -0.0 into +0.0) */
-static double plain_zero(double v)
+/* Numbers separated by sep, each with the fewest digits that read back to it. */
+static void put_numbers(dhcal_text *t, const double *v, size_t n, const char *sep)
 {
-    return v + 0.0;
+    for (size_t k = 0U; k < n; ++k) {
+        if (k > 0U) {
+            dhcal_text_str(t, sep);
+        }
+        dhcal_text_number(t, v[k]);
+    }
 }
 
 static void put_origin(dhcal_text *t, const dhc_frame *f)
 {
+    double xyz_m[3];
     double rpy[3];
+    dhc_vec3_scale(f->pos, 1.0 / MM_PER_M, xyz_m);
     dhc_rot_to_rpy(&f->rot, rpy);
-    dhcal_text_printf(t, "    <origin xyz=\"%.17g %.17g %.17g\" rpy=\"%.17g %.17g %.17g\"/>\n",
-                      plain_zero(f->pos[0] / MM_PER_M), plain_zero(f->pos[1] / MM_PER_M),
-                      plain_zero(f->pos[2] / MM_PER_M), plain_zero(rpy[0]), plain_zero(rpy[1]),
-                      plain_zero(rpy[2]));
+    dhcal_text_str(t, "    <origin xyz=\"");
+    put_numbers(t, xyz_m, 3U, " ");
+    dhcal_text_str(t, "\" rpy=\"");
+    put_numbers(t, rpy, 3U, " ");
+    dhcal_text_str(t, "\"/>\n");
 }
 
 static void put_fixed_joint(dhcal_text *t, const char *name, const char *parent,
@@ -638,29 +646,30 @@ static void put_not_geometry(dhcal_text *t, const dhcal_model *model)
         const dhcal_effect_value *e = &model->effects[k];
         dhcal_text_str(t, "       effect ");
         put_comment_text(t, e->name);
-        dhcal_text_str(t, ":");
-        for (size_t v = 0U; v < e->n_values; ++v) {
-            dhcal_text_printf(t, " %.17g", e->values[v]);
-        }
+        dhcal_text_str(t, ": ");
+        put_numbers(t, e->values, e->n_values, " ");
         dhcal_text_str(t, " (file units: docs/formats.md, 2.5)\n");
     }
     if (model->has_measurer) {
         dhcal_text_str(t, "       measurer: draw-wire anchors_mm");
         for (size_t a = 0U; a < 3U; ++a) {
-            dhcal_text_printf(t, " [%.17g, %.17g, %.17g]", model->anchors_mm[a][0],
-                              model->anchors_mm[a][1], model->anchors_mm[a][2]);
+            dhcal_text_str(t, " [");
+            put_numbers(t, model->anchors_mm[a], 3U, ", ");
+            dhcal_text_str(t, "]");
         }
         double rpy[3];
         const dhc_frame *f = &model->measurer_frame;
         dhc_rot_to_rpy(&f->rot, rpy);
-        dhcal_text_printf(t,
-                          " in its own frame, which sits in the world at xyz_mm [%.17g, %.17g, "
-                          "%.17g], rpy_deg [%.17g, %.17g, %.17g]\n",
-                          f->pos[0], f->pos[1], f->pos[2], plain_zero(rpy[0] / DHC_DEG),
-                          plain_zero(rpy[1] / DHC_DEG), plain_zero(rpy[2] / DHC_DEG));
+        dhc_vec3_scale(rpy, 1.0 / DHC_DEG, rpy);
+        dhcal_text_str(t, " in its own frame, which sits in the world at xyz_mm [");
+        put_numbers(t, f->pos, 3U, ", ");
+        dhcal_text_str(t, "], rpy_deg [");
+        put_numbers(t, rpy, 3U, ", ");
+        dhcal_text_str(t, "]\n");
     }
-    dhcal_text_printf(t, "       gravity (world frame): [%.17g, %.17g, %.17g]\n",
-                      model->gravity[0], model->gravity[1], model->gravity[2]);
+    dhcal_text_str(t, "       gravity (world frame): [");
+    put_numbers(t, model->gravity, 3U, ", ");
+    dhcal_text_str(t, "]\n");
     dhcal_text_str(t, "  -->\n");
 }
 
@@ -700,10 +709,11 @@ int dhcal_urdf_export(const char *path, const dhcal_model *model, const char *so
                           link);
         put_origin(&t, &previous);
         dhcal_text_str(&t, "    <axis xyz=\"0 0 1\"/>\n");
-        dhcal_text_printf(&t,
-                          "    <limit lower=\"%.17g\" upper=\"%.17g\" effort=\"0\" "
-                          "velocity=\"0\"/>\n",
-                          j->min_rad, j->max_rad);
+        dhcal_text_str(&t, "    <limit lower=\"");
+        dhcal_text_number(&t, j->min_rad);
+        dhcal_text_str(&t, "\" upper=\"");
+        dhcal_text_number(&t, j->max_rad);
+        dhcal_text_str(&t, "\" effort=\"0\" velocity=\"0\"/>\n");
         dhcal_text_str(&t, "  </joint>\n");
         (void)dhc_joint_transform(arm, i, 0.0, &previous);
         snprintf(parent, sizeof parent, "%s", link);
