@@ -1,5 +1,5 @@
 /* dhcal_urdf.h - URDF files (ROS' robot description, XML) as model files and back
- * (docs/formats.md, section 11; the commands: docs/cli.md, 1.6 and 1.7).
+ * (docs/formats.md, section 11; the commands: docs/cli.md, 1.7 and 1.8).
  *
  * Reading parses with libxml2 (no network, no entity expansion), keeps the direct <link> and
  * <joint> children of <robot> (a <transmission>'s <joint> is not a joint), walks the joints

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """dhcal import-urdf and export-urdf against forward kinematics computed here, independently
-of dhcal's code (docs/cli.md, 1.6 and 1.7; docs/formats.md, section 11).
+of dhcal's code (docs/cli.md, 1.7 and 1.8; docs/formats.md, section 11).
 
 Two computations written from the specifications, in plain Python:
   - urdf_fk: the URDF's kinematics from the URDF specification: for each joint from the base

@@ -1,5 +1,5 @@
 /* dhcal_urdf_cmd.h - the commands import-urdf and export-urdf of the dhcal program
- * (docs/cli.md, sections 1.6 and 1.7). */
+ * (docs/cli.md, sections 1.7 and 1.8). */
 #ifndef DHCAL_URDF_CMD_H
 #define DHCAL_URDF_CMD_H
 
