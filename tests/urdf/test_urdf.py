@@ -411,6 +411,63 @@ def random_chains(c, d, rng, count):
     c.check('random chains: ranges kept, continuous joints +-720 deg', continuous_ok)
 
 
+def chain_urdf(name, joints):
+    """A URDF of links l0..lN from (type, xyz, rpy, axis) tuples (axis None for fixed)."""
+    lines = [f'<robot name="{name}">', '  <link name="l0"/>']
+    for k, (kind, xyz, rpy, axis) in enumerate(joints):
+        lines.append(f'  <link name="l{k + 1}"/>')
+        lines.append(f'  <joint name="j{k + 1}" type="{kind}"><parent link="l{k}"/>'
+                     f'<child link="l{k + 1}"/><origin xyz="{xyz}" rpy="{rpy}"/>')
+        if axis is not None:
+            lines.append(f'    <axis xyz="{axis}"/>')
+        if kind == 'revolute':
+            lines.append('    <limit lower="-3" upper="3" effort="1" velocity="1"/>')
+        lines.append('  </joint>')
+    lines.append('</robot>')
+    return '\n'.join(lines) + '\n', len(joints)
+
+
+# Degenerate geometry a random chain hardly ever draws.
+SPECIAL_CHAINS = {
+    'coincident axes (a = 0, x kept)': [
+        ('revolute', '0 0 0.1', '0 0 0', '0 0 1'), ('revolute', '0 0 0.2', '0 0 0.4', '0 0 1'),
+        ('revolute', '0.3 0 0', '0 0 0', '0 1 0')],
+    'antiparallel axes (Hayati, alpha 180)': [
+        ('revolute', '0 0 0', '0 0 0', '0 1 0'), ('revolute', '0.4 0.1 0', '0 0 0', '0 -1 0'),
+        ('revolute', '0.3 0 0.05', '0 0 0', '0 1 0')],
+    'axis 1 along the base x (frame 0 x from y)': [
+        ('revolute', '0.1 0.2 0.3', '0 0 0', '1 0 0'), ('revolute', '0.2 0 0', '0 0 0', '0 0 -1'),
+        ('fixed', '0 0.1 0', '0.5 0.2 0.1', None)],
+    'tip turned 90 deg about x, a continuous joint': [
+        ('revolute', '0 0 0.2', '0 0 0', '0 0 1'), ('continuous', '0 0 0.3', '0 0 0', '0 1 0'),
+        ('fixed', '0.2 0 0', '1.5707963267948966 0 0.3', None)],
+    'tip y along the last axis (gimbal lock of the z-x-y angles)': [
+        ('revolute', '0 0 0.2', '0 0 0', '0 0 1'), ('revolute', '0 0 0.3', '0 0 0', '0 1 0'),
+        ('fixed', '0.2 0.01 0', '0 0.7 0', None)],
+    'tip z against the last axis, -z axes': [
+        ('revolute', '0 0 0.2', '0 0 0', '0 0 -1'), ('revolute', '0 0 0.3', '3.14159 0 0', '0 0 -1'),
+        ('fixed', '0 0 0.1', '3.141592653589793 0 0', None)],
+    'one joint, fixed joints around it': [
+        ('fixed', '0.1 0 0', '0.1 0.2 0.3', None), ('revolute', '0 0.2 0', '0 0 0', '0 1 1'),
+        ('fixed', '0 0 0.05', '0 0 0', None), ('fixed', '0.01 0.02 0.03', '0.3 0 0', None)],
+}
+
+
+def special_chains(c, d, rng):
+    for name, joints in SPECIAL_CHAINS.items():
+        text, last = chain_urdf('special', joints)
+        path = d.path('special.urdf')
+        with open(path, 'w') as f:
+            f.write(text)
+        chain = urdf_chain(path, 'l0', f'l{last}')
+        qs = [random_q(rng, joint_limits(chain)) for _ in range(40)]
+        out = d.path('special.json')
+        r = d.import_urdf(path, 'l0', f'l{last}', out, (5.0, -7.0, 11.0))
+        c.check(f'{name}: import exit 0', r.returncode == 0, r.stderr.strip())
+        if r.returncode == 0:
+            check_against_urdf(c, d, name, out, r.stdout, chain, qs, (5.0, -7.0, 11.0))
+
+
 def export_comment(c, d):
     """Effects, measurer and gravity are listed in a comment; the file is XML that re-imports."""
     model = json.load(open(PAPER_MODEL))
@@ -591,6 +648,7 @@ def main():
         rng = random.Random(1616)
         paper_arm(c, d, rng)
         random_chains(c, d, rng, 40)
+        special_chains(c, d, rng)
         export_comment(c, d)
         bad_input(c, d)
     print(f'{c.passed} passed, {c.failed} failed')
