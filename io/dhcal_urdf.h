@@ -18,7 +18,7 @@
 #include "dhcal_model_file.h"
 
 /* Largest URDF file read (bytes): robot descriptions with inline meshes stay far below. */
-#define DHCAL_URDF_MAX_BYTES (16U * 1048576U)
+#define DHCAL_URDF_MAX_BYTES 16777216U /* 16 MiB */
 
 /* What an import found besides the model. */
 typedef struct {
