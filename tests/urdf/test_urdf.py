@@ -24,7 +24,10 @@ reason when the folder is absent.
 
 Tolerances: 1e-6 mm on tool points, 1e-9 rad on orientations.
 
-Usage: test_urdf.py --dhcal PATH --scratch DIR [--realdata DIR]
+Usage: test_urdf.py --dhcal PATH --scratch DIR [--realdata DIR] [--wrapper 'CMD ARGS']
+  --wrapper runs every import-urdf and export-urdf under CMD (e.g. valgrind with
+  --error-exitcode=99): a wrapper that reports through its exit code fails the case's exit
+  code assertion. `dhcal compare`, the check's instrument, runs unwrapped.
 """
 import argparse
 import json
@@ -32,6 +35,7 @@ import math
 import os
 import random
 import re
+import shlex
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
@@ -180,16 +184,18 @@ class Checks:
 
 
 class Dhcal:
-    def __init__(self, exe, scratch):
+    def __init__(self, exe, scratch, wrapper=()):
         self.exe = exe
         self.scratch = scratch
+        self.wrapper = list(wrapper)
         self.count = 0
 
     def path(self, name):
         return os.path.join(self.scratch, name)
 
     def run(self, *args):
-        return subprocess.run([self.exe] + list(args), capture_output=True, text=True,
+        wrapper = self.wrapper if args[0] in ('import-urdf', 'export-urdf') else []
+        return subprocess.run(wrapper + [self.exe] + list(args), capture_output=True, text=True,
                               timeout=300)
 
     def import_urdf(self, urdf, base, tip, out, tool=None):
@@ -631,9 +637,10 @@ def main():
     ap.add_argument('--dhcal', required=True)
     ap.add_argument('--scratch', required=True)
     ap.add_argument('--realdata')
+    ap.add_argument('--wrapper', default='')
     args = ap.parse_args()
     os.makedirs(args.scratch, exist_ok=True)
-    d = Dhcal(args.dhcal, args.scratch)
+    d = Dhcal(args.dhcal, args.scratch, shlex.split(args.wrapper))
     c = Checks()
     if args.realdata is not None:
         needed = [os.path.join(args.realdata, 'urdf', f'{r}.fk.csv') for r, _, _ in ROBOTS]
