@@ -40,10 +40,14 @@ typedef struct {
     const char *path;
     xmlDoc *doc;
     xmlNode *robot;
-    urdf_link *links;
+    urdf_link *links; /* document order (messages name the first defect) */
     size_t n_links;
     urdf_joint *joints;
     size_t n_joints;
+    /* the same sorted by link name and by child link name: a URDF of many thousand links
+     * is looked up in O(log n), not scanned for every joint */
+    const urdf_link **links_by_name;
+    const urdf_joint **joints_by_child;
 } urdf_doc;
 
 static long line_of(const xmlNode *node)
@@ -92,6 +96,8 @@ static void free_doc(urdf_doc *d)
     }
     free(d->links);
     free(d->joints);
+    free(d->links_by_name);
+    free(d->joints_by_child);
     if (d->doc != NULL) {
         xmlFreeDoc(d->doc);
     }
@@ -127,6 +133,8 @@ static int read_file(const char *path, char **text, size_t *len, dhcal_error *er
     *len = got;
     return DHCAL_IO_OK;
 }
+
+static int index_doc(urdf_doc *d, dhcal_error *err);
 
 /* Parses the file and lists the robot's links and joints (their names and links only). */
 static int load_doc(const char *path, urdf_doc *d, dhcal_error *err)
@@ -216,17 +224,67 @@ static int load_doc(const char *path, urdf_doc *d, dhcal_error *err)
             }
         }
     }
+    rc = index_doc(d, err);
+    if (rc != DHCAL_IO_OK) {
+        free_doc(d);
+    }
+    return rc;
+}
+
+static int by_link_name(const void *a, const void *b)
+{
+    return strcmp((*(const urdf_link *const *)a)->name, (*(const urdf_link *const *)b)->name);
+}
+
+static int by_child_name(const void *a, const void *b)
+{
+    return strcmp((*(const urdf_joint *const *)a)->child,
+                  (*(const urdf_joint *const *)b)->child);
+}
+
+/* The sorted indexes of d's links and joints; DHCAL_IO_FAILED when out of memory. */
+static int index_doc(urdf_doc *d, dhcal_error *err)
+{
+    d->links_by_name = calloc(d->n_links + 1U, sizeof *d->links_by_name);
+    d->joints_by_child = calloc(d->n_joints + 1U, sizeof *d->joints_by_child);
+    if (d->links_by_name == NULL || d->joints_by_child == NULL) {
+        return dhcal_error_set(err, DHCAL_IO_FAILED, "%s: out of memory", d->path);
+    }
+    for (size_t k = 0U; k < d->n_links; ++k) {
+        d->links_by_name[k] = &d->links[k];
+    }
+    for (size_t k = 0U; k < d->n_joints; ++k) {
+        d->joints_by_child[k] = &d->joints[k];
+    }
+    qsort(d->links_by_name, d->n_links, sizeof *d->links_by_name, by_link_name);
+    qsort(d->joints_by_child, d->n_joints, sizeof *d->joints_by_child, by_child_name);
     return DHCAL_IO_OK;
+}
+
+/* bsearch's comparisons of a name (the key) with an index entry. */
+static int name_vs_link(const void *name, const void *entry)
+{
+    return strcmp(name, (*(const urdf_link *const *)entry)->name);
+}
+
+static int name_vs_child(const void *name, const void *entry)
+{
+    return strcmp(name, (*(const urdf_joint *const *)entry)->child);
 }
 
 static const urdf_link *find_link(const urdf_doc *d, const char *name)
 {
-    for (size_t k = 0U; k < d->n_links; ++k) {
-        if (strcmp(d->links[k].name, name) == 0) {
-            return &d->links[k];
-        }
-    }
-    return NULL;
+    const urdf_link *const *hit =
+        bsearch(name, d->links_by_name, d->n_links, sizeof *d->links_by_name, name_vs_link);
+    return hit != NULL ? *hit : NULL;
+}
+
+/* The joint whose child is link, or NULL (the root). */
+static const urdf_joint *parent_joint(const urdf_doc *d, const char *link)
+{
+    const urdf_joint *const *hit = bsearch(link, d->joints_by_child, d->n_joints,
+                                           sizeof *d->joints_by_child, name_vs_child);
+    return hit != NULL ? *hit : NULL;
 }
 
 /* "x y z" (spaces, tabs or line breaks between): exactly three finite numbers. */
@@ -426,35 +484,34 @@ static int find_chain(const urdf_doc *d, const char *base, const char *tip, size
                                        dhcal_quote(ends[e], strlen(ends[e]), quoted));
             }
         }
-        for (size_t m = 0U; m < k; ++m) {
-            if (strcmp(d->joints[m].child, j->child) == 0) {
-                return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
-                                       "%s:%ld: link '%s' is the child of joint '%s' (line %ld) "
-                                       "and of joint '%s': not a tree",
-                                       d->path, line_of(j->node), j->child, d->joints[m].name,
-                                       line_of(d->joints[m].node), j->name);
-            }
+    }
+    for (size_t k = 1U; k < d->n_joints; ++k) { /* sorted by child: a repeat is adjacent */
+        const urdf_joint *a = d->joints_by_child[k - 1U];
+        const urdf_joint *b = d->joints_by_child[k];
+        if (strcmp(a->child, b->child) == 0) {
+            const int a_first = line_of(a->node) <= line_of(b->node);
+            const urdf_joint *first = a_first ? a : b;
+            const urdf_joint *second = a_first ? b : a;
+            return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
+                                   "%s:%ld: link '%s' is the child of joint '%s' (line %ld) "
+                                   "and of joint '%s': not a tree",
+                                   d->path, line_of(second->node), second->child, first->name,
+                                   line_of(first->node), second->name);
         }
     }
     /* Up from the tip; each link has at most one parent joint, so at most n_joints steps. */
     const char *at = tip;
     size_t count = 0U;
     while (strcmp(at, base) != 0) {
-        size_t found = d->n_joints;
-        for (size_t k = 0U; k < d->n_joints; ++k) {
-            if (strcmp(d->joints[k].child, at) == 0) {
-                found = k;
-                break;
-            }
-        }
-        if (found == d->n_joints || count == d->n_joints) {
+        const urdf_joint *up = parent_joint(d, at);
+        if (up == NULL || count == d->n_joints) {
             return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
                                    "%s:%ld: link '%s' (--tip) is not below link '%s' (--base): "
                                    "going up from it ends at link '%s'",
                                    d->path, line_of(find_link(d, tip)->node), tip, base, at);
         }
-        order[count++] = found;
-        at = d->joints[found].parent;
+        order[count++] = (size_t)(up - d->joints);
+        at = up->parent;
     }
     for (size_t k = 0U; k < count / 2U; ++k) { /* tip-first -> base-first */
         const size_t t = order[k];
@@ -465,22 +522,33 @@ static int find_chain(const urdf_doc *d, const char *base, const char *tip, size
     return DHCAL_IO_OK;
 }
 
-static int arm_in_ranges(const urdf_doc *d, const dhc_arm *arm, dhcal_error *err)
+/* The model file's length ranges; a defect is named at the joint (or the tip link) whose
+ * geometry made it. */
+static int arm_in_ranges(const urdf_doc *d, const dhc_arm *arm,
+                         const dhcal_urdf_import_report *rep, long tip_line, dhcal_error *err)
 {
     for (size_t i = 0U; i < arm->n_joints; ++i) {
         if (fabs(arm->joint[i].a_mm) > LEN_MAX_MM || fabs(arm->joint[i].d_mm) > LEN_MAX_MM) {
             return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
-                                   "%s: joint %zu's DH lengths (a %.6g mm, d %.6g mm) exceed the "
-                                   "model file's 1e5 mm (nearly but not quite parallel axes?)",
-                                   d->path, i + 1U, arm->joint[i].a_mm, arm->joint[i].d_mm);
+                                   "%s:%ld: joint '%s': its DH lengths (a %.6g mm, d %.6g mm) "
+                                   "exceed the model file's 1e5 mm (axes nearly, but not quite, "
+                                   "parallel?)",
+                                   d->path, rep->joint_lines[i], rep->joint_names[i],
+                                   arm->joint[i].a_mm, arm->joint[i].d_mm);
         }
     }
     for (size_t k = 0U; k < 3U; ++k) {
-        if (fabs(arm->tool_mm[k]) > LEN_MAX_MM || fabs(arm->base.pos[k]) > LEN_MAX_MM) {
+        if (fabs(arm->base.pos[k]) > LEN_MAX_MM) {
             return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
-                                   "%s: the base or the tool point lies beyond the model file's "
-                                   "1e5 mm",
-                                   d->path);
+                                   "%s:%ld: joint '%s': frame 0 lies beyond the model file's "
+                                   "1e5 mm from the base link",
+                                   d->path, rep->joint_lines[0], rep->joint_names[0]);
+        }
+        if (fabs(arm->tool_mm[k]) > LEN_MAX_MM) {
+            return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
+                                   "%s:%ld: the tool point lies beyond the model file's 1e5 mm "
+                                   "from frame %zu",
+                                   d->path, tip_line, arm->n_joints);
         }
     }
     return DHCAL_IO_OK;
@@ -532,18 +600,19 @@ int dhcal_urdf_import(const char *path, const char *base_link, const char *tip_l
         const dhcal_urdf_chain_status st =
             dhcal_urdf_chain_to_arm(chain, n, tool_in_tip_mm != NULL ? tool_in_tip_mm : origin,
                                     &model->arm, &rep.tip_in_frame_n);
+        const long tip_line = line_of(find_link(&d, tip_link)->node);
         if (st == DHCAL_URDF_CHAIN_NO_JOINT) {
             rc = dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
-                                 "%s: no revolute or continuous joint between link '%s' and "
-                                 "link '%s'",
-                                 path, base_link, tip_link);
+                                 "%s:%ld: no revolute or continuous joint between link '%s' "
+                                 "and link '%s'",
+                                 path, tip_line, base_link, tip_link);
         } else if (st != DHCAL_URDF_CHAIN_OK) {
             rc = dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
-                                 "%s: the chain from '%s' to '%s' gives a model that is not "
+                                 "%s:%ld: the chain from '%s' to '%s' gives a model that is not "
                                  "finite",
-                                 path, base_link, tip_link);
+                                 path, tip_line, base_link, tip_link);
         } else {
-            rc = arm_in_ranges(&d, &model->arm, err);
+            rc = arm_in_ranges(&d, &model->arm, &rep, tip_line, err);
         }
     }
     if (rc == DHCAL_IO_OK) {

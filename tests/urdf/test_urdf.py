@@ -519,6 +519,13 @@ BAD_CASES = [
     ('Inf in a limit', 'inf', 'base_link', 'tool_flange',
      r':37: joint \'shoulder\': <limit lower="-inf">: expected a finite number'),
     ('tip not below base', None, 'forearm', 'column', r":\d+: link 'column' \(--tip\) is not below"),
+    ('no revolute joint between the links', None, 'forearm', 'tool_flange',
+     r":16: no revolute or continuous joint between link 'forearm' and link 'tool_flange'"),
+    ('nearly parallel axes (a DH length beyond 1e5 mm)', 'skew', 'base_link', 'tool_flange',
+     r":32: joint 'shoulder': its DH lengths \(a [-0-9.e+]+ mm, d [-0-9.e+]+ mm\) exceed"),
+    ('a link with two parents', 'two-parents', 'base_link', 'tool_flange',
+     r":48: link 'forearm' is the child of joint 'elbow' \(line 40\) and of joint 'flange': "
+     r"not a tree"),
 ]
 
 
@@ -526,6 +533,11 @@ def bad_input(c, d):
     paper = open(PAPER_URDF).read()
     variants = {
         'child': paper.replace('<link name="forearm"/>\n', ''),
+        # elbow's axis 0.0015 rad off the shoulder's: |sin| above the Hayati threshold, the
+        # common normal 0.4 m / 0.0015 = 270 m away
+        'skew': paper.replace('<origin xyz="0 0.05 0.4" rpy="0 0 0"/>',
+                              '<origin xyz="0 0.05 0.4" rpy="0.0015 0 0"/>'),
+        'two-parents': paper.replace('<child link="tool_flange"/>', '<child link="forearm"/>'),
         'prismatic': paper.replace('name="shoulder" type="revolute"', 'name="shoulder" type="prismatic"'),
         'nan': paper.replace('xyz="0 0.05 0.4"', 'xyz="0 nan 0.4"'),
         'inf': paper.replace('<limit lower="-2.9670597283903604" upper="2.9670597283903604" '
