@@ -104,36 +104,6 @@ static void free_doc(urdf_doc *d)
     memset(d, 0, sizeof *d);
 }
 
-/* The whole file into a heap buffer, at most DHCAL_URDF_MAX_BYTES. */
-static int read_file(const char *path, char **text, size_t *len, dhcal_error *err)
-{
-    FILE *f = fopen(path, "rb");
-    if (f == NULL) {
-        return dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s: cannot open: %s", path,
-                               strerror(errno));
-    }
-    char *buf = malloc(DHCAL_URDF_MAX_BYTES + 1U);
-    if (buf == NULL) {
-        fclose(f);
-        return dhcal_error_set(err, DHCAL_IO_FAILED, "%s: out of memory", path);
-    }
-    const size_t got = fread(buf, 1U, DHCAL_URDF_MAX_BYTES + 1U, f);
-    const int failed = ferror(f);
-    fclose(f);
-    if (failed) {
-        free(buf);
-        return dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s: cannot read", path);
-    }
-    if (got > DHCAL_URDF_MAX_BYTES) {
-        free(buf);
-        return dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s: larger than %u bytes", path,
-                               DHCAL_URDF_MAX_BYTES);
-    }
-    *text = buf;
-    *len = got;
-    return DHCAL_IO_OK;
-}
-
 static int index_doc(urdf_doc *d, dhcal_error *err);
 
 /* Parses the file and lists the robot's links and joints (their names and links only). */
@@ -143,7 +113,7 @@ static int load_doc(const char *path, urdf_doc *d, dhcal_error *err)
     d->path = path;
     char *text = NULL;
     size_t len = 0U;
-    int rc = read_file(path, &text, &len, err);
+    int rc = dhcal_read_whole(path, DHCAL_URDF_MAX_BYTES, "a URDF", &text, &len, err);
     if (rc != DHCAL_IO_OK) {
         return rc;
     }
