@@ -44,11 +44,17 @@ typedef struct {
     size_t n_links;
     urdf_joint *joints;
     size_t n_joints;
-    /* the same sorted by link name and by child link name: a URDF of many thousand links
-     * is looked up in O(log n), not scanned for every joint */
-    const urdf_link **links_by_name;
-    const urdf_joint **joints_by_child;
+    /* links by name and joints by child link, sorted: a URDF of many thousand links is
+     * looked up in O(log n), not scanned for every joint */
+    struct name_index *links_by_name;
+    struct name_index *joints_by_child;
 } urdf_doc;
+
+/* A name and the index of the link or joint it belongs to. */
+struct name_index {
+    const char *name;
+    size_t index;
+};
 
 static long line_of(const xmlNode *node)
 {
@@ -201,60 +207,57 @@ static int load_doc(const char *path, urdf_doc *d, dhcal_error *err)
     return rc;
 }
 
-static int by_link_name(const void *a, const void *b)
+static int by_name(const void *a, const void *b)
 {
-    return strcmp((*(const urdf_link *const *)a)->name, (*(const urdf_link *const *)b)->name);
+    return strcmp(((const struct name_index *)a)->name, ((const struct name_index *)b)->name);
 }
 
-static int by_child_name(const void *a, const void *b)
+/* bsearch's comparison of a name (the key) with an entry */
+static int name_vs_entry(const void *name, const void *entry)
 {
-    return strcmp((*(const urdf_joint *const *)a)->child,
-                  (*(const urdf_joint *const *)b)->child);
+    return strcmp(name, ((const struct name_index *)entry)->name);
 }
 
 /* The sorted indexes of d's links and joints; DHCAL_IO_FAILED when out of memory. */
 static int index_doc(urdf_doc *d, dhcal_error *err)
 {
-    d->links_by_name = calloc(d->n_links + 1U, sizeof *d->links_by_name);
-    d->joints_by_child = calloc(d->n_joints + 1U, sizeof *d->joints_by_child);
+    d->links_by_name = calloc(d->n_links + 1U, sizeof(struct name_index));
+    d->joints_by_child = calloc(d->n_joints + 1U, sizeof(struct name_index));
     if (d->links_by_name == NULL || d->joints_by_child == NULL) {
         return dhcal_error_set(err, DHCAL_IO_FAILED, "%s: out of memory", d->path);
     }
     for (size_t k = 0U; k < d->n_links; ++k) {
-        d->links_by_name[k] = &d->links[k];
+        d->links_by_name[k].name = d->links[k].name;
+        d->links_by_name[k].index = k;
     }
     for (size_t k = 0U; k < d->n_joints; ++k) {
-        d->joints_by_child[k] = &d->joints[k];
+        d->joints_by_child[k].name = d->joints[k].child;
+        d->joints_by_child[k].index = k;
     }
-    qsort(d->links_by_name, d->n_links, sizeof *d->links_by_name, by_link_name);
-    qsort(d->joints_by_child, d->n_joints, sizeof *d->joints_by_child, by_child_name);
+    qsort(d->links_by_name, d->n_links, sizeof(struct name_index), by_name);
+    qsort(d->joints_by_child, d->n_joints, sizeof(struct name_index), by_name);
     return DHCAL_IO_OK;
 }
 
-/* bsearch's comparisons of a name (the key) with an index entry. */
-static int name_vs_link(const void *name, const void *entry)
+static const struct name_index *look_up(const struct name_index *sorted, size_t n,
+                                        const char *name)
 {
-    return strcmp(name, (*(const urdf_link *const *)entry)->name);
-}
-
-static int name_vs_child(const void *name, const void *entry)
-{
-    return strcmp(name, (*(const urdf_joint *const *)entry)->child);
+    return n > 0U && sorted != NULL
+               ? bsearch(name, sorted, n, sizeof(struct name_index), name_vs_entry)
+               : NULL;
 }
 
 static const urdf_link *find_link(const urdf_doc *d, const char *name)
 {
-    const urdf_link *const *hit =
-        bsearch(name, d->links_by_name, d->n_links, sizeof *d->links_by_name, name_vs_link);
-    return hit != NULL ? *hit : NULL;
+    const struct name_index *hit = look_up(d->links_by_name, d->n_links, name);
+    return hit != NULL ? &d->links[hit->index] : NULL;
 }
 
 /* The joint whose child is link, or NULL (the root). */
 static const urdf_joint *parent_joint(const urdf_doc *d, const char *link)
 {
-    const urdf_joint *const *hit = bsearch(link, d->joints_by_child, d->n_joints,
-                                           sizeof *d->joints_by_child, name_vs_child);
-    return hit != NULL ? *hit : NULL;
+    const struct name_index *hit = look_up(d->joints_by_child, d->n_joints, link);
+    return hit != NULL ? &d->joints[hit->index] : NULL;
 }
 
 /* "x y z" (spaces, tabs or line breaks between): exactly three finite numbers. */
@@ -456,8 +459,8 @@ static int find_chain(const urdf_doc *d, const char *base, const char *tip, size
         }
     }
     for (size_t k = 1U; k < d->n_joints; ++k) { /* sorted by child: a repeat is adjacent */
-        const urdf_joint *a = d->joints_by_child[k - 1U];
-        const urdf_joint *b = d->joints_by_child[k];
+        const urdf_joint *a = &d->joints[d->joints_by_child[k - 1U].index];
+        const urdf_joint *b = &d->joints[d->joints_by_child[k].index];
         if (strcmp(a->child, b->child) == 0) {
             const int a_first = line_of(a->node) <= line_of(b->node);
             const urdf_joint *first = a_first ? a : b;
