@@ -27,4 +27,11 @@ static inline int same_double(double a, double b)
 /* 1 and the index of name among names[0..n-1] in *idx when it is there, else 0. */
 int dhcal_find_name(const char *name, const char *const *names, size_t n, size_t *idx);
 
+/* Reads path whole into a NUL-terminated heap buffer (*text, to be freed; *len bytes before
+ * the NUL), growing it as it reads. DHCAL_IO_BAD_INPUT with "path: ..." when the file
+ * cannot be opened or read or is larger than max_bytes ("not <what>"); DHCAL_IO_FAILED
+ * when out of memory. */
+int dhcal_read_whole(const char *path, size_t max_bytes, const char *what, char **text,
+                     size_t *len, dhcal_error *err);
+
 #endif /* DHCAL_IO_COMMON_H */

@@ -384,56 +384,6 @@ int dhcal_jframe(const dhcal_jctx *c, const cJSON *obj, const char *parent, cons
 
 /* ------------------------------------------------------------------ whole files */
 
-/* Reads the whole file into a NUL-terminated heap buffer. */
-static int read_whole(const char *path, size_t max_bytes, const char *what, char **text,
-                      size_t *len, dhcal_error *err)
-{
-    *text = NULL;
-    *len = 0U;
-    FILE *const f = fopen(path, "rb");
-    if (f == NULL) {
-        return dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s: cannot open: %s", path,
-                               strerror(errno));
-    }
-    size_t cap = 4096U;
-    size_t n = 0U;
-    char *buf = malloc(cap);
-    int rc = buf == NULL ? dhcal_error_set(err, DHCAL_IO_FAILED, "%s: out of memory", path)
-                         : DHCAL_IO_OK;
-    while (rc == DHCAL_IO_OK) {
-        if (n + 1U == cap) {
-            char *const grown = realloc(buf, cap * 2U);
-            if (grown == NULL) {
-                rc = dhcal_error_set(err, DHCAL_IO_FAILED, "%s: out of memory", path);
-                break;
-            }
-            buf = grown;
-            cap *= 2U;
-        }
-        const size_t got = fread(buf + n, 1U, cap - 1U - n, f);
-        n += got;
-        if (n > max_bytes) {
-            rc = dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s: larger than %zu bytes: not %s",
-                                 path, max_bytes, what);
-        } else if (got == 0U) {
-            if (ferror(f)) {
-                rc = dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s: read error: %s", path,
-                               strerror(errno));
-            }
-            break;
-        }
-    }
-    (void)fclose(f);
-    if (rc != DHCAL_IO_OK || buf == NULL) {
-        free(buf);
-        return rc != DHCAL_IO_OK ? rc : DHCAL_IO_FAILED;
-    }
-    buf[n] = '\0';
-    *text = buf;
-    *len = n;
-    return DHCAL_IO_OK;
-}
-
 static void line_col(const char *text, size_t pos, size_t *line, size_t *col)
 {
     *line = 1U;
@@ -597,7 +547,7 @@ int dhcal_json_load(const char *path, size_t max_bytes, const char *what, cJSON 
     *root = NULL;
     char *text = NULL;
     size_t len = 0U;
-    int rc = read_whole(path, max_bytes, what, &text, &len, err);
+    int rc = dhcal_read_whole(path, max_bytes, what, &text, &len, err);
     if (rc == DHCAL_IO_OK) {
         rc = parse_text(path, text, len, root, err);
     }

@@ -299,15 +299,7 @@ int dhcal_model_load(const char *path, dhcal_model *model, dhcal_error *err)
 /* The shortest of %.15g, %.16g, %.17g that reads back to v (%.17g always does). */
 static void put_exact(dhcal_text *sb, double v)
 {
-    char num[40];
-    v = v + 0.0; /* -0 becomes +0 */
-    for (int prec = 15; prec <= 17; ++prec) {
-        (void)snprintf(num, sizeof num, "%.*g", prec, v);
-        if (same_double(strtod(num, NULL), v)) {
-            break;
-        }
-    }
-    dhcal_text_printf(sb, "%s", num);
+    dhcal_text_number(sb, v);
 }
 
 /* Angles in degrees: the fewest digits (15 to 17) that load back to the same radians, so

@@ -72,3 +72,16 @@ void dhcal_text_printf(dhcal_text *t, const char *fmt, ...)
     va_end(ap);
     t->len += (size_t)n;
 }
+
+void dhcal_text_number(dhcal_text *t, double v)
+{
+    char num[40];
+    v = v + 0.0; /* -0 becomes +0 */
+    for (int prec = 15; prec <= 17; ++prec) {
+        (void)snprintf(num, sizeof num, "%.*g", prec, v);
+        if (!(strtod(num, NULL) < v) && !(strtod(num, NULL) > v)) { /* == without -Wfloat-equal */
+            break;
+        }
+    }
+    dhcal_text_str(t, num);
+}

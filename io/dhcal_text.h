@@ -32,5 +32,8 @@ void dhcal_text_put(dhcal_text *t, const char *s, size_t n);
 void dhcal_text_str(dhcal_text *t, const char *s);
 /* Appends printf's output. */
 void dhcal_text_printf(dhcal_text *t, const char *fmt, ...) DHCAL_PRINTF(2, 3);
+/* Appends v with the fewest digits (15 to 17 significant) that read back to the same double;
+ * -0 as 0. What every writer of numbers meant to be read again uses. */
+void dhcal_text_number(dhcal_text *t, double v);
 
 #endif /* DHCAL_TEXT_H */

@@ -112,12 +112,27 @@ probe_cjson() {
   ./j || prereq_fail "cJSON's program did not run"
 }
 
+# libxml2 (dhcal import-urdf): compiled and linked through pkg-config as CMake finds it, and
+# the program parses a document.
+probe_libxml2() {
+  printf '%s\n' '#include <libxml/parser.h>' \
+    'int main(void) { xmlDoc *d = xmlReadMemory("<robot/>", 8, "p.xml", NULL, XML_PARSE_NONET);' \
+    '  int ok = d != NULL && xmlDocGetRootElement(d) != NULL; xmlFreeDoc(d); return ok ? 0 : 1; }' >x.c
+  local flags
+  flags=$(pkg-config --cflags --libs libxml-2.0 2>/dev/null) ||
+    prereq_fail "pkg-config finds no libxml-2.0" || return 1
+  # shellcheck disable=SC2086 # word splitting intended: compiler flags
+  gcc -o x x.c $flags >log 2>&1 || prereq_fail "cannot link libxml2: $(tail -3 log)" ||
+    return 1
+  ./x || prereq_fail "libxml2's program did not run"
+}
+
 probe_pip() {
   python3 -m pip --version >/dev/null 2>&1 || prereq_fail "no pip for python3 (Unity comes from PyPI)"
 }
 
 probe_demo() {
-  probe_build_tools && probe_host_c && probe_cjson && probe_pip
+  probe_build_tools && probe_host_c && probe_cjson && probe_libxml2 && probe_pip
 }
 
 # The installed package is used from C++ (tests/install): g++ compiles, links and runs.
@@ -174,7 +189,7 @@ probe_asan() {
 }
 
 probe_fuzz() {
-  probe_build_tools && probe_cjson || return 1
+  probe_build_tools && probe_cjson && probe_libxml2 || return 1
   prereq_cmd clang || return 1
   printf '%s\n' '#include <stddef.h>' '#include <stdint.h>' \
     'int LLVMFuzzerTestOneInput(const uint8_t *d, size_t n) { (void)d; (void)n; return 0; }' >f.c

@@ -32,6 +32,7 @@ check "cortex-m4 lists newlib" 'has cortex-m4 libnewlib-arm-none-eabi'
 check "cortex-m4 lists qemu-system-arm" 'has cortex-m4 qemu-system-arm'
 check "fuzz lists the libFuzzer runtime" 'has fuzz libclang-rt-dev'
 check "demo lists cJSON" 'has demo libcjson-dev'
+check "demo lists libxml2" 'has demo libxml2-dev'
 check "demo lists the host C library" 'has demo libc6-dev'
 check "linux-port lists libgpiod" 'has linux-port libgpiod-dev'
 check "demo needs no cross or analysis package" \

@@ -20,6 +20,7 @@
 #include "dhcal_plan_cmd.h"
 #include "dhcal_plot.h"
 #include "dhcal_refine.h"
+#include "dhcal_urdf_cmd.h"
 
 #define EXIT_COMPUTE 1
 #define EXIT_USAGE 2
@@ -67,6 +68,8 @@ static const char *const usage_text =
     "  compensate joint angles that put a calibrated model's tool on targets\n"
     "             (--model C.json --targets T.csv --out J.csv: its own options)\n"
     "  plan       the poses to measure: an optimal plan (dhcal plan --help)\n"
+    "  import-urdf  a URDF's serial chain as a model file (dhcal import-urdf --help)\n"
+    "  export-urdf  a model file as a URDF (dhcal export-urdf --help)\n"
     "'dhcal <command> --help' describes each; 'dhcal --version' prints the version.\n"
     "exit codes: 0 success, 1 computation failed, 2 bad input or usage\n";
 
@@ -1218,6 +1221,9 @@ int main(int argc, char **argv)
     }
     if (argc >= 2 && strcmp(argv[1], "compensate") == 0) {
         return dhcal_compensate_main(argc, argv); /* targets, not measurements */
+    }
+    if (argc >= 2 && dhcal_urdf_is_command(argv[1])) {
+        return dhcal_urdf_command(argc, argv);
     }
     options o;
     int rc = parse_args(argc, argv, &o);
