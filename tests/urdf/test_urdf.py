@@ -502,6 +502,28 @@ def export_comment(c, d):
     c.check('export: links world, base_link, link1..3, flange, tool0',
             names == ['world', 'base_link', 'link1', 'link2', 'link3', 'flange', 'tool0'],
             str(names))
+    # what the effects left out cost, against the same computed here: joint_scale:1 alone
+    # (q1 -> (1 + s) q1), RMS over poses uniform in the joint ranges, Monte Carlo
+    model['effects'] = {'joint_scale:1': [0.001]}
+    src = d.path('scale-model.json')
+    with open(src, 'w') as f:
+        json.dump(model, f)
+    r = d.run('export-urdf', src, '--out', d.path('scale.urdf'))
+    said = re.search(r'move the model\'s tool point by ([0-9.e+-]+) mm RMS, ([0-9.e+-]+) mm at '
+                     r'most', r.stdout)
+    rng = random.Random(17)
+    lims = [(math.radians(j.get('min_deg', -180.0)), math.radians(j.get('max_deg', 180.0)))
+            for j in model['joints']]
+    sq = []
+    for _ in range(20000):
+        q = [rng.uniform(lo, hi) for lo, hi in lims]
+        moved = [q[0] * 1.001] + q[1:]
+        sq.append(dist(model_fk(model, q)[1], model_fk(model, moved)[1]) ** 2)
+    expect = math.sqrt(sum(sq) / len(sq))
+    c.check('export: the effects left out, measured as here (RMS within 5 %)',
+            said is not None and abs(float(said.group(1)) - expect) <= 0.05 * expect and
+            float(said.group(2)) >= float(said.group(1)),
+            f'{said.group(0) if said else r.stdout.strip()}; computed here {expect:.4g} mm RMS')
 
 
 BAD_CASES = [
