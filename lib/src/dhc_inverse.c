@@ -1,8 +1,6 @@
 /* dhc_inverse.c - inverse kinematics on the full measurement model (dhc_inverse.h). */
 #include "dhcal/dhc_inverse.h"
 
-#if DHC_WITH_INVERSE
-
 #include <math.h>
 #include <string.h>
 
@@ -16,6 +14,8 @@ void dhc_inverse_default_options(dhc_inverse_options *opt)
     opt->weight_mm_per_rad = DHC_ORIENTATION_WEIGHT_MM_PER_RAD;
     opt->max_iterations = 100U;
 }
+
+#if DHC_WITH_INVERSE
 
 /* d(q_eff_i)/d(q_i) through the effects on a joint's own angle: the derivative of
  * dhc_model_evaluate's s q + A sin q + B cos q + sum_k (A_k sin kq + B_k cos kq). */
@@ -337,6 +337,24 @@ dhc_status dhc_model_inverse(const dhc_model *model, const dhc_sample *target,
     result->outcome =
         at_rest(arm, q, &jac, r, err2) ? DHC_INVERSE_OUT_OF_REACH : DHC_INVERSE_NOT_CONVERGED;
     return DHC_ERR_NOT_CONVERGED;
+}
+
+#else /* the feature left out of this build (dhc_config.h) */
+
+dhc_status dhc_model_command_jacobian(const dhc_model *model, const dhc_sample *s,
+                                      double weight_mm_per_rad, dhc_inverse_workspace *ws,
+                                      dhc_mat *jac, dhc_prediction *pred)
+{
+    (void)model, (void)s, (void)weight_mm_per_rad, (void)ws, (void)jac, (void)pred;
+    return DHC_ERR_ARGUMENT;
+}
+
+dhc_status dhc_model_inverse(const dhc_model *model, const dhc_sample *target,
+                             const dhc_inverse_options *opt, dhc_inverse_workspace *ws,
+                             double q_rad[DHC_MAX_JOINTS], dhc_inverse_result *result)
+{
+    (void)model, (void)target, (void)opt, (void)ws, (void)q_rad, (void)result;
+    return DHC_ERR_ARGUMENT;
 }
 
 #endif /* DHC_WITH_INVERSE */

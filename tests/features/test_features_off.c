@@ -10,12 +10,13 @@
 #include "dhcal/dhc_diagnose.h"
 #include "dhcal/dhc_effects.h"
 #include "dhcal/dhc_uncertainty.h"
+#include "dhcal/dhc_inverse.h"
 #include "dhcal/dhc_plan.h"
 #include "unity.h"
 
 #if DHC_WITH_DIAGNOSE || DHC_WITH_SESSION_TESTS || DHC_WITH_UNCERTAINTY || DHC_WITH_EIV ||   \
     DHC_WITH_POSE_SAMPLES || DHC_WITH_ROBUST_START || DHC_WITH_EFFECT_SUMMARIES ||              \
-    DHC_WITH_CONVERSIONS || DHC_WITH_INVERSE
+    DHC_WITH_CONVERSIONS || DHC_WITH_INVERSE || DHC_WITH_PLAN
 #error "this test is built with every DHC_WITH_* feature 0"
 #endif
 
@@ -153,6 +154,22 @@ static void test_pose_selection_is_refused_its_score_kept(void)
     TEST_ASSERT_TRUE(o1 > 0.0 && rank > 0U);
 }
 
+static dhc_inverse_workspace inverse_ws;
+
+static void test_the_inverse_kinematics_is_refused(void)
+{
+    const dhc_model model = test_paper3_model();
+    dhc_sample target;
+    const double q[3] = {0.1, 0.5, -0.3};
+    dhc_model_sample_at(&model, q, NULL, DHC_MEAS_POSITION, &target);
+    dhc_inverse_options opt;
+    dhc_inverse_default_options(&opt);
+    double out[DHC_MAX_JOINTS];
+    dhc_inverse_result res;
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
+                      dhc_model_inverse(&model, &target, &opt, &inverse_ws, out, &res));
+}
+
 static void test_effects_keep_their_names_without_summaries(void)
 {
     const dhc_effect_info *info = dhc_effect_at(0U);
@@ -169,6 +186,7 @@ int main(void)
     RUN_TEST(test_a_pose_sample_is_refused);
     RUN_TEST(test_the_diagnosis_and_the_uncertainty_are_refused);
     RUN_TEST(test_pose_selection_is_refused_its_score_kept);
+    RUN_TEST(test_the_inverse_kinematics_is_refused);
     RUN_TEST(test_effects_keep_their_names_without_summaries);
     return UNITY_END();
 }

@@ -35,12 +35,12 @@ DHC_STATIC_ASSERT(DHC_MAX_PARAMS <= 256U, "DHC_MAX_PARAMS too large for the inde
  * The whole build, callers included, must agree. A feature left out answers with a
  * status, never with a silently different result: its entry points return
  * DHC_ERR_ARGUMENT (dhc_diagnose, dhc_uncertainty_*, dhc_lsq_prediction_variance,
- * dhc_arm_to_standard_dh, dhc_plan_select), options and samples that need it are refused (a noise model
- * that is on, robust_start, pose samples: dhc_calib_fit, dhc_sample_check), and functions
- * that return a value rather than a status (dhc_diagnose_candidates, dhc_chi2_log10_sf,
- * dhc_f_log10_sf, dhc_rot_log, the quaternion and roll-pitch-yaw conversions) are not
- * declared: a caller fails to compile. scripts/target-report --features lists each one's
- * bytes on the Cortex-M4. */
+ * dhc_arm_to_standard_dh, dhc_plan_select, dhc_model_inverse, dhc_model_command_jacobian),
+ * options and samples that need it are refused (a noise model that is on, robust_start, pose
+ * samples: dhc_calib_fit, dhc_sample_check), and functions that return a value rather than
+ * a status (dhc_diagnose_candidates, dhc_chi2_log10_sf, dhc_f_log10_sf, dhc_rot_log, the
+ * quaternion and roll-pitch-yaw conversions) are not declared: a caller fails to compile.
+ * scripts/target-report --features lists each one's bytes on the Cortex-M4. */
 #ifndef DHC_WITH_DIAGNOSE        /* dhc_diagnose.h: the score test of missing effects */
 #define DHC_WITH_DIAGNOSE 1
 #endif

@@ -27,7 +27,8 @@
  * through compliance (O(N) without), an N x N Cholesky. The scratch (2.1 KiB: the arm's
  * trigonometry and a model evaluation) is the caller's dhc_inverse_workspace; the stack
  * below dhc_model_inverse is about 3 KiB on the Cortex-M4 (scripts/target-report).
- * Built when DHC_WITH_INVERSE is 1 (dhc_config.h); otherwise not declared.
+ * Built when DHC_WITH_INVERSE is 1 (dhc_config.h); a build without it answers
+ * dhc_model_inverse and dhc_model_command_jacobian with DHC_ERR_ARGUMENT.
  */
 #ifndef DHC_INVERSE_H
 #define DHC_INVERSE_H
@@ -43,8 +44,6 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
-
-#if DHC_WITH_INVERSE
 
 typedef enum {
     DHC_INVERSE_CONVERGED = 0,
@@ -95,8 +94,6 @@ dhc_status dhc_model_command_jacobian(const dhc_model *model, const dhc_sample *
 dhc_status dhc_model_inverse(const dhc_model *model, const dhc_sample *target,
                              const dhc_inverse_options *opt, dhc_inverse_workspace *ws,
                              double q_rad[DHC_MAX_JOINTS], dhc_inverse_result *result);
-
-#endif /* DHC_WITH_INVERSE */
 
 #ifdef __cplusplus
 }
