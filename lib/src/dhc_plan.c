@@ -151,8 +151,7 @@ static double gain(dhc_plan_workspace *ws)
     if (!small_chol(u, rows)) {
         return -HUGE_VAL;
     }
-    /* trace(U^-1 V) = sum over V's columns c of c^T U^-1 c... as |C^-1 V^(1/2)|: here
-     * trace(U^-1 V) = sum_k (U^-1 V)_kk, column by column through U's factor */
+    /* trace(U^-1 V) = sum_k (U^-1 V)_kk: V's columns solved through U's factor, one by one */
     double tr = 0.0;
     for (size_t col = 0U; col < rows; ++col) {
         double x[DHC_MAX_ROWS_PER_SAMPLE];
