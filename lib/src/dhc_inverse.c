@@ -110,7 +110,7 @@ static dhc_status command_jacobian(const dhc_model *model, const dhc_sample *s,
         add_compliance_slope(model, ws->ev.frames, slope);
     }
     for (size_t r = 0U; r < rows; ++r) {
-        double row[DHC_MAX_JOINTS];
+        double row[DHC_MAX_JOINTS] = {0.0};
         for (size_t k = 0U; k < n; ++k) {
             row[k] = 0.0;
             for (size_t i = 0U; i < n; ++i) {
@@ -188,7 +188,7 @@ static dhc_status damped_step(const dhc_arm *arm, const double *q, const dhc_mat
     double a_buf[DHC_MAX_JOINTS * DHC_MAX_JOINTS];
     int pinned[DHC_MAX_JOINTS];
     dhc_mat a;
-    (void)dhc_mat_init(&a, n, n, a_buf, DHC_MAX_JOINTS * DHC_MAX_JOINTS);
+    (void)dhc_mat_init(&a, n, n, a_buf, sizeof a_buf / sizeof a_buf[0]);
     free_descent(arm, q, jac, r, dq, pinned);
     for (size_t i = 0U; i < n; ++i) {
         for (size_t j = 0U; j <= i; ++j) {
@@ -268,7 +268,8 @@ dhc_status dhc_model_inverse(const dhc_model *model, const dhc_sample *target,
     }
     const double w = opt->weight_mm_per_rad;
     dhc_sample s = *target; /* s.q_rad: the angles being tried */
-    double q[DHC_MAX_JOINTS]; /* the best so far */
+    double q[DHC_MAX_JOINTS] = {0.0}; /* the best so far */
+    memcpy(q, s.q_rad, sizeof q);
     for (size_t i = 0U; i < n; ++i) {
         s.q_rad[i] = clamp_to_range(&arm->joint[i], s.q_rad[i]);
         q[i] = s.q_rad[i];
@@ -276,7 +277,7 @@ dhc_status dhc_model_inverse(const dhc_model *model, const dhc_sample *target,
     double jac_buf[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_JOINTS];
     dhc_mat jac;
     (void)dhc_mat_init(&jac, dhc_sample_rows(&s), n, jac_buf,
-                       DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_JOINTS);
+                       sizeof jac_buf / sizeof jac_buf[0]);
     double r[DHC_MAX_ROWS_PER_SAMPLE] = {0.0};
     double err2 = 0.0;
     dhc_arm_prepare(arm, &ws->trig);

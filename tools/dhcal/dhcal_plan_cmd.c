@@ -253,8 +253,8 @@ static void report(const plan_options *o, const dhc_param_set *set, const dhc_pl
         cJSON_AddNumberToObject(obj, "identifiable", (double)rep->identifiable);
         cJSON *left = cJSON_AddArrayToObject(obj, "left_out");
         for (size_t k = 0U; k < set->count; ++k) {
-            char name[64];
             if (!kept[k]) {
+                char name[64];
                 (void)dhc_params_name(set, k, name, sizeof name);
                 cJSON_AddItemToArray(left, cJSON_CreateString(name));
             }
@@ -281,8 +281,8 @@ static void report(const plan_options *o, const dhc_param_set *set, const dhc_pl
            set->count);
     const char *sep = "; left out: ";
     for (size_t k = 0U; k < set->count; ++k) {
-        char name[64];
         if (!kept[k]) {
+            char name[64];
             (void)dhc_params_name(set, k, name, sizeof name);
             printf("%s%s", sep, name);
             sep = ", ";

@@ -40,7 +40,8 @@ typedef struct {
 /* Poses in a plan, at most (each gives one sample: FW_ACQ_MAX_SAMPLES), and the candidates
  * a planned plan is chosen from. */
 #define FW_PLAN_MAX_POSES 128U
-#define FW_PLAN_MAX_CANDIDATES (4U * FW_PLAN_MAX_POSES)
+#define FW_PLAN_MAX_CANDIDATES 512U
+DHC_STATIC_ASSERT(FW_PLAN_MAX_CANDIDATES == 4U * FW_PLAN_MAX_POSES, "four candidates a pose");
 
 /* Scratch of fw_plan_select and fw_plan_observability (about 32 DHC_MAX_PARAMS^2 bytes and
  * the candidates: keep it off small stacks); its contents mean nothing between calls. */
