@@ -350,11 +350,11 @@ int dhcal_py_run(const char *command, const dhcal_py_model *m, const dhcal_py_ro
     }
     /* As the program: fit and refine fail (after their report) on a fit that did not
      * converge or is no plausible calibration; diagnose reports whatever the fit gave. */
-    if (rc == DHCAL_IO_OK && !is_diagnose &&
+    if (rc == DHCAL_IO_OK && !is_diagnose && fit != NULL &&
         (implausible(m, fit, &e) || not_converged(fit, is_refine ? "final fit" : "fit", &e))) {
         rc = DHCAL_IO_FAILED;
     }
-    if (*report != NULL && !is_diagnose) {
+    if (*report != NULL && !is_diagnose && fit != NULL) {
         dhcal_error unused;
         *fitted = fitted_model(m, fit, &unused);
     }
