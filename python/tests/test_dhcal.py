@@ -275,3 +275,28 @@ def test_calls_do_not_leak_into_each_other(model, train) -> None:
                                                         abs=1e-3)
     assert again.rms_mm == first.rms_mm
     assert [p.value for p in again.parameters] == [p.value for p in first.parameters]
+
+
+def test_threads_take_turns(model, train) -> None:
+    """The C side keeps static workspaces; PyDLL holds the interpreter lock through each call,
+    so fits from several threads give what one thread gives."""
+    from concurrent.futures import ThreadPoolExecutor
+    args = [(train["q_deg"], train["xyz_mm"] + np.array([0.0, 0.0, dz])) for dz in (0, 1, 2, 3)]
+    serial = [dhcal.fit(model, q, x).rms_mm for q, x in args]
+    with ThreadPoolExecutor(4) as pool:
+        threaded = list(pool.map(lambda a: dhcal.fit(model, *a).rms_mm, args * 3))
+    assert threaded == serial * 3
+
+
+def test_readme_session_is_true(tmp_path: Path, monkeypatch) -> None:
+    """python/README.md's session, run as a doctest: its printed numbers are the package's."""
+    import doctest
+    text = (ROOT / "python" / "README.md").read_text()
+    session = re.search(r"```python\n(.*?)```", text, re.S).group(1)
+    monkeypatch.chdir(ROOT)
+    session = session.replace('"calibrated.json"', repr(str(tmp_path / "calibrated.json")))
+    test = doctest.DocTestParser().get_doctest(session, {}, "README", "python/README.md", 0)
+    runner = doctest.DocTestRunner(optionflags=doctest.NORMALIZE_WHITESPACE)
+    runner.run(test)
+    assert runner.failures == 0 and runner.tries > 8
+    assert dhcal.load_model(tmp_path / "calibrated.json").n_joints == 3
