@@ -300,3 +300,36 @@ def test_readme_session_is_true(tmp_path: Path, monkeypatch) -> None:
     runner.run(test)
     assert runner.failures == 0 and runner.tries > 8
     assert dhcal.load_model(tmp_path / "calibrated.json").n_joints == 3
+
+
+def test_time_and_temperature_columns_as_the_program(model, train, run_cli,
+                                                     tmp_path: Path) -> None:
+    """t_s and temp_c reach the C side as the CSV's columns do: the diagnosis, whose drift
+    and thermal candidates read them, equals the program's on the same rows in a file."""
+    n = train["q_deg"].shape[0]
+    t_s = np.arange(n) * 37.5 + 1000.0 + 20.0 * (np.arange(n) % 7)  # not the row number
+    temp_c = 20.0 + 0.05 * np.arange(n) + 0.25 * np.sin(np.arange(n))
+    path = tmp_path / "timed.csv"
+    with open(path, "w") as f:
+        f.write("q1,q2,q3,dir1,dir2,dir3,x,y,z,temp_c,t_s\n")
+        for i in range(n):
+            values = [*train["q_deg"][i], *train["directions"][i], *train["xyz_mm"][i],
+                      temp_c[i], t_s[i]]
+            f.write(",".join(repr(float(v)) for v in values) + "\n")
+    result = dhcal.diagnose(model, train["q_deg"], train["xyz_mm"],
+                            directions=train["directions"], temp_c=temp_c, t_s=t_s)
+    report = run_cli("diagnose", "--model", MODEL, "--data", path)
+    assert_fit_equal(result, report)
+    assert close(result.time_pose_r2, report["time_pose_r2"])
+    assert [(c.label, c.significant) for c in result.candidates] == \
+        [(f'{d["effect"]}:{d["joint"]}' if d["joint"] else d["effect"], d["significant"])
+         for d in report["candidates"]]
+    assert any(c.effect == "thermal_scale" for c in result.candidates)
+    assert all(close(c.explained, d["explained"])
+               for c, d in zip(result.candidates, report["candidates"]))
+    untimed = dhcal.diagnose(model, train["q_deg"], train["xyz_mm"],
+                             directions=train["directions"])
+    assert untimed.time_pose_r2 != result.time_pose_r2  # the times were used
+    assert not any(c.effect == "thermal_scale" for c in untimed.candidates)
+    read = dhcal.load_measurements(path, model)
+    assert np.array_equal(read.t_s, t_s) and np.array_equal(read.temp_c, temp_c)
