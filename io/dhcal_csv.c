@@ -548,12 +548,54 @@ static int parse_value(csv_ctx *c, csv_col col, span f, double *out)
     return DHCAL_IO_OK;
 }
 
+/* The CSV's range rule for one value of a column kind (docs/formats.md, 4.2): NULL when v
+ * keeps it, else the allowed range in words. One rule for the file reader and for rows handed
+ * in as arrays (dhcal_dataset_from_arrays), so both accept exactly the same values. */
+static const char *value_rule(col_kind kind, double v)
+{
+    switch (kind) {
+    case COL_Q:
+        return v < -CSV_Q_MAX_DEG || v > CSV_Q_MAX_DEG ? "[-720, 720] deg" : NULL;
+    case COL_XYZ:
+        return v < -LEN_MAX_MM || v > LEN_MAX_MM ? "[-1e5, 1e5] mm" : NULL;
+    case COL_WIRE:
+        return !(v > 0.0) || v > LEN_MAX_MM ? "(0, 1e5] mm" : NULL;
+    case COL_QUAT:
+        return NULL;
+    case COL_DIR:
+        /* Exactly -1 or +1; written as two comparisons because of -Wfloat-equal. */
+        return (v >= 1.0 && v <= 1.0) || (v >= -1.0 && v <= -1.0) ? NULL : "-1 or +1";
+    case COL_TIME:
+        return v < -TIME_MAX_S || v > TIME_MAX_S ? "[-1e9, 1e9] s" : NULL;
+    case COL_TEMP:
+    case COL_KIND_COUNT:
+    default:
+        return v < TEMP_MIN_C || v > TEMP_MAX_C ? "[-60, 150] degC" : NULL;
+    }
+}
+
 static int out_of_range(csv_ctx *c, csv_col col, span f, const char *range)
 {
     char nb[16];
     char sb[DHCAL_QUOTE_CAP];
     return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT, "%s:%zu: column '%s': %s is outside %s",
                      c->rd.path, c->rd.line_no, col_name(col, nb), dhcal_quote(f.s, f.n, sb), range);
+}
+
+/* A value that kept its column's rule, into the row (angles to radians). */
+static void store_value(dhcal_row *row, csv_col col, double v)
+{
+    switch (col.kind) {
+    case COL_Q: row->q_rad[col.idx] = v * DHC_DEG; break;
+    case COL_XYZ: row->xyz_mm[col.idx] = v; break;
+    case COL_WIRE: row->wires_mm[col.idx] = v; break;
+    case COL_QUAT: row->quat[col.idx] = v; break;
+    case COL_DIR: row->dir[col.idx] = v > 0.0 ? 1 : -1; break;
+    case COL_TIME: row->t_s = v; break;
+    case COL_TEMP:
+    case COL_KIND_COUNT:
+    default: row->temp_c = v; break;
+    }
 }
 
 static int parse_row(csv_ctx *c, dhcal_row *row)
@@ -578,54 +620,18 @@ static int parse_row(csv_ctx *c, dhcal_row *row)
         if (rc != DHCAL_IO_OK) {
             return rc;
         }
-        switch (col.kind) {
-        case COL_Q:
-            if (v < -CSV_Q_MAX_DEG || v > CSV_Q_MAX_DEG) {
-                return out_of_range(c, col, f, "[-720, 720] deg");
-            }
-            row->q_rad[col.idx] = v * DHC_DEG;
-            break;
-        case COL_XYZ:
-            if (v < -LEN_MAX_MM || v > LEN_MAX_MM) {
-                return out_of_range(c, col, f, "[-1e5, 1e5] mm");
-            }
-            row->xyz_mm[col.idx] = v;
-            break;
-        case COL_WIRE:
-            if (!(v > 0.0) || v > LEN_MAX_MM) {
-                return out_of_range(c, col, f, "(0, 1e5] mm");
-            }
-            row->wires_mm[col.idx] = v;
-            break;
-        case COL_QUAT:
-            row->quat[col.idx] = v;
-            break;
-        case COL_DIR:
-            /* Exactly -1 or +1; written as two comparisons because of -Wfloat-equal. */
-            if (!((v >= 1.0 && v <= 1.0) || (v >= -1.0 && v <= -1.0))) {
-                char nb[16];
-                char sb[DHCAL_QUOTE_CAP];
-                return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
-                                 "%s:%zu: column '%s': %s is not -1 or +1", c->rd.path,
-                                 c->rd.line_no, col_name(col, nb), dhcal_quote(f.s, f.n, sb));
-            }
-            row->dir[col.idx] = v > 0.0 ? 1 : -1;
-            break;
-        case COL_TIME:
-            if (v < -TIME_MAX_S || v > TIME_MAX_S) {
-                return out_of_range(c, col, f, "[-1e9, 1e9] s");
-            }
-            row->t_s = v;
-            break;
-        case COL_TEMP:
-        case COL_KIND_COUNT:
-        default:
-            if (v < TEMP_MIN_C || v > TEMP_MAX_C) {
-                return out_of_range(c, col, f, "[-60, 150] degC");
-            }
-            row->temp_c = v;
-            break;
+        const char *const rule = value_rule(col.kind, v);
+        if (rule != NULL && col.kind == COL_DIR) {
+            char nb[16];
+            char sb[DHCAL_QUOTE_CAP];
+            return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
+                             "%s:%zu: column '%s': %s is not -1 or +1", c->rd.path,
+                             c->rd.line_no, col_name(col, nb), dhcal_quote(f.s, f.n, sb));
         }
+        if (rule != NULL) {
+            return out_of_range(c, col, f, rule);
+        }
+        store_value(row, col, v);
     }
     if (c->has_quat) {
         /* Each component is finite, but their squares may overflow: the norm then is inf
@@ -782,6 +788,78 @@ void dhcal_dataset_free(dhcal_dataset *data)
     }
     free(data->rows);
     memset(data, 0, sizeof *data);
+}
+
+/* ------------------------------------------------------------------ rows as arrays */
+
+int dhcal_dataset_from_arrays(const dhcal_arrays *a, dhcal_dataset *data, dhcal_error *err)
+{
+    memset(data, 0, sizeof *data);
+    const char *const name = a->name != NULL ? a->name : "data";
+    if (a->n_joints == 0U || a->n_joints > DHC_MAX_JOINTS) {
+        return dhcal_error_set(err, DHCAL_IO_FAILED, "%s: joint count %zu outside 1..%u", name,
+                               a->n_joints, DHC_MAX_JOINTS);
+    }
+    if (a->n_rows == 0U) {
+        return dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s: no rows", name);
+    }
+    if (a->q_deg == NULL || a->xyz_mm == NULL) {
+        return dhcal_error_set(err, DHCAL_IO_FAILED, "%s: joint angles and tool points required",
+                               name);
+    }
+    if (a->n_rows > SIZE_MAX / sizeof *data->rows) {
+        return dhcal_error_set(err, DHCAL_IO_FAILED, "%s: out of memory for %zu rows", name,
+                               a->n_rows);
+    }
+    data->rows = calloc(a->n_rows, sizeof *data->rows);
+    if (data->rows == NULL) {
+        return dhcal_error_set(err, DHCAL_IO_FAILED, "%s: out of memory for %zu rows", name,
+                               a->n_rows);
+    }
+    data->n_rows = a->n_rows;
+    data->n_joints = a->n_joints;
+    data->has_q = 1;
+    data->has_xyz = 1;
+    data->has_dir = a->dir != NULL;
+    data->has_temp = a->temp_c != NULL;
+    data->has_time = a->t_s != NULL;
+    const size_t nj = a->n_joints;
+    for (size_t i = 0U; i < a->n_rows; ++i) {
+        dhcal_row *const row = &data->rows[i];
+        row->line = i + 1U;
+        /* each value through the CSV's own rule and store, column by column as a file
+         * would give them */
+        struct {
+            col_kind kind;
+            size_t count;
+            const double *v;
+        } const groups[5] = {{COL_Q, nj, a->q_deg + i * nj},
+                             {COL_XYZ, 3U, a->xyz_mm + i * 3U},
+                             {COL_DIR, nj, a->dir != NULL ? a->dir + i * nj : NULL},
+                             {COL_TEMP, 1U, a->temp_c != NULL ? a->temp_c + i : NULL},
+                             {COL_TIME, 1U, a->t_s != NULL ? a->t_s + i : NULL}};
+        for (size_t g = 0U; g < 5U; ++g) {
+            /* k < DHC_MAX_JOINTS always holds (count <= n_joints); said for the compiler,
+             * which bounds the column name's digits by it */
+            for (size_t k = 0U; groups[g].v != NULL && k < groups[g].count && k < DHC_MAX_JOINTS;
+                 ++k) {
+                const csv_col col = {groups[g].kind, k};
+                const double v = groups[g].v[k];
+                const char *const rule = isfinite(v) ? value_rule(col.kind, v) : "finite numbers";
+                if (rule != NULL) {
+                    char nb[16];
+                    const int rc = dhcal_error_set(
+                        err, DHCAL_IO_BAD_INPUT, "%s: row %zu, column '%s': %.17g is not %s%s",
+                        name, i + 1U, col_name(col, nb), v,
+                        col.kind == COL_DIR || !isfinite(v) ? "" : "inside ", rule);
+                    dhcal_dataset_free(data);
+                    return rc;
+                }
+                store_value(row, col, v);
+            }
+        }
+    }
+    return DHCAL_IO_OK;
 }
 
 /* ------------------------------------------------------------------ writing */

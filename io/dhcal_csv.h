@@ -72,6 +72,28 @@ int dhcal_csv_load_targets(const char *path, size_t n_joints, dhcal_dataset *tar
 /* Frees the rows and empties *data; NULL and already-empty datasets are fine. */
 void dhcal_dataset_free(dhcal_dataset *data);
 
+/* Measurement rows handed in as arrays rather than a file (the Python package): row-major,
+ * q_deg n_rows x n_joints in degrees, xyz_mm n_rows x 3 (both required); dir (n_rows x
+ * n_joints, each -1 or +1), temp_c and t_s (n_rows each) optional (NULL: no such column).
+ * name stands for the file in messages. */
+typedef struct {
+    const char *name;
+    size_t n_rows;
+    size_t n_joints;
+    const double *q_deg;
+    const double *xyz_mm;
+    const double *dir;
+    const double *temp_c;
+    const double *t_s;
+} dhcal_arrays;
+
+/* The dataset dhcal_csv_load would give for a file with these columns and values: every
+ * value under the CSV's rules and converted as the reader converts it, so a fit of the
+ * arrays equals a fit of the file. A defect names the row (1-based) and the column:
+ *     training data: row 4, column 'q2': 800 is not inside [-720, 720] deg
+ * NaN and infinities are rejected like out-of-range values. On error *data is empty. */
+int dhcal_dataset_from_arrays(const dhcal_arrays *a, dhcal_dataset *data, dhcal_error *err);
+
 /* The columns a writer puts down (the has_ flags of dhcal_dataset), always in this order:
  * q1..qN, dir1..dirN, x,y,z, L1,L2,L3, qw,qx,qy,qz, temp_c, t_s. */
 typedef struct {

@@ -11,7 +11,7 @@
 #   prereq_scipy_python       the python3 that imports numpy and scipy (need bench)
 #
 # The needs are the names in scripts/packages: demo host static valgrind linux-port asan
-# fuzz cortex-m4 aarch64-linux bench.
+# fuzz cortex-m4 aarch64-linux bench python.
 
 prereq_root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 prereq_list=$prereq_root/scripts/packages
@@ -147,6 +147,16 @@ probe_host_cxx() {
 
 probe_host() {
   probe_demo && probe_host_cxx
+}
+
+# The Python package (need python): the C build of probe_demo, and a virtual environment
+# with pip made by the python3 the step uses (Debian's needs python3-venv for it).
+probe_python() {
+  probe_build_tools && probe_host_c && probe_cjson && probe_libxml2 || return 1
+  python3 -m venv v >log 2>&1 ||
+    prereq_fail "python3 -m venv cannot make a virtual environment: $(tail -3 log)" || return 1
+  v/bin/python -m pip --version >log 2>&1 ||
+    prereq_fail "the virtual environment has no pip: $(tail -3 log)"
 }
 
 probe_static() {

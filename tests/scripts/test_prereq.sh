@@ -35,13 +35,15 @@ check "demo lists cJSON" 'has demo libcjson-dev'
 check "demo lists libxml2" 'has demo libxml2-dev'
 check "demo lists the host C library" 'has demo libc6-dev'
 check "linux-port lists libgpiod" 'has linux-port libgpiod-dev'
+check "python lists the venv module" 'has python python3-venv'
+check "python lists cJSON (the package builds io/)" 'has python libcjson-dev'
 check "demo needs no cross or analysis package" \
   '! prereq_packages demo | grep -Eq "arm|aarch64|clang|qemu|valgrind|cppcheck|gpiod"'
 
 # Every need named in the list, and every need the scripts ask for, has a probe.
 needs=$(awk '!/^[[:space:]]*(#|$)/ { for (i = 2; i <= NF; ++i) print $i }' \
           "$root/scripts/packages" | sort -u)
-for n in $needs demo host static valgrind linux-port asan fuzz cortex-m4 aarch64-linux bench; do
+for n in $needs demo host static valgrind linux-port asan fuzz cortex-m4 aarch64-linux bench python; do
   check "need $n has a probe" "declare -F probe_${n//-/_} >/dev/null"
   check "need $n lists packages" "[ -n \"\$(prereq_packages $n)\" ]"
 done

@@ -220,6 +220,12 @@ static int fit_errors(const dhc_model *model, const dhcal_samples *s, const doub
     return DHCAL_IO_OK;
 }
 
+void dhcal_fit_errors_forget(void)
+{
+    free(fit_rows.rows);
+    memset(&fit_rows, 0, sizeof fit_rows);
+}
+
 int dhcal_fit_errors(const dhc_model *model, const dhcal_samples *s, double *resid,
                      double *err_mm, dhcal_error_stats *stats)
 {

@@ -20,6 +20,7 @@
 #include "dhcal_plan_cmd.h"
 #include "dhcal_plot.h"
 #include "dhcal_refine.h"
+#include "dhcal_report.h"
 #include "dhcal_urdf_cmd.h"
 
 #define EXIT_COMPUTE 1
@@ -363,17 +364,6 @@ static int cmd_compare(const options *o, session *s)
 
 /* ---------------------------------------------------------------- fit reporting */
 
-/* The contract's name of an outlier's reason (docs/cli.md, 1.4, `fit`). */
-static const char *outlier_reason(uint8_t flag)
-{
-    switch (flag) {
-    case DHC_SAMPLE_JOINT_RANGE: return "joint_range";
-    case DHC_SAMPLE_BEYOND_REACH: return "beyond_reach";
-    case DHC_SAMPLE_ROBUST: return "robust";
-    default: return "residual";
-    }
-}
-
 static const char *outlier_words(uint8_t flag)
 {
     switch (flag) {
@@ -381,55 +371,6 @@ static const char *outlier_words(uint8_t flag)
     case DHC_SAMPLE_BEYOND_REACH: return "farther from the base than the arm reaches";
     case DHC_SAMPLE_ROBUST: return "far from the robust start";
     default: return "far from the fit";
-    }
-}
-
-/* What a report adds to a fit: adequacy, extrapolation to the held-out rows, CV. */
-typedef struct {
-    int have_adequacy;
-    dhcal_adequacy adequacy;
-    int have_extrapolation;
-    dhcal_extrapolation extrapolation;
-    int have_cv;
-    dhcal_cv cv;
-} fit_extras;
-
-static void compute_extras(const dhcal_fit *f, const session *s, fit_extras *x)
-{
-    memset(x, 0, sizeof *x);
-    x->have_adequacy = dhcal_assess(f, &s->samples, &x->adequacy) == DHCAL_IO_OK;
-    x->have_extrapolation =
-        s->have_held && dhcal_extrapolate(f, &s->samples, &s->held, &x->extrapolation) ==
-                            DHCAL_IO_OK;
-}
-
-static void json_number_or_null(cJSON *obj, const char *key, int have, double v)
-{
-    if (have) {
-        cJSON_AddNumberToObject(obj, key, v);
-    } else {
-        cJSON_AddNullToObject(obj, key);
-    }
-}
-
-static void json_extras(cJSON *obj, const dhcal_fit *f, const fit_extras *x)
-{
-    cJSON_AddStringToObject(obj, "geometry", dhcal_geometry_name(f->geometry));
-    if (x->have_cv) {
-        cJSON_AddNumberToObject(obj, "cv_rms_mm", x->cv.rms_mm);
-    }
-    if (x->have_extrapolation) {
-        cJSON_AddNumberToObject(obj, "heldout_outside_range", (double)x->extrapolation.outside_range);
-        cJSON_AddNumberToObject(obj, "predicted_std_mm", x->extrapolation.predicted_std_mm);
-    }
-    if (x->have_adequacy) {
-        const dhcal_adequacy *a = &x->adequacy;
-        cJSON *j = cJSON_AddObjectToObject(obj, "adequacy");
-        json_number_or_null(j, "noise_mm", a->have_noise, a->noise_mm);
-        cJSON_AddStringToObject(j, "noise_source", a->source);
-        json_number_or_null(j, "lack_of_fit_log10_p", a->have_test, a->lack_of_fit_log10_p);
-        json_number_or_null(j, "systematic_mm", a->have_systematic, a->systematic_mm);
-        cJSON_AddStringToObject(j, "verdict", a->verdict);
     }
 }
 
@@ -502,7 +443,7 @@ static void text_where(const dhcal_fit *f, const session *s)
     free(err);
 }
 
-static void text_extras(const dhcal_fit *f, const session *s, const fit_extras *x,
+static void text_extras(const dhcal_fit *f, const session *s, const dhcal_fit_extras *x,
                         int diagnosed_nothing)
 {
     if (x->have_cv) {
@@ -545,63 +486,6 @@ static void text_extras(const dhcal_fit *f, const session *s, const fit_extras *
            a->systematic_mm, a->noise_mm, ref, a->lack_of_fit_log10_p,
            diagnosed_nothing ? "; no effect of the catalogue explains it" : "");
     text_where(f, s);
-}
-
-static void json_fit(cJSON *obj, const dhcal_fit *f, const session *s, const double *row_err)
-{
-    cJSON_AddNumberToObject(obj, "rms_mm", f->rep.rms_mm);
-    cJSON_AddNumberToObject(obj, "mean_mm", f->train.mean_mm);
-    cJSON_AddNumberToObject(obj, "max_mm", f->rep.max_mm);
-    if (f->have_heldout) {
-        cJSON_AddNumberToObject(obj, "heldout_rms_mm", f->heldout.rms_mm);
-        cJSON_AddNumberToObject(obj, "heldout_mean_mm", f->heldout.mean_mm);
-    }
-    cJSON_AddNumberToObject(obj, "iterations", (double)f->rep.iterations);
-    cJSON_AddBoolToObject(obj, "converged", f->rep.converged);
-    if (dhcal_noise_on(&f->noise)) {
-        /* weighted rows: the residual's sd is in units of the noise model (1: it fits) */
-        cJSON *nm = cJSON_AddObjectToObject(obj, "noise_model");
-        cJSON_AddNumberToObject(nm, "joint_deg", f->noise.joint_rad[0] * 180.0 / DHC_PI);
-        cJSON_AddNumberToObject(nm, "meas_mm", f->noise.meas_mm);
-        cJSON_AddNumberToObject(nm, "whitened_sd", f->rep.sigma);
-    } else {
-        cJSON_AddNumberToObject(obj, "sigma_mm", f->rep.sigma);
-    }
-    cJSON *params = cJSON_AddArrayToObject(obj, "parameters");
-    cJSON *unid = cJSON_AddArrayToObject(obj, "unidentifiable");
-    char name[48];
-    for (size_t k = 0U; k < f->set.count; ++k) {
-        (void)dhc_params_name(&f->set, k, name, sizeof name);
-        if (f->rep.identifiable[k]) {
-            cJSON *p = cJSON_CreateObject();
-            cJSON_AddStringToObject(p, "name", name);
-            cJSON_AddNumberToObject(p, "value", dhcal_param_fitted(f, &s->model, k));
-            cJSON_AddNumberToObject(p, "std", dhcal_param_display(&f->set, k, f->rep.std_err[k]));
-            cJSON_AddItemToArray(params, p);
-            continue;
-        }
-        cJSON *u = cJSON_CreateObject();
-        cJSON_AddStringToObject(u, "param", name);
-        cJSON *with = cJSON_AddArrayToObject(u, "confounded_with");
-        for (size_t m = 0U; m < f->set.count; ++m) {
-            if (f->rep.confounded[k][m]) {
-                char other[48];
-                (void)dhc_params_name(&f->set, m, other, sizeof other);
-                cJSON_AddItemToArray(with, cJSON_CreateString(other));
-            }
-        }
-        cJSON_AddItemToArray(unid, u);
-    }
-    cJSON *outl = cJSON_AddArrayToObject(obj, "outliers");
-    for (size_t i = 0U; i < s->samples.n; ++i) {
-        if (dhc_sample_is_outlier(s->samples.flags[i])) {
-            cJSON *r = cJSON_CreateObject();
-            cJSON_AddNumberToObject(r, "row", (double)(i + 1U));
-            cJSON_AddNumberToObject(r, "error_mm", row_err[i]);
-            cJSON_AddStringToObject(r, "reason", outlier_reason(s->samples.flags[i]));
-            cJSON_AddItemToArray(outl, r);
-        }
-    }
 }
 
 static void text_fit(const dhcal_fit *f, const session *s, const options *o, const double *row_err)
@@ -742,12 +626,12 @@ static void text_covariates_fitted(const dhcal_fit *fit, const dhcal_samples *sa
 static int cmd_fit(const options *o, session *s)
 {
     static dhcal_fit fit;
-    static fit_extras extras;
+    static dhcal_fit_extras extras;
     double *row_err = NULL;
     int rc = do_fit(o, s, &fit, &row_err);
     const int implausible = rc == 0 ? refuse_implausible(s, &fit, o->out) : 0;
     if (rc == 0) {
-        compute_extras(&fit, s, &extras);
+        dhcal_fit_extras_compute(&fit, &s->samples, s->have_held ? &s->held : NULL, &extras);
         if (o->cv) {
             dhcal_error err;
             memset(&err, 0, sizeof err);
@@ -774,8 +658,8 @@ static int cmd_fit(const options *o, session *s)
     if (rc == 0) {
         if (o->json) {
             cJSON *obj = cJSON_CreateObject();
-            json_fit(obj, &fit, s, row_err);
-            json_extras(obj, &fit, &extras);
+            dhcal_json_fit(obj, &fit, &s->model, &s->samples, row_err);
+            dhcal_json_extras(obj, &fit, &extras);
             rc = print_json(obj);
         } else {
             text_fit(&fit, s, o, row_err);
@@ -794,23 +678,6 @@ static int cmd_fit(const options *o, session *s)
 }
 
 /* ---------------------------------------------------------------- diagnose */
-
-static void candidate_params(const dhcal_fit *fit, const dhc_candidate_result *c, cJSON *arr)
-{
-    dhc_param_set one;
-    dhc_params_clear(&one);
-    if (dhc_params_add_effect(&one, &fit->model, c->effect, c->joint) != DHC_OK) {
-        return;
-    }
-    char name[48];
-    for (size_t k = 0U; k < one.count && k < DHC_MAX_CANDIDATE_PARAMS; ++k) {
-        (void)dhc_params_name(&one, k, name, sizeof name);
-        cJSON *p = cJSON_CreateObject();
-        cJSON_AddStringToObject(p, "name", name);
-        cJSON_AddNumberToObject(p, "value", dhcal_param_display(&one, k, c->value[k]));
-        cJSON_AddItemToArray(arr, p);
-    }
-}
 
 /* Why drift or thermal candidates were left out: the session covariate moved in step with
  * the pose, so an error that grows with it cannot be told from one that depends on the pose. */
@@ -833,7 +700,7 @@ static void text_covariates(const dhcal_covariates *cov)
 
 /* diagnose --cv: the fit's own cross-validation and each candidate's, as refine tries them */
 static int cross_validate_candidates(const dhcal_fit *fit, const dhc_diagnosis *diag,
-                                     session *s, fit_extras *extras, dhcal_trials *trials)
+                                     session *s, dhcal_fit_extras *extras, dhcal_trials *trials)
 {
     dhcal_error err;
     memset(&err, 0, sizeof err);
@@ -920,7 +787,7 @@ static int cmd_diagnose(const options *o, session *s)
 {
     static dhcal_fit fit;
     static dhc_diagnosis diag;
-    static fit_extras extras;
+    static dhcal_fit_extras extras;
     dhcal_covariates cov;
     double *row_err = NULL;
     int rc = do_fit(o, s, &fit, &row_err);
@@ -933,7 +800,7 @@ static int cmd_diagnose(const options *o, session *s)
     static dhcal_trials trials;
     memset(&trials, 0, sizeof trials);
     if (rc == 0) {
-        compute_extras(&fit, s, &extras);
+        dhcal_fit_extras_compute(&fit, &s->samples, s->have_held ? &s->held : NULL, &extras);
         if (o->cv) {
             rc = cross_validate_candidates(&fit, &diag, s, &extras, &trials);
         }
@@ -941,35 +808,9 @@ static int cmd_diagnose(const options *o, session *s)
     if (rc == 0) {
         if (o->json) {
             cJSON *obj = cJSON_CreateObject();
-            json_fit(obj, &fit, s, row_err);
-            json_extras(obj, &fit, &extras);
-            cJSON_AddNumberToObject(obj, "time_pose_r2", cov.time_r2);
-            cJSON *cands = cJSON_AddArrayToObject(obj, "candidates");
-            for (size_t i = 0U; i < diag.count; ++i) {
-                const dhc_candidate_result *c = &diag.c[i];
-                cJSON *j = cJSON_CreateObject();
-                cJSON_AddStringToObject(j, "effect", dhc_effect_name(c->effect));
-                if (dhc_effect_is_per_joint(c->effect)) {
-                    cJSON_AddNumberToObject(j, "joint", (double)(c->joint + 1U));
-                } else {
-                    cJSON_AddNullToObject(j, "joint");
-                }
-                cJSON_AddNumberToObject(j, "explained", c->explained);
-                cJSON_AddBoolToObject(j, "significant", c->significant);
-                cJSON_AddNumberToObject(j, "log10_p", c->rank > 0U ? c->log10_p : 0.0);
-                cJSON_AddNumberToObject(j, "dof", (double)c->rank);
-                candidate_params(&fit, c, cJSON_AddArrayToObject(j, "params"));
-                if (trials.trial[i].tried && !trials.trial[i].unsupported) {
-                    cJSON_AddNumberToObject(j, "cv_rms_mm", trials.trial[i].cv.rms_mm);
-                }
-                if (c->lookalike < diag.count) {
-                    char label[64];
-                    (void)dhc_effect_label(diag.c[c->lookalike].effect, diag.c[c->lookalike].joint,
-                                       label, sizeof label);
-                    cJSON_AddStringToObject(j, "lookalike", label);
-                }
-                cJSON_AddItemToArray(cands, j);
-            }
+            dhcal_json_fit(obj, &fit, &s->model, &s->samples, row_err);
+            dhcal_json_extras(obj, &fit, &extras);
+            dhcal_json_diagnosis(obj, &fit, &diag, &cov, o->cv ? &trials : NULL);
             rc = print_json(obj);
         } else {
             text_fit(&fit, s, o, row_err);
@@ -987,7 +828,7 @@ static int cmd_diagnose(const options *o, session *s)
 static int cmd_refine(const options *o, session *s)
 {
     static dhcal_refine_result res;
-    static fit_extras extras;
+    static dhcal_fit_extras extras;
     dhcal_error err;
     memset(&err, 0, sizeof err);
     int rc = dhcal_run_refine(&s->model, o->effects, o->geometry != NULL ? &s->geometry : NULL,
@@ -1007,7 +848,7 @@ static int cmd_refine(const options *o, session *s)
         fprintf(stderr, "dhcal: evaluation failed\n");
         return EXIT_COMPUTE;
     }
-    compute_extras(fit, s, &extras);
+    dhcal_fit_extras_compute(fit, &s->samples, s->have_held ? &s->held : NULL, &extras);
     extras.have_cv = 1;
     extras.cv = res.cv;
     rc = 0;
@@ -1021,42 +862,9 @@ static int cmd_refine(const options *o, session *s)
     }
     if (o->json) {
         cJSON *obj = cJSON_CreateObject();
-        json_fit(obj, fit, s, row_err);
-        json_extras(obj, fit, &extras);
-        cJSON *effects = cJSON_AddArrayToObject(obj, "effects");
-        char list[DHCAL_EFFECTS_CAP];
-        snprintf(list, sizeof list, "%s", res.effects);
-        for (char *save = NULL, *tok = strtok_r(list, ",", &save); tok != NULL;
-             tok = strtok_r(NULL, ",", &save)) {
-            cJSON_AddItemToArray(effects, cJSON_CreateString(tok));
-        }
-        cJSON *steps = cJSON_AddArrayToObject(obj, "steps");
-        for (size_t k = 0U; k < res.n_steps; ++k) {
-            const dhcal_refine_step *st = &res.step[k];
-            cJSON *j = cJSON_CreateObject();
-            if (st->added[0] != '\0') {
-                cJSON_AddStringToObject(j, "added", st->added);
-            } else {
-                cJSON_AddNullToObject(j, "added");
-            }
-            cJSON *e = cJSON_AddArrayToObject(j, "effects");
-            snprintf(list, sizeof list, "%s", st->effects);
-            for (char *save = NULL, *tok = strtok_r(list, ",", &save); tok != NULL;
-                 tok = strtok_r(NULL, ",", &save)) {
-                cJSON_AddItemToArray(e, cJSON_CreateString(tok));
-            }
-            cJSON_AddNumberToObject(j, "rms_mm", st->rms_mm);
-            cJSON_AddNumberToObject(j, "cv_rms_mm", st->cv_rms_mm);
-            if (st->have_heldout) {
-                cJSON_AddNumberToObject(j, "heldout_rms_mm", st->heldout_rms_mm);
-                cJSON_AddNumberToObject(j, "heldout_mean_mm", st->heldout_mean_mm);
-            }
-            cJSON_AddItemToArray(steps, j);
-        }
-        if (res.geometry_chosen) {
-            cJSON_AddStringToObject(obj, "geometry_why", res.geometry_why);
-        }
-        cJSON_AddStringToObject(obj, "stopped", res.stopped_why);
+        dhcal_json_fit(obj, fit, &s->model, &s->samples, row_err);
+        dhcal_json_extras(obj, fit, &extras);
+        dhcal_json_refine(obj, &res);
         const int prc = print_json(obj);
         rc = rc != 0 ? rc : prc;
     } else {

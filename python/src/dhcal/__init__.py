@@ -1,0 +1,490 @@
+"""dhcal: robot DH-parameter calibration, from Python.
+
+The fit, the diagnosis of missing physical effects and the refine loop are the C code the
+``dhcal`` command-line program runs (``dhcal fit|diagnose|refine --json``): the results carry
+the same numbers under the same names (docs/cli.md, 1.4), read from the program's own JSON
+report. Arrays in and out are numpy arrays: joint angles in degrees (N x joints), tool points
+in mm (N x 3).
+
+    >>> model = dhcal.load_model("examples/data/compliance/model.json")
+    >>> data = dhcal.load_measurements("examples/data/compliance/train.csv", model)
+    >>> result = dhcal.fit(model, data.q_deg, data.xyz_mm, directions=data.directions)
+    >>> result.rms_mm, result.parameters[0].name
+"""
+from __future__ import annotations
+
+import ctypes
+import json
+import math
+import os
+import tempfile
+from dataclasses import dataclass, field
+from typing import Any, Dict, Iterable, List, Optional, Tuple, Union
+
+import numpy as np
+
+from . import _native
+
+__all__ = [
+    "DhcalError", "DhcalInputError", "Model", "Measurements", "Parameter", "Unidentifiable",
+    "Outlier", "Candidate", "FitResult", "Diagnosis", "RefineResult", "load_model",
+    "load_measurements", "fit", "diagnose", "refine", "__version__",
+]
+
+__version__: str = _native.LIB.dhcal_py_version().decode("ascii")
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+
+class DhcalError(Exception):
+    """A computation dhcal could not make (the program's exit code 1), or bad input.
+
+    ``result`` holds the report when there is one: a fit that did not converge, or whose
+    model is no plausible calibration, is reported (as the program prints its report before
+    it exits 1) and refused.
+    """
+
+    def __init__(self, message: str, code: int = _native.FAILED,
+                 result: Optional["FitResult"] = None) -> None:
+        super().__init__(message)
+        self.message = message
+        self.code = code
+        self.result = result
+
+
+class DhcalInputError(DhcalError, ValueError):
+    """Bad input (the program's exit code 2): a file that cannot be read or is invalid (the
+    message names the file and the line, or the JSON path), a bad effect name, values out of
+    range. Also a ``ValueError``."""
+
+    def __init__(self, message: str) -> None:
+        super().__init__(message, _native.BAD_INPUT)
+
+
+def _raise(code: int, err: ctypes.Array, result: Optional["FitResult"] = None) -> None:
+    message = err.value.decode("utf-8", "replace")
+    if code == _native.BAD_INPUT:
+        raise DhcalInputError(message)
+    raise DhcalError(message, code, result)
+
+
+# ---------------------------------------------------------------- models
+
+class Model:
+    """A robot model: what a model file holds (docs/formats.md, section 2), loaded and checked
+    by the C file layer. Made by :func:`load_model` or by a fit."""
+
+    def __init__(self, handle: int, origin: str) -> None:
+        self._handle: Optional[int] = handle
+        info = json.loads(_native.take_text(_native.LIB.dhcal_py_model_info(handle)) or "{}")
+        self.name: str = info["name"]
+        self.n_joints: int = int(info["n_joints"])
+        self.has_measurer: bool = bool(info["has_measurer"])
+        self.origin: str = origin  # the file it came from, or what made it
+
+    def __del__(self) -> None:
+        handle, self._handle = getattr(self, "_handle", None), None
+        if handle:
+            _native.LIB.dhcal_py_model_free(handle)
+
+    def _ptr(self) -> int:
+        if not self._handle:
+            raise ValueError("dhcal: this model was freed")
+        return self._handle
+
+    def save(self, path: PathLike) -> None:
+        """Writes the model file (the C writer: same schema, written to a temporary file and
+        renamed over ``path``, so a failure never leaves a half-written file)."""
+        err = _native.err_buffer()
+        code = _native.LIB.dhcal_py_model_save(self._ptr(), os.fsencode(path), err,
+                                               _native.ERR_CAP)
+        if code != _native.OK:
+            _raise(code, err)
+
+    def to_dict(self) -> Dict[str, Any]:
+        """The model file's content as a dict, as :meth:`save` writes it."""
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "model.json")
+            self.save(path)
+            with open(path, encoding="utf-8") as f:
+                return json.load(f)
+
+    def __repr__(self) -> str:
+        return f"<dhcal.Model '{self.name}', {self.n_joints} joints, from {self.origin}>"
+
+
+def load_model(path: PathLike) -> Model:
+    """Loads a model file; :class:`DhcalInputError` names the file and the JSON path (or the
+    line and column of a syntax error) of a defect."""
+    err = _native.err_buffer()
+    code = ctypes.c_int(0)
+    handle = _native.LIB.dhcal_py_model_load(os.fsencode(path), ctypes.byref(code), err,
+                                             _native.ERR_CAP)
+    if not handle:
+        _raise(code.value, err)
+    return Model(handle, os.fspath(path))
+
+
+# ---------------------------------------------------------------- measurements
+
+@dataclass
+class Measurements:
+    """Measurement rows: ``q_deg`` (N x joints, degrees), ``xyz_mm`` (N x 3), and the
+    optional columns ``directions`` (N x joints, -1 or +1: the approach direction of each
+    joint), ``temp_c`` and ``t_s`` (N each), or None."""
+
+    q_deg: np.ndarray
+    xyz_mm: np.ndarray
+    directions: Optional[np.ndarray] = None
+    temp_c: Optional[np.ndarray] = None
+    t_s: Optional[np.ndarray] = None
+
+    def __len__(self) -> int:
+        return int(self.q_deg.shape[0])
+
+
+def load_measurements(path: PathLike, model: Model) -> Measurements:
+    """Reads a measurement CSV (docs/formats.md, 4.2) for ``model`` with the C reader the
+    program uses; a defect raises :class:`DhcalInputError` naming the file and the line.
+    Angles come back in degrees (converted back from the reader's radians: within an ulp of
+    the file's values)."""
+    err = _native.err_buffer()
+    rows = ctypes.c_void_p()
+    n = ctypes.c_size_t(0)
+    columns = ctypes.c_int(0)
+    code = _native.LIB.dhcal_py_rows_load(os.fsencode(path), model._ptr(), ctypes.byref(rows),
+                                          ctypes.byref(n), ctypes.byref(columns), err,
+                                          _native.ERR_CAP)
+    if code != _native.OK:
+        _raise(code, err)
+    try:
+        if not columns.value & 8:
+            raise DhcalInputError(f"{os.fspath(path)}: no x,y,z columns: the Python package "
+                                  "takes tool points (wire lengths L1..L3 only through the "
+                                  "program)")
+        nr, nj = n.value, model.n_joints
+        q = np.empty((nr, nj))
+        xyz = np.empty((nr, 3))
+        d = np.empty((nr, nj)) if columns.value & 1 else None
+        temp = np.empty(nr) if columns.value & 2 else None
+        t = np.empty(nr) if columns.value & 4 else None
+        _native.LIB.dhcal_py_rows_copy(rows, *(_pointer(a) for a in (q, xyz, d, temp, t)))
+    finally:
+        _native.LIB.dhcal_py_rows_free(rows)
+    return Measurements(q, xyz, d, temp, t)
+
+
+def _pointer(a: Optional[np.ndarray]) -> Any:
+    return None if a is None else a.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+
+
+def _array(name: str, value: Any, shape: Tuple[Optional[int], ...]) -> np.ndarray:
+    """value as a C-ordered float64 array of the shape (None: any length), every entry
+    finite; ValueError otherwise."""
+    try:
+        a = np.ascontiguousarray(value, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise ValueError(f"dhcal: {name}: not an array of numbers ({e})") from None
+    if len(shape) == 2 and a.ndim == 1 and shape[1] == 1:
+        a = a.reshape(-1, 1)
+    if a.ndim != len(shape) or any(want is not None and got != want
+                                   for got, want in zip(a.shape, shape)):
+        want_text = " x ".join("N" if s is None else str(s) for s in shape)
+        raise ValueError(f"dhcal: {name}: shape {a.shape}, expected {want_text}")
+    bad = ~np.isfinite(a)
+    if bad.any():
+        where = np.argwhere(bad)[0]
+        raise ValueError(f"dhcal: {name}: row {int(where[0]) + 1} holds {a[tuple(where)]}: "
+                         "every value must be a finite number")
+    return a
+
+
+class _Rows:
+    """Measurement arrays checked and held for one call (ctypes keeps only pointers)."""
+
+    def __init__(self, what: str, model: Model, m: Measurements) -> None:
+        q = _array(f"{what} q_deg", m.q_deg, (None, model.n_joints))
+        n = q.shape[0]
+        if n == 0:
+            raise ValueError(f"dhcal: {what}: no rows")
+        self.arrays = [q, _array(f"{what} xyz_mm", m.xyz_mm, (n, 3))]
+        optional = [(m.directions, "directions", (n, model.n_joints)), (m.temp_c, "temp_c", (n,)),
+                    (m.t_s, "t_s", (n,))]
+        self.arrays += [None if v is None else _array(f"{what} {name}", v, shape)
+                        for v, name, shape in optional]
+        self.c = _native.Rows(n, *(_pointer(a) for a in self.arrays))
+
+
+def _measurements(q_deg: Any, xyz_mm: Any, directions: Any, temp_c: Any,
+                  t_s: Any) -> Measurements:
+    if isinstance(q_deg, Measurements):
+        if xyz_mm is not None:
+            raise TypeError("dhcal: give Measurements alone, or q_deg and xyz_mm")
+        return q_deg
+    if xyz_mm is None:
+        raise TypeError("dhcal: xyz_mm (N x 3, mm) is required with q_deg")
+    return Measurements(q_deg, xyz_mm, directions, temp_c, t_s)
+
+
+def _heldout(heldout: Any) -> Optional[Measurements]:
+    if heldout is None or isinstance(heldout, Measurements):
+        return heldout
+    if isinstance(heldout, (tuple, list)) and len(heldout) in (2, 3):
+        return Measurements(*heldout)
+    raise TypeError("dhcal: heldout must be Measurements or (q_deg, xyz_mm[, directions])")
+
+
+# ---------------------------------------------------------------- results
+
+@dataclass(frozen=True)
+class Parameter:
+    """An identified parameter in display units (docs/cli.md, 1.4): angles in degrees,
+    compliances in degrees per mm of moment arm, lengths in mm."""
+
+    name: str
+    value: float
+    std: float
+
+
+@dataclass(frozen=True)
+class Unidentifiable:
+    """A parameter kept at its input value, and those it trades off with."""
+
+    param: str
+    confounded_with: Tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class Outlier:
+    """A row left out of the fit: 1-based row number, its error, and why (joint_range,
+    beyond_reach, robust, residual)."""
+
+    row: int
+    error_mm: float
+    reason: str
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """An effect the diagnosis scored against the fit's residual."""
+
+    effect: str
+    joint: Optional[int]
+    explained: float
+    significant: bool
+    log10_p: float
+    dof: int
+    params: Dict[str, float]
+    cv_rms_mm: Optional[float] = None
+    lookalike: Optional[str] = None
+
+    @property
+    def label(self) -> str:
+        """The name ``--effects`` and :func:`fit`'s ``effects`` take: ``joint_compliance:2``."""
+        return self.effect if self.joint is None else f"{self.effect}:{self.joint}"
+
+
+@dataclass
+class FitResult:
+    """A fit's report (the keys of ``dhcal fit --json``) and the calibrated model."""
+
+    report: Dict[str, Any]
+    model: Optional[Model]
+    rms_mm: float = field(init=False)
+    mean_mm: float = field(init=False)
+    max_mm: float = field(init=False)
+    iterations: int = field(init=False)
+    converged: bool = field(init=False)
+    geometry: str = field(init=False)
+    parameters: List[Parameter] = field(init=False)
+    unidentifiable: List[Unidentifiable] = field(init=False)
+    outliers: List[Outlier] = field(init=False)
+    sigma_mm: Optional[float] = field(init=False)
+    heldout_rms_mm: Optional[float] = field(init=False)
+    heldout_mean_mm: Optional[float] = field(init=False)
+    cv_rms_mm: Optional[float] = field(init=False)
+    adequacy: Optional[Dict[str, Any]] = field(init=False)
+
+    def __post_init__(self) -> None:
+        r = self.report
+        self.rms_mm, self.mean_mm, self.max_mm = r["rms_mm"], r["mean_mm"], r["max_mm"]
+        self.iterations, self.converged = int(r["iterations"]), bool(r["converged"])
+        self.geometry = r["geometry"]
+        self.parameters = [Parameter(p["name"], p["value"], p["std"]) for p in r["parameters"]]
+        self.unidentifiable = [Unidentifiable(u["param"], tuple(u["confounded_with"]))
+                               for u in r["unidentifiable"]]
+        self.outliers = [Outlier(int(o["row"]), o["error_mm"], o["reason"])
+                         for o in r["outliers"]]
+        self.sigma_mm = r.get("sigma_mm")
+        self.heldout_rms_mm = r.get("heldout_rms_mm")
+        self.heldout_mean_mm = r.get("heldout_mean_mm")
+        self.cv_rms_mm = r.get("cv_rms_mm")
+        self.adequacy = r.get("adequacy")
+
+    def parameter(self, name: str) -> Parameter:
+        """The identified parameter called name (KeyError when it is not identified)."""
+        for p in self.parameters:
+            if p.name == name:
+                return p
+        raise KeyError(name)
+
+    def summary(self) -> str:
+        """The result in a few lines of text."""
+        lines = [f"{'converged' if self.converged else 'NOT converged'} after "
+                 f"{self.iterations} iterations ({self.geometry} geometry): "
+                 f"RMS {self.rms_mm:.4f} mm, max {self.max_mm:.4f} mm"]
+        if self.heldout_rms_mm is not None:
+            lines.append(f"held-out RMS {self.heldout_rms_mm:.4f} mm")
+        if self.cv_rms_mm is not None:
+            lines.append(f"cross-validated RMS {self.cv_rms_mm:.4f} mm")
+        lines += [f"  {p.name:<18} {p.value:16.8g} +- {p.std:.3g}" for p in self.parameters]
+        lines += [f"  not identifiable: {u.param}"
+                  + (f" (trades off with {', '.join(u.confounded_with)})"
+                     if u.confounded_with else "") for u in self.unidentifiable]
+        lines += [f"  outlier: row {o.row}, {o.error_mm:.4f} mm ({o.reason})"
+                  for o in self.outliers]
+        return "\n".join(lines)
+
+
+@dataclass
+class Diagnosis(FitResult):
+    """``dhcal diagnose --json``: the fit, and the candidate effects best first."""
+
+    candidates: List[Candidate] = field(init=False)
+    time_pose_r2: float = field(init=False)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        r = self.report
+        self.time_pose_r2 = r["time_pose_r2"]
+        self.candidates = [
+            Candidate(c["effect"], c["joint"], c["explained"], bool(c["significant"]),
+                      c["log10_p"], int(c["dof"]), {p["name"]: p["value"] for p in c["params"]},
+                      c.get("cv_rms_mm"), c.get("lookalike"))
+            for c in r["candidates"]]
+
+    @property
+    def named(self) -> Optional[Candidate]:
+        """The effect to add next: the best candidate when it is significant, else None."""
+        if self.candidates and self.candidates[0].significant:
+            return self.candidates[0]
+        return None
+
+    def summary(self) -> str:
+        best = self.named
+        head = (f"found: add '{best.label}' (explains {100 * best.explained:.0f}% of the "
+                "residual)" if best is not None else "no missing effect found")
+        return super().summary() + "\n" + head
+
+
+@dataclass
+class RefineResult(FitResult):
+    """``dhcal refine --json``: the final fit, its effects and the steps that led there."""
+
+    effects: List[str] = field(init=False)
+    steps: List[Dict[str, Any]] = field(init=False)
+    stopped: str = field(init=False)
+    geometry_why: Optional[str] = field(init=False)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        r = self.report
+        self.effects = list(r["effects"])
+        self.steps = list(r["steps"])
+        self.stopped = r["stopped"]
+        self.geometry_why = r.get("geometry_why")
+
+    def summary(self) -> str:
+        steps = [f"  step {k}: {s['added'] or '(start)'}: RMS {s['rms_mm']:.4f} mm, "
+                 f"CV RMS {s['cv_rms_mm']:.4f} mm" for k, s in enumerate(self.steps)]
+        return "\n".join([*steps, f"stopped: {self.stopped}",
+                          f"effects: {', '.join(self.effects) or '(none)'}", super().summary()])
+
+
+# ---------------------------------------------------------------- commands
+
+Effects = Union[str, Iterable[str]]
+
+
+def _run(command: str, model: Model, data: Measurements, effects: Effects,
+         heldout: Optional[Measurements], noise: Optional[Tuple[float, float]],
+         geometry: Optional[str], cv: bool) -> Tuple[int, Dict[str, Any], Optional[Model], Any]:
+    if not isinstance(model, Model):
+        raise TypeError("dhcal: model must be a dhcal.Model (dhcal.load_model)")
+    train = _Rows("training data", model, data)
+    held = _Rows("held-out data", model, heldout) if heldout is not None else None
+    effect_list = effects if isinstance(effects, str) else ",".join(effects)
+    noise_text = None
+    if noise is not None:
+        joint_deg, meas_mm = (float(v) for v in noise)
+        if not (math.isfinite(joint_deg) and math.isfinite(meas_mm)):
+            raise ValueError("dhcal: noise must be two finite numbers (joint_deg, meas_mm)")
+        noise_text = f"{joint_deg!r},{meas_mm!r}"  # repr: the shortest text of the same double
+    report = ctypes.c_void_p()
+    fitted = ctypes.c_void_p()
+    err = _native.err_buffer()
+    code = _native.LIB.dhcal_py_run(
+        command.encode(), model._ptr(), ctypes.byref(train.c),
+        ctypes.byref(held.c) if held is not None else None, _native.encode(effect_list),
+        _native.encode(noise_text), _native.encode(geometry), int(bool(cv)),
+        ctypes.byref(report), ctypes.byref(fitted), err, _native.ERR_CAP)
+    text = _native.take_text(report.value)
+    out_model = Model(fitted.value, f"dhcal.{command}") if fitted.value else None
+    return code, json.loads(text) if text is not None else {}, out_model, err
+
+
+def _finish(cls: type, code: int, report: Dict[str, Any], model: Optional[Model],
+            err: Any) -> Any:
+    result = cls(report, model) if report else None
+    if code != _native.OK:
+        _raise(code, err, result)
+    return result
+
+
+def fit(model: Model, q_deg: Any, xyz_mm: Any = None, effects: Effects = (),
+        heldout: Any = None, *, directions: Any = None, temp_c: Any = None, t_s: Any = None,
+        noise: Optional[Tuple[float, float]] = None, geometry: Optional[str] = None,
+        cv: bool = False) -> FitResult:
+    """Least-squares calibration of ``model`` to the measured tool points, as ``dhcal fit``.
+
+    q_deg: joint angles, N x joints, degrees (or a :class:`Measurements`, then no xyz_mm).
+    xyz_mm: measured tool points, N x 3, mm. effects: effect names to fit besides the base
+    model (``["joint_compliance:2"]`` or ``"base_frame,tool_offset"``). heldout:
+    :class:`Measurements` or ``(q_deg, xyz_mm)`` evaluated with the fitted model, never
+    fitted. directions, temp_c, t_s: the optional columns. noise: ``(joint_deg, meas_mm)``
+    weights every row by its covariance (``--noise``). geometry: ``"offsets"``,
+    ``"lengths"`` or ``"full"``. cv: also cross-validate (``cv_rms_mm``).
+
+    Raises ValueError for arrays of the wrong shape or with NaN or infinite values,
+    :class:`DhcalInputError` for values the measurement rules refuse or a bad effect name,
+    and :class:`DhcalError` when the fit fails, does not converge or is no plausible
+    calibration (``error.result`` holds the report then)."""
+    data = _measurements(q_deg, xyz_mm, directions, temp_c, t_s)
+    return _finish(FitResult, *_run("fit", model, data, effects, _heldout(heldout), noise,
+                                    geometry, cv))
+
+
+def diagnose(model: Model, q_deg: Any, xyz_mm: Any = None, effects: Effects = (),
+             heldout: Any = None, *, directions: Any = None, temp_c: Any = None,
+             t_s: Any = None, noise: Optional[Tuple[float, float]] = None,
+             geometry: Optional[str] = None, cv: bool = False) -> Diagnosis:
+    """``dhcal diagnose``: the fit, then every effect of the catalogue the model does not have
+    scored against the remaining residual (score test, Holm-corrected at 0.1 %).
+    ``result.named`` is the effect to add next, or None. Arguments as :func:`fit`; cv also
+    refits the best significant candidates and cross-validates each."""
+    data = _measurements(q_deg, xyz_mm, directions, temp_c, t_s)
+    return _finish(Diagnosis, *_run("diagnose", model, data, effects, _heldout(heldout),
+                                    noise, geometry, cv))
+
+
+def refine(model: Model, q_deg: Any, xyz_mm: Any = None, effects: Effects = (),
+           heldout: Any = None, *, directions: Any = None, temp_c: Any = None,
+           t_s: Any = None, noise: Optional[Tuple[float, float]] = None,
+           geometry: Optional[str] = None) -> RefineResult:
+    """``dhcal refine``: from the base model plus ``effects`` (the start set), adds the
+    diagnosed effect that lowers the cross-validated RMS most, while that falls by 1 % or
+    more; held-out rows are evaluated at every step, never used to choose. Arguments as
+    :func:`fit`; ``result.model`` is the final calibrated model."""
+    data = _measurements(q_deg, xyz_mm, directions, temp_c, t_s)
+    return _finish(RefineResult, *_run("refine", model, data, effects, _heldout(heldout),
+                                       noise, geometry, False))

@@ -1,0 +1,369 @@
+/* dhcal_py.c - the C boundary of the Python package (dhcal_py.h). It only turns arrays
+ * into the program's samples and runs the program's own steps (tools/dhcal: dhcal_analysis,
+ * dhcal_refine, dhcal_report) in the order main.c runs them for `--json`. */
+#include "dhcal_py.h"
+
+#include <cjson/cJSON.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dhcal/dhc_version.h"
+#include "dhcal_analysis.h"
+#include "dhcal_data.h"
+#include "dhcal_io.h"
+#include "dhcal_model_map.h"
+#include "dhcal_refine.h"
+#include "dhcal_report.h"
+
+struct dhcal_py_model {
+    char path[1024]; /* stands for the file in messages */
+    dhcal_model file;
+    dhc_model lib;
+};
+
+static int fail(char *err, size_t cap, int code, const char *msg)
+{
+    if (err != NULL && cap > 0U) {
+        snprintf(err, cap, "%s", msg);
+    }
+    return code;
+}
+
+const char *dhcal_py_version(void)
+{
+    return DHCAL_VERSION_STRING;
+}
+
+/* ---------------------------------------------------------------- models */
+
+/* The library's model of a file model, as the program builds it after loading --model. */
+static dhcal_py_model *model_of(const dhcal_model *file, const char *path, int *code,
+                                dhcal_error *e)
+{
+    dhcal_py_model *m = calloc(1U, sizeof *m);
+    if (m == NULL) {
+        *code = dhcal_error_set(e, DHCAL_IO_FAILED, "out of memory");
+        return NULL;
+    }
+    snprintf(m->path, sizeof m->path, "%s", path);
+    m->file = *file;
+    *code = dhcal_model_to_lib(&m->file, m->path, &m->lib, e);
+    if (*code != DHCAL_IO_OK) {
+        free(m);
+        return NULL;
+    }
+    return m;
+}
+
+dhcal_py_model *dhcal_py_model_load(const char *path, int *code, char *err, size_t err_cap)
+{
+    static dhcal_model file; /* large; one call at a time (dhcal_py.h) */
+    dhcal_error e;
+    memset(&e, 0, sizeof e);
+    *code = dhcal_model_load(path, &file, &e);
+    dhcal_py_model *m = *code == DHCAL_IO_OK ? model_of(&file, path, code, &e) : NULL;
+    if (m == NULL) {
+        (void)fail(err, err_cap, *code, e.msg);
+    }
+    return m;
+}
+
+void dhcal_py_model_free(dhcal_py_model *m)
+{
+    free(m);
+}
+
+int dhcal_py_model_save(const dhcal_py_model *m, const char *path, char *err, size_t err_cap)
+{
+    dhcal_error e;
+    memset(&e, 0, sizeof e);
+    const int rc = dhcal_model_save(path, &m->file, &e);
+    return rc == DHCAL_IO_OK ? rc : fail(err, err_cap, rc, e.msg);
+}
+
+char *dhcal_py_model_info(const dhcal_py_model *m)
+{
+    cJSON *obj = cJSON_CreateObject();
+    cJSON_AddStringToObject(obj, "name", m->file.name);
+    cJSON_AddNumberToObject(obj, "n_joints", (double)m->lib.arm.n_joints);
+    cJSON_AddBoolToObject(obj, "has_measurer", m->file.has_measurer);
+    char *text = cJSON_PrintUnformatted(obj);
+    cJSON_Delete(obj);
+    return text;
+}
+
+/* ---------------------------------------------------------------- rows */
+
+int dhcal_py_rows_load(const char *path, const dhcal_py_model *m, void **rows, size_t *n_rows,
+                       int *columns, char *err, size_t err_cap)
+{
+    *rows = NULL;
+    dhcal_dataset *d = calloc(1U, sizeof *d);
+    if (d == NULL) {
+        return fail(err, err_cap, DHCAL_IO_FAILED, "out of memory");
+    }
+    dhcal_error e;
+    memset(&e, 0, sizeof e);
+    const int rc = dhcal_csv_load(path, m->lib.arm.n_joints, d, &e);
+    if (rc != DHCAL_IO_OK) {
+        free(d);
+        return fail(err, err_cap, rc, e.msg);
+    }
+    *rows = d;
+    *n_rows = d->n_rows;
+    *columns = (d->has_dir ? 1 : 0) | (d->has_temp ? 2 : 0) | (d->has_time ? 4 : 0) |
+               (d->has_xyz ? 8 : 0);
+    return DHCAL_IO_OK;
+}
+
+void dhcal_py_rows_copy(const void *rows, double *q_deg, double *xyz_mm, double *dir,
+                        double *temp_c, double *t_s)
+{
+    const dhcal_dataset *d = rows;
+    const size_t nj = d->n_joints;
+    for (size_t i = 0U; i < d->n_rows; ++i) {
+        const dhcal_row *r = &d->rows[i];
+        for (size_t j = 0U; j < nj; ++j) {
+            q_deg[i * nj + j] = r->q_rad[j] / DHC_DEG;
+            if (dir != NULL) {
+                dir[i * nj + j] = (double)r->dir[j];
+            }
+        }
+        for (size_t c = 0U; c < 3U && xyz_mm != NULL; ++c) {
+            xyz_mm[i * 3U + c] = r->xyz_mm[c];
+        }
+        if (temp_c != NULL) {
+            temp_c[i] = r->temp_c;
+        }
+        if (t_s != NULL) {
+            t_s[i] = r->t_s;
+        }
+    }
+}
+
+void dhcal_py_rows_free(void *rows)
+{
+    dhcal_dataset_free(rows);
+    free(rows);
+}
+
+/* ---------------------------------------------------------------- commands */
+
+/* What one command works on: main.c's session, built from arrays instead of files. */
+typedef struct {
+    dhc_noise_model noise;
+    dhcal_geometry geometry;
+    dhcal_dataset data;
+    dhcal_samples samples;
+    dhcal_dataset held_data;
+    dhcal_samples held;
+    int have_held;
+} py_session;
+
+static int rows_to_samples(const dhcal_py_model *m, const dhcal_py_rows *r, const char *name,
+                           dhcal_dataset *data, dhcal_samples *samples, dhcal_error *e)
+{
+    const dhcal_arrays a = {name,     r->n_rows, m->lib.arm.n_joints, r->q_deg, r->xyz_mm,
+                            r->dir,   r->temp_c, r->t_s};
+    int rc = dhcal_dataset_from_arrays(&a, data, e);
+    if (rc == DHCAL_IO_OK) {
+        rc = dhcal_samples_build(&m->lib, data, name, samples, e);
+    }
+    return rc;
+}
+
+static int open_session(const dhcal_py_model *m, const dhcal_py_rows *train,
+                        const dhcal_py_rows *held, const char *noise, const char *geometry,
+                        py_session *s, dhcal_error *e)
+{
+    memset(s, 0, sizeof *s);
+    int rc = dhcal_parse_noise(noise, &s->noise, e);
+    if (rc == DHCAL_IO_OK) {
+        rc = dhcal_parse_geometry(geometry, &s->geometry, e);
+    }
+    if (rc == DHCAL_IO_OK) {
+        rc = rows_to_samples(m, train, "training data", &s->data, &s->samples, e);
+    }
+    if (rc == DHCAL_IO_OK && held != NULL) {
+        rc = rows_to_samples(m, held, "held-out data", &s->held_data, &s->held, e);
+        s->have_held = rc == DHCAL_IO_OK;
+    }
+    return rc;
+}
+
+static void close_session(py_session *s)
+{
+    /* the analysis knows the rows it evaluated last by the samples' address */
+    dhcal_fit_errors_forget();
+    dhcal_samples_free(&s->samples);
+    dhcal_samples_free(&s->held);
+    dhcal_dataset_free(&s->data);
+    dhcal_dataset_free(&s->held_data);
+}
+
+/* The calibrated model as `--out` writes it, and as loading that file gives it back. */
+static dhcal_py_model *fitted_model(const dhcal_py_model *m, const dhcal_fit *fit,
+                                    dhcal_error *e)
+{
+    static dhcal_model out;
+    dhcal_model_from_lib(&fit->model, &m->file, &out);
+    int code = 0;
+    return model_of(&out, m->path, &code, e);
+}
+
+/* A fit outside the physical range, in main.c's words for its refusal. */
+static int implausible(const dhcal_py_model *m, const dhcal_fit *fit, dhcal_error *e)
+{
+    char why[200];
+    if (!dhcal_implausible(&m->lib, fit, why, sizeof why)) {
+        return 0;
+    }
+    (void)dhcal_error_set(e, DHCAL_IO_FAILED,
+                          "not a calibration: %s; the rows cannot support this much geometry "
+                          "(try geometry='lengths' or 'offsets', or dhcal.refine, which "
+                          "chooses by cross-validation)",
+                          why);
+    return 1;
+}
+
+static int not_converged(const dhcal_fit *fit, const char *what, dhcal_error *e)
+{
+    if (fit->status == DHC_OK) {
+        return 0;
+    }
+    (void)dhcal_error_set(e, DHCAL_IO_FAILED, "the %s did not converge in %zu iterations", what,
+                          fit->rep.iterations);
+    return 1;
+}
+
+/* fit and diagnose: main.c's do_fit, then its report (cmd_fit, cmd_diagnose). */
+static int run_fit_or_diagnose(int diagnose, const dhcal_py_model *m, py_session *s,
+                               const char *effects, int cv, cJSON *obj, dhcal_fit **fit_out,
+                               dhcal_error *e)
+{
+    static dhcal_fit fit;
+    static dhcal_fit_extras extras;
+    static dhc_diagnosis diag;
+    static dhcal_trials trials;
+    dhcal_covariates cov;
+    int rc = dhcal_run_fit(&m->lib, effects, s->geometry, &s->noise, &s->samples,
+                           s->have_held ? &s->held : NULL, &fit, e);
+    if (rc != DHCAL_IO_OK) {
+        return rc;
+    }
+    double *row_err = calloc(s->samples.n > 0U ? s->samples.n : 1U, sizeof *row_err);
+    dhcal_error_stats unused;
+    if (row_err == NULL ||
+        dhcal_fit_errors(&fit.model, &s->samples, NULL, row_err, &unused) != DHCAL_IO_OK) {
+        free(row_err);
+        return dhcal_error_set(e, DHCAL_IO_FAILED, "evaluation failed");
+    }
+    if (diagnose) {
+        rc = dhcal_run_diagnose(&fit, &s->samples, &diag, &cov, e);
+    }
+    memset(&trials, 0, sizeof trials);
+    if (rc == DHCAL_IO_OK) {
+        dhcal_fit_extras_compute(&fit, &s->samples, s->have_held ? &s->held : NULL, &extras);
+        if (cv) {
+            extras.have_cv = dhcal_cross_validate(&fit.model, &fit.set, &s->noise, &s->samples,
+                                                  &extras.cv, e) == DHCAL_IO_OK;
+            rc = extras.have_cv ? DHCAL_IO_OK : DHCAL_IO_FAILED;
+        }
+        if (rc == DHCAL_IO_OK && cv && diagnose) {
+            rc = dhcal_try_candidates(&fit, &diag, &s->noise, &s->samples,
+                                      s->have_held ? &s->held : NULL, &trials, NULL, NULL, e);
+        }
+    }
+    if (rc == DHCAL_IO_OK) {
+        dhcal_json_fit(obj, &fit, &m->lib, &s->samples, row_err);
+        dhcal_json_extras(obj, &fit, &extras);
+        if (diagnose) {
+            dhcal_json_diagnosis(obj, &fit, &diag, &cov, cv ? &trials : NULL);
+        }
+        *fit_out = &fit;
+    }
+    free(row_err);
+    return rc;
+}
+
+/* refine: main.c's cmd_refine. */
+static int run_refine(const dhcal_py_model *m, py_session *s, const char *effects,
+                      const char *geometry, cJSON *obj, dhcal_fit **fit_out, dhcal_error *e)
+{
+    static dhcal_refine_result res;
+    static dhcal_fit_extras extras;
+    int rc = dhcal_run_refine(&m->lib, effects, geometry != NULL ? &s->geometry : NULL,
+                              &s->noise, &s->samples, s->have_held ? &s->held : NULL, &res, e);
+    if (rc != DHCAL_IO_OK) {
+        return rc;
+    }
+    double *row_err = calloc(s->samples.n + 1U, sizeof *row_err);
+    dhcal_error_stats es;
+    if (row_err == NULL ||
+        dhcal_samples_errors(&res.fit.model, &s->samples, NULL, row_err, &es) != DHCAL_IO_OK) {
+        free(row_err);
+        return dhcal_error_set(e, DHCAL_IO_FAILED, "evaluation failed");
+    }
+    dhcal_fit_extras_compute(&res.fit, &s->samples, s->have_held ? &s->held : NULL, &extras);
+    extras.have_cv = 1;
+    extras.cv = res.cv;
+    dhcal_json_fit(obj, &res.fit, &m->lib, &s->samples, row_err);
+    dhcal_json_extras(obj, &res.fit, &extras);
+    dhcal_json_refine(obj, &res);
+    free(row_err);
+    *fit_out = &res.fit;
+    return DHCAL_IO_OK;
+}
+
+int dhcal_py_run(const char *command, const dhcal_py_model *m, const dhcal_py_rows *train,
+                 const dhcal_py_rows *held, const char *effects, const char *noise,
+                 const char *geometry, int cv, char **report, dhcal_py_model **fitted,
+                 char *err, size_t err_cap)
+{
+    *report = NULL;
+    *fitted = NULL;
+    const int is_fit = strcmp(command, "fit") == 0;
+    const int is_diagnose = strcmp(command, "diagnose") == 0;
+    const int is_refine = strcmp(command, "refine") == 0;
+    if (!is_fit && !is_diagnose && !is_refine) {
+        return fail(err, err_cap, DHCAL_IO_BAD_INPUT, "unknown command");
+    }
+    static py_session s;
+    dhcal_error e;
+    memset(&e, 0, sizeof e);
+    int rc = open_session(m, train, held, noise, geometry, &s, &e);
+    cJSON *obj = cJSON_CreateObject();
+    dhcal_fit *fit = NULL;
+    if (rc == DHCAL_IO_OK && obj == NULL) {
+        rc = dhcal_error_set(&e, DHCAL_IO_FAILED, "out of memory");
+    }
+    if (rc == DHCAL_IO_OK) {
+        rc = is_refine ? run_refine(m, &s, effects, geometry, obj, &fit, &e)
+                       : run_fit_or_diagnose(is_diagnose, m, &s, effects, cv, obj, &fit, &e);
+    }
+    if (rc == DHCAL_IO_OK) {
+        *report = cJSON_PrintUnformatted(obj);
+        if (*report == NULL) {
+            rc = dhcal_error_set(&e, DHCAL_IO_FAILED, "out of memory");
+        }
+    }
+    /* As the program: fit and refine fail (after their report) on a fit that did not
+     * converge or is no plausible calibration; diagnose reports whatever the fit gave. */
+    if (rc == DHCAL_IO_OK && !is_diagnose && fit != NULL &&
+        (implausible(m, fit, &e) || not_converged(fit, is_refine ? "final fit" : "fit", &e))) {
+        rc = DHCAL_IO_FAILED;
+    }
+    if (*report != NULL && !is_diagnose && fit != NULL) {
+        dhcal_error unused;
+        *fitted = fitted_model(m, fit, &unused);
+    }
+    cJSON_Delete(obj);
+    close_session(&s);
+    return rc == DHCAL_IO_OK ? rc : fail(err, err_cap, rc, e.msg);
+}
+
+void dhcal_py_free(char *text)
+{
+    free(text);
+}
