@@ -23,6 +23,7 @@
 #include "dhcal/dhc_geometry.h"
 #include "dhcal/dhc_inverse.h"
 #include "dhcal_io.h"
+#include "dhcal_options.h"
 #include "dhcal_text.h"
 
 #define EXIT_COMPUTE 1
@@ -92,13 +93,15 @@ static int parse_options(int argc, char **argv, compensate_options *o)
                                           {"out", required_argument, NULL, OPT_OUT},
                                           {"nominal", required_argument, NULL, OPT_NOMINAL},
                                           {NULL, 0, NULL, 0}};
-    opterr = 0;
-    optind = 1;
-    char **args = argv + 1; /* the command stands where getopt expects the program */
-    const int n_args = argc - 1;
+    dhcal_options opts;
+    dhcal_options_begin(&opts, argc, argv);
     int c;
-    while ((c = getopt_long(n_args, args, ":h", longs, NULL)) != -1) {
-        const char *given = args[optind - 1];
+    while ((c = dhcal_options_next(&opts, longs)) != -1) {
+        char msg[300];
+        if (dhcal_options_error(&opts, c, longs, msg, sizeof msg)) {
+            return usage("%s", msg);
+        }
+        const char *given = opts.given;
         const char **slot = NULL;
         switch (c) {
         case OPT_JSON: o->json = 1; continue;
@@ -108,16 +111,15 @@ static int parse_options(int argc, char **argv, compensate_options *o)
         case OPT_TARGETS: slot = &o->targets; break;
         case OPT_OUT: slot = &o->out; break;
         case OPT_NOMINAL: slot = &o->nominal; break;
-        case ':': return usage("option '%.200s' needs a value", given);
-        default: return usage("unknown option '%.200s'", given);
+        default: continue; /* not reached: dhcal_options_error took every other value */
         }
         if (*slot != NULL) {
             return usage("option '%.200s' given twice", given);
         }
         *slot = optarg;
     }
-    if (optind < n_args) {
-        return usage("unexpected argument '%.200s'", args[optind]);
+    if (optind < opts.argc) {
+        return usage("unexpected argument '%.200s'", opts.argv[optind]);
     }
     if (o->model == NULL || o->targets == NULL || o->out == NULL) {
         return usage("%s", "compensate needs --model, --targets and --out");

@@ -22,6 +22,7 @@
 #include "dhcal_file.h"
 #include "dhcal_model_file.h"
 #include "dhcal_model_map.h"
+#include "dhcal_options.h"
 
 #define PLAN_MAX_CANDIDATES 100000UL
 /* the candidates' Jacobians are kept when they take at most this much memory */
@@ -164,14 +165,14 @@ static int parse_plan_args(int argc, char **argv, plan_options *o)
     memset(o, 0, sizeof *o);
     o->seed = 1UL;
     o->min_z = -HUGE_VAL;
-    opterr = 0;
-    optind = 1;
-    char **args = argv + 1;
-    const int n_args = argc - 1;
+    dhcal_options opts;
+    dhcal_options_begin(&opts, argc, argv);
     int c;
-    while ((c = getopt_long(n_args, args, ":h", long_options, NULL)) != -1) {
-        const char *given = args[optind - 1];
+    while ((c = dhcal_options_next(&opts, long_options)) != -1) {
         char msg[300];
+        if (dhcal_options_error(&opts, c, long_options, msg, sizeof msg)) {
+            return plan_usage_error(msg);
+        }
         switch (c) {
         case OPT_MODEL: o->model = optarg; break;
         case OPT_EFFECTS: o->effects = optarg; break;
@@ -210,17 +211,12 @@ static int parse_plan_args(int argc, char **argv, plan_options *o)
             }
             break;
         }
-        case ':':
-            snprintf(msg, sizeof msg, "option '%.200s' needs a value", given);
-            return plan_usage_error(msg);
-        default:
-            snprintf(msg, sizeof msg, "unknown option '%.200s'", given);
-            return plan_usage_error(msg);
+        default: break; /* not reached: dhcal_options_error took every other value */
         }
     }
-    if (optind < n_args) {
+    if (optind < opts.argc) {
         char msg[300];
-        snprintf(msg, sizeof msg, "unexpected argument '%.200s'", args[optind]);
+        snprintf(msg, sizeof msg, "unexpected argument '%.200s'", opts.argv[optind]);
         return plan_usage_error(msg);
     }
     if (o->model == NULL || o->out == NULL || o->poses == 0UL) {

@@ -16,6 +16,7 @@
 
 #include "dhcal/dhc_model.h"
 #include "dhcal_io.h"
+#include "dhcal_options.h"
 #include "dhcal_urdf.h"
 
 #define EXIT_WRITE 1
@@ -75,14 +76,17 @@ static int parse(int argc, char **argv, urdf_options *o)
                                                  {"tool-mm", required_argument, NULL, OPT_TOOL},
                                                  {"out", required_argument, NULL, OPT_OUT},
                                                  {NULL, 0, NULL, 0}};
-    opterr = 0;
-    optind = 1;
-    char **args = argv + 1;
-    const int n_args = argc - 1;
+    dhcal_options opts;
+    dhcal_options_begin(&opts, argc, argv);
+    char **args = opts.argv;
+    const int n_args = opts.argc;
     int c;
-    while ((c = getopt_long(n_args, args, ":h", long_options, NULL)) != -1) {
-        const char *given = args[optind - 1];
+    while ((c = dhcal_options_next(&opts, long_options)) != -1) {
         char msg[300];
+        if (dhcal_options_error(&opts, c, long_options, msg, sizeof msg)) {
+            return usage(command, msg);
+        }
+        const char *given = opts.given;
         const char **slot = NULL;
         switch (c) {
         case 'h':
@@ -91,12 +95,7 @@ static int parse(int argc, char **argv, urdf_options *o)
         case OPT_TIP: slot = &o->tip; break;
         case OPT_TOOL: slot = &o->tool; break;
         case OPT_OUT: slot = &o->out; break;
-        case ':':
-            snprintf(msg, sizeof msg, "option '%.200s' needs a value", given);
-            return usage(command, msg);
-        default:
-            snprintf(msg, sizeof msg, "unknown option '%.200s'", given);
-            return usage(command, msg);
+        default: continue; /* not reached: dhcal_options_error took every other value */
         }
         if (!import && slot != &o->out) {
             snprintf(msg, sizeof msg, "option '%.200s' is for import-urdf", given);

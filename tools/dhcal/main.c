@@ -17,6 +17,7 @@
 #include "dhcal_data.h"
 #include "dhcal_io.h"
 #include "dhcal_model_map.h"
+#include "dhcal_options.h"
 #include "dhcal_plan_cmd.h"
 #include "dhcal_plot.h"
 #include "dhcal_refine.h"
@@ -182,16 +183,14 @@ static int parse_args(int argc, char **argv, options *o)
         {"noise", required_argument, NULL, OPT_NOISE},
         {"geometry", required_argument, NULL, OPT_GEOMETRY},
         {NULL, 0, NULL, 0}};
-    /* The command stands where getopt expects the program's name. Errors are ours
-     * (opterr 0, ':' first): they name the option and end with the usage. */
-    opterr = 0;
-    optind = 1;
-    char **args = argv + 1;
-    const int n_args = argc - 1;
+    dhcal_options opts;
+    dhcal_options_begin(&opts, argc, argv);
     int c;
-    while ((c = getopt_long(n_args, args, ":h", long_options, NULL)) != -1) {
-        const char *given = args[optind - 1];
+    while ((c = dhcal_options_next(&opts, long_options)) != -1) {
         char msg[300];
+        if (dhcal_options_error(&opts, c, long_options, msg, sizeof msg)) {
+            return usage_error(msg);
+        }
         const char **slot = NULL;
         switch (c) {
         case OPT_JSON: o->json = 1; continue;
@@ -205,12 +204,7 @@ static int parse_args(int argc, char **argv, options *o)
         case OPT_EFFECTS: slot = &o->effects; break;
         case OPT_NOISE: slot = &o->noise; break;
         case OPT_GEOMETRY: slot = &o->geometry; break;
-        case ':':
-            snprintf(msg, sizeof msg, "option '%.200s' needs a value", given);
-            return usage_error(msg);
-        default:
-            snprintf(msg, sizeof msg, "unknown option '%.200s'", given);
-            return usage_error(msg);
+        default: continue; /* not reached: dhcal_options_error took every other value */
         }
         if (*slot != NULL) {
             snprintf(msg, sizeof msg, "option '--%s' given twice", long_options[c - 1].name);
@@ -218,9 +212,9 @@ static int parse_args(int argc, char **argv, options *o)
         }
         *slot = optarg;
     }
-    if (optind < n_args) {
+    if (optind < opts.argc) {
         char msg[300];
-        snprintf(msg, sizeof msg, "unexpected argument '%.200s'", args[optind]);
+        snprintf(msg, sizeof msg, "unexpected argument '%.200s'", opts.argv[optind]);
         return usage_error(msg);
     }
     const char *known[5] = {"compare", "fit", "diagnose", "plot", "refine"};
