@@ -68,6 +68,9 @@ static const char *const help_text =
     "                        else dhcal-fw.nv; sim: RAM unless given)\n"
     "  --samples N           poses in the plan (10..128, default 30)\n"
     "  --plan-seed N         seed of the pose plan (default 4242)\n"
+    "  --plan-candidates K   measure the N poses of K random candidates that the fit\n"
+    "                        predicts the tool best from (K > N, at most 512; default 0:\n"
+    "                        N random poses)\n"
     "  --run-seed N          sim port: the plant's run seed (default 7, as dhcal-sim bus)\n"
     "  --hold-ticks N        ticks averaged per sample (default 200)\n"
     "  --params-out FILE     the calibrated parameters, one 'name value' line each\n"
@@ -94,6 +97,7 @@ typedef struct {
     unsigned long long start_timeout_ms;
     unsigned long long samples;
     unsigned long long plan_seed;
+    unsigned long long plan_candidates;
     unsigned long long run_seed;
     unsigned long long hold_ticks;
     unsigned long long gpio_watch;
@@ -143,6 +147,7 @@ static int set_option(options *o, const char *key, const char *val)
         {"start-timeout-ms", &o->start_timeout_ms, 600000ULL},
         {"samples", &o->samples, FW_ACQ_MAX_SAMPLES},
         {"plan-seed", &o->plan_seed, 0xFFFFFFFFULL},
+        {"plan-candidates", &o->plan_candidates, FW_PLAN_MAX_CANDIDATES},
         {"run-seed", &o->run_seed, 0xFFFFFFFFULL},
         {"hold-ticks", &o->hold_ticks, 100000ULL},
         {"gpio-watch", &o->gpio_watch, 1000000ULL},
@@ -267,6 +272,7 @@ static const struct option long_options[] = {
     {"start-timeout-ms", required_argument, NULL, 0},
     {"nv", required_argument, NULL, 0},              {"samples", required_argument, NULL, 0},
     {"plan-seed", required_argument, NULL, 0},       {"run-seed", required_argument, NULL, 0},
+    {"plan-candidates", required_argument, NULL, 0},
     {"hold-ticks", required_argument, NULL, 0},      {"params-out", required_argument, NULL, 0},
     {"gpio-chip", required_argument, NULL, 0},       {"enc-lines", required_argument, NULL, 0},
     {"gpio-watch", required_argument, NULL, 0},      {"gpio-timeout-ms", required_argument, NULL, 0},
@@ -344,6 +350,9 @@ static int parse_args(int argc, char **argv, options *o)
     }
     if (o->gpio_watch == 0U && o->samples < 10U) {
         return usage("%s", "--samples: 10..128");
+    }
+    if (o->plan_candidates != 0U && o->plan_candidates <= o->samples) {
+        return usage("%s", "--plan-candidates: more candidates than --samples, or 0");
     }
     if ((o->gpio_chip != NULL) != (o->have_lines != 0)) {
         return usage("%s", "--gpio-chip and --enc-lines go together");
@@ -712,6 +721,7 @@ static int run_calibration(options *o)
     }
     jc.n_samples = (size_t)o->samples;
     jc.plan_seed = (uint32_t)o->plan_seed;
+    jc.plan_candidates = (size_t)o->plan_candidates;
     jc.hold_ticks = (uint32_t)o->hold_ticks;
     fw_fault fault = FW_FAULT_NONE;
     if (strcmp(o->port, "linux") == 0) {

@@ -259,10 +259,10 @@ static const char *const usage_text =
     "  --no-diagnose    fit only those; do not look for a missing one\n"
     "  --unweighted     no noise model (encoder quantisation, wire noise): plain least "
     "squares\n"
-    "  --plan-candidates K  measure the N poses of K random candidates that observe the\n"
-    "                   fitted parameters best (an optimal plan; K > N, at most "
-    "4 x 128); 0, the\n"
-    "                   default: N random poses\n";
+    "  --samples N      samples to collect (10..128, default 40)\n"
+    "  --plan-candidates K  measure the N poses of K random candidates from which the fit\n"
+    "                   (and the diagnosis' candidate effects) predicts the tool best (K > N,\n"
+    "                   at most 512; default 160); 0: N random poses\n";
 
 /* A count in 0..max, digits only. */
 static int parse_count(const char *s, size_t max, size_t *out)
@@ -331,9 +331,9 @@ int main(int argc, char **argv)
     const char *out_dir = NULL;
     int json = 0;
     int mixed_dirs = 0;
-    size_t n_samples = 60U;
+    size_t n_samples = 40U;
     size_t n_targets = 20U;
-    size_t n_candidates = 0U;
+    size_t n_candidates = 160U;
     fw_autocal_config autocal;
     fw_autocal_default_config(&autocal);
     const char *effects = NULL;

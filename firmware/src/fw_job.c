@@ -82,6 +82,19 @@ fw_fault fw_job_plan(fw_job *job)
         if (!ok) {
             return job_fault(job, FW_FAULT_ARGUMENT);
         }
+#if DHC_WITH_DIAGNOSE
+        if (ac->diagnose) {
+            /* and what the diagnosis may add: a plan for the base model alone gathers its
+             * poses where look-alike effects cannot be told apart (fw_job.h) */
+            dhc_candidate cands[DHC_MAX_CANDIDATES];
+            const size_t nc = dhc_diagnose_candidates(&job->nominal, &fitted, &fw_autocal_scope,
+                                                      cands, DHC_MAX_CANDIDATES);
+            for (size_t c = 0U; c < nc; ++c) { /* as many as the set holds */
+                (void)dhc_params_add_effect(&fitted, &job->nominal, cands[c].effect,
+                                            cands[c].joint);
+            }
+        }
+#endif
 #if DHC_WITH_PLAN
         job->n_plan = fw_plan_select(&job->nominal, &fitted, job->cfg.n_samples,
                                      job->cfg.plan_candidates, job->cfg.plan_seed,

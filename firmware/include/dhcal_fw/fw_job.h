@@ -34,12 +34,13 @@ typedef struct {
     size_t plan_candidates; /* 0: the plan is n_samples random poses; else the n_samples
                                of this many random candidates (at most
                                FW_PLAN_MAX_CANDIDATES) that observe the base model and the
-                               configured effects best (fw_plan_select). Such a plan
-                               gathers the poses where those parameters show most: a
-                               diagnosis of effects not named needs the spread of random
-                               poses (measured: dhcal-demo's hidden joint_compliance:2 is
-                               told from joint_scale:2 with 30 random poses, not with 30
-                               planned ones) */
+                               configured effects best (fw_plan_select), and with the
+                               diagnosis on the effects it may add as well: a plan for the
+                               base model alone gathers its poses where look-alikes cannot
+                               be told apart (measured, dhcal-demo: with it, 50 planned
+                               poses took joint_compliance:2 for joint_scale:2; with the
+                               candidates, 40 planned poses find every hidden effect of
+                               host_sim/scenarios as 60 random ones do) */
     int mixed_dirs;        /* approach directions drawn +-1 (fw_plan.h) */
     uint32_t hold_ticks;   /* ticks averaged per sample */
     int noise_model;       /* 1: the fits weight by the encoders' quantisation and the
