@@ -40,10 +40,14 @@ static dhc_status candidate_jacobian(const dhc_model *model, const dhc_param_set
         return DHC_ERR_ARGUMENT;
     }
     dhc_mat jac;
-    st = dhc_mat_init(&jac, rows, p, ws->jac, sizeof ws->jac / sizeof ws->jac[0]);
+    st = dhc_sample_check(model, &ws->sample);
     if (st == DHC_OK) {
-        st = dhc_model_jacobian(model, set, &ws->sample, DHC_ORIENTATION_WEIGHT_MM_PER_RAD,
-                                &jac, NULL);
+        st = dhc_mat_init(&jac, rows, p, ws->jac, sizeof ws->jac / sizeof ws->jac[0]);
+    }
+    if (st == DHC_OK) {
+        st = dhc_model_jacobian_prepared(model, &ws->trig, set, &ws->sample, NULL,
+                                         DHC_ORIENTATION_WEIGHT_MM_PER_RAD, &jac, &ws->pred,
+                                         &ws->ev);
     }
     return st;
 }
@@ -249,6 +253,7 @@ static dhc_status survey(const dhc_model *model, const dhc_param_set *set,
     const size_t p = set->count;
     dhc_status st = dhc_normal_eq_init(&ws->ne, p);
     const double zero[DHC_MAX_ROWS_PER_SAMPLE] = {0.0};
+    dhc_arm_prepare(&model->arm, &ws->trig);
     ws->rows_per_pose = 0U;
     *usable = 0U;
     for (size_t c = 0U; c < k && st == DHC_OK; ++c) {
@@ -452,6 +457,7 @@ dhc_status dhc_plan_observability(const dhc_model *model, const dhc_param_set *s
     const size_t p = set->count;
     dhc_status st = dhc_normal_eq_init(&ws->ne, p);
     const double zero[DHC_MAX_ROWS_PER_SAMPLE] = {0.0};
+    dhc_arm_prepare(&model->arm, &ws->trig);
     ws->rows_per_pose = 0U;
     for (size_t i = 0U; i < n && st == DHC_OK; ++i) {
         st = candidate_jacobian(model, set, read, ctx, index != NULL ? index[i] : i, NULL, ws);

@@ -42,6 +42,7 @@
 
 #include "dhc_calib.h"
 #include "dhc_config.h"
+#include "dhc_jacobian.h"
 #include "dhc_lsq.h"
 #include "dhc_model.h"
 #include "dhc_params.h"
@@ -69,6 +70,9 @@ typedef struct {
     size_t n_kept;
     size_t rows_per_pose;
     dhc_sample sample;
+    dhc_arm_trig trig;    /* the model's, prepared once a call */
+    dhc_model_eval ev;    /* an evaluation's scratch: off the stack */
+    dhc_prediction pred;
 } dhc_plan_workspace;
 
 typedef struct {
