@@ -63,13 +63,13 @@ static long line_of(const xmlNode *node)
 
 static int is_element(const xmlNode *node, const char *name)
 {
-    return node->type == XML_ELEMENT_NODE && xmlStrcmp(node->name, BAD_CAST name) == 0;
+    return node->type == XML_ELEMENT_NODE && xmlStrcmp(node->name, (const xmlChar *)name) == 0;
 }
 
 /* The attribute's value as a C string on the heap (NULL when absent). */
 static char *attribute(xmlNode *node, const char *name)
 {
-    xmlChar *v = xmlGetProp(node, BAD_CAST name);
+    xmlChar *v = xmlGetProp(node, (const xmlChar *)name);
     if (v == NULL) {
         return NULL;
     }

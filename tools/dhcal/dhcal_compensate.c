@@ -199,7 +199,7 @@ static void nominal_target(const dhc_model *nominal, const compensated_row *r, i
     dhc_model_sample_at(nominal, r->q_rad, NULL, DHC_MEAS_POSITION, &s);
     dhc_prediction pred;
     if (dhc_model_predict(nominal, &s, &pred) != DHC_OK) {
-        dhc_vec3_set(out->nominal_p_mm, NAN, NAN, NAN); /* refused when written */
+        dhc_vec3_set(out->nominal_p_mm, (double)NAN, (double)NAN, (double)NAN); /* refused when written */
         return;
     }
     dhc_vec3_copy(pred.p_mm, out->nominal_p_mm);
