@@ -331,6 +331,25 @@ static double trace_of_inverse(dhc_plan_workspace *ws)
     return s;
 }
 
+/* sum over the rows y of ws->rows of |M^-1 y|^2 = trace(M^-2 Y^T Y), M = L L^T the factored
+ * information: how fast the candidate's weight pulls trace(M^-1) down. */
+static double pull(dhc_plan_workspace *ws)
+{
+    const size_t r = ws->n_kept;
+    const dhc_tri t = chol_tri(ws);
+    double s = 0.0;
+    for (size_t row = 0U; row < ws->rows_per_pose; ++row) {
+        double *g = ws->back + row * r;
+        memcpy(g, ws->rows + row * r, r * sizeof g[0]);
+        dhc_tri_forward(&t, r, g);
+        dhc_tri_backward(&t, r, g);
+        for (size_t i = 0U; i < r; ++i) {
+            s += g[i] * g[i];
+        }
+    }
+    return s;
+}
+
 /* Fedorov's exchange: each chosen pose against every unchosen candidate, while a swap
  * raises ln det. ws->info holds the plan's information on entry and on return. */
 static dhc_status exchange(const dhc_model *model, const dhc_param_set *set,
@@ -433,7 +452,92 @@ dhc_status dhc_plan_select(const dhc_model *model, const dhc_param_set *set,
     return dhc_plan_observability(model, set, read, ctx, chosen, n, ws, &rep->o1, &rep->rank);
 }
 
+/* The multiplicative algorithm (Silvey, Titterington and Torsney) on the transformed
+ * information M(w) = sum_c w_c Y_c^T Y_c:
+ *     w_c <- w_c pull_c / trace(M^-1),  then normalised to sum 1
+ * (at the optimum every weighted candidate pulls trace(M^-1), so the weights rest there).
+ * trace(X^-1) is convex, so at every w, for any weighting w' (a plan of n poses, repeats
+ * allowed, is w' = its poses' counts / n):
+ *     trace(M(w')^-1) >= trace(M^-1) - <M^-2, M(w') - M> >= 2 trace(M^-1) - max_c pull_c,
+ * the floor (Kiefer and Wolfowitz: it meets trace(M^-1) at the optimum). Both numbers hold
+ * at whatever step the iteration stops: the floor is a bound, the value a weighting's. */
+dhc_status dhc_plan_weighting(const dhc_model *model, const dhc_param_set *set,
+                              dhc_sample_reader read, void *ctx, size_t k, size_t n,
+                              double *rows_store, double *weights, dhc_plan_workspace *ws,
+                              dhc_plan_weighting_report *rep)
+{
+    if (model == NULL || set == NULL || read == NULL || ws == NULL || weights == NULL ||
+        rep == NULL || n == 0U) {
+        return DHC_ERR_ARGUMENT;
+    }
+    if (set->count == 0U || set->count > DHC_MAX_PARAMS) {
+        return DHC_ERR_CAPACITY;
+    }
+    memset(rep, 0, sizeof *rep);
+    size_t usable = 0U;
+    dhc_status st = survey(model, set, read, ctx, k, rows_store, ws, &usable);
+    if (st != DHC_OK) {
+        return st;
+    }
+    for (size_t c = 0U; c < k; ++c) {
+        weights[c] = 1.0;
+    }
+    double total = (double)k;
+    for (size_t it = 0U; it < DHC_PLAN_MAX_WEIGHT_ITERATIONS; ++it) {
+        memset(ws->info, 0, sizeof ws->info);
+        for (size_t c = 0U; c < k; ++c) {
+            weights[c] /= total;
+            if (weights[c] > 0.0 && load_rows(model, set, read, ctx, c, rows_store, ws, &st)) {
+                info_add(ws, weights[c]);
+            } else if (st != DHC_OK) {
+                return st;
+            } else {
+                weights[c] = 0.0; /* not usable */
+            }
+        }
+        if (factor_info(ws) != DHC_OK) {
+            return DHC_ERR_UNDERDETERMINED;
+        }
+        const double phi = trace_of_inverse(ws);
+        double most = 0.0;
+        total = 0.0;
+        for (size_t c = 0U; c < k; ++c) { /* every usable candidate: a plan may take any */
+            if (load_rows(model, set, read, ctx, c, rows_store, ws, &st)) {
+                const double d = pull(ws);
+                most = fmax(most, d);
+                weights[c] *= d / phi;
+                total += weights[c];
+            } else if (st != DHC_OK) {
+                return st;
+            }
+        }
+        rep->iterations = it + 1U;
+        rep->variance = phi / (double)n;
+        rep->floor = fmax(rep->floor, (2.0 * phi - most) / (double)n);
+        if (rep->floor >= (1.0 - DHC_PLAN_WEIGHT_TOL) * rep->variance || !(total > 0.0)) {
+            break;
+        }
+    }
+    /* the weighting the iteration reached (one update past the value reported) */
+    rep->support = 0U;
+    for (size_t c = 0U; c < k && total > 0.0; ++c) {
+        weights[c] /= total;
+        rep->support += weights[c] * (double)n >= 0.01 ? 1U : 0U;
+    }
+    return DHC_OK;
+}
+
 #else /* the feature left out of this build (dhc_config.h) */
+
+dhc_status dhc_plan_weighting(const dhc_model *model, const dhc_param_set *set,
+                              dhc_sample_reader read, void *ctx, size_t k, size_t n,
+                              double *rows_store, double *weights, dhc_plan_workspace *ws,
+                              dhc_plan_weighting_report *rep)
+{
+    (void)model, (void)set, (void)read, (void)ctx, (void)k, (void)n, (void)rows_store;
+    (void)weights, (void)ws, (void)rep;
+    return DHC_ERR_ARGUMENT;
+}
 
 dhc_status dhc_plan_select(const dhc_model *model, const dhc_param_set *set,
                            dhc_sample_reader read, void *ctx, size_t k, size_t n,

@@ -232,6 +232,75 @@ static void test_small_pool_gets_the_best_plan(void)
     }
 }
 
+/* The best weighting of 10 candidates for 4 poses, and the floor under every plan: checked
+ * against all 715 plans of 4 poses with repeats (every multiset, scored here by Gauss-Jordan)
+ * and the weighting's own value recomputed here from its weights. */
+static void test_floor_is_under_every_plan(void)
+{
+    dhc_model m = test_paper3_as_built();
+    dhc_param_set set;
+    dhc_params_clear(&set);
+    for (size_t j = 0U; j < 3U; ++j) {
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add(&set, &m, DHC_P_A, j, 0U));
+        TEST_ASSERT_EQUAL(DHC_OK, j < 2U ? dhc_params_add(&set, &m, DHC_P_ALPHA, j, 0U)
+                                         : dhc_params_add(&set, &m, DHC_P_D, 0U, 0U));
+    }
+    fill_pool(&m, DHC_MEAS_POSITION, 1, 5U);
+    const size_t k = 10U;
+    const size_t n = 4U;
+    const size_t p = set.count;
+    double weights[10];
+    dhc_plan_weighting_report best;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_weighting(&m, &set, read_pool, NULL, k, n, NULL, weights,
+                                                 &ws, &best));
+    double unit[DHC_MAX_PARAMS];
+    for (size_t i = 0U; i < p; ++i) {
+        unit[i] = 1.0;
+    }
+    static double w[DHC_MAX_PARAMS * DHC_MAX_PARAMS];
+    static double info[DHC_MAX_PARAMS * DHC_MAX_PARAMS];
+    static double one[DHC_MAX_PARAMS * DHC_MAX_PARAMS];
+    information(&m, &set, NULL, k, unit, w);
+    for (size_t i = 0U; i < p * p; ++i) {
+        w[i] /= (double)k;
+    }
+    double sum = 0.0;
+    memset(info, 0, sizeof info);
+    for (size_t c = 0U; c < k; ++c) {
+        TEST_ASSERT_TRUE(weights[c] >= 0.0);
+        sum += weights[c];
+        information(&m, &set, &c, 1U, unit, one);
+        for (size_t i = 0U; i < p * p; ++i) {
+            info[i] += (double)n * weights[c] * one[i];
+        }
+    }
+    TEST_ASSERT_DOUBLE_WITHIN(1e-12, 1.0, sum);
+    const double weighted = trace_inv_times(info, w, p);
+    TEST_ASSERT_DOUBLE_WITHIN(2e-3 * weighted, weighted, best.variance);
+    TEST_ASSERT_TRUE(best.floor >= (1.0 - 1.001e-3) * best.variance); /* converged */
+    double lowest = HUGE_VAL;
+    size_t idx[4];
+    for (idx[0] = 0U; idx[0] < k; ++idx[0]) {
+        for (idx[1] = idx[0]; idx[1] < k; ++idx[1]) {
+            for (idx[2] = idx[1]; idx[2] < k; ++idx[2]) {
+                for (idx[3] = idx[2]; idx[3] < k; ++idx[3]) {
+                    if (idx[0] == idx[3]) {
+                        continue; /* one pose four times: 3 rows for 6 parameters */
+                    }
+                    information(&m, &set, idx, n, unit, info);
+                    const double v = trace_inv_times(info, w, p);
+                    if (v > 0.0) { /* a singular plan's elimination gives rounding noise */
+                        lowest = fmin(lowest, v);
+                    }
+                }
+            }
+        }
+    }
+    TEST_ASSERT_TRUE(best.floor <= lowest);
+    TEST_ASSERT_TRUE(best.variance <= lowest * (1.0 + 1e-9));
+    TEST_ASSERT_TRUE(best.support >= 2U && best.support <= k);
+}
+
 /* 15 planned poses of 200 candidates observe the paper arm's parameters better than any of
  * 20 random 15-pose plans from the same candidates (O1), 10 % better than their mean, and
  * the store changes nothing. */
@@ -335,6 +404,7 @@ int main(void)
     UNITY_BEGIN();
     RUN_TEST(test_observability_is_the_scaled_determinant);
     RUN_TEST(test_small_pool_gets_the_best_plan);
+    RUN_TEST(test_floor_is_under_every_plan);
     RUN_TEST(test_plan_beats_random_plans);
     RUN_TEST(test_unidentifiable_parameters_are_left_out);
     RUN_TEST(test_bad_requests_are_refused);

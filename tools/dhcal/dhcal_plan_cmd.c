@@ -233,7 +233,7 @@ static int parse_plan_args(int argc, char **argv, plan_options *o)
 }
 
 static void report(const plan_options *o, const dhc_param_set *set, const dhc_plan_report *rep,
-                   double o1_random, size_t rank_random, const dhc_plan_workspace *ws,
+                   const dhc_plan_weighting_report *best, double o1_random, size_t rank_random, const dhc_plan_workspace *ws,
                    dhc_meas_kind kind)
 {
     uint8_t kept[DHC_MAX_PARAMS] = {0};
@@ -257,6 +257,9 @@ static void report(const plan_options *o, const dhc_param_set *set, const dhc_pl
         }
         cJSON_AddNumberToObject(obj, "variance", rep->variance);
         cJSON_AddNumberToObject(obj, "variance_random", rep->variance_first);
+        cJSON_AddNumberToObject(obj, "variance_floor", best->floor);
+        cJSON_AddNumberToObject(obj, "variance_weighted", best->variance);
+        cJSON_AddNumberToObject(obj, "weighting_iterations", (double)best->iterations);
         cJSON_AddNumberToObject(obj, "o1", rep->o1);
         cJSON_AddNumberToObject(obj, "rank", (double)rep->rank);
         cJSON_AddNumberToObject(obj, "o1_random", o1_random);
@@ -290,6 +293,9 @@ static void report(const plan_options *o, const dhc_param_set *set, const dhc_pl
     printf("prediction variance over the candidates' poses, per unit measurement variance: "
            "planned %.4g, random plan %.4g: %.2fx less\n", rep->variance, rep->variance_first,
            rep->variance > 0.0 ? rep->variance_first / rep->variance : HUGE_VAL);
+    printf("no plan of %lu poses from these candidates predicts below %.4g (their best "
+           "weighting %.4g): the plan is within %.1f %% of the best possible\n", o->poses,
+           best->floor, best->variance, 100.0 * (rep->variance / best->floor - 1.0));
 }
 
 int dhcal_plan_command(int argc, char **argv)
@@ -325,13 +331,14 @@ int dhcal_plan_command(int argc, char **argv)
     const dhc_meas_kind kind = model.measurer.present ? DHC_MEAS_WIRES : DHC_MEAS_POSITION;
     double *q = malloc(k * nj * sizeof *q);
     size_t *chosen = malloc(o.poses * sizeof *chosen);
+    double *weights = malloc(k * sizeof *weights);
     const size_t store_doubles = k * 3U * set.count;
     double *store = store_doubles * sizeof(double) <= PLAN_STORE_BYTES
                         ? malloc(store_doubles * sizeof *store)
                         : NULL; /* optional: the same plan, slower */
     static dhc_plan_workspace ws;
     rc = 1;
-    if (q == NULL || chosen == NULL) {
+    if (q == NULL || chosen == NULL || weights == NULL) {
         fprintf(stderr, "dhcal: plan: out of memory\n");
         goto done;
     }
@@ -363,11 +370,20 @@ int dhcal_plan_command(int argc, char **argv)
         fprintf(stderr, "dhcal: plan: %s\n", err.msg);
         goto done;
     }
-    report(&o, &set, &rep, o1_random, rank_random, &ws, kind);
+    /* how good any plan of these candidates can be: after the plan, its scratch reused */
+    dhc_plan_weighting_report best;
+    st = dhc_plan_weighting(&model, &set, read_candidate, &c, k, o.poses, store, weights, &ws,
+                            &best);
+    if (st != DHC_OK) {
+        fprintf(stderr, "dhcal: plan: the candidates' best weighting: %s\n", dhc_status_str(st));
+        goto done;
+    }
+    report(&o, &set, &rep, &best, o1_random, rank_random, &ws, kind);
     rc = 0;
 done:
     free(q);
     free(chosen);
+    free(weights);
     free(store);
     return rc;
 }

@@ -35,7 +35,7 @@ DHC_STATIC_ASSERT(DHC_MAX_PARAMS <= 256U, "DHC_MAX_PARAMS too large for the inde
  * The whole build, callers included, must agree. A feature left out answers with a
  * status, never with a silently different result: its entry points return
  * DHC_ERR_ARGUMENT (dhc_diagnose, dhc_uncertainty_*, dhc_lsq_prediction_variance,
- * dhc_arm_to_standard_dh, dhc_plan_select, dhc_model_inverse, dhc_model_command_jacobian),
+ * dhc_arm_to_standard_dh, dhc_plan_select, dhc_plan_weighting, dhc_model_inverse, dhc_model_command_jacobian),
  * options and samples that need it are refused (a noise model that is on, robust_start, pose
  * samples: dhc_calib_fit, dhc_sample_check), and functions that return a value rather than
  * a status (dhc_diagnose_candidates, dhc_chi2_log10_sf, dhc_f_log10_sf, dhc_rot_log, the

@@ -21,6 +21,14 @@
  * swap does or DHC_PLAN_MAX_EXCHANGE_PASSES passes over the plan. Ties go to the lower
  * candidate index: the same candidates give the same plan.
  *
+ * dhc_plan_weighting says how good any plan of n poses from the candidates can be: it
+ * weights the candidates (the approximate design) by the multiplicative algorithm until the
+ * equivalence theorem's floor (Kiefer and Wolfowitz: trace(M^-1) is convex, so the best
+ * weighting's value is bounded below at every step) is within DHC_PLAN_WEIGHT_TOL of the
+ * weighting's own value. No plan of n poses, repeats allowed, predicts below the floor: a
+ * plan's variance next to it is the plan's distance from the best possible, and a variance
+ * asked of fewer poses than the floor allows is out of reach whatever the selection.
+ *
  * dhc_plan_observability scores any plan with the observability index O1 of Borm and Menq,
  *     O1 = (prod_k sigma_k)^(1/r) / sqrt(m),
  * sigma_k the singular values of the plan's identification Jacobian (m rows, its columns
@@ -32,7 +40,8 @@
  * workspace's (about 40 DHC_MAX_PARAMS^2 bytes: static storage, not a stack). Optional
  * storage of the caller's for the candidates' Jacobian rows spares evaluating the model
  * again on every pass (the same plan either way). A build with DHC_WITH_PLAN 0 leaves the
- * selection out (dhc_plan_select answers DHC_ERR_ARGUMENT); the score stays.
+ * selection and the weighting out (dhc_plan_select and dhc_plan_weighting answer
+ * DHC_ERR_ARGUMENT); the score stays.
  */
 #ifndef DHC_PLAN_H
 #define DHC_PLAN_H
@@ -54,6 +63,10 @@ extern "C" {
 
 /* Passes of Fedorov's exchange over the plan, at most. */
 #define DHC_PLAN_MAX_EXCHANGE_PASSES 20U
+/* dhc_plan_weighting: iterations at most, and the floor's relative distance below the
+ * weighting's value at which it stops. */
+#define DHC_PLAN_MAX_WEIGHT_ITERATIONS 2000U
+#define DHC_PLAN_WEIGHT_TOL 1e-3
 
 typedef struct {
     dhc_normal_eq ne;   /* the candidates' (or the plan's) information, unscaled */
@@ -100,6 +113,27 @@ dhc_status dhc_plan_select(const dhc_model *model, const dhc_param_set *set,
                            dhc_sample_reader read, void *ctx, size_t k, size_t n,
                            double *rows_store, dhc_plan_workspace *ws, size_t *chosen,
                            dhc_plan_report *rep);
+
+typedef struct {
+    double variance;   /* what n poses weighted by the weights would predict: trace(M^-1 W)
+                          of the weighting, divided by n (no plan of n poses of the
+                          candidates does better than the best weighting) */
+    double floor;      /* no plan of n poses of the candidates (repeats allowed) predicts
+                          below this: between floor and variance lies the best weighting */
+    size_t iterations; /* of the multiplicative algorithm */
+    size_t support;    /* candidates whose weight is a hundredth of a pose or more */
+} dhc_plan_weighting_report;
+
+/* The candidates' best weighting for n poses (weights[0 .. k-1], the caller's: the
+ * weighting the iteration reached, summing to 1; a candidate whose Jacobian is not finite
+ * weighs 0) and the floor under any n-pose
+ * plan's variance, over the parameters dhc_plan_select keeps. rows_store as for
+ * dhc_plan_select (NULL: the model is evaluated k times per iteration). Errors as
+ * dhc_plan_select's; DHC_ERR_ARGUMENT also when the build leaves plans out. */
+dhc_status dhc_plan_weighting(const dhc_model *model, const dhc_param_set *set,
+                              dhc_sample_reader read, void *ctx, size_t k, size_t n,
+                              double *rows_store, double *weights, dhc_plan_workspace *ws,
+                              dhc_plan_weighting_report *rep);
 
 /* O1 of the plan made of read(ctx, index[i]) for i < n (index NULL: 0 .. n-1) for the
  * set, and in *rank (may be NULL) the parameters it identifies. Errors of the reader and of
