@@ -540,13 +540,16 @@ int main(int argc, char **argv)
         fprintf(log, "    whitened residual sd %.3f (1: as the noise model predicts)\n",
                 res->geo.sigma);
     }
-    if (autocal.diagnose != 0) {
+    if (autocal.diagnose != 0 && res->diagnosis != DHC_OK) {
+        fprintf(log, "(d) diagnosis: failed (%s): no effect named, none ruled out\n",
+                dhc_status_str(res->diagnosis));
+    } else if (autocal.diagnose != 0) {
         fprintf(log, "(d) diagnosis: %s (log10 p %.1f)\n", effect, res->effect_log10_p);
     } else {
         fprintf(log, "(d) diagnosis: off (--no-diagnose)\n");
     }
     fprintf(log, "(e) with %s: wire residual RMS %.4f mm; stored: %s (seq %u)\n", effect,
-            res->found ? res->eff.rms_mm : res->geo.rms_mm, res->saved ? "yes" : "no",
+            res->effect_fitted ? res->eff.rms_mm : res->geo.rms_mm, res->saved ? "yes" : "no",
             (unsigned)res->seq);
     where_it_fails(&job.geometric, n_done, log);
 
@@ -565,7 +568,7 @@ int main(int argc, char **argv)
     }
     dhc_param_set fset;
     (void)fw_job_param_set(&job, &fset);
-    const dhc_calib_report *fr = res->found ? &res->eff : &res->geo;
+    const dhc_calib_report *fr = res->effect_fitted ? &res->eff : &res->geo;
     const double floor_mm = noise_floor(&final_model, &fset, fr, &ph[2], res);
 
     fprintf(log, "\n%-28s %10s %10s\n", "model (fresh targets)", "RMS mm", "max mm");

@@ -99,12 +99,20 @@ char *fw_autocal_effect_label(const fw_autocal_result *res, char *buf, size_t ca
     if (cap == 0U) {
         return buf;
     }
+    buf[0] = '\0';
+    if (res->diagnosis != DHC_OK) {
+        (void)strncat(buf, "diagnosis failed", cap - 1U);
+        return buf;
+    }
     if (!res->found) {
-        buf[0] = '\0';
         (void)strncat(buf, "none", cap - 1U);
         return buf;
     }
     (void)dhc_effect_label(res->effect, res->effect_joint, buf, cap);
+    if (!res->effect_fitted) {
+        const size_t len = strlen(buf);
+        (void)strncat(buf, " (its refit failed: not added)", cap - 1U - len);
+    }
     return buf;
 }
 
@@ -205,11 +213,13 @@ fw_fault fw_autocal_configured(const fw_autocal_config *cfg, dhc_model *model,
     }
     const size_t nc = 0U;
 #endif
-    if (nc > 0U &&
-        dhc_diagnose(&ws->geo, &set, res->geo.identifiable, res->geo.sigma * res->geo.sigma,
-                     ws->cands, nc, read_sample, &buf, n, ws->flags, &dopt, &ws->diag_ws,
-                     &ws->diag) == DHC_OK &&
-        ws->diag.count > 0U && ws->diag.c[0].significant) {
+    res->diagnosis = nc > 0U ? dhc_diagnose(&ws->geo, &set, res->geo.identifiable,
+                                            res->geo.sigma * res->geo.sigma, ws->cands, nc,
+                                            read_sample, &buf, n, ws->flags, &dopt,
+                                            &ws->diag_ws, &ws->diag)
+                             : DHC_OK;
+    if (nc > 0U && res->diagnosis == DHC_OK && ws->diag.count > 0U &&
+        ws->diag.c[0].significant) {
         res->found = 1;
         res->effect = ws->diag.c[0].effect;
         res->effect_joint = ws->diag.c[0].joint;
@@ -222,6 +232,7 @@ fw_fault fw_autocal_configured(const fw_autocal_config *cfg, dhc_model *model,
                               &res->eff) == DHC_OK) {
                 *model = m2;
                 final_fit = &res->eff;
+                res->effect_fitted = 1;
             }
         }
     }

@@ -206,7 +206,7 @@ dhc_status fw_job_param_set(const fw_job *job, dhc_param_set *set)
     for (size_t e = 0U; e < ac->n_effects && st == DHC_OK; ++e) {
         st = dhc_params_add_effect(set, &job->calibrated, ac->effect[e], ac->effect_joint[e]);
     }
-    if (st == DHC_OK && job->result.found) {
+    if (st == DHC_OK && job->result.effect_fitted) {
         st = dhc_params_add_effect(set, &job->calibrated, job->result.effect,
                                    job->result.effect_joint);
     }

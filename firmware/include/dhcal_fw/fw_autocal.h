@@ -43,11 +43,14 @@ extern const dhc_candidate_scope fw_autocal_scope;
 
 typedef struct {
     dhc_calib_report geo;    /* base model fit */
+    dhc_status diagnosis;    /* DHC_OK when the diagnosis ran (or is off); its error when it
+                                failed: then nothing is named, and no effect was ruled out */
     int found;               /* the diagnosis named a significant effect */
     dhc_effect effect;
     size_t effect_joint;     /* 0-based */
     double effect_log10_p;
-    dhc_calib_report eff;    /* refit with the effect (valid when found) */
+    int effect_fitted;       /* the refit with it succeeded: the model carries the effect */
+    dhc_calib_report eff;    /* refit with the effect (valid when effect_fitted) */
     double new_rms_mm;       /* of the final model on the samples */
     double new_fpe_mm;       /* its final prediction error (see above; HUGE_VAL when the
                                 fit has no spare equations) */

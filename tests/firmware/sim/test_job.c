@@ -192,12 +192,22 @@ static void test_the_effect_label_is_the_effect_table_name(void)
     char buf[64];
     TEST_ASSERT_EQUAL_STRING("none", fw_autocal_effect_label(&r, buf, sizeof buf));
     r.found = 1;
+    r.effect_fitted = 1;
     r.effect = DHC_EFFECT_JOINT_COMPLIANCE;
     r.effect_joint = 11U;
     TEST_ASSERT_EQUAL_STRING("joint_compliance:12", fw_autocal_effect_label(&r, buf, sizeof buf));
     TEST_ASSERT_EQUAL_STRING("joint_co", fw_autocal_effect_label(&r, buf, 9U));
     r.effect = DHC_EFFECT_MEASURER_SCALE;
     TEST_ASSERT_EQUAL_STRING("measurer_scale", fw_autocal_effect_label(&r, buf, sizeof buf));
+    /* named, but the model could not take it: it must not read as added */
+    r.effect_fitted = 0;
+    TEST_ASSERT_EQUAL_STRING("measurer_scale (its refit failed: not added)",
+                             fw_autocal_effect_label(&r, buf, sizeof buf));
+    TEST_ASSERT_EQUAL_STRING("measurer_scale (i", fw_autocal_effect_label(&r, buf, 18U));
+    /* a diagnosis that failed found nothing and ruled nothing out: never "none" */
+    memset(&r, 0, sizeof r);
+    r.diagnosis = DHC_ERR_NOT_SPD;
+    TEST_ASSERT_EQUAL_STRING("diagnosis failed", fw_autocal_effect_label(&r, buf, sizeof buf));
 }
 
 int main(void)
