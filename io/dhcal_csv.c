@@ -803,9 +803,9 @@ int dhcal_dataset_from_arrays(const dhcal_arrays *a, dhcal_dataset *data, dhcal_
     if (a->n_rows == 0U) {
         return dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s: no rows", name);
     }
-    if (a->q_deg == NULL || a->xyz_mm == NULL) {
-        return dhcal_error_set(err, DHCAL_IO_FAILED, "%s: joint angles and tool points required",
-                               name);
+    if (a->q_deg == NULL || (a->xyz_mm == NULL && a->wires_mm == NULL)) {
+        return dhcal_error_set(err, DHCAL_IO_FAILED,
+                               "%s: joint angles and tool points or wire lengths required", name);
     }
     if (a->n_rows > SIZE_MAX / sizeof *data->rows) {
         return dhcal_error_set(err, DHCAL_IO_FAILED, "%s: out of memory for %zu rows", name,
@@ -819,7 +819,8 @@ int dhcal_dataset_from_arrays(const dhcal_arrays *a, dhcal_dataset *data, dhcal_
     data->n_rows = a->n_rows;
     data->n_joints = a->n_joints;
     data->has_q = 1;
-    data->has_xyz = 1;
+    data->has_xyz = a->xyz_mm != NULL;
+    data->has_wires = a->wires_mm != NULL;
     data->has_dir = a->dir != NULL;
     data->has_temp = a->temp_c != NULL;
     data->has_time = a->t_s != NULL;
@@ -833,12 +834,13 @@ int dhcal_dataset_from_arrays(const dhcal_arrays *a, dhcal_dataset *data, dhcal_
             col_kind kind;
             size_t count;
             const double *v;
-        } const groups[5] = {{COL_Q, nj, a->q_deg + i * nj},
-                             {COL_XYZ, 3U, a->xyz_mm + i * 3U},
+        } const groups[6] = {{COL_Q, nj, a->q_deg + i * nj},
+                             {COL_XYZ, 3U, a->xyz_mm != NULL ? a->xyz_mm + i * 3U : NULL},
+                             {COL_WIRE, 3U, a->wires_mm != NULL ? a->wires_mm + i * 3U : NULL},
                              {COL_DIR, nj, a->dir != NULL ? a->dir + i * nj : NULL},
                              {COL_TEMP, 1U, a->temp_c != NULL ? a->temp_c + i : NULL},
                              {COL_TIME, 1U, a->t_s != NULL ? a->t_s + i : NULL}};
-        for (size_t g = 0U; g < 5U; ++g) {
+        for (size_t g = 0U; g < 6U; ++g) {
             /* k < DHC_MAX_JOINTS always holds (count <= n_joints); said for the compiler,
              * which bounds the column name's digits by it */
             for (size_t k = 0U; groups[g].v != NULL && k < groups[g].count && k < DHC_MAX_JOINTS;

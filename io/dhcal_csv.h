@@ -73,9 +73,10 @@ int dhcal_csv_load_targets(const char *path, size_t n_joints, dhcal_dataset *tar
 void dhcal_dataset_free(dhcal_dataset *data);
 
 /* Measurement rows handed in as arrays rather than a file (the Python package): row-major,
- * q_deg n_rows x n_joints in degrees, xyz_mm n_rows x 3 (both required); dir (n_rows x
- * n_joints, each -1 or +1), temp_c and t_s (n_rows each) optional (NULL: no such column).
- * name stands for the file in messages. */
+ * q_deg n_rows x n_joints in degrees (required), xyz_mm and wires_mm (L1..L3) n_rows x 3
+ * (one of them, or both as a file may have both); dir (n_rows x n_joints, each -1 or +1),
+ * temp_c and t_s (n_rows each) optional (NULL: no such column). name stands for the file in
+ * messages. */
 typedef struct {
     const char *name;
     size_t n_rows;
@@ -85,6 +86,7 @@ typedef struct {
     const double *dir;
     const double *temp_c;
     const double *t_s;
+    const double *wires_mm;
 } dhcal_arrays;
 
 /* The dataset dhcal_csv_load would give for a file with these columns and values: every

@@ -113,12 +113,12 @@ int dhcal_py_rows_load(const char *path, const dhcal_py_model *m, void **rows, s
     *rows = d;
     *n_rows = d->n_rows;
     *columns = (d->has_dir ? 1 : 0) | (d->has_temp ? 2 : 0) | (d->has_time ? 4 : 0) |
-               (d->has_xyz ? 8 : 0);
+               (d->has_xyz ? 8 : 0) | (d->has_wires ? 16 : 0);
     return DHCAL_IO_OK;
 }
 
 void dhcal_py_rows_copy(const void *rows, double *q_deg, double *xyz_mm, double *dir,
-                        double *temp_c, double *t_s)
+                        double *temp_c, double *t_s, double *wires_mm)
 {
     const dhcal_dataset *d = rows;
     const size_t nj = d->n_joints;
@@ -132,6 +132,9 @@ void dhcal_py_rows_copy(const void *rows, double *q_deg, double *xyz_mm, double 
         }
         for (size_t c = 0U; c < 3U && xyz_mm != NULL; ++c) {
             xyz_mm[i * 3U + c] = r->xyz_mm[c];
+        }
+        for (size_t c = 0U; c < 3U && wires_mm != NULL; ++c) {
+            wires_mm[i * 3U + c] = r->wires_mm[c];
         }
         if (temp_c != NULL) {
             temp_c[i] = r->temp_c;
@@ -164,8 +167,8 @@ typedef struct {
 static int rows_to_samples(const dhcal_py_model *m, const dhcal_py_rows *r, const char *name,
                            dhcal_dataset *data, dhcal_samples *samples, dhcal_error *e)
 {
-    const dhcal_arrays a = {name,     r->n_rows, m->lib.arm.n_joints, r->q_deg, r->xyz_mm,
-                            r->dir,   r->temp_c, r->t_s};
+    const dhcal_arrays a = {name,   r->n_rows,  m->lib.arm.n_joints, r->q_deg, r->xyz_mm,
+                            r->dir, r->temp_c, r->t_s,              r->wires_mm};
     int rc = dhcal_dataset_from_arrays(&a, data, e);
     if (rc == DHCAL_IO_OK) {
         rc = dhcal_samples_build(&m->lib, data, name, samples, e);

@@ -30,8 +30,8 @@
 typedef struct dhcal_py_model dhcal_py_model;
 
 /* Measurement rows as row-major arrays (dhcal_arrays of io/dhcal_csv.h): q_deg n x
- * n_joints (degrees) and xyz_mm n x 3 required; dir (n x n_joints, -1 or +1), temp_c and
- * t_s (n each) may be NULL. */
+ * n_joints (degrees) required, xyz_mm and wires_mm (L1..L3) n x 3, one of them at least;
+ * dir (n x n_joints, -1 or +1), temp_c and t_s (n each) may be NULL. */
 typedef struct {
     size_t n_rows;
     const double *q_deg;
@@ -39,6 +39,7 @@ typedef struct {
     const double *dir;
     const double *temp_c;
     const double *t_s;
+    const double *wires_mm;
 } dhcal_py_rows;
 
 DHCAL_PY_API const char *dhcal_py_version(void);
@@ -56,14 +57,14 @@ DHCAL_PY_API char *dhcal_py_model_info(const dhcal_py_model *m);
 
 /* Reads a measurement CSV for the model (dhcal_csv_load). *rows receives a handle for
  * dhcal_py_rows_copy and dhcal_py_rows_free, *n_rows the rows, *columns the optional
- * columns present: bit 0 dir, bit 1 temp_c, bit 2 t_s, bit 3 x,y,z (absent: wire lengths
- * only, which the package does not take). */
+ * columns present: bit 0 dir, bit 1 temp_c, bit 2 t_s, bit 3 x,y,z, bit 4 L1..L3. */
 DHCAL_PY_API int dhcal_py_rows_load(const char *path, const dhcal_py_model *m, void **rows,
                                     size_t *n_rows, int *columns, char *err, size_t err_cap);
 /* Copies the rows out; angles in degrees (radians / DHC_DEG: within an ulp of the file's).
  * Arrays of absent columns may be NULL. */
 DHCAL_PY_API void dhcal_py_rows_copy(const void *rows, double *q_deg, double *xyz_mm,
-                                     double *dir, double *temp_c, double *t_s);
+                                     double *dir, double *temp_c, double *t_s,
+                                     double *wires_mm);
 DHCAL_PY_API void dhcal_py_rows_free(void *rows);
 
 /* Runs command "fit", "diagnose" or "refine" as the program runs it with --json: the model

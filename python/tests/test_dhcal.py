@@ -333,3 +333,58 @@ def test_time_and_temperature_columns_as_the_program(model, train, run_cli,
     assert not any(c.effect == "thermal_scale" for c in untimed.candidates)
     read = dhcal.load_measurements(path, model)
     assert np.array_equal(read.t_s, t_s) and np.array_equal(read.temp_c, temp_c)
+
+
+def wire_lengths(model_path: Path, xyz_mm: np.ndarray) -> np.ndarray:
+    """The paper's draw-wire lengths L1..L3 of the tool points, computed here from the model
+    file's measurer block (anchors in the measurer's frame, the frame's rpy a z-y-x turn):
+    |R^T (p - t) - anchor_k| (no scale or offset effect)."""
+    meas = json.loads(model_path.read_text())["measurer"]
+    roll, pitch, yaw = np.radians(meas["frame"]["rpy_deg"])
+    cx, sx, cy, sy, cz, sz = (math.cos(roll), math.sin(roll), math.cos(pitch),
+                              math.sin(pitch), math.cos(yaw), math.sin(yaw))
+    rot = (np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]]) @
+           np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]]) @
+           np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]]))
+    local = (xyz_mm - np.array(meas["frame"]["xyz_mm"])) @ rot
+    anchors = np.array(meas["anchors_mm"])
+    return np.linalg.norm(local[:, None, :] - anchors[None, :, :], axis=2)
+
+
+def test_wire_lengths_fit_as_the_program(model, train, run_cli, tmp_path: Path) -> None:
+    """The paper's instrument: wire lengths in, the fit in wire-length space, equal to the
+    program's on the same rows in a file; and the calibration it gives is the one the tool
+    points give (same arm, same noise seen through the wires)."""
+    wires = wire_lengths(MODEL, train["xyz_mm"])
+    path = tmp_path / "wires.csv"
+    with open(path, "w") as f:
+        f.write("q1,q2,q3,dir1,dir2,dir3,L1,L2,L3\n")
+        for i in range(wires.shape[0]):
+            values = [*train["q_deg"][i], *train["directions"][i], *wires[i]]
+            f.write(",".join(repr(float(v)) for v in values) + "\n")
+    result = dhcal.fit(model, train["q_deg"], wires_mm=wires, effects=["joint_compliance:2"],
+                       directions=train["directions"])
+    report = run_cli("fit", "--model", MODEL, "--data", path, "--effects", "joint_compliance:2")
+    assert_fit_equal(result, report)
+    points = dhcal.fit(model, train["q_deg"], train["xyz_mm"], ["joint_compliance:2"],
+                       directions=train["directions"])
+    assert result.rms_mm < 0.15  # wire residuals of the compliance fitted: near the noise
+    assert result.parameter("a2").value == pytest.approx(points.parameter("a2").value,
+                                                         abs=0.1)
+    read = dhcal.load_measurements(path, model)
+    assert read.xyz_mm is None and np.array_equal(read.wires_mm, wires)
+    assert_fit_equal(dhcal.fit(model, read, effects=["joint_compliance:2"]), report)
+
+
+def test_wire_lengths_need_a_measurer(train, tmp_path: Path) -> None:
+    data = json.loads(MODEL.read_text())
+    del data["measurer"]
+    (tmp_path / "bare.json").write_text(json.dumps(data))
+    bare = dhcal.load_model(tmp_path / "bare.json")
+    wires = wire_lengths(MODEL, train["xyz_mm"])
+    with pytest.raises(dhcal.DhcalInputError, match="measurer"):
+        dhcal.fit(bare, train["q_deg"], wires_mm=wires)
+    with pytest.raises(ValueError, match="wires_mm"):
+        dhcal.fit(bare, train["q_deg"], wires_mm=wires[:, :2])
+    with pytest.raises(TypeError, match="xyz_mm or wires_mm"):
+        dhcal.fit(bare, train["q_deg"])

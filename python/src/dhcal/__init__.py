@@ -129,15 +129,18 @@ def load_model(path: PathLike) -> Model:
 
 @dataclass
 class Measurements:
-    """Measurement rows: ``q_deg`` (N x joints, degrees), ``xyz_mm`` (N x 3), and the
-    optional columns ``directions`` (N x joints, -1 or +1: the approach direction of each
+    """Measurement rows: ``q_deg`` (N x joints, degrees), what was measured: ``xyz_mm``
+    (N x 3, tool points) or ``wires_mm`` (N x 3, the wire lengths L1..L3 of the model's
+    measurer), or both as a file may have both (a model with a measurer fits the wires), and
+    the optional columns ``directions`` (N x joints, -1 or +1: the approach direction of each
     joint), ``temp_c`` and ``t_s`` (N each), or None."""
 
     q_deg: np.ndarray
-    xyz_mm: np.ndarray
+    xyz_mm: Optional[np.ndarray] = None
     directions: Optional[np.ndarray] = None
     temp_c: Optional[np.ndarray] = None
     t_s: Optional[np.ndarray] = None
+    wires_mm: Optional[np.ndarray] = None
 
     def __len__(self) -> int:
         return int(self.q_deg.shape[0])
@@ -158,20 +161,17 @@ def load_measurements(path: PathLike, model: Model) -> Measurements:
     if code != _native.OK:
         _raise(code, err)
     try:
-        if not columns.value & 8:
-            raise DhcalInputError(f"{os.fspath(path)}: no x,y,z columns: the Python package "
-                                  "takes tool points (wire lengths L1..L3 only through the "
-                                  "program)")
         nr, nj = n.value, model.n_joints
         q = np.empty((nr, nj))
-        xyz = np.empty((nr, 3))
+        xyz = np.empty((nr, 3)) if columns.value & 8 else None
         d = np.empty((nr, nj)) if columns.value & 1 else None
         temp = np.empty(nr) if columns.value & 2 else None
         t = np.empty(nr) if columns.value & 4 else None
-        _native.LIB.dhcal_py_rows_copy(rows, *(_pointer(a) for a in (q, xyz, d, temp, t)))
+        wires = np.empty((nr, 3)) if columns.value & 16 else None
+        _native.LIB.dhcal_py_rows_copy(rows, *(_pointer(a) for a in (q, xyz, d, temp, t, wires)))
     finally:
         _native.LIB.dhcal_py_rows_free(rows)
-    return Measurements(q, xyz, d, temp, t)
+    return Measurements(q, xyz, d, temp, t, wires)
 
 
 def _pointer(a: Optional[np.ndarray]) -> Any:
@@ -207,23 +207,26 @@ class _Rows:
         n = q.shape[0]
         if n == 0:
             raise ValueError(f"dhcal: {what}: no rows")
-        self.arrays = [q, _array(f"{what} xyz_mm", m.xyz_mm, (n, 3))]
-        optional = [(m.directions, "directions", (n, model.n_joints)), (m.temp_c, "temp_c", (n,)),
-                    (m.t_s, "t_s", (n,))]
+        if m.xyz_mm is None and m.wires_mm is None:
+            raise ValueError(f"dhcal: {what}: xyz_mm or wires_mm (N x 3, mm) is required")
+        self.arrays = [q]
+        optional = [(m.xyz_mm, "xyz_mm", (n, 3)),
+                    (m.directions, "directions", (n, model.n_joints)), (m.temp_c, "temp_c", (n,)),
+                    (m.t_s, "t_s", (n,)), (m.wires_mm, "wires_mm", (n, 3))]
         self.arrays += [None if v is None else _array(f"{what} {name}", v, shape)
                         for v, name, shape in optional]
         self.c = _native.Rows(n, *(_pointer(a) for a in self.arrays))
 
 
-def _measurements(q_deg: Any, xyz_mm: Any, directions: Any, temp_c: Any,
-                  t_s: Any) -> Measurements:
+def _measurements(q_deg: Any, xyz_mm: Any, directions: Any, temp_c: Any, t_s: Any,
+                  wires_mm: Any) -> Measurements:
     if isinstance(q_deg, Measurements):
-        if xyz_mm is not None:
-            raise TypeError("dhcal: give Measurements alone, or q_deg and xyz_mm")
+        if xyz_mm is not None or wires_mm is not None:
+            raise TypeError("dhcal: give Measurements alone, or q_deg and xyz_mm or wires_mm")
         return q_deg
-    if xyz_mm is None:
-        raise TypeError("dhcal: xyz_mm (N x 3, mm) is required with q_deg")
-    return Measurements(q_deg, xyz_mm, directions, temp_c, t_s)
+    if xyz_mm is None and wires_mm is None:
+        raise TypeError("dhcal: xyz_mm or wires_mm (N x 3, mm) is required with q_deg")
+    return Measurements(q_deg, xyz_mm, directions, temp_c, t_s, wires_mm)
 
 
 def _heldout(heldout: Any) -> Optional[Measurements]:
@@ -443,12 +446,13 @@ def _finish(cls: type, code: int, report: Dict[str, Any], model: Optional[Model]
 
 def fit(model: Model, q_deg: Any, xyz_mm: Any = None, effects: Effects = (),
         heldout: Any = None, *, directions: Any = None, temp_c: Any = None, t_s: Any = None,
-        noise: Optional[Tuple[float, float]] = None, geometry: Optional[str] = None,
-        cv: bool = False) -> FitResult:
+        wires_mm: Any = None, noise: Optional[Tuple[float, float]] = None,
+        geometry: Optional[str] = None, cv: bool = False) -> FitResult:
     """Least-squares calibration of ``model`` to the measured tool points, as ``dhcal fit``.
 
     q_deg: joint angles, N x joints, degrees (or a :class:`Measurements`, then no xyz_mm).
-    xyz_mm: measured tool points, N x 3, mm. effects: effect names to fit besides the base
+    xyz_mm: measured tool points, N x 3, mm; or wires_mm: the wire lengths L1..L3 of the
+    model's measurer, N x 3, mm (the paper's draw-wire instrument). effects: effect names to fit besides the base
     model (``["joint_compliance:2"]`` or ``"base_frame,tool_offset"``). heldout:
     :class:`Measurements` or ``(q_deg, xyz_mm)`` evaluated with the fitted model, never
     fitted. directions, temp_c, t_s: the optional columns. noise: ``(joint_deg, meas_mm)``
@@ -459,32 +463,34 @@ def fit(model: Model, q_deg: Any, xyz_mm: Any = None, effects: Effects = (),
     :class:`DhcalInputError` for values the measurement rules refuse or a bad effect name,
     and :class:`DhcalError` when the fit fails, does not converge or is no plausible
     calibration (``error.result`` holds the report then)."""
-    data = _measurements(q_deg, xyz_mm, directions, temp_c, t_s)
+    data = _measurements(q_deg, xyz_mm, directions, temp_c, t_s, wires_mm)
     return _finish(FitResult, *_run("fit", model, data, effects, _heldout(heldout), noise,
                                     geometry, cv))
 
 
 def diagnose(model: Model, q_deg: Any, xyz_mm: Any = None, effects: Effects = (),
              heldout: Any = None, *, directions: Any = None, temp_c: Any = None,
-             t_s: Any = None, noise: Optional[Tuple[float, float]] = None,
-             geometry: Optional[str] = None, cv: bool = False) -> Diagnosis:
+             t_s: Any = None, wires_mm: Any = None,
+             noise: Optional[Tuple[float, float]] = None, geometry: Optional[str] = None,
+             cv: bool = False) -> Diagnosis:
     """``dhcal diagnose``: the fit, then every effect of the catalogue the model does not have
     scored against the remaining residual (score test, Holm-corrected at 0.1 %).
     ``result.named`` is the effect to add next, or None. Arguments as :func:`fit`; cv also
     refits the best significant candidates and cross-validates each."""
-    data = _measurements(q_deg, xyz_mm, directions, temp_c, t_s)
+    data = _measurements(q_deg, xyz_mm, directions, temp_c, t_s, wires_mm)
     return _finish(Diagnosis, *_run("diagnose", model, data, effects, _heldout(heldout),
                                     noise, geometry, cv))
 
 
 def refine(model: Model, q_deg: Any, xyz_mm: Any = None, effects: Effects = (),
            heldout: Any = None, *, directions: Any = None, temp_c: Any = None,
-           t_s: Any = None, noise: Optional[Tuple[float, float]] = None,
+           t_s: Any = None, wires_mm: Any = None,
+           noise: Optional[Tuple[float, float]] = None,
            geometry: Optional[str] = None) -> RefineResult:
     """``dhcal refine``: from the base model plus ``effects`` (the start set), adds the
     diagnosed effect that lowers the cross-validated RMS most, while that falls by 1 % or
     more; held-out rows are evaluated at every step, never used to choose. Arguments as
     :func:`fit`; ``result.model`` is the final calibrated model."""
-    data = _measurements(q_deg, xyz_mm, directions, temp_c, t_s)
+    data = _measurements(q_deg, xyz_mm, directions, temp_c, t_s, wires_mm)
     return _finish(RefineResult, *_run("refine", model, data, effects, _heldout(heldout),
                                        noise, geometry, False))
