@@ -251,6 +251,9 @@ static dhc_status survey(const dhc_model *model, const dhc_param_set *set,
                          dhc_plan_workspace *ws, size_t *usable)
 {
     const size_t p = set->count;
+    if (p == 0U || p > DHC_MAX_PARAMS) {
+        return DHC_ERR_CAPACITY;
+    }
     dhc_status st = dhc_normal_eq_init(&ws->ne, p);
     const double zero[DHC_MAX_ROWS_PER_SAMPLE] = {0.0};
     dhc_arm_prepare(&model->arm, &ws->trig);
@@ -403,9 +406,6 @@ dhc_status dhc_plan_select(const dhc_model *model, const dhc_param_set *set,
         rep == NULL || n == 0U) {
         return DHC_ERR_ARGUMENT;
     }
-    if (set->count == 0U || set->count > DHC_MAX_PARAMS) {
-        return DHC_ERR_CAPACITY;
-    }
     memset(rep, 0, sizeof *rep);
     dhc_status st = survey(model, set, read, ctx, k, rows_store, ws, &rep->usable);
     if (st != DHC_OK) {
@@ -469,9 +469,6 @@ dhc_status dhc_plan_weighting(const dhc_model *model, const dhc_param_set *set,
     if (model == NULL || set == NULL || read == NULL || ws == NULL || weights == NULL ||
         rep == NULL || n == 0U) {
         return DHC_ERR_ARGUMENT;
-    }
-    if (set->count == 0U || set->count > DHC_MAX_PARAMS) {
-        return DHC_ERR_CAPACITY;
     }
     memset(rep, 0, sizeof *rep);
     size_t usable = 0U;

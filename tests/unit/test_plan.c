@@ -166,20 +166,27 @@ static double trace_inv_times(const double *n, const double *w, size_t p)
     return t;
 }
 
+/* The paper's arm, six of its parameters (the link lengths, two twists, d1) and a pool of
+ * tool-position candidates: problems small enough to enumerate every plan. */
+static void small_pool(const dhc_model *m, dhc_param_set *set)
+{
+    dhc_params_clear(set);
+    for (size_t j = 0U; j < 3U; ++j) {
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add(set, m, DHC_P_A, j, 0U));
+        TEST_ASSERT_EQUAL(DHC_OK, j < 2U ? dhc_params_add(set, m, DHC_P_ALPHA, j, 0U)
+                                         : dhc_params_add(set, m, DHC_P_D, 0U, 0U));
+    }
+    fill_pool(m, DHC_MEAS_POSITION, 1, 5U);
+}
+
 /* 10 candidates, 4 poses: all 210 plans scored here by their prediction variance averaged
  * over the candidates, trace(M^-1 W). An exchange finds a local optimum: the selection must
  * be within 2 % of the best plan and better than all but a few of the 210. */
 static void test_small_pool_gets_the_best_plan(void)
 {
-    dhc_model m = test_paper3_as_built();
+    const dhc_model m = test_paper3_as_built();
     dhc_param_set set;
-    dhc_params_clear(&set);
-    for (size_t j = 0U; j < 3U; ++j) { /* the link lengths, two twists, d1: 6 parameters */
-        TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add(&set, &m, DHC_P_A, j, 0U));
-        TEST_ASSERT_EQUAL(DHC_OK, j < 2U ? dhc_params_add(&set, &m, DHC_P_ALPHA, j, 0U)
-                                         : dhc_params_add(&set, &m, DHC_P_D, 0U, 0U));
-    }
-    fill_pool(&m, DHC_MEAS_POSITION, 1, 5U);
+    small_pool(&m, &set);
     const size_t k = 10U;
     const size_t n = 4U;
     size_t chosen[4];
@@ -237,15 +244,9 @@ static void test_small_pool_gets_the_best_plan(void)
  * and the weighting's own value recomputed here from its weights. */
 static void test_floor_is_under_every_plan(void)
 {
-    dhc_model m = test_paper3_as_built();
+    const dhc_model m = test_paper3_as_built();
     dhc_param_set set;
-    dhc_params_clear(&set);
-    for (size_t j = 0U; j < 3U; ++j) {
-        TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add(&set, &m, DHC_P_A, j, 0U));
-        TEST_ASSERT_EQUAL(DHC_OK, j < 2U ? dhc_params_add(&set, &m, DHC_P_ALPHA, j, 0U)
-                                         : dhc_params_add(&set, &m, DHC_P_D, 0U, 0U));
-    }
-    fill_pool(&m, DHC_MEAS_POSITION, 1, 5U);
+    small_pool(&m, &set);
     const size_t k = 10U;
     const size_t n = 4U;
     const size_t p = set.count;
