@@ -79,7 +79,7 @@ static double median(double *v, size_t n)
 void fw_autocal_default_config(fw_autocal_config *cfg)
 {
     memset(cfg, 0, sizeof *cfg);
-    cfg->diagnose = 1;
+    cfg->diagnose = DHC_WITH_DIAGNOSE; /* what the build can do */
     cfg->io = NULL;
     cfg->acq = NULL;
     cfg->wire_noise_mm = 0.0;

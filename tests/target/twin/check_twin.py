@@ -120,6 +120,10 @@ def main():
     ap.add_argument("what", choices=["fit", "job"])
     ap.add_argument("--host", required=True)
     ap.add_argument("--target", required=True)
+    ap.add_argument("--no-diagnosis", action="store_true",
+                    help="the target's library leaves the diagnosis out (the controller's "
+                    "set): a job configured to diagnose must be refused there, and the job "
+                    "with the effect configured must match")
     a = ap.parse_args()
     if not comparison_sees_differences():
         print("FAIL: the comparison does not tell a 2e-9 difference from a 1e-10 one")
@@ -135,11 +139,19 @@ def main():
             return 1
     if a.what == "fit":
         cases = [("3-DOF wires + joint_compliance:2", [demo]), ("6-DOF poses", [arm6])]
+    elif a.no_diagnosis:
+        cases = [("job, joint_compliance:2 configured, no diagnosis", [demo, "configured"])]
     else:
         cases = [("job, diagnosis on", [demo]),
                  ("job, joint_compliance:2 configured, no diagnosis", [demo, "configured"])]
     env = dict(os.environ, DHCAL_QEMU_OPTS="-icount shift=0")
     bad = []
+    if a.what == "job" and a.no_diagnosis:
+        rc_t, out_t = run([a.emulator, a.target, demo, "diagnose"], env=env)
+        print(out_t, end="")
+        if rc_t == 0 or "fault argument" not in out_t:
+            bad.append("a job configured to diagnose was not refused by a library without "
+                       f"the diagnosis (exit {rc_t})")
     for label, args in cases:
         rc_h, out_h = run([a.host] + args)
         rc_t, out_t = run([a.emulator, a.target] + args, env=env)

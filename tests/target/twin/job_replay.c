@@ -1,12 +1,13 @@
 /* job_replay.c - the controller's job (fw_job) on recorded samples, the same on the
  * Cortex-M4 and on the host (twin.h):
- *   job_replay FILE [configured]
+ *   job_replay FILE [configured|diagnose]
  * FILE: wire samples of the paper's 3-DOF arm as dhcal-demo collected them. The job boots
  * on a port whose arm stands still at the start pose (nothing moves: the samples are
  * recorded), plans, takes the recording as its acquisition (fw_job_acquire_recorded),
- * calibrates with the demo's configuration (noise model on, the diagnosis on; with
- * `configured`, as `dhcal-demo --effects joint_compliance:2 --no-diagnose`: the effect
- * known and fitted from the start, no diagnosis) and stores
+ * calibrates with the demo's configuration (noise model on, the diagnosis when the library
+ * has it; with `diagnose`, the diagnosis asked for in any case; with `configured`, as
+ * `dhcal-demo --effects joint_compliance:2 --no-diagnose`: the effect known and fitted from
+ * the start, no diagnosis) and stores
  * into a RAM store through fw_calstore. Prints what the job found, the parameters of the
  * calibration it stored (read back with fw_cal_load), the store's bytes and the
  * instructions fw_job_calibrate took (0 on the host). */
@@ -117,10 +118,11 @@ int twin_main(int argc, char **argv)
     size_t n = 0U;
     size_t nj = 0U;
     const int configured = argc == 3 && strcmp(argv[2], "configured") == 0;
-    if ((argc != 2 && !configured) ||
+    const int diagnose = argc == 3 && strcmp(argv[2], "diagnose") == 0;
+    if ((argc != 2 && !configured && !diagnose) ||
         twin_load_samples(argv[1], recorded, TWIN_MAX_SAMPLES, &n, &nj) != 0 || nj != 3U) {
-        twin_puts("usage: job_replay FILE [configured] (wire samples of the 3-DOF paper "
-                  "arm)\n");
+        twin_puts("usage: job_replay FILE [configured|diagnose] (wire samples of the 3-DOF "
+                  "paper arm)\n");
         return 2;
     }
     dhc_model nominal = test_paper3_model();
@@ -152,6 +154,9 @@ int twin_main(int argc, char **argv)
         cfg.autocal.effect[0] = DHC_EFFECT_JOINT_COMPLIANCE;
         cfg.autocal.effect_joint[0] = 1U;
         cfg.autocal.diagnose = 0;
+    }
+    if (diagnose) {
+        cfg.autocal.diagnose = 1; /* whatever the build's default */
     }
 
     fw_fault f = fw_job_boot(&job, &cfg, &nominal, &port, &io);
