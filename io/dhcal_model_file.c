@@ -141,7 +141,7 @@ static int effect_name_ok(const char *name, size_t n_joints)
 size_t dhcal_effect_catalogue(char *buf, size_t cap)
 {
     size_t pos = 0U;
-    for (size_t i = 0U; i < (size_t)DHC_EFFECT_COUNT; ++i) {
+    for (size_t i = 0U; dhc_effect_at(i) != NULL; ++i) {
         const dhc_effect_info *fx = dhc_effect_at(i);
         const int n = snprintf(buf + (pos < cap ? pos : cap), pos < cap ? cap - pos : 0U,
                                "%s%s%s", i == 0U ? "" : ", ", fx->name, fx->per_joint ? ":i" : "");

@@ -150,14 +150,14 @@ void dhcal_model_from_lib(const dhc_model *m, const dhcal_model *template_model,
     out->n_effects = 0U;
     /* joint by joint, then the others: each in the catalogue's order */
     for (size_t j = 0U; j < m->arm.n_joints; ++j) {
-        for (size_t i = 0U; i < (size_t)DHC_EFFECT_COUNT; ++i) {
+        for (size_t i = 0U; dhc_effect_at(i) != NULL; ++i) {
             const dhc_effect_info *fx = dhc_effect_at(i);
             if (fx->per_joint) {
                 effect_from_lib(m, fx, j, out);
             }
         }
     }
-    for (size_t i = 0U; i < (size_t)DHC_EFFECT_COUNT; ++i) {
+    for (size_t i = 0U; dhc_effect_at(i) != NULL; ++i) {
         const dhc_effect_info *fx = dhc_effect_at(i);
         if (!fx->per_joint && !fx->in_frames) {
             effect_from_lib(m, fx, 0U, out);

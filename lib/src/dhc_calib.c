@@ -149,16 +149,8 @@ dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_arm_trig *trig,
         }
     }
     for (size_t j = 0U; j < n; ++j) {
-        const dhc_joint_effects *fx = &model->effect[j];
-        const double q = s->q_rad[j];
-        double slope = 1.0 + fx->scale + fx->harmonic_sin_rad * cos(q) -
-                       fx->harmonic_cos_rad * sin(q);
-        for (size_t k = 0U; k + 1U < DHC_HARMONIC_MAX_ORDER; ++k) {
-            const double order = (double)(k + 2U);
-            slope += order * (fx->harmonic_hi_sin_rad[k] * cos(order * q) -
-                              fx->harmonic_hi_cos_rad[k] * sin(order * q));
-        }
-        const double sd = joint_noise_rad[j] * slope;
+        const double sd =
+            joint_noise_rad[j] * dhc_joint_effects_slope(&model->effect[j], s->q_rad[j]);
         for (size_t a = 0U; a < rows; ++a) {
             for (size_t b = 0U; b <= a; ++b) {
                 c[a * DHC_MAX_ROWS_PER_SAMPLE + b] +=

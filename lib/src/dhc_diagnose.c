@@ -271,6 +271,9 @@ size_t dhc_diagnose_candidates(const dhc_model *model, const dhc_param_set *base
     for (unsigned e = 0U; e < (unsigned)DHC_EFFECT_COUNT; ++e) {
         const dhc_effect effect = (dhc_effect)e;
         const dhc_effect_info *fx = dhc_effect_info_of(effect);
+        if (fx == NULL) {
+            continue; /* left out of this build */
+        }
         if (((fx->needs & DHC_NEEDS_WIRES) != 0U && !(scope->wires && model->measurer.present)) ||
             ((fx->needs & DHC_NEEDS_TEMPERATURE) != 0U && !scope->temperature) ||
             ((fx->needs & DHC_NEEDS_TIME) != 0U && !scope->time)) {

@@ -13,8 +13,9 @@
 #define SUMMARY(text) "" /* left out of this build (DHC_WITH_EFFECT_SUMMARIES 0) */
 #endif
 
-/* In the order of docs/effects.md; the summaries are what a diagnosis says of a candidate. */
-static const dhc_effect_info catalogue[DHC_EFFECT_COUNT] = {
+/* In the order of docs/effects.md; the summaries are what a diagnosis says of a candidate.
+ * The effects this build leaves out (dhc_config.h) are not in it. */
+static const dhc_effect_info catalogue[] = {
     {"base_frame",
      SUMMARY("a constant shift and a rotation growing with distance (robot or measurer placement)"),
      DHC_EFFECT_BASE_FRAME, 0U, KINDS(DHC_P_BASE_X, DHC_P_BASE_RZ), 0U, 1U, 0U,
@@ -22,11 +23,14 @@ static const dhc_effect_info catalogue[DHC_EFFECT_COUNT] = {
     {"tool_offset", SUMMARY("an error vector that turns with the last link (tool point unknown)"),
      DHC_EFFECT_TOOL_OFFSET, 0U, KINDS(DHC_P_TOOL_X, DHC_P_TOOL_Z), 0U, 1U, 0U,
      DHC_EFFECT_REF_NONE, 1U},
+#if DHC_WITH_EFFECT_JOINT_SCALE
     {"joint_scale",
      SUMMARY("a joint error growing in proportion to the joint angle (gear ratio or encoder "
      "resolution)"),
      DHC_EFFECT_JOINT_SCALE, 1U, KINDS(DHC_P_JOINT_SCALE, DHC_P_JOINT_SCALE), 0U, 1U,
      DHC_NEEDS_ANGLE_RANGE, DHC_EFFECT_REF_NONE, 0U},
+#endif
+#if DHC_WITH_EFFECT_JOINT_HARMONIC
     {"joint_harmonic", SUMMARY("a joint error periodic in the joint angle (encoder or gear eccentricity)"),
      DHC_EFFECT_JOINT_HARMONIC, 1U, KINDS(DHC_P_HARMONIC_SIN, DHC_P_HARMONIC_COS), 0U, 1U,
      DHC_NEEDS_ANGLE_RANGE, DHC_EFFECT_REF_NONE, 0U},
@@ -40,12 +44,18 @@ static const dhc_effect_info catalogue[DHC_EFFECT_COUNT] = {
     {"joint_harmonic4", SUMMARY("a joint error repeating four times per turn (gear harmonic)"),
      DHC_EFFECT_JOINT_HARMONIC4, 1U, KINDS(DHC_P_HARMONIC_SIN, DHC_P_HARMONIC_COS), 3U, 1U,
      DHC_NEEDS_ANGLE_RANGE, DHC_EFFECT_REF_NONE, 0U},
+#endif
+#if DHC_WITH_EFFECT_JOINT_BACKLASH
     {"joint_backlash", SUMMARY("a joint error that splits by approach direction (gear backlash)"),
      DHC_EFFECT_JOINT_BACKLASH, 1U, KINDS(DHC_P_BACKLASH, DHC_P_BACKLASH), 0U, 1U,
      DHC_NEEDS_BOTH_DIRECTIONS, DHC_EFFECT_REF_NONE, 0U},
+#endif
+#if DHC_WITH_EFFECT_JOINT_COMPLIANCE
     {"joint_compliance", SUMMARY("a joint error that follows the gravity torque (joint stiffness)"),
      DHC_EFFECT_JOINT_COMPLIANCE, 1U, KINDS(DHC_P_COMPLIANCE, DHC_P_COMPLIANCE), 0U, 0U,
      DHC_NEEDS_GRAVITY, DHC_EFFECT_REF_NONE, 0U},
+#endif
+#if DHC_WITH_EFFECT_MEASURER
     {"measurer_scale", SUMMARY("wire errors growing with wire length (friction-wheel radius)"),
      DHC_EFFECT_MEASURER_SCALE, 0U, KINDS(DHC_P_MEAS_SCALE, DHC_P_MEAS_SCALE), 0U, 1U,
      DHC_NEEDS_WIRES, DHC_EFFECT_REF_NONE, 0U},
@@ -56,9 +66,13 @@ static const dhc_effect_info catalogue[DHC_EFFECT_COUNT] = {
      SUMMARY("errors pointing at the measurer's anchors (measurer built off its drawing)"),
      DHC_EFFECT_MEASURER_ANCHORS, 0U, KINDS(DHC_P_MEAS_ANCHOR, DHC_P_MEAS_ANCHOR), 0U, 9U,
      DHC_NEEDS_WIRES, DHC_EFFECT_REF_NONE, 1U},
+#endif
+#if DHC_WITH_EFFECT_THERMAL
     {"thermal_scale", SUMMARY("lengths growing with temperature (thermal expansion)"),
      DHC_EFFECT_THERMAL_SCALE, 0U, KINDS(DHC_P_THERMAL, DHC_P_THERMAL), 0U, 1U,
      DHC_NEEDS_TEMPERATURE, DHC_EFFECT_REF_TEMPERATURE, 0U},
+#endif
+#if DHC_WITH_EFFECT_DRIFT
     {"drift_scale",
      SUMMARY("errors growing over the session in proportion to the distance from the base (warming "
      "arm)"),
@@ -67,16 +81,20 @@ static const dhc_effect_info catalogue[DHC_EFFECT_COUNT] = {
     {"drift_offset", SUMMARY("a constant error growing over the session (measurer or base moving)"),
      DHC_EFFECT_DRIFT_OFFSET, 0U, KINDS(DHC_P_DRIFT_OFFSET, DHC_P_DRIFT_OFFSET), 0U, 3U,
      DHC_NEEDS_TIME, DHC_EFFECT_REF_TIME, 0U},
+#endif
 };
+
+#define CATALOGUE_SIZE (sizeof catalogue / sizeof catalogue[0])
+DHC_STATIC_ASSERT(CATALOGUE_SIZE <= (size_t)DHC_EFFECT_COUNT, "one row per effect at most");
 
 const dhc_effect_info *dhc_effect_at(size_t index)
 {
-    return index < (size_t)DHC_EFFECT_COUNT ? &catalogue[index] : NULL;
+    return index < CATALOGUE_SIZE ? &catalogue[index] : NULL;
 }
 
 const dhc_effect_info *dhc_effect_info_of(dhc_effect effect)
 {
-    for (size_t i = 0U; i < (size_t)DHC_EFFECT_COUNT; ++i) {
+    for (size_t i = 0U; i < CATALOGUE_SIZE; ++i) {
         if (catalogue[i].effect == (uint8_t)effect) {
             return &catalogue[i];
         }
@@ -132,7 +150,7 @@ dhc_status dhc_effect_parse(const char *text, size_t len, size_t n_joints, dhc_e
     while (name_len < len && text[name_len] != ':') {
         ++name_len;
     }
-    for (size_t i = 0U; i < (size_t)DHC_EFFECT_COUNT; ++i) {
+    for (size_t i = 0U; i < CATALOGUE_SIZE; ++i) {
         const dhc_effect_info *fx = &catalogue[i];
         if (strlen(fx->name) != name_len || memcmp(fx->name, text, name_len) != 0) {
             continue;

@@ -17,19 +17,6 @@ void dhc_inverse_default_options(dhc_inverse_options *opt)
 
 #if DHC_WITH_INVERSE
 
-/* d(q_eff_i)/d(q_i) through the effects on a joint's own angle: the derivative of
- * dhc_model_evaluate's s q + A sin q + B cos q + sum_k (A_k sin kq + B_k cos kq). */
-static double own_slope(const dhc_joint_effects *fx, double q)
-{
-    double d = 1.0 + fx->scale + fx->harmonic_sin_rad * cos(q) - fx->harmonic_cos_rad * sin(q);
-    for (size_t k = 0U; k + 1U < DHC_HARMONIC_MAX_ORDER; ++k) {
-        const double order = (double)(k + 2U);
-        d += order * (fx->harmonic_hi_sin_rad[k] * cos(order * q) -
-                      fx->harmonic_hi_cos_rad[k] * sin(order * q));
-    }
-    return d;
-}
-
 /* slope[i][k] += d(sum_j c_ij tau_ij)/d(q_k), tau_ij = g . (z_i x (o_{j+1} - o_i)) on the
  * frames f at the commanded angles (where dhc_model_evaluate takes the moments). Joint k
  * turns everything beyond it about z_k: for k < i the axis z_i and the lever together,
@@ -95,7 +82,7 @@ static dhc_status command_jacobian(const dhc_model *model, const dhc_sample *s,
     double slope[DHC_MAX_JOINTS * DHC_MAX_JOINTS];
     memset(slope, 0, sizeof slope);
     for (size_t i = 0U; i < n; ++i) {
-        slope[i * n + i] = own_slope(&model->effect[i], s->q_rad[i]);
+        slope[i * n + i] = dhc_joint_effects_slope(&model->effect[i], s->q_rad[i]);
     }
     if (dhc_model_has_compliance(model)) {
         double sin_q[DHC_MAX_JOINTS];

@@ -188,7 +188,7 @@ dhc_status dhc_identification_jacobian(const dhc_arm *arm, const dhc_param_set *
 
 static int set_has_compliance(const dhc_param_set *set)
 {
-    for (size_t k = 0U; k < set->count; ++k) {
+    for (size_t k = 0U; DHC_WITH_EFFECT_JOINT_COMPLIANCE && k < set->count; ++k) {
         if (set->id[k].kind == (uint8_t)DHC_P_COMPLIANCE) {
             return 1;
         }
@@ -196,17 +196,27 @@ static int set_has_compliance(const dhc_param_set *set)
     return 0;
 }
 
-/* Factor by which a joint effect parameter scales its joint's column: d(dq_i)/d(param). */
+/* Factor by which a joint effect parameter scales its joint's column: d(dq_i)/d(param).
+ * (A set never holds the parameters of an effect the build leaves out: dhc_params_add.) */
 static double joint_effect_factor(const dhc_param_id *id, const dhc_sample *s,
                                   const double *tau_row)
 {
     const double q = s->q_rad[id->joint];
+    (void)q, (void)tau_row; /* a build without the effects that read them */
     switch ((dhc_param_kind)id->kind) {
+#if DHC_WITH_EFFECT_JOINT_SCALE
     case DHC_P_JOINT_SCALE: return q;
+#endif
+#if DHC_WITH_EFFECT_JOINT_HARMONIC
     case DHC_P_HARMONIC_SIN: return sin((double)(id->aux + 1U) * q);
     case DHC_P_HARMONIC_COS: return cos((double)(id->aux + 1U) * q);
+#endif
+#if DHC_WITH_EFFECT_JOINT_BACKLASH
     case DHC_P_BACKLASH: return 0.5 * (double)s->dir[id->joint];
+#endif
+#if DHC_WITH_EFFECT_JOINT_COMPLIANCE
     case DHC_P_COMPLIANCE: return tau_row[id->aux];
+#endif
     default: return 0.0;
     }
 }
@@ -224,17 +234,20 @@ static void wire_rows(const dhc_model *model, const dhc_param_id *id, const doub
         const double len = dhc_vec3_norm(d);
         double u[3];
         dhc_vec3_scale(d, len > 0.0 ? 1.0 / len : 0.0, u);
+        const double scale = DHC_WITH_EFFECT_MEASURER ? 1.0 + m->scale : 1.0;
         switch ((dhc_param_kind)id->kind) {
+#if DHC_WITH_EFFECT_MEASURER
         case DHC_P_MEAS_SCALE: out[k] = len; break;
         case DHC_P_MEAS_OFFSET: out[k] = id->aux == k ? 1.0 : 0.0; break;
         case DHC_P_MEAS_ANCHOR: {
             /* moving anchor k along its own axis shortens wire k by u . (R e_axis) */
             double e[3];
             dhc_rot_column(&m->frame.rot, (size_t)id->aux % 3U, e);
-            out[k] = (size_t)id->aux / 3U == k ? -(1.0 + m->scale) * dhc_vec3_dot(u, e) : 0.0;
+            out[k] = (size_t)id->aux / 3U == k ? -scale * dhc_vec3_dot(u, e) : 0.0;
             break;
         }
-        default: out[k] = (1.0 + m->scale) * dhc_vec3_dot(u, dp); break;
+#endif
+        default: out[k] = scale * dhc_vec3_dot(u, dp); break;
         }
     }
 }
@@ -322,15 +335,15 @@ static dhc_status jacobian_prepared(const dhc_model *model, const dhc_arm_trig *
             geometric_column(arm, ev->frames, ev->axes, p_arm, &joint_theta, dp, dw);
             dhc_vec3_scale(dp, factor, dp);
             dhc_vec3_scale(dw, factor, dw);
-        } else if (id->kind == (uint8_t)DHC_P_THERMAL) {
+        } else if (DHC_WITH_EFFECT_THERMAL && id->kind == (uint8_t)DHC_P_THERMAL) {
             /* scaling every length scales the tool point about the base origin */
             dhc_vec3_sub(p_arm, arm->base.pos, dp);
             dhc_vec3_scale(dp, dtemp / ev->length_scale, dp);
-        } else if (id->kind == (uint8_t)DHC_P_DRIFT_SCALE) {
+        } else if (DHC_WITH_EFFECT_DRIFT && id->kind == (uint8_t)DHC_P_DRIFT_SCALE) {
             dhc_vec3_sub(p_arm, arm->base.pos, dp);
             dhc_vec3_scale(dp, dt, dp);
             dp_scale = 1.0;
-        } else if (id->kind == (uint8_t)DHC_P_DRIFT_OFFSET) {
+        } else if (DHC_WITH_EFFECT_DRIFT && id->kind == (uint8_t)DHC_P_DRIFT_OFFSET) {
             dp[id->aux % 3U] = dt;
             dp_scale = 1.0;
         }

@@ -64,7 +64,8 @@ dhc_status dhc_sample_check(const dhc_model *model, const dhc_sample *s)
 
 double dhc_model_length_scale(const dhc_model *model, double temp_c)
 {
-    return 1.0 + model->thermal_per_k * (temp_c - model->thermal_ref_c);
+    return DHC_WITH_EFFECT_THERMAL ? 1.0 + model->thermal_per_k * (temp_c - model->thermal_ref_c)
+                                   : 1.0;
 }
 
 /* tau from frames already computed at the measured angles. */
@@ -115,11 +116,16 @@ dhc_status dhc_model_gravity_moments(const dhc_model *model, double length_scale
 
 double dhc_model_drift_factor(const dhc_model *model, double t_s)
 {
-    return 1.0 + model->drift_scale_per_s * (t_s - model->drift_ref_s);
+    return DHC_WITH_EFFECT_DRIFT ? 1.0 + model->drift_scale_per_s * (t_s - model->drift_ref_s)
+                                 : 1.0;
 }
 
 void dhc_model_drift(const dhc_model *model, double t_s, const double p_arm[3], double p[3])
 {
+    if (!DHC_WITH_EFFECT_DRIFT) {
+        dhc_vec3_copy(p_arm, p);
+        return;
+    }
     const double dt = t_s - model->drift_ref_s;
     const double f = dhc_model_drift_factor(model, t_s);
     const double *const b = model->arm.base.pos;
@@ -128,8 +134,25 @@ void dhc_model_drift(const dhc_model *model, double t_s, const double p_arm[3], 
     }
 }
 
+double dhc_joint_effects_slope(const dhc_joint_effects *fx, double q)
+{
+    double d = 1.0 + (DHC_WITH_EFFECT_JOINT_SCALE ? fx->scale : 0.0);
+    if (DHC_WITH_EFFECT_JOINT_HARMONIC) {
+        d = d + fx->harmonic_sin_rad * cos(q) - fx->harmonic_cos_rad * sin(q);
+    }
+    for (size_t k = 0U; DHC_WITH_EFFECT_JOINT_HARMONIC && k + 1U < DHC_HARMONIC_MAX_ORDER; ++k) {
+        const double order = (double)(k + 2U);
+        d += order * (fx->harmonic_hi_sin_rad[k] * cos(order * q) -
+                      fx->harmonic_hi_cos_rad[k] * sin(order * q));
+    }
+    return d;
+}
+
 int dhc_model_has_compliance(const dhc_model *model)
 {
+    if (!DHC_WITH_EFFECT_JOINT_COMPLIANCE) {
+        return 0;
+    }
     for (size_t i = 0U; i < model->arm.n_joints; ++i) {
         for (size_t j = i; j < model->arm.n_joints; ++j) {
             if (fabs(model->effect[i].compliance[j]) > 0.0) {
@@ -159,6 +182,39 @@ dhc_status dhc_model_evaluate(const dhc_model *model, const dhc_sample *s, int n
     return dhc_model_evaluate_prepared(model, &trig, s, NULL, need_moments, ev, out);
 }
 
+#if !DHC_WITH_ALL_EFFECTS
+/* 1 when the model holds a value of an effect this build leaves out (dhc_config.h): its
+ * prediction without it would be another model's. */
+static int carries_left_out_effect(const dhc_model *model)
+{
+    int left_out = 0;
+    for (size_t i = 0U; i < model->arm.n_joints; ++i) {
+        const dhc_joint_effects *fx = &model->effect[i];
+        left_out |= !DHC_WITH_EFFECT_JOINT_SCALE && fabs(fx->scale) > 0.0;
+        left_out |= !DHC_WITH_EFFECT_JOINT_BACKLASH && fabs(fx->backlash_rad) > 0.0;
+        double harmonic = fabs(fx->harmonic_sin_rad) + fabs(fx->harmonic_cos_rad);
+        double compliance = 0.0;
+        for (size_t k = 0U; k + 1U < DHC_HARMONIC_MAX_ORDER; ++k) {
+            harmonic += fabs(fx->harmonic_hi_sin_rad[k]) + fabs(fx->harmonic_hi_cos_rad[k]);
+        }
+        for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
+            compliance += fabs(fx->compliance[j]);
+        }
+        left_out |= !DHC_WITH_EFFECT_JOINT_HARMONIC && harmonic > 0.0;
+        left_out |= !DHC_WITH_EFFECT_JOINT_COMPLIANCE && compliance > 0.0;
+    }
+    const dhc_measurer_model *m = &model->measurer;
+    left_out |= !DHC_WITH_EFFECT_MEASURER && (fabs(m->scale) > 0.0 || fabs(m->offset_mm[0]) > 0.0 ||
+                                              fabs(m->offset_mm[1]) > 0.0 ||
+                                              fabs(m->offset_mm[2]) > 0.0);
+    left_out |= !DHC_WITH_EFFECT_THERMAL && fabs(model->thermal_per_k) > 0.0;
+    left_out |= !DHC_WITH_EFFECT_DRIFT &&
+                (fabs(model->drift_scale_per_s) > 0.0 || fabs(model->drift_mm_per_s[0]) > 0.0 ||
+                 fabs(model->drift_mm_per_s[1]) > 0.0 || fabs(model->drift_mm_per_s[2]) > 0.0);
+    return left_out;
+}
+#endif
+
 dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_trig *trig,
                                        const dhc_sample *s, const double *sincos_q,
                                        int need_moments, dhc_model_eval *ev,
@@ -171,6 +227,11 @@ dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_tri
     if (st != DHC_OK) {
         return st;
     }
+#if !DHC_WITH_ALL_EFFECTS
+    if (carries_left_out_effect(model)) {
+        return DHC_ERR_ARGUMENT;
+    }
+#endif
     const size_t n = model->arm.n_joints;
     if (n == 0U || n > DHC_MAX_JOINTS) {
         return DHC_ERR_CAPACITY;
@@ -199,11 +260,15 @@ dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_tri
     for (size_t i = 0U; i < n; ++i) {
         const dhc_joint_effects *fx = &model->effect[i];
         const double q = s->q_rad[i];
-        double dq = fx->scale * q + 0.5 * fx->backlash_rad * (double)s->dir[i];
-        if (fabs(fx->harmonic_sin_rad) > 0.0 || fabs(fx->harmonic_cos_rad) > 0.0) {
+        double dq = DHC_WITH_EFFECT_JOINT_SCALE || DHC_WITH_EFFECT_JOINT_BACKLASH
+                        ? fx->scale * q + 0.5 * fx->backlash_rad * (double)s->dir[i]
+                        : 0.0;
+        if (DHC_WITH_EFFECT_JOINT_HARMONIC &&
+            (fabs(fx->harmonic_sin_rad) > 0.0 || fabs(fx->harmonic_cos_rad) > 0.0)) {
             dq += fx->harmonic_sin_rad * sin_q[i] + fx->harmonic_cos_rad * cos_q[i];
         }
-        for (size_t k = 0U; k + 1U < DHC_HARMONIC_MAX_ORDER; ++k) {
+        for (size_t k = 0U; DHC_WITH_EFFECT_JOINT_HARMONIC && k + 1U < DHC_HARMONIC_MAX_ORDER;
+             ++k) {
             const double a = fx->harmonic_hi_sin_rad[k];
             const double b = fx->harmonic_hi_cos_rad[k];
             if (fabs(a) > 0.0 || fabs(b) > 0.0) {
@@ -237,7 +302,9 @@ dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_tri
             double d[3];
             dhc_measurer_anchor_world(m, k, anchor);
             dhc_vec3_sub(out->p_mm, anchor, d);
-            out->wire_mm[k] = (1.0 + m->scale) * dhc_vec3_norm(d) + m->offset_mm[k];
+            out->wire_mm[k] = DHC_WITH_EFFECT_MEASURER
+                                  ? (1.0 + m->scale) * dhc_vec3_norm(d) + m->offset_mm[k]
+                                  : dhc_vec3_norm(d);
         }
     }
     for (size_t r = 0U; r < 3U; ++r) {

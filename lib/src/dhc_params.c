@@ -33,6 +33,25 @@ static scope kind_scope(unsigned kind)
     }
 }
 
+/* 0 for the parameters of an effect the build leaves out (dhc_config.h). */
+static int kind_built(unsigned kind)
+{
+    switch ((dhc_param_kind)kind) {
+    case DHC_P_JOINT_SCALE: return DHC_WITH_EFFECT_JOINT_SCALE;
+    case DHC_P_HARMONIC_SIN:
+    case DHC_P_HARMONIC_COS: return DHC_WITH_EFFECT_JOINT_HARMONIC;
+    case DHC_P_BACKLASH: return DHC_WITH_EFFECT_JOINT_BACKLASH;
+    case DHC_P_COMPLIANCE: return DHC_WITH_EFFECT_JOINT_COMPLIANCE;
+    case DHC_P_MEAS_SCALE:
+    case DHC_P_MEAS_OFFSET:
+    case DHC_P_MEAS_ANCHOR: return DHC_WITH_EFFECT_MEASURER;
+    case DHC_P_THERMAL: return DHC_WITH_EFFECT_THERMAL;
+    case DHC_P_DRIFT_SCALE:
+    case DHC_P_DRIFT_OFFSET: return DHC_WITH_EFFECT_DRIFT;
+    default: return 1;
+    }
+}
+
 static int needs_measurer(unsigned kind)
 {
     return kind == (unsigned)DHC_P_MEAS_SCALE || kind == (unsigned)DHC_P_MEAS_OFFSET ||
@@ -64,7 +83,7 @@ dhc_status dhc_params_add(dhc_param_set *set, const dhc_model *model, dhc_param_
                           size_t joint, size_t aux)
 {
     if (set == NULL || model == NULL || (unsigned)kind >= (unsigned)DHC_P_KIND_COUNT ||
-        !indices_fit(model, (unsigned)kind, joint, aux) ||
+        !kind_built((unsigned)kind) || !indices_fit(model, (unsigned)kind, joint, aux) ||
         (needs_measurer((unsigned)kind) && !model->measurer.present)) {
         return DHC_ERR_ARGUMENT;
     }
@@ -130,8 +149,11 @@ dhc_status dhc_params_add_effect(dhc_param_set *set, const dhc_model *model, dhc
 
 dhc_effect dhc_params_effect_of(const dhc_param_id *id)
 {
-    for (size_t i = 0U; i < (size_t)DHC_EFFECT_COUNT; ++i) {
+    for (size_t i = 0U;; ++i) {
         const dhc_effect_info *fx = dhc_effect_at(i);
+        if (fx == NULL) {
+            break;
+        }
         const int kind_in = id->kind >= fx->first_kind && id->kind < fx->first_kind + fx->kinds;
         const int aux_in = fx->aux_count == 0U ||
                            (id->aux >= fx->aux_first && id->aux < fx->aux_first + fx->aux_count);

@@ -1,6 +1,7 @@
 /* test_features_off.c - the library built with every optional feature left out
- * (dhc_config.h's DHC_WITH_* all 0, as a controller's build may choose): what is left still
- * calibrates, and what is out answers with a status, never with a different result. */
+ * (dhc_config.h's DHC_WITH_* all 0, as a controller's build may choose) and of the
+ * catalogue's effects joint_compliance alone: what is left still calibrates, and what is out
+ * answers with a status, never with a different result. */
 #include <string.h>
 
 #include "dhc_test_arms.h"
@@ -18,6 +19,11 @@
     DHC_WITH_POSE_SAMPLES || DHC_WITH_ROBUST_START || DHC_WITH_EFFECT_SUMMARIES ||              \
     DHC_WITH_CONVERSIONS || DHC_WITH_INVERSE || DHC_WITH_PLAN
 #error "this test is built with every DHC_WITH_* feature 0"
+#endif
+#if DHC_WITH_EFFECT_JOINT_SCALE || DHC_WITH_EFFECT_JOINT_HARMONIC ||                         \
+    DHC_WITH_EFFECT_JOINT_BACKLASH || DHC_WITH_EFFECT_MEASURER || DHC_WITH_EFFECT_THERMAL ||   \
+    DHC_WITH_EFFECT_DRIFT || !DHC_WITH_EFFECT_JOINT_COMPLIANCE
+#error "this test is built with joint_compliance the only effect"
 #endif
 
 void setUp(void) {}
@@ -178,6 +184,105 @@ static void test_effects_keep_their_names_without_summaries(void)
     TEST_ASSERT_EQUAL_STRING("", info->summary);
 }
 
+/* The catalogue lists the geometry and the one effect built; the others are unknown. */
+static void test_effects_left_out_are_not_in_the_catalogue(void)
+{
+    const char *const expected[] = {"base_frame", "tool_offset", "joint_compliance"};
+    size_t n = 0U;
+    for (const dhc_effect_info *fx = dhc_effect_at(0U); fx != NULL; fx = dhc_effect_at(++n)) {
+        TEST_ASSERT_TRUE(n < 3U);
+        TEST_ASSERT_EQUAL_STRING(expected[n], fx->name);
+    }
+    TEST_ASSERT_EQUAL_size_t(3U, n);
+    TEST_ASSERT_NULL(dhc_effect_info_of(DHC_EFFECT_JOINT_SCALE));
+    TEST_ASSERT_NULL(dhc_effect_name(DHC_EFFECT_THERMAL_SCALE));
+    dhc_effect e;
+    size_t joint;
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_effect_parse("joint_scale:1", 13U, 3U, &e, &joint));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_effect_parse("joint_compliance:2", 18U, 3U, &e, &joint));
+}
+
+/* No parameter of an effect left out joins a set; the one built does. */
+static void test_parameters_of_effects_left_out_are_refused(void)
+{
+    dhc_model m = test_paper3_model();
+    test_put_paper_measurer(&m);
+    dhc_param_set set;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &m));
+    const size_t base = set.count;
+    const dhc_effect out[] = {DHC_EFFECT_JOINT_SCALE, DHC_EFFECT_JOINT_HARMONIC,
+                              DHC_EFFECT_JOINT_BACKLASH, DHC_EFFECT_MEASURER_SCALE,
+                              DHC_EFFECT_MEASURER_ANCHORS, DHC_EFFECT_THERMAL_SCALE,
+                              DHC_EFFECT_DRIFT_OFFSET};
+    for (size_t k = 0U; k < sizeof out / sizeof out[0]; ++k) {
+        TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_params_add_effect(&set, &m, out[k], 0U));
+    }
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_params_add(&set, &m, DHC_P_BACKLASH, 1U, 0U));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_params_add(&set, &m, DHC_P_DRIFT_SCALE, 0U, 0U));
+    TEST_ASSERT_EQUAL_size_t(base, set.count);
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(&set, &m, DHC_EFFECT_JOINT_COMPLIANCE, 1U));
+    TEST_ASSERT_EQUAL_size_t(base + 2U, set.count); /* c_22, c_23 */
+}
+
+/* A model holding a value of an effect left out is refused, never predicted without it. */
+static void test_a_model_with_an_effect_left_out_is_refused(void)
+{
+    const double q[3] = {0.3, 0.9, -0.6};
+    double p[3];
+    dhc_model m = test_paper3_model();
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_model_tool_point(&m, q, NULL, p));
+    m.effect[0].scale = 1e-4;
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_model_tool_point(&m, q, NULL, p));
+    m = test_paper3_model();
+    m.effect[2].harmonic_hi_cos_rad[1] = 1e-5;
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_model_tool_point(&m, q, NULL, p));
+    m = test_paper3_model();
+    m.thermal_per_k = 1e-5;
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_model_tool_point(&m, q, NULL, p));
+    m = test_paper3_model();
+    test_put_paper_measurer(&m);
+    m.measurer.offset_mm[1] = 0.2;
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_model_tool_point(&m, q, NULL, p));
+}
+
+/* The effect built works: joint 2 bending under gravity moves the tool as the rigid arm at
+ * the bent angle (q2 + c22 tau22 + c23 tau23, the moments from dhc_model_gravity_moments),
+ * and a fit of noise-free samples of the compliant arm finds c22 and c23 again. */
+static void test_the_compliance_built_predicts_and_fits(void)
+{
+    dhc_model truth = test_paper3_model();
+    truth.effect[1].compliance[1] = 2.0e-6;
+    truth.effect[1].compliance[2] = 1.0e-6;
+    const double q[3] = {0.3, 0.9, -0.6};
+    double tau[DHC_MAX_JOINTS][DHC_MAX_JOINTS];
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_model_gravity_moments(&truth, 1.0, q, tau));
+    const double bent[3] = {q[0], q[1] + 2.0e-6 * tau[1][1] + 1.0e-6 * tau[1][2], q[2]};
+    const dhc_model rigid = test_paper3_model();
+    double p[3];
+    double p_rigid[3];
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_model_tool_point(&truth, q, NULL, p));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_model_tool_point(&rigid, bent, NULL, p_rigid));
+    TEST_ASSERT_TRUE(fabs(bent[1] - q[1]) > 1e-4); /* a real bend */
+    for (size_t r = 0U; r < 3U; ++r) {
+        TEST_ASSERT_DOUBLE_WITHIN(1e-9, p_rigid[r], p[r]);
+    }
+    test_rng rng = {0xC0FFEEULL};
+    test_measure_model(&paper.data, &truth, 40U, DHC_MEAS_POSITION, &rng);
+    dhc_model model = test_paper3_model();
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&paper.set, &model));
+    TEST_ASSERT_EQUAL(DHC_OK,
+                      dhc_params_add_effect(&paper.set, &model, DHC_EFFECT_JOINT_COMPLIANCE, 1U));
+    dhc_calib_options opt;
+    dhc_calib_default_options(&opt);
+    opt.robust_start = 0;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_calib_fit(&model, &paper.set, test_read_sample, &paper.data,
+                                            paper.data.n, paper.data.flags, &opt, &paper.ws,
+                                            &paper.rep));
+    TEST_ASSERT_TRUE(paper.rep.rms_mm < 1e-7);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-11, 2.0e-6, model.effect[1].compliance[1]);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-11, 1.0e-6, model.effect[1].compliance[2]);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -188,5 +293,9 @@ int main(void)
     RUN_TEST(test_pose_selection_is_refused_its_score_kept);
     RUN_TEST(test_the_inverse_kinematics_is_refused);
     RUN_TEST(test_effects_keep_their_names_without_summaries);
+    RUN_TEST(test_effects_left_out_are_not_in_the_catalogue);
+    RUN_TEST(test_parameters_of_effects_left_out_are_refused);
+    RUN_TEST(test_a_model_with_an_effect_left_out_is_refused);
+    RUN_TEST(test_the_compliance_built_predicts_and_fits);
     return UNITY_END();
 }

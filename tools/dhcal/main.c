@@ -81,7 +81,7 @@ static void print_effect_names(void)
     enum { INDENT = 21, WIDTH = 88 };
     size_t column = INDENT;
     printf("%*s", INDENT, "");
-    for (size_t i = 0U; i < (size_t)DHC_EFFECT_COUNT; ++i) {
+    for (size_t i = 0U; dhc_effect_at(i) != NULL; ++i) {
         const dhc_effect_info *fx = dhc_effect_at(i);
         const size_t len = strlen(fx->name) + (fx->per_joint ? 2U : 0U) + 2U; /* ", " */
         if (i > 0U && column + len > WIDTH) {

@@ -74,6 +74,41 @@ DHC_STATIC_ASSERT(DHC_MAX_PARAMS <= 256U, "DHC_MAX_PARAMS too large for the inde
 #define DHC_WITH_INVERSE 1
 #endif
 
+/* The catalogue's effects (dhc_effects.h), each family behind its own macro (1: built, the
+ * default): a controller that fits only the effects its machines have leaves the others'
+ * code out. The geometry (base_frame, tool_offset) is always built. An effect left out is
+ * not in the build's catalogue (dhc_effect_info_of answers NULL, dhc_effect_at lists the
+ * built ones), so dhc_params_add_effect and dhc_params_add refuse its parameters
+ * (DHC_ERR_ARGUMENT) and the diagnosis never offers it; a model that carries a value of one
+ * is refused where it is evaluated (dhc_model_evaluate and everything built on it:
+ * DHC_ERR_ARGUMENT), never predicted without it. */
+#ifndef DHC_WITH_EFFECT_JOINT_SCALE      /* joint_scale */
+#define DHC_WITH_EFFECT_JOINT_SCALE 1
+#endif
+#ifndef DHC_WITH_EFFECT_JOINT_HARMONIC   /* joint_harmonic, joint_harmonic2 .. 4 */
+#define DHC_WITH_EFFECT_JOINT_HARMONIC 1
+#endif
+#ifndef DHC_WITH_EFFECT_JOINT_BACKLASH   /* joint_backlash */
+#define DHC_WITH_EFFECT_JOINT_BACKLASH 1
+#endif
+#ifndef DHC_WITH_EFFECT_JOINT_COMPLIANCE /* joint_compliance */
+#define DHC_WITH_EFFECT_JOINT_COMPLIANCE 1
+#endif
+#ifndef DHC_WITH_EFFECT_MEASURER         /* measurer_scale, measurer_offset, measurer_anchors
+                                            (the measurer itself, its wire lengths, stay) */
+#define DHC_WITH_EFFECT_MEASURER 1
+#endif
+#ifndef DHC_WITH_EFFECT_THERMAL          /* thermal_scale */
+#define DHC_WITH_EFFECT_THERMAL 1
+#endif
+#ifndef DHC_WITH_EFFECT_DRIFT            /* drift_scale, drift_offset */
+#define DHC_WITH_EFFECT_DRIFT 1
+#endif
+#define DHC_WITH_ALL_EFFECTS                                                                 \
+    (DHC_WITH_EFFECT_JOINT_SCALE && DHC_WITH_EFFECT_JOINT_HARMONIC &&                        \
+     DHC_WITH_EFFECT_JOINT_BACKLASH && DHC_WITH_EFFECT_JOINT_COMPLIANCE &&                   \
+     DHC_WITH_EFFECT_MEASURER && DHC_WITH_EFFECT_THERMAL && DHC_WITH_EFFECT_DRIFT)
+
 /* DHC_SMALL_CODE: 1 chooses the compact form of a few loops that faster builds unroll
  * (the same arithmetic in the same order: the same results). Default: on where the
  * compiler optimises for size (-Os, -Oz). */

@@ -74,18 +74,20 @@ typedef struct {
     uint8_t in_frames;
 } dhc_effect_info;
 
-/* Entry index (0 .. DHC_EFFECT_COUNT - 1) of the catalogue, in the order of docs/effects.md
- * (base_frame, tool_offset, the joint effects, the measurer, thermal, drift); NULL past it. */
+/* Entry index of the catalogue, in the order of docs/effects.md (base_frame, tool_offset,
+ * the joint effects, the measurer, thermal, drift); NULL past it. Every effect, 0 ..
+ * DHC_EFFECT_COUNT - 1, unless the build leaves some out (dhc_config.h, DHC_WITH_EFFECT_*):
+ * then only those it has, so a loop runs to the first NULL. */
 const dhc_effect_info *dhc_effect_at(size_t index);
 
-/* The entry of one effect; NULL for an unknown value. */
+/* The entry of one effect; NULL for an unknown value or an effect the build leaves out. */
 const dhc_effect_info *dhc_effect_info_of(dhc_effect effect);
 
 /* Parameters the effect adds on an arm of n_joints joints at joint (0-based; ignored when not
  * per joint); 0 for an unknown effect or a joint outside the arm. */
 size_t dhc_effect_param_count(dhc_effect effect, size_t n_joints, size_t joint);
 
-/* "joint_compliance" etc.; NULL for an unknown value. */
+/* "joint_compliance" etc.; NULL for an unknown value (or one the build leaves out). */
 const char *dhc_effect_name(dhc_effect effect);
 /* 1 when the effect is written "name:i" (per joint). */
 int dhc_effect_is_per_joint(dhc_effect effect);

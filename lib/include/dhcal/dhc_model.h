@@ -114,6 +114,11 @@ double dhc_model_length_scale(const dhc_model *model, double temp_c);
 double dhc_model_drift_factor(const dhc_model *model, double t_s);
 void dhc_model_drift(const dhc_model *model, double t_s, const double p_arm[3], double p[3]);
 
+/* d(q_eff)/d(q) through the effects on a joint's own angle at its angle q: the derivative of
+ * the joint's s q + A sin q + B cos q + sum_k (A_k sin kq + B_k cos kq) in the evaluation,
+ * plus 1 (the noise model's and the inverse kinematics' chain rule). */
+double dhc_joint_effects_slope(const dhc_joint_effects *fx, double q);
+
 /* 1 when any compliance c_ij of the model is not zero (its predictions need the gravity
  * moments). */
 int dhc_model_has_compliance(const dhc_model *model);
