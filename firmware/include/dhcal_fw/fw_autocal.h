@@ -70,7 +70,8 @@ typedef struct {
     size_t n_effects;
     dhc_effect effect[FW_AUTOCAL_MAX_EFFECTS];
     size_t effect_joint[FW_AUTOCAL_MAX_EFFECTS]; /* 0-based; ignored for measurer effects */
-    int diagnose;
+    int diagnose; /* default: when the library has the diagnosis (DHC_WITH_DIAGNOSE); a
+                     build without it faults (argument) on a job that asks for it */
     /* Noise model of the fits and the diagnosis (errors in variables, dhc_calib.h). The
      * samples carry encoder angles, quantised to one count: uniform, sd = 1 / (counts_per_rad
      * sqrt(12)) per joint, at the tool several times the averaged wires' noise and larger
