@@ -6,7 +6,9 @@ from the same sample files, in this run, and compares what they computed.
                 fit|job --host PROG --target ELF
 
 fit: parity_fit on the demo's 3-DOF wire samples and on a 6-DOF pose set; job: job_replay on
-the demo's samples, with the diagnosis and with the effect configured instead. Every parameter ("p." lines) must agree to 1e-9 relative, and so must
+the demo's samples, with the diagnosis and with the effect configured instead (the stored
+calibration, and the angles the controller's inverse kinematics commands with it), and the
+live acquisition of an arm that does not move (the same fault on both, no sample). Every parameter ("p." lines) must agree to 1e-9 relative, and so must
 the fit's other numbers; counts and names (status, rank, effect, stored sequence) must be
 equal. The target runs with -icount shift=0: the instructions it reports for the fit or the
 job's calibration are printed with their time at 168 MHz."""
@@ -161,6 +163,18 @@ def main():
             continue
         b, target = compare(label, out_h, out_t)
         bad += b + cost(label, target)
+    if a.what == "job":
+        # a controller whose arm does not follow its drives: stopped before any sample, the
+        # same fault on both
+        rc_h, out_h = run([a.host, demo, "live"])
+        rc_t, out_t = run([a.emulator, a.target, demo, "live"], env=env)
+        fault_h, fault_t = parse(out_h)[0].get("fault"), parse(out_t)[0].get("fault")
+        print(f"job, live acquisition of an arm that does not move: host fault {fault_h}, "
+              f"target fault {fault_t}")
+        if rc_h == 0 or rc_t == 0 or fault_h in (None, "none") or fault_h != fault_t or \
+                parse(out_t)[0].get("samples") != "0":
+            print(f"--- host ({rc_h})\n{out_h}--- target ({rc_t})\n{out_t}", end="")
+            bad.append("live job on a still arm: not the same fault before any sample")
     for b in bad:
         print("FAIL:", b)
     print(f"{'FAILED' if bad else 'OK'}: {a.what} parity of the Cortex-M4 and the host")

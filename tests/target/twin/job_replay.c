@@ -1,6 +1,6 @@
 /* job_replay.c - the controller's job (fw_job) on recorded samples, the same on the
  * Cortex-M4 and on the host (twin.h):
- *   job_replay FILE [configured|diagnose]
+ *   job_replay FILE [configured|diagnose|live]
  * FILE: wire samples of the paper's 3-DOF arm as dhcal-demo collected them. The job boots
  * on a port whose arm stands still at the start pose (nothing moves: the samples are
  * recorded), plans, takes the recording as its acquisition (fw_job_acquire_recorded),
@@ -9,13 +9,18 @@
  * `dhcal-demo --effects joint_compliance:2 --no-diagnose`: the effect known and fitted from
  * the start, no diagnosis) and stores
  * into a RAM store through fw_calstore. Prints what the job found, the parameters of the
- * calibration it stored (read back with fw_cal_load), the store's bytes and the
- * instructions fw_job_calibrate took (0 on the host). */
+ * calibration it stored (read back with fw_cal_load), the store's bytes, the angles the
+ * controller's inverse kinematics (fw_ik) commands for three points on the stored model and
+ * the instructions fw_job_calibrate took (0 on the host). `live`: the job acquires through
+ * the port (fw_job_acquire), whose arm never moves: the controller must stop with a fault,
+ * drives at zero, before it takes a sample. So the program holds everything a controller
+ * runs: its linked bytes are the controller's flash for the library (scripts/target-report). */
 #include <string.h>
 
 #include "dhc_test_arms.h"
 #include "dhcal/dhc_params.h"
 #include "dhcal_fw/fw_calstore.h"
+#include "dhcal_fw/fw_ik.h"
 #include "dhcal_fw/fw_job.h"
 #include "twin.h"
 
@@ -119,10 +124,11 @@ int twin_main(int argc, char **argv)
     size_t nj = 0U;
     const int configured = argc == 3 && strcmp(argv[2], "configured") == 0;
     const int diagnose = argc == 3 && strcmp(argv[2], "diagnose") == 0;
-    if ((argc != 2 && !configured && !diagnose) ||
+    const int live = argc == 3 && strcmp(argv[2], "live") == 0;
+    if ((argc != 2 && !configured && !diagnose && !live) ||
         twin_load_samples(argv[1], recorded, TWIN_MAX_SAMPLES, &n, &nj) != 0 || nj != 3U) {
-        twin_puts("usage: job_replay FILE [configured|diagnose] (wire samples of the 3-DOF "
-                  "paper arm)\n");
+        twin_puts("usage: job_replay FILE [configured|diagnose|live] (wire samples of the "
+                  "3-DOF paper arm)\n");
         return 2;
     }
     dhc_model nominal = test_paper3_model();
@@ -164,7 +170,7 @@ int twin_main(int argc, char **argv)
         f = fw_job_plan(&job);
     }
     if (f == FW_FAULT_NONE) {
-        f = fw_job_acquire_recorded(&job, recorded, n, NULL);
+        f = live ? fw_job_acquire(&job) : fw_job_acquire_recorded(&job, recorded, n, NULL);
     }
     uint64_t took = 0U;
     if (f == FW_FAULT_NONE) {
@@ -214,6 +220,34 @@ int twin_main(int argc, char **argv)
         twin_put_double(name, dhc_params_value(&set, &stored, k));
     }
     put_store();
+    /* What the controller does with the calibration: points moved to on the stored model
+     * (fw_ik, the library's inverse kinematics through the effects), 3 mm off the tool
+     * points of three recorded poses, from those poses' angles. */
+    const double shift[3] = {3.0, -2.0, 3.0};
+    for (size_t k = 0U; k < 3U; ++k) {
+        const dhc_sample *at = &recorded[k * (n - 1U) / 2U];
+        double target[3];
+        double q[DHC_MAX_JOINTS];
+        memcpy(q, at->q_rad, sizeof q);
+        if (dhc_model_tool_point(&stored, at->q_rad, at->dir, target) != DHC_OK) {
+            twin_puts("error: no tool point\n");
+            return 1;
+        }
+        for (size_t c = 0U; c < 3U; ++c) {
+            target[c] += shift[c];
+        }
+        char key[16] = "ik0";
+        key[2] = (char)('0' + (int)k);
+        twin_puts(key);
+        twin_puts(fw_ik_solve(&stored, at, target, 1e-6, 50U, q) == FW_IK_OK ? " ok\n"
+                                                                            : " failed\n");
+        for (size_t j = 0U; j < 3U; ++j) {
+            char qkey[16] = "ik0.q0";
+            qkey[2] = (char)('0' + (int)k);
+            qkey[5] = (char)('1' + (int)j);
+            twin_put_double(qkey, q[j]);
+        }
+    }
     twin_puts("instructions ");
     twin_put_u64(took);
     twin_putchar('\n');
