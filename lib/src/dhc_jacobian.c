@@ -307,8 +307,6 @@ static dhc_status jacobian_prepared(const dhc_model *model, const dhc_arm_trig *
         return st;
     }
     const dhc_arm *const arm = &model->arm;
-    const double dtemp = s->temp_c - model->thermal_ref_c;
-    const double dt = s->t_s - model->drift_ref_s;
     /* the session's drift scales every move of the arm's point about the base origin; a
      * move of the base origin itself moves the measured point one to one */
     const double drift = dhc_model_drift_factor(model, s->t_s);
@@ -338,13 +336,13 @@ static dhc_status jacobian_prepared(const dhc_model *model, const dhc_arm_trig *
         } else if (DHC_WITH_EFFECT_THERMAL && id->kind == (uint8_t)DHC_P_THERMAL) {
             /* scaling every length scales the tool point about the base origin */
             dhc_vec3_sub(p_arm, arm->base.pos, dp);
-            dhc_vec3_scale(dp, dtemp / ev->length_scale, dp);
+            dhc_vec3_scale(dp, (s->temp_c - model->thermal_ref_c) / ev->length_scale, dp);
         } else if (DHC_WITH_EFFECT_DRIFT && id->kind == (uint8_t)DHC_P_DRIFT_SCALE) {
             dhc_vec3_sub(p_arm, arm->base.pos, dp);
-            dhc_vec3_scale(dp, dt, dp);
+            dhc_vec3_scale(dp, s->t_s - model->drift_ref_s, dp);
             dp_scale = 1.0;
         } else if (DHC_WITH_EFFECT_DRIFT && id->kind == (uint8_t)DHC_P_DRIFT_OFFSET) {
-            dp[id->aux % 3U] = dt;
+            dp[id->aux % 3U] = s->t_s - model->drift_ref_s;
             dp_scale = 1.0;
         }
         dhc_vec3_scale(dp, dp_scale, dp);

@@ -36,20 +36,16 @@ static scope kind_scope(unsigned kind)
 /* 0 for the parameters of an effect the build leaves out (dhc_config.h). */
 static int kind_built(unsigned kind)
 {
-    switch ((dhc_param_kind)kind) {
-    case DHC_P_JOINT_SCALE: return DHC_WITH_EFFECT_JOINT_SCALE;
-    case DHC_P_HARMONIC_SIN:
-    case DHC_P_HARMONIC_COS: return DHC_WITH_EFFECT_JOINT_HARMONIC;
-    case DHC_P_BACKLASH: return DHC_WITH_EFFECT_JOINT_BACKLASH;
-    case DHC_P_COMPLIANCE: return DHC_WITH_EFFECT_JOINT_COMPLIANCE;
-    case DHC_P_MEAS_SCALE:
-    case DHC_P_MEAS_OFFSET:
-    case DHC_P_MEAS_ANCHOR: return DHC_WITH_EFFECT_MEASURER;
-    case DHC_P_THERMAL: return DHC_WITH_EFFECT_THERMAL;
-    case DHC_P_DRIFT_SCALE:
-    case DHC_P_DRIFT_OFFSET: return DHC_WITH_EFFECT_DRIFT;
-    default: return 1;
-    }
+    return (DHC_WITH_EFFECT_JOINT_SCALE || kind != (unsigned)DHC_P_JOINT_SCALE) &&
+           (DHC_WITH_EFFECT_JOINT_HARMONIC ||
+            (kind != (unsigned)DHC_P_HARMONIC_SIN && kind != (unsigned)DHC_P_HARMONIC_COS)) &&
+           (DHC_WITH_EFFECT_JOINT_BACKLASH || kind != (unsigned)DHC_P_BACKLASH) &&
+           (DHC_WITH_EFFECT_JOINT_COMPLIANCE || kind != (unsigned)DHC_P_COMPLIANCE) &&
+           (DHC_WITH_EFFECT_MEASURER ||
+            kind < (unsigned)DHC_P_MEAS_SCALE || kind > (unsigned)DHC_P_MEAS_ANCHOR) &&
+           (DHC_WITH_EFFECT_THERMAL || kind != (unsigned)DHC_P_THERMAL) &&
+           (DHC_WITH_EFFECT_DRIFT ||
+            (kind != (unsigned)DHC_P_DRIFT_SCALE && kind != (unsigned)DHC_P_DRIFT_OFFSET));
 }
 
 static int needs_measurer(unsigned kind)
