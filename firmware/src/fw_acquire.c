@@ -115,19 +115,23 @@ fw_fault fw_acquire_one(fw_ctrl *c, const dhc_model *model, uint32_t hold_ticks,
     }
     memcpy(s.wire_mm, w, sizeof w);
     if (model->measurer.present) {
-        double pt[3];
-        double pm[3];
-        const dhc_status ts = dhc_model_wire_point(model, w, 1.0, pt);
-        if (ts != DHC_OK || dhc_model_tool_point(model, s.q_rad, s.dir, pm) != DHC_OK) {
+        /* the lengths against the model's at the encoder angles, wire by wire: a tool point
+         * that far off moves some wire by about as much, and no trilateration (a solver
+         * with its own failure modes, and flash) stands between the check and the counts */
+        fw_pose at;
+        memset(&at, 0, sizeof at);
+        memcpy(at.q_rad, s.q_rad, sizeof at.q_rad);
+        memcpy(at.dir, s.dir, sizeof at.dir);
+        double pred[3];
+        if (fw_pose_wires(model, &at, pred) != DHC_OK) {
             fw_ctrl_fault(c, FW_FAULT_WIRES_INCONSISTENT, 0U);
             return c->fault;
         }
-        const double dx = pt[0] - pm[0];
-        const double dy = pt[1] - pm[1];
-        const double dz = pt[2] - pm[2];
-        if (sqrt(dx * dx + dy * dy + dz * dz) > 50.0) {
-            fw_ctrl_fault(c, FW_FAULT_WIRES_INCONSISTENT, 0U);
-            return c->fault;
+        for (size_t k = 0U; k < 3U; ++k) {
+            if (!(fabs(w[k] - pred[k]) <= FW_ACQ_WIRE_TOL_MM)) {
+                fw_ctrl_fault(c, FW_FAULT_WIRES_INCONSISTENT, k);
+                return c->fault;
+            }
         }
     }
     *out = s;

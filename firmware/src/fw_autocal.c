@@ -159,6 +159,9 @@ fw_fault fw_autocal_configured(const fw_autocal_config *cfg, dhc_model *model,
     }
     opt.joint_sincos = ws->joint_sincos;
     opt.sample_error2 = ws->err2;
+    /* a build without the robust start relies on the acquisition's checks alone (every
+     * sample's wires against the model, each move's change: fw_acquire.h) */
+    opt.robust_start = DHC_WITH_ROBUST_START;
     dhc_diagnose_options dopt;
     dhc_diagnose_default_options(&dopt);
     if (cfg->io != NULL) {

@@ -1301,7 +1301,7 @@ static void fill_report(const fit_context *fc, const pass_totals *tot, dhc_calib
         for (size_t m = 0U; m < p; ++m) {
             rep->confounded[k][m] = 0U;
         }
-        if (!ws->fac.identifiable[k]) {
+        if (DHC_WITH_REPORT_EXTRAS && !ws->fac.identifiable[k]) {
             size_t count;
             (void)dhc_lsq_confounded(&ws->ne, &ws->fac, k, rep->confounded[k], p, &count);
         }

@@ -16,10 +16,12 @@
 /* In the order of docs/effects.md; the summaries are what a diagnosis says of a candidate.
  * The effects this build leaves out (dhc_config.h) are not in it. */
 static const dhc_effect_info catalogue[] = {
+#if DHC_WITH_EFFECT_BASE_FRAME
     {"base_frame",
      SUMMARY("a constant shift and a rotation growing with distance (robot or measurer placement)"),
      DHC_EFFECT_BASE_FRAME, 0U, KINDS(DHC_P_BASE_X, DHC_P_BASE_RZ), 0U, 1U, 0U,
      DHC_EFFECT_REF_NONE, 1U},
+#endif
     {"tool_offset", SUMMARY("an error vector that turns with the last link (tool point unknown)"),
      DHC_EFFECT_TOOL_OFFSET, 0U, KINDS(DHC_P_TOOL_X, DHC_P_TOOL_Z), 0U, 1U, 0U,
      DHC_EFFECT_REF_NONE, 1U},

@@ -62,12 +62,12 @@ static inline void geometric_column(const dhc_arm *arm, const dhc_frame *f,
             dhc_vec3_copy(v, dw);
             break;
         }
-    } else if (id->kind <= (uint8_t)DHC_P_BASE_Z) {
+    } else if (DHC_WITH_EFFECT_BASE_FRAME && id->kind <= (uint8_t)DHC_P_BASE_Z) {
         dp[id->kind - (uint8_t)DHC_P_BASE_X] = 1.0;
-    } else if (id->kind <= (uint8_t)DHC_P_BASE_RZ) {
+    } else if (DHC_WITH_EFFECT_BASE_FRAME && id->kind <= (uint8_t)DHC_P_BASE_RZ) {
         dw[id->kind - (uint8_t)DHC_P_BASE_RX] = 1.0;
         rotation_column(dw, arm->base.pos, p, dp);
-    } else {
+    } else if (id->kind >= (uint8_t)DHC_P_TOOL_X) { /* a base parameter never reaches here */
         dhc_rot_column(&f[arm->n_joints].rot, (size_t)(id->kind - (uint8_t)DHC_P_TOOL_X), dp);
     }
 }

@@ -359,7 +359,7 @@ dhc_status dhc_lsq_analyse(const dhc_normal_eq *ne, double rel_tol, dhc_lsq_fact
     }
     fac->n = n;
     fac->rank = rank;
-    fac->condition = dhc_chol_condition_estimate(&m, rank);
+    fac->condition = DHC_WITH_REPORT_EXTRAS ? dhc_chol_condition_estimate(&m, rank) : 0.0;
     return DHC_OK;
 }
 

@@ -36,7 +36,9 @@ static scope kind_scope(unsigned kind)
 /* 0 for the parameters of an effect the build leaves out (dhc_config.h). */
 static int kind_built(unsigned kind)
 {
-    return (DHC_WITH_EFFECT_JOINT_SCALE || kind != (unsigned)DHC_P_JOINT_SCALE) &&
+    return (DHC_WITH_EFFECT_BASE_FRAME ||
+            kind < (unsigned)DHC_P_BASE_X || kind > (unsigned)DHC_P_BASE_RZ) &&
+           (DHC_WITH_EFFECT_JOINT_SCALE || kind != (unsigned)DHC_P_JOINT_SCALE) &&
            (DHC_WITH_EFFECT_JOINT_HARMONIC ||
             (kind != (unsigned)DHC_P_HARMONIC_SIN && kind != (unsigned)DHC_P_HARMONIC_COS)) &&
            (DHC_WITH_EFFECT_JOINT_BACKLASH || kind != (unsigned)DHC_P_BACKLASH) &&
@@ -256,12 +258,15 @@ dhc_status dhc_params_apply(const dhc_param_set *set, dhc_model *model, const do
         }
     }
     /* The Jacobian treats the three base rotations as one small rotation vector about the
-     * base origin in world axes; composing it exactly keeps the rotation orthonormal. */
-    dhc_mat3 r;
-    dhc_mat3 rotated;
-    dhc_rot_exp(base_rot, &r);
-    dhc_rot_mul(&r, &model->arm.base.rot, &rotated);
-    model->arm.base.rot = rotated;
+     * base origin in world axes; composing it exactly keeps the rotation orthonormal. (A
+     * build without base_frame has no such parameter: nothing to compose.) */
+    if (DHC_WITH_EFFECT_BASE_FRAME) {
+        dhc_mat3 r;
+        dhc_mat3 rotated;
+        dhc_rot_exp(base_rot, &r);
+        dhc_rot_mul(&r, &model->arm.base.rot, &rotated);
+        model->arm.base.rot = rotated;
+    }
     return DHC_OK;
 }
 

@@ -17,10 +17,11 @@
 
 #if DHC_WITH_DIAGNOSE || DHC_WITH_SESSION_TESTS || DHC_WITH_UNCERTAINTY || DHC_WITH_EIV ||   \
     DHC_WITH_POSE_SAMPLES || DHC_WITH_ROBUST_START || DHC_WITH_EFFECT_SUMMARIES ||              \
-    DHC_WITH_CONVERSIONS || DHC_WITH_INVERSE || DHC_WITH_PLAN
+    DHC_WITH_CONVERSIONS || DHC_WITH_INVERSE || DHC_WITH_PLAN || DHC_WITH_REPORT_EXTRAS
 #error "this test is built with every DHC_WITH_* feature 0"
 #endif
-#if DHC_WITH_EFFECT_JOINT_SCALE || DHC_WITH_EFFECT_JOINT_HARMONIC ||                         \
+#if DHC_WITH_EFFECT_BASE_FRAME || DHC_WITH_EFFECT_JOINT_SCALE ||                             \
+    DHC_WITH_EFFECT_JOINT_HARMONIC ||                                                          \
     DHC_WITH_EFFECT_JOINT_BACKLASH || DHC_WITH_EFFECT_MEASURER || DHC_WITH_EFFECT_THERMAL ||   \
     DHC_WITH_EFFECT_DRIFT || !DHC_WITH_EFFECT_JOINT_COMPLIANCE
 #error "this test is built with joint_compliance the only effect"
@@ -61,6 +62,14 @@ static void test_the_core_fit_reaches_the_true_arm(void)
     TEST_ASSERT_EQUAL(DHC_OK, calibrate(6U, 30U, 0xFEA7ULL, &cal));
     TEST_ASSERT_TRUE(paper.rep.converged);
     TEST_ASSERT_TRUE(paper.rep.rms_mm < 1e-6);
+    /* the report's explanations for people are left out: no condition estimate, no
+     * partners (the full build's condition of this fit is well above 1) */
+    TEST_ASSERT_TRUE(paper.rep.condition <= 0.0 && paper.rep.condition >= 0.0);
+    for (size_t k = 0U; k < paper.set.count; ++k) {
+        for (size_t m = 0U; m < paper.set.count; ++m) {
+            TEST_ASSERT_EQUAL_UINT8(0U, paper.rep.confounded[k][m]);
+        }
+    }
     dhc_arm truth;
     dhc_arm nominal;
     test_paper_arms(6U, &truth, &nominal);
@@ -187,13 +196,13 @@ static void test_effects_keep_their_names_without_summaries(void)
 /* The catalogue lists the geometry and the one effect built; the others are unknown. */
 static void test_effects_left_out_are_not_in_the_catalogue(void)
 {
-    const char *const expected[] = {"base_frame", "tool_offset", "joint_compliance"};
+    const char *const expected[] = {"tool_offset", "joint_compliance"};
     size_t n = 0U;
     for (const dhc_effect_info *fx = dhc_effect_at(0U); fx != NULL; fx = dhc_effect_at(++n)) {
-        TEST_ASSERT_TRUE(n < 3U);
+        TEST_ASSERT_TRUE(n < 2U);
         TEST_ASSERT_EQUAL_STRING(expected[n], fx->name);
     }
-    TEST_ASSERT_EQUAL_size_t(3U, n);
+    TEST_ASSERT_EQUAL_size_t(2U, n);
     TEST_ASSERT_NULL(dhc_effect_info_of(DHC_EFFECT_JOINT_SCALE));
     TEST_ASSERT_NULL(dhc_effect_name(DHC_EFFECT_THERMAL_SCALE));
     dhc_effect e;
@@ -210,7 +219,8 @@ static void test_parameters_of_effects_left_out_are_refused(void)
     dhc_param_set set;
     TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &m));
     const size_t base = set.count;
-    const dhc_effect out[] = {DHC_EFFECT_JOINT_SCALE, DHC_EFFECT_JOINT_HARMONIC,
+    const dhc_effect out[] = {DHC_EFFECT_BASE_FRAME, DHC_EFFECT_JOINT_SCALE,
+                              DHC_EFFECT_JOINT_HARMONIC,
                               DHC_EFFECT_JOINT_BACKLASH, DHC_EFFECT_MEASURER_SCALE,
                               DHC_EFFECT_MEASURER_ANCHORS, DHC_EFFECT_THERMAL_SCALE,
                               DHC_EFFECT_DRIFT_OFFSET};
@@ -219,6 +229,9 @@ static void test_parameters_of_effects_left_out_are_refused(void)
     }
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_params_add(&set, &m, DHC_P_BACKLASH, 1U, 0U));
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_params_add(&set, &m, DHC_P_DRIFT_SCALE, 0U, 0U));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_params_add(&set, &m, DHC_P_BASE_RY, 0U, 0U));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(&set, &m, DHC_EFFECT_TOOL_OFFSET, 0U));
+    set.count = base;
     TEST_ASSERT_EQUAL_size_t(base, set.count);
     TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(&set, &m, DHC_EFFECT_JOINT_COMPLIANCE, 1U));
     TEST_ASSERT_EQUAL_size_t(base + 2U, set.count); /* c_22, c_23 */

@@ -5,8 +5,10 @@
  * reference all through it, else it approaches the target again from the same side and
  * holds again, up to FW_ACQ_HOLD_ATTEMPTS holds, then FW_FAULT_SETTLE_TIMEOUT: lengths
  * averaged over a moving arm match no pose, e.g. after an encoder glitch below the jump
- * bound kicked the servo), check them by trilateration (DHC_ERR_INCONSISTENT, or a point
- * more than 50 mm from where the model puts the tool: FW_FAULT_WIRES_INCONSISTENT), and keep
+ * bound kicked the servo), check them against the lengths the model predicts at the encoder
+ * angles (a wire more than FW_ACQ_WIRE_TOL_MM off: FW_FAULT_WIRES_INCONSISTENT, fault_index
+ * the wire; a tool point that far from where the model puts it moves some wire by about as
+ * much, and wires that no point can have are caught the same way), and keep
  * a DHC_MEAS_WIRES sample with the ENCODER angles, the approach directions and the raw
  * lengths. On a fault the samples already taken stay in the buffer (*n_done of them).
  * fw_acquire also checks each pose against the one before (the first against where the arm
@@ -39,6 +41,9 @@
 #include "dhcal_fw/fw_plan.h"
 
 #define FW_ACQ_MAX_SAMPLES FW_PLAN_MAX_POSES
+/* each sample's wires against the model's lengths at its encoder angles, mm: gross errors
+ * only (a broken wire, another machine's configuration), far above a nominal model's few mm */
+#define FW_ACQ_WIRE_TOL_MM 50.0
 /* pair check of fw_acquire: |measured - predicted wire change| bound, mm and share */
 #define FW_ACQ_PAIR_TOL_MM 10.0
 #define FW_ACQ_PAIR_TOL_REL 0.25

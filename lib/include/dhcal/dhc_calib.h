@@ -151,12 +151,14 @@ typedef struct {
                                the noise model's (about 1 when the model is right; std_err
                                are still in parameter units, from sigma^2 (J^T W J)^-1).
                                rms_mm, max_mm and rms_rad stay physical (unweighted). */
-    double condition;       /* condition estimate of the scaled identifiable block */
+    double condition;       /* condition estimate of the scaled identifiable block (0 in a
+                               build without DHC_WITH_REPORT_EXTRAS) */
     double value[DHC_MAX_PARAMS];    /* parameter values after the fit (dhc_params_value) */
     double std_err[DHC_MAX_PARAMS];  /* standard errors (0 for unidentifiable) */
     uint8_t identifiable[DHC_MAX_PARAMS];
     uint8_t structurally_identifiable[DHC_MAX_PARAMS];
-    /* confounded[j][k] = 1: unidentifiable parameter j moves with parameter k */
+    /* confounded[j][k] = 1: unidentifiable parameter j moves with parameter k (none in a
+     * build without DHC_WITH_REPORT_EXTRAS) */
     uint8_t confounded[DHC_MAX_PARAMS][DHC_MAX_PARAMS];
 } dhc_calib_report;
 

@@ -69,6 +69,12 @@ DHC_STATIC_ASSERT(DHC_MAX_PARAMS <= 256U, "DHC_MAX_PARAMS too large for the inde
 #ifndef DHC_WITH_PLAN            /* dhc_plan_select: optimal pose plans */
 #define DHC_WITH_PLAN 1
 #endif
+#ifndef DHC_WITH_REPORT_EXTRAS   /* what a fit's report explains for people: the condition
+                                    estimate (dhc_lsq_factor.condition, dhc_calib_report
+                                    .condition: 0 when left out) and the parameters each
+                                    unidentifiable one trades off with (.confounded: none) */
+#define DHC_WITH_REPORT_EXTRAS 1
+#endif
 #ifndef DHC_WITH_INVERSE         /* dhc_inverse.h: commanded angles for a target on the full
                                     model (the controller's IK, dhcal compensate) */
 #define DHC_WITH_INVERSE 1
@@ -76,12 +82,17 @@ DHC_STATIC_ASSERT(DHC_MAX_PARAMS <= 256U, "DHC_MAX_PARAMS too large for the inde
 
 /* The catalogue's effects (dhc_effects.h), each family behind its own macro (1: built, the
  * default): a controller that fits only the effects its machines have leaves the others'
- * code out. The geometry (base_frame, tool_offset) is always built. An effect left out is
+ * code out. tool_offset is always built; base_frame's macro leaves out fitting the base's
+ * position and rotation (the model's base transform itself always applies). An effect left
+ * out is
  * not in the build's catalogue (dhc_effect_info_of answers NULL, dhc_effect_at lists the
  * built ones), so dhc_params_add_effect and dhc_params_add refuse its parameters
  * (DHC_ERR_ARGUMENT) and the diagnosis never offers it; a model that carries a value of one
  * is refused where it is evaluated (dhc_model_evaluate and everything built on it:
  * DHC_ERR_ARGUMENT), never predicted without it. */
+#ifndef DHC_WITH_EFFECT_BASE_FRAME       /* base_frame (its parameters, not the base) */
+#define DHC_WITH_EFFECT_BASE_FRAME 1
+#endif
 #ifndef DHC_WITH_EFFECT_JOINT_SCALE      /* joint_scale */
 #define DHC_WITH_EFFECT_JOINT_SCALE 1
 #endif
@@ -105,7 +116,8 @@ DHC_STATIC_ASSERT(DHC_MAX_PARAMS <= 256U, "DHC_MAX_PARAMS too large for the inde
 #define DHC_WITH_EFFECT_DRIFT 1
 #endif
 #define DHC_WITH_ALL_EFFECTS                                                                 \
-    (DHC_WITH_EFFECT_JOINT_SCALE && DHC_WITH_EFFECT_JOINT_HARMONIC &&                        \
+    (DHC_WITH_EFFECT_BASE_FRAME && DHC_WITH_EFFECT_JOINT_SCALE &&                            \
+     DHC_WITH_EFFECT_JOINT_HARMONIC &&                                                       \
      DHC_WITH_EFFECT_JOINT_BACKLASH && DHC_WITH_EFFECT_JOINT_COMPLIANCE &&                   \
      DHC_WITH_EFFECT_MEASURER && DHC_WITH_EFFECT_THERMAL && DHC_WITH_EFFECT_DRIFT)
 

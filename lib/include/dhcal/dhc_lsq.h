@@ -51,7 +51,8 @@ typedef struct {
                                           as zero (never identifiable) */
     double factor[DHC_MAX_PARAMS * DHC_MAX_PARAMS]; /* L of the scaled, pivoted matrix */
     uint8_t identifiable[DHC_MAX_PARAMS];
-    double condition;                  /* estimate for the identifiable block (scaled) */
+    double condition;                  /* estimate for the identifiable block (scaled; 0
+                                          without DHC_WITH_REPORT_EXTRAS) */
 } dhc_lsq_factor;
 
 /* Starts an empty accumulator for n parameters. DHC_ERR_CAPACITY when n is 0 or above

@@ -189,10 +189,15 @@ int twin_main(int argc, char **argv)
     if (f != FW_FAULT_NONE) {
         return 1;
     }
+    /* Keys by number, not name: the program links what a controller links (it names no
+     * parameter and no effect; the desk does), so its map measures the controller's flash. */
     const fw_autocal_result *r = &job.result;
-    char effect[64];
-    twin_puts("effect ");
-    twin_puts(fw_autocal_effect_label(r, effect, sizeof effect));
+    twin_puts("diagnosis ");
+    twin_put_u64((uint64_t)r->diagnosis);
+    twin_puts("\nfound ");
+    twin_put_u64((uint64_t)r->found);
+    twin_puts("\neffect ");
+    twin_put_u64(r->found ? (uint64_t)r->effect * 100U + r->effect_joint : 0U);
     twin_puts("\nsaved ");
     twin_put_u64((uint64_t)r->saved);
     twin_puts("\ngeo_rank ");
@@ -215,9 +220,10 @@ int twin_main(int argc, char **argv)
         return 1;
     }
     for (size_t k = 0U; k < set.count; ++k) {
-        char name[40] = "p.";
-        (void)dhc_params_name(&set, k, name + 2, sizeof name - 2U);
-        twin_put_double(name, dhc_params_value(&set, &stored, k));
+        char key[8] = "p.00"; /* the parameter's index in the job's set (fw_job_param_set) */
+        key[2] = (char)('0' + (int)(k / 10U));
+        key[3] = (char)('0' + (int)(k % 10U));
+        twin_put_double(key, dhc_params_value(&set, &stored, k));
     }
     put_store();
     /* What the controller does with the calibration: points moved to on the stored model
