@@ -278,7 +278,7 @@ static void test_floor_is_under_every_plan(void)
     TEST_ASSERT_DOUBLE_WITHIN(1e-12, 1.0, sum);
     const double weighted = trace_inv_times(info, w, p);
     TEST_ASSERT_DOUBLE_WITHIN(2e-3 * weighted, weighted, best.variance);
-    TEST_ASSERT_TRUE(best.floor >= (1.0 - 1.001e-3) * best.variance); /* converged */
+    TEST_ASSERT_TRUE(best.floor >= (1.0 - DHC_PLAN_WEIGHT_TOL) * best.variance); /* converged */
     double lowest = HUGE_VAL;
     size_t idx[4];
     for (idx[0] = 0U; idx[0] < k; ++idx[0]) {

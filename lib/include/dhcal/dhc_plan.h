@@ -66,7 +66,7 @@ extern "C" {
 /* dhc_plan_weighting: iterations at most, and the floor's relative distance below the
  * weighting's value at which it stops. */
 #define DHC_PLAN_MAX_WEIGHT_ITERATIONS 2000U
-#define DHC_PLAN_WEIGHT_TOL 1e-3
+#define DHC_PLAN_WEIGHT_TOL 1e-2
 
 typedef struct {
     dhc_normal_eq ne;   /* the candidates' (or the plan's) information, unscaled */
