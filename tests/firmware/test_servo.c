@@ -48,7 +48,7 @@ static void test_converter_codes(void)
     TEST_ASSERT_EQUAL_UINT16(0U, fw_dac_code(&io, -10.0));
     TEST_ASSERT_EQUAL_UINT16(4095U, fw_dac_code(&io, 12.0)); /* clamped */
     TEST_ASSERT_EQUAL_UINT16(0U, fw_dac_code(&io, -1e9));
-    TEST_ASSERT_EQUAL_UINT16(2048U, fw_dac_code(&io, NAN)); /* a broken command is 0 V */
+    TEST_ASSERT_EQUAL_UINT16(2048U, fw_dac_code(&io, (double)NAN)); /* a broken command is 0 V */
     TEST_ASSERT_EQUAL_UINT16(3072U, fw_dac_code(&io, 5.0));
     TEST_ASSERT_DOUBLE_WITHIN(1e-12, 0.0, fw_adc_volts(&io, 2048U));
     TEST_ASSERT_DOUBLE_WITHIN(1e-12, -10.0, fw_adc_volts(&io, 0U));

@@ -487,7 +487,7 @@ static void test_bad_arguments_change_nothing(void)
     sc.joint[0].mass_kg = -1.0;
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhs_plant_init(&plant2, &sc, 1U, &q0));
     turntable(&sc);
-    const double bad = NAN;
+    const double bad = (double)NAN;
     TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, dhs_plant_init(&plant2, &sc, 1U, &bad));
 }
 

@@ -45,7 +45,7 @@ static void test_defaults_are_physics_md_plant_table(void)
 typedef void (*breaker)(dhs_scenario *s);
 static void neg_mass(dhs_scenario *s) { s->joint[1].mass_kg = -1.0; }
 static void neg_stiffness(dhs_scenario *s) { s->joint[2].stiffness_nm_per_rad = -5.0; }
-static void nan_ratio(dhs_scenario *s) { s->joint[0].gear_ratio = NAN; }
+static void nan_ratio(dhs_scenario *s) { s->joint[0].gear_ratio = (double)NAN; }
 static void zero_r(dhs_scenario *s) { s->joint[0].r_ohm = 0.0; }
 static void rigid_backlash(dhs_scenario *s) { s->joint[1].backlash_rad = 0.001; }
 static void rigid_te(dhs_scenario *s)

@@ -365,7 +365,7 @@ static void test_failures_leave_the_arm_unchanged(void)
                                                          data.n, data.flags, &opt, &ws, &rep));
     TEST_ASSERT_EQUAL_MEMORY(&model_before, &model, sizeof model);
 
-    data.s[9].p_mm[1] = NAN;
+    data.s[9].p_mm[1] = (double)NAN;
     TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, fit(&arm, &opt));
     TEST_ASSERT_EQUAL_MEMORY(&nominal, &arm, sizeof arm);
 

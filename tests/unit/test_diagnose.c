@@ -203,8 +203,9 @@ static void test_bad_arguments_are_refused(void)
     dhc_diagnose_default_options(&dopt);
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_diagnose(&m, &set, ident, 0.0, &c, 1U, test_read_sample,
                                                      &data, data.n, data.flags, &dopt, &dws, &diag));
-    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_diagnose(&m, &set, ident, NAN, &c, 1U, test_read_sample,
-                                                     &data, data.n, data.flags, &dopt, &dws, &diag));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
+                      dhc_diagnose(&m, &set, ident, (double)NAN, &c, 1U, test_read_sample, &data,
+                                   data.n, data.flags, &dopt, &dws, &diag));
     /* A candidate already in the base set is a caller error. */
     TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(&set, &m, DHC_EFFECT_JOINT_SCALE, 0U));
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_diagnose(&m, &set, ident, 1.0, &c, 1U, test_read_sample,
@@ -321,7 +322,7 @@ static void test_time_in_step_with_the_pose(void)
     for (size_t i = 0U; i < data.n; ++i) {
         data.s[i].temp_c = 21.0;
     }
-    data.s[3].temp_c = NAN;
+    data.s[3].temp_c = (double)NAN;
     data.flags[3] = (uint8_t)DHC_SAMPLE_OUTLIER;
     TEST_ASSERT_EQUAL(DHC_OK, dhc_covariate_pose_r2(nj, DHC_COVARIATE_TEMPERATURE,
                                                     test_read_sample, &data, data.n, data.flags,

@@ -364,7 +364,7 @@ static void test_bad_arguments_are_refused_without_writing(void)
     dhc_sample s = sample_of(&m, start, DHC_MEAS_POSITION);
     double q[DHC_MAX_JOINTS] = {9.0, 9.0, 9.0};
     dhc_inverse_result res;
-    s.p_mm[1] = NAN;
+    s.p_mm[1] = (double)NAN;
     TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, dhc_model_inverse(&m, &s, &opt, &ws, q, &res));
     s.p_mm[1] = 0.0;
     s.kind = (uint8_t)DHC_MEAS_POSE; /* three joints cannot orient the tool */

@@ -230,7 +230,7 @@ static void test_rejects_bad_shapes_and_non_finite_angles(void)
     TEST_ASSERT_EQUAL(DHC_ERR_DIMENSION,
                       dhc_identification_jacobian(&arm, &set, q, DHC_MAX_JOINTS, 1, &jac, NULL, NULL));
     TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&jac, 6U, set.count, buf, 6U * DHC_MAX_PARAMS));
-    q[1] = NAN;
+    q[1] = (double)NAN;
     TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE,
                       dhc_identification_jacobian(&arm, &set, q, DHC_MAX_JOINTS, 1, &jac, NULL, NULL));
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
@@ -253,7 +253,7 @@ static void test_non_finite_geometry_is_reported_not_returned(void)
     for (size_t bad = 0U; bad < 2U; ++bad) {
         dhc_arm broken = arm;
         if (bad == 0U) {
-            broken.joint[1].alpha_rad = NAN;
+            broken.joint[1].alpha_rad = (double)NAN;
         } else {
             broken.joint[0].a_mm = 1e308;
             broken.joint[1].a_mm = 1e308;

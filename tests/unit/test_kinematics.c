@@ -302,10 +302,10 @@ static void test_rejects_bad_arms_and_angles(void)
     TEST_ASSERT_EQUAL(DHC_ERR_CAPACITY, dhc_arm_init(&arm, DHC_MAX_JOINTS + 1U));
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_arm_init(NULL, 3U));
     TEST_ASSERT_EQUAL(DHC_OK, dhc_arm_init(&arm, 3U));
-    double q[DHC_MAX_JOINTS] = {0.0, INFINITY, 0.0};
+    double q[DHC_MAX_JOINTS] = {0.0, (double)INFINITY, 0.0};
     dhc_frame tool;
     TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, dhc_forward(&arm, q, DHC_MAX_JOINTS, &tool));
-    q[1] = NAN;
+    q[1] = (double)NAN;
     TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, dhc_forward(&arm, q, DHC_MAX_JOINTS, &tool));
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_joint_transform(&arm, 3U, 0.0, &tool));
 }

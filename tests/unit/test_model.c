@@ -467,10 +467,10 @@ static void test_bad_samples_are_refused(void)
     s.dir[0] = 2;
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_model_predict(&m, &s, &pred));
     s.dir[0] = 1;
-    s.wire_mm[2] = NAN;
+    s.wire_mm[2] = (double)NAN;
     TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, dhc_model_predict(&m, &s, &pred));
     s.wire_mm[2] = 800.0;
-    s.temp_c = INFINITY;
+    s.temp_c = (double)INFINITY;
     TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, dhc_model_predict(&m, &s, &pred));
     s.temp_c = 20.0;
     m.measurer.present = 0;
@@ -506,12 +506,13 @@ static void test_non_finite_slopes_and_residuals_are_reported(void)
     dhc_rot_exp(w, &s.rot);
     TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&jac, 6U, set.count, buf, 6U * DHC_MAX_PARAMS));
     TEST_ASSERT_EQUAL(DHC_OK, dhc_model_jacobian(&m, &set, &s, 100.0, &jac, NULL));
-    TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, dhc_model_jacobian(&m, &set, &s, NAN, &jac, NULL));
-    TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, dhc_model_jacobian(&m, &set, &s, INFINITY, &jac, NULL));
+    TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, dhc_model_jacobian(&m, &set, &s, (double)NAN, &jac, NULL));
+    TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE,
+                      dhc_model_jacobian(&m, &set, &s, (double)INFINITY, &jac, NULL));
     double r[DHC_MAX_ROWS_PER_SAMPLE] = {-1.0, -1.0, -1.0, -1.0, -1.0, -1.0};
     size_t rows = 99U;
-    TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, dhc_model_residual(&m, &s, NAN, r, &rows));
-    TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, dhc_model_residual(&m, &s, -INFINITY, r, &rows));
+    TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, dhc_model_residual(&m, &s, (double)NAN, r, &rows));
+    TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, dhc_model_residual(&m, &s, -(double)INFINITY, r, &rows));
     for (size_t k = 0U; k < DHC_MAX_ROWS_PER_SAMPLE; ++k) {
         TEST_ASSERT_TRUE(r[k] >= -1.0 && r[k] <= -1.0); /* not written */
     }
