@@ -78,8 +78,10 @@ static fw_fault hold_still(fw_ctrl *c, uint32_t hold_ticks, fw_acq_stats *st, do
     return FW_FAULT_NONE;
 }
 
-fw_fault fw_acquire_one(fw_ctrl *c, const dhc_model *model, uint32_t hold_ticks,
-                        fw_acq_stats *st, dhc_sample *out)
+/* fw_acquire_one, and the wire lengths the model predicts for the sample in pred (with a
+ * measurer in the model; untouched without one): fw_acquire's pair check reads them. */
+static fw_fault acquire_checked(fw_ctrl *c, const dhc_model *model, uint32_t hold_ticks,
+                                fw_acq_stats *st, dhc_sample *out, double pred[3])
 {
     double w[3] = {0.0, 0.0, 0.0};
     int still = 0;
@@ -122,7 +124,6 @@ fw_fault fw_acquire_one(fw_ctrl *c, const dhc_model *model, uint32_t hold_ticks,
         memset(&at, 0, sizeof at);
         memcpy(at.q_rad, s.q_rad, sizeof at.q_rad);
         memcpy(at.dir, s.dir, sizeof at.dir);
-        double pred[3];
         if (fw_pose_wires(model, &at, pred) != DHC_OK) {
             fw_ctrl_fault(c, FW_FAULT_WIRES_INCONSISTENT, 0U);
             return c->fault;
@@ -136,6 +137,13 @@ fw_fault fw_acquire_one(fw_ctrl *c, const dhc_model *model, uint32_t hold_ticks,
     }
     *out = s;
     return FW_FAULT_NONE;
+}
+
+fw_fault fw_acquire_one(fw_ctrl *c, const dhc_model *model, uint32_t hold_ticks,
+                        fw_acq_stats *st, dhc_sample *out)
+{
+    double pred[3];
+    return acquire_checked(c, model, hold_ticks, st, out, pred);
 }
 
 /* The wires' change from the reference pose to this one against the model's prediction of
@@ -158,12 +166,12 @@ fw_fault fw_acquire(fw_ctrl *c, const dhc_model *model, const fw_pose *poses, si
                     size_t *n_done)
 {
     /* reference for the pair check: where the arm is now and what its wires read */
-    fw_pose ref;
-    memset(&ref, 0, sizeof ref);
     double ref_w[3] = {0.0, 0.0, 0.0};
     double ref_pred[3] = {0.0, 0.0, 0.0};
     int have_ref = 0;
     if (model->measurer.present && c->fault == FW_FAULT_NONE) {
+        fw_pose ref;
+        memset(&ref, 0, sizeof ref);
         for (size_t j = 0U; j < c->n; ++j) {
             ref.q_rad[j] = c->q_rad[j];
             ref.dir[j] = c->dir[j] < 0 ? (int8_t)-1 : (int8_t)1;
@@ -176,25 +184,16 @@ fw_fault fw_acquire(fw_ctrl *c, const dhc_model *model, const fw_pose *poses, si
             return c->fault;
         }
         dhc_sample s;
-        if (fw_acquire_one(c, model, hold_ticks, st, &s) != FW_FAULT_NONE) {
+        double pred[3];
+        if (acquire_checked(c, model, hold_ticks, st, &s, pred) != FW_FAULT_NONE) {
             return c->fault;
         }
         if (model->measurer.present) {
-            fw_pose cur;
-            memset(&cur, 0, sizeof cur);
-            memcpy(cur.q_rad, s.q_rad, sizeof cur.q_rad);
-            memcpy(cur.dir, s.dir, sizeof cur.dir);
-            double pred[3];
-            if (fw_pose_wires(model, &cur, pred) != DHC_OK) {
-                fw_ctrl_fault(c, FW_FAULT_WIRES_INCONSISTENT, 0U);
-                return c->fault;
-            }
             const size_t bad = have_ref ? pair_check(ref_w, ref_pred, s.wire_mm, pred) : 3U;
             if (bad < 3U) {
                 fw_ctrl_fault(c, FW_FAULT_WIRES_INCONSISTENT, bad);
                 return c->fault;
             }
-            ref = cur;
             memcpy(ref_w, s.wire_mm, sizeof ref_w);
             memcpy(ref_pred, pred, sizeof ref_pred);
             have_ref = 1;

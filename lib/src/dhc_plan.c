@@ -476,49 +476,61 @@ dhc_status dhc_plan_weighting(const dhc_model *model, const dhc_param_set *set,
     if (st != DHC_OK) {
         return st;
     }
+    /* The uniform weighting over the usable candidates: its transformed information is I
+     * (the rows are transformed by W, their average information). Each pass then pulls
+     * every candidate against the factored M and gathers the next M from the updated
+     * weights: one evaluation of a candidate's rows per iteration. A weight of -1 marks a
+     * candidate that cannot be evaluated. */
     for (size_t c = 0U; c < k; ++c) {
         weights[c] = 1.0;
     }
-    double total = (double)k;
+    double total = (double)usable;
+    memset(ws->info, 0, sizeof ws->info);
+    for (size_t i = 0U; i < ws->n_kept; ++i) {
+        ws->info[i * (DHC_MAX_PARAMS + 1U)] = 1.0;
+    }
     for (size_t it = 0U; it < DHC_PLAN_MAX_WEIGHT_ITERATIONS; ++it) {
-        memset(ws->info, 0, sizeof ws->info);
-        for (size_t c = 0U; c < k; ++c) {
-            weights[c] /= total;
-            if (weights[c] > 0.0 && load_rows(model, set, read, ctx, c, rows_store, ws, &st)) {
-                info_add(ws, weights[c]);
-            } else if (st != DHC_OK) {
-                return st;
-            } else {
-                weights[c] = 0.0; /* not usable */
-            }
-        }
         if (factor_info(ws) != DHC_OK) {
             return DHC_ERR_UNDERDETERMINED;
         }
         const double phi = trace_of_inverse(ws);
         double most = 0.0;
-        total = 0.0;
+        double next = 0.0;
+        memset(ws->info, 0, sizeof ws->info);
         for (size_t c = 0U; c < k; ++c) { /* every usable candidate: a plan may take any */
-            if (load_rows(model, set, read, ctx, c, rows_store, ws, &st)) {
-                const double d = pull(ws);
-                most = fmax(most, d);
-                weights[c] *= d / phi;
-                total += weights[c];
-            } else if (st != DHC_OK) {
-                return st;
+            if (!(weights[c] >= 0.0)) {
+                continue;
             }
+            if (!load_rows(model, set, read, ctx, c, rows_store, ws, &st)) {
+                if (st != DHC_OK) {
+                    return st;
+                }
+                weights[c] = -1.0;
+                continue;
+            }
+            const double d = pull(ws);
+            most = fmax(most, d);
+            weights[c] *= d / (phi * total);
+            next += weights[c];
+            info_add(ws, weights[c]);
         }
         rep->iterations = it + 1U;
         rep->variance = phi / (double)n;
         rep->floor = fmax(rep->floor, (2.0 * phi - most) / (double)n);
+        total = next;
         if (rep->floor >= (1.0 - DHC_PLAN_WEIGHT_TOL) * rep->variance || !(total > 0.0)) {
             break;
+        }
+        for (size_t i = 0U; i < ws->n_kept; ++i) {
+            for (size_t j = 0U; j <= i; ++j) {
+                ws->info[i * DHC_MAX_PARAMS + j] /= total;
+            }
         }
     }
     /* the weighting the iteration reached (one update past the value reported) */
     rep->support = 0U;
-    for (size_t c = 0U; c < k && total > 0.0; ++c) {
-        weights[c] /= total;
+    for (size_t c = 0U; c < k; ++c) {
+        weights[c] = weights[c] > 0.0 && total > 0.0 ? weights[c] / total : 0.0;
         rep->support += weights[c] * (double)n >= 0.01 ? 1U : 0U;
     }
     return DHC_OK;
