@@ -73,6 +73,18 @@ int dhcal_samples_build(const dhc_model *model, const dhcal_dataset *data, const
     return DHCAL_IO_OK;
 }
 
+int dhcal_samples_check_held(const dhcal_samples *train, const dhcal_samples *held,
+                             const char *held_path, dhcal_error *err)
+{
+    if (held->wires == train->wires) {
+        return DHCAL_IO_OK;
+    }
+    snprintf(err->msg, sizeof err->msg,
+             "%s: held-out rows must be measured like the training rows (x,y,z vs L1..L3)",
+             held_path);
+    return DHCAL_IO_BAD_INPUT;
+}
+
 void dhcal_samples_free(dhcal_samples *s)
 {
     free(s->samples);

@@ -35,6 +35,11 @@ int dhcal_samples_build(const dhc_model *model, const dhcal_dataset *data, const
                         dhcal_samples *out, dhcal_error *err);
 void dhcal_samples_free(dhcal_samples *s);
 
+/* Held-out rows must be measured as the training rows are (x,y,z or L1..L3): errors of the
+ * two kinds are not comparable. DHCAL_IO_BAD_INPUT naming held_path otherwise. */
+int dhcal_samples_check_held(const dhcal_samples *train, const dhcal_samples *held,
+                             const char *held_path, dhcal_error *err);
+
 /* dhc_sample_reader over dhcal_samples. */
 dhc_status dhcal_samples_read(void *ctx, size_t index, dhc_sample *out);
 

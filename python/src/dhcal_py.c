@@ -191,6 +191,9 @@ static int open_session(const dhcal_py_model *m, const dhcal_py_rows *train,
     if (rc == DHCAL_IO_OK && held != NULL) {
         rc = rows_to_samples(m, held, "held-out data", &s->held_data, &s->held, e);
         s->have_held = rc == DHCAL_IO_OK;
+        if (rc == DHCAL_IO_OK) {
+            rc = dhcal_samples_check_held(&s->samples, &s->held, "held-out data", e);
+        }
     }
     return rc;
 }

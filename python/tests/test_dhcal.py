@@ -388,3 +388,13 @@ def test_wire_lengths_need_a_measurer(train, tmp_path: Path) -> None:
         dhcal.fit(bare, train["q_deg"], wires_mm=wires[:, :2])
     with pytest.raises(TypeError, match="xyz_mm or wires_mm"):
         dhcal.fit(bare, train["q_deg"])
+
+
+def test_heldout_measured_otherwise_is_refused_as_the_program_does(model, train,
+                                                                   heldout) -> None:
+    """Training rows of wire lengths, held-out rows of tool points: errors of two kinds are
+    not comparable (the program's rule, dhcal_samples_check_held)."""
+    wires = wire_lengths(MODEL, train["xyz_mm"])
+    with pytest.raises(dhcal.DhcalInputError, match="measured like the training rows"):
+        dhcal.fit(model, train["q_deg"], wires_mm=wires, heldout=heldout,
+                  directions=train["directions"])

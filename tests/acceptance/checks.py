@@ -1,4 +1,5 @@
-"""The acceptance scripts' tally: each check prints ok or FAIL with its detail."""
+"""The test scripts' tally (acceptance, urdf, realdata): each check prints ok or FAIL with its
+detail, at once (a long run shows where it is)."""
 
 
 class Checks:
@@ -7,7 +8,8 @@ class Checks:
         self.failed = 0
 
     def check(self, name, ok, detail=""):
-        print("%s  %s%s" % ("ok  " if ok else "FAIL", name, ": " + detail if detail else ""))
+        print("%s  %s%s" % ("ok  " if ok else "FAIL", name, ": " + detail if detail else ""),
+              flush=True)
         if ok:
             self.passed += 1
         else:

@@ -283,12 +283,8 @@ static int load_session(const options *o, session *s)
             rc = dhcal_samples_build(&s->model, &s->held_data, o->heldout, &s->held, &err);
             s->have_held = rc == DHCAL_IO_OK;
         }
-        if (rc == DHCAL_IO_OK && s->held.wires != s->samples.wires) {
-            snprintf(err.msg, sizeof err.msg,
-                     "%s: held-out rows must be measured like the training rows (x,y,z vs "
-                     "L1..L3)",
-                     o->heldout);
-            rc = DHCAL_IO_BAD_INPUT;
+        if (rc == DHCAL_IO_OK) {
+            rc = dhcal_samples_check_held(&s->samples, &s->held, o->heldout, &err);
         }
     }
     if (rc != DHCAL_IO_OK) {
