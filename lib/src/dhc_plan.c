@@ -180,11 +180,12 @@ static double gain(dhc_plan_workspace *ws)
 /* The candidate's rows over the kept parameters into ws->rows, scaled and transformed by
  * C^-1 (W = C C^T the candidates' average information: trace(M^-1 W) becomes trace(M^-1));
  * 0 (never chosen) for a candidate whose Jacobian is not finite, *st for other errors. */
-static int load_rows(const dhc_model *model, const dhc_param_set *set, dhc_sample_reader read,
-                     void *ctx, size_t c, const double *store, dhc_plan_workspace *ws,
-                     dhc_status *st)
+static int load_rows(const dhc_model *model, const dhc_param_set *set,
+                     const dhc_plan_candidates *cand, size_t c, const double *store,
+                     dhc_plan_workspace *ws, dhc_status *st)
 {
-    const dhc_status js = candidate_jacobian(model, set, read, ctx, c, store, ws);
+    const dhc_status js =
+        candidate_jacobian(model, set, cand->read, cand->ctx, c, store, ws);
     if (js == DHC_ERR_NONFINITE) {
         return 0;
     }
@@ -217,19 +218,19 @@ static int is_chosen(const size_t *chosen, size_t n, size_t c)
 /* The unchosen candidate that raises ln det of the factored information the most, and that
  * gain; *best = k when none can be evaluated. */
 static dhc_status best_candidate(const dhc_model *model, const dhc_param_set *set,
-                                 dhc_sample_reader read, void *ctx, size_t k,
-                                 const double *store, dhc_plan_workspace *ws,
+                                 const dhc_plan_candidates *cand, const double *store,
+                                 dhc_plan_workspace *ws,
                                  const size_t *chosen, size_t n_chosen, size_t *best,
                                  double *best_gain)
 {
     dhc_status st = DHC_OK;
-    *best = k;
+    *best = cand->count;
     *best_gain = -HUGE_VAL;
-    for (size_t c = 0U; c < k; ++c) {
+    for (size_t c = 0U; c < cand->count; ++c) {
         if (is_chosen(chosen, n_chosen, c)) {
             continue;
         }
-        if (!load_rows(model, set, read, ctx, c, store, ws, &st)) {
+        if (!load_rows(model, set, cand, c, store, ws, &st)) {
             if (st != DHC_OK) {
                 return st;
             }
@@ -244,10 +245,17 @@ static dhc_status best_candidate(const dhc_model *model, const dhc_param_set *se
     return DHC_OK;
 }
 
-/* Every candidate once: the rows per pose, the store, the joint information and from it the
- * parameters kept and their scales. */
+/* The candidates where the arm works: all of them unless the caller says fewer. */
+static size_t workspace_count(const dhc_plan_candidates *cand)
+{
+    return cand->workspace == 0U || cand->workspace > cand->count ? cand->count
+                                                                   : cand->workspace;
+}
+
+/* Every candidate once: the rows per pose, the store, the workspace candidates' joint
+ * information and from it the parameters kept, their scales and W. */
 static dhc_status survey(const dhc_model *model, const dhc_param_set *set,
-                         dhc_sample_reader read, void *ctx, size_t k, double *store,
+                         const dhc_plan_candidates *cand, double *store,
                          dhc_plan_workspace *ws, size_t *usable)
 {
     const size_t p = set->count;
@@ -256,11 +264,14 @@ static dhc_status survey(const dhc_model *model, const dhc_param_set *set,
     }
     dhc_status st = dhc_normal_eq_init(&ws->ne, p);
     const double zero[DHC_MAX_ROWS_PER_SAMPLE] = {0.0};
+    const size_t in_workspace = workspace_count(cand);
+    size_t usable_workspace = 0U;
     dhc_arm_prepare(&model->arm, &ws->trig);
     ws->rows_per_pose = 0U;
     *usable = 0U;
-    for (size_t c = 0U; c < k && st == DHC_OK; ++c) {
-        const dhc_status js = candidate_jacobian(model, set, read, ctx, c, NULL, ws);
+    for (size_t c = 0U; c < cand->count && st == DHC_OK; ++c) {
+        const dhc_status js =
+            candidate_jacobian(model, set, cand->read, cand->ctx, c, NULL, ws);
         if (ws->rows_per_pose == 0U && (js == DHC_OK || js == DHC_ERR_NONFINITE)) {
             ws->rows_per_pose = dhc_sample_rows(&ws->sample);
         }
@@ -277,8 +288,9 @@ static dhc_status survey(const dhc_model *model, const dhc_param_set *set,
             st = dhc_mat_init(&jac, ws->rows_per_pose, p, ws->jac,
                               sizeof ws->jac / sizeof ws->jac[0]);
         }
-        if (st == DHC_OK) {
+        if (st == DHC_OK && c < in_workspace) {
             st = dhc_normal_eq_add(&ws->ne, &jac, zero, NULL, ws->rows_per_pose);
+            usable_workspace += st == DHC_OK ? 1U : 0U;
         }
         if (st == DHC_OK) {
             ++*usable;
@@ -287,7 +299,7 @@ static dhc_status survey(const dhc_model *model, const dhc_param_set *set,
             }
         }
     }
-    if (st == DHC_OK && *usable == 0U) {
+    if (st == DHC_OK && usable_workspace == 0U) {
         return DHC_ERR_ARGUMENT;
     }
     if (st == DHC_OK) {
@@ -296,10 +308,11 @@ static dhc_status survey(const dhc_model *model, const dhc_param_set *set,
     if (st != DHC_OK) {
         return st;
     }
+    const double per_pose = (double)usable_workspace;
     ws->n_kept = 0U;
     for (size_t j = 0U; j < p; ++j) {
         /* one pose's average information in the column becomes 1 */
-        ws->scale[j] = sqrt((double)*usable / ws->ne.jtj[j * p + j]);
+        ws->scale[j] = sqrt(per_pose / ws->ne.jtj[j * p + j]);
         if (ws->fac.identifiable[j]) {
             ws->kept[ws->n_kept++] = j;
         }
@@ -313,7 +326,7 @@ static dhc_status survey(const dhc_model *model, const dhc_param_set *set,
             const size_t i = ws->kept[a];
             const size_t j = ws->kept[b];
             ws->wchol[a * DHC_MAX_PARAMS + b] =
-                ws->ne.jtj[i * p + j] * ws->scale[i] * ws->scale[j] / (double)*usable;
+                ws->ne.jtj[i * p + j] * ws->scale[i] * ws->scale[j] / per_pose;
         }
     }
     const dhc_tri w = {ws->wchol, DHC_MAX_PARAMS, 1U, ws->wchol, DHC_MAX_PARAMS + 1U};
@@ -356,14 +369,14 @@ static double pull(dhc_plan_workspace *ws)
 /* Fedorov's exchange: each chosen pose against every unchosen candidate, while a swap
  * raises ln det. ws->info holds the plan's information on entry and on return. */
 static dhc_status exchange(const dhc_model *model, const dhc_param_set *set,
-                           dhc_sample_reader read, void *ctx, size_t k, const double *store,
+                           const dhc_plan_candidates *cand, const double *store,
                            dhc_plan_workspace *ws, size_t *chosen, size_t n, size_t *swaps)
 {
     dhc_status st = DHC_OK;
     for (size_t pass = 0U; pass < DHC_PLAN_MAX_EXCHANGE_PASSES; ++pass) {
         size_t swapped = 0U;
         for (size_t i = 0U; i < n; ++i) {
-            if (!load_rows(model, set, read, ctx, chosen[i], store, ws, &st)) {
+            if (!load_rows(model, set, cand, chosen[i], store, ws, &st)) {
                 return st != DHC_OK ? st : DHC_ERR_NONFINITE;
             }
             info_add(ws, -1.0);
@@ -374,17 +387,16 @@ static dhc_status exchange(const dhc_model *model, const dhc_param_set *set,
             const double own = gain(ws);
             size_t best;
             double best_gain;
-            st = best_candidate(model, set, read, ctx, k, store, ws, chosen, n, &best,
-                                &best_gain);
+            st = best_candidate(model, set, cand, store, ws, chosen, n, &best, &best_gain);
             if (st != DHC_OK) {
                 return st;
             }
-            const int better = best < k && best_gain > own + PLAN_MIN_GAIN * (1.0 + fabs(own));
+            const int better = best < cand->count && best_gain > own + PLAN_MIN_GAIN * (1.0 + fabs(own));
             if (better) {
                 chosen[i] = best;
                 ++swapped;
             }
-            if (!load_rows(model, set, read, ctx, chosen[i], store, ws, &st)) {
+            if (!load_rows(model, set, cand, chosen[i], store, ws, &st)) {
                 return st != DHC_OK ? st : DHC_ERR_NONFINITE;
             }
             info_add(ws, 1.0);
@@ -398,16 +410,15 @@ static dhc_status exchange(const dhc_model *model, const dhc_param_set *set,
 }
 
 dhc_status dhc_plan_select(const dhc_model *model, const dhc_param_set *set,
-                           dhc_sample_reader read, void *ctx, size_t k, size_t n,
-                           double *rows_store, dhc_plan_workspace *ws, size_t *chosen,
-                           dhc_plan_report *rep)
+                           const dhc_plan_candidates *cand, size_t n, double *rows_store,
+                           dhc_plan_workspace *ws, size_t *chosen, dhc_plan_report *rep)
 {
-    if (model == NULL || set == NULL || read == NULL || ws == NULL || chosen == NULL ||
-        rep == NULL || n == 0U) {
+    if (model == NULL || set == NULL || cand == NULL || cand->read == NULL || ws == NULL ||
+        chosen == NULL || rep == NULL || n == 0U) {
         return DHC_ERR_ARGUMENT;
     }
     memset(rep, 0, sizeof *rep);
-    dhc_status st = survey(model, set, read, ctx, k, rows_store, ws, &rep->usable);
+    dhc_status st = survey(model, set, cand, rows_store, ws, &rep->usable);
     if (st != DHC_OK) {
         return st;
     }
@@ -418,7 +429,7 @@ dhc_status dhc_plan_select(const dhc_model *model, const dhc_param_set *set,
     /* the first n candidates: a random plan when the candidates are random */
     clear_info(ws);
     for (size_t c = 0U; c < n; ++c) {
-        if (load_rows(model, set, read, ctx, c, rows_store, ws, &st)) {
+        if (load_rows(model, set, cand, c, rows_store, ws, &st)) {
             info_add(ws, 1.0);
         } else if (st != DHC_OK) {
             return st;
@@ -428,28 +439,29 @@ dhc_status dhc_plan_select(const dhc_model *model, const dhc_param_set *set,
     clear_info(ws);
     for (size_t got = 0U; got < n; ++got) {
         st = factor_info(ws);
-        size_t best = k;
+        size_t best = cand->count;
         double best_gain;
         if (st == DHC_OK) {
-            st = best_candidate(model, set, read, ctx, k, rows_store, ws, chosen, got, &best,
+            st = best_candidate(model, set, cand, rows_store, ws, chosen, got, &best,
                                 &best_gain);
         }
-        if (st == DHC_OK && best == k) {
+        if (st == DHC_OK && best == cand->count) {
             st = DHC_ERR_ARGUMENT; /* fewer usable candidates than asked for */
         }
         if (st != DHC_OK) {
             return st;
         }
         chosen[got] = best;
-        (void)load_rows(model, set, read, ctx, best, rows_store, ws, &st);
+        (void)load_rows(model, set, cand, best, rows_store, ws, &st);
         info_add(ws, 1.0);
     }
-    st = exchange(model, set, read, ctx, k, rows_store, ws, chosen, n, &rep->exchanges);
+    st = exchange(model, set, cand, rows_store, ws, chosen, n, &rep->exchanges);
     if (st != DHC_OK) {
         return st;
     }
     rep->variance = trace_of_inverse(ws);
-    return dhc_plan_observability(model, set, read, ctx, chosen, n, ws, &rep->o1, &rep->rank);
+    return dhc_plan_observability(model, set, cand->read, cand->ctx, chosen, n, ws, &rep->o1,
+                                  &rep->rank);
 }
 
 /* The multiplicative algorithm (Silvey, Titterington and Torsney) on the transformed
@@ -462,33 +474,38 @@ dhc_status dhc_plan_select(const dhc_model *model, const dhc_param_set *set,
  * the floor (Kiefer and Wolfowitz: it meets trace(M^-1) at the optimum). Both numbers hold
  * at whatever step the iteration stops: the floor is a bound, the value a weighting's. */
 dhc_status dhc_plan_weighting(const dhc_model *model, const dhc_param_set *set,
-                              dhc_sample_reader read, void *ctx, size_t k, size_t n,
-                              double *rows_store, double *weights, dhc_plan_workspace *ws,
+                              const dhc_plan_candidates *cand, size_t n, double *rows_store,
+                              double *weights, dhc_plan_workspace *ws,
                               dhc_plan_weighting_report *rep)
 {
-    if (model == NULL || set == NULL || read == NULL || ws == NULL || weights == NULL ||
-        rep == NULL || n == 0U) {
+    if (model == NULL || set == NULL || cand == NULL || cand->read == NULL || ws == NULL ||
+        weights == NULL || rep == NULL || n == 0U) {
         return DHC_ERR_ARGUMENT;
     }
     memset(rep, 0, sizeof *rep);
     size_t usable = 0U;
-    dhc_status st = survey(model, set, read, ctx, k, rows_store, ws, &usable);
+    dhc_status st = survey(model, set, cand, rows_store, ws, &usable);
     if (st != DHC_OK) {
         return st;
     }
-    /* The uniform weighting over the usable candidates: its transformed information is I
-     * (the rows are transformed by W, their average information). Each pass then pulls
-     * every candidate against the factored M and gathers the next M from the updated
-     * weights: one evaluation of a candidate's rows per iteration. A weight of -1 marks a
-     * candidate that cannot be evaluated. */
-    for (size_t c = 0U; c < k; ++c) {
-        weights[c] = 1.0;
-    }
-    double total = (double)usable;
+    const size_t k = cand->count;
+    /* The uniform weighting over the usable candidates, its information gathered in a first
+     * pass (it is I only when every candidate is the workspace's: the rows are transformed
+     * by W). Each pass then pulls every candidate against the factored M and gathers the
+     * next M from the updated weights: one evaluation of a candidate's rows per iteration.
+     * A weight of -1 marks a candidate that cannot be evaluated. */
     memset(ws->info, 0, sizeof ws->info);
-    for (size_t i = 0U; i < ws->n_kept; ++i) {
-        ws->info[i * (DHC_MAX_PARAMS + 1U)] = 1.0;
+    for (size_t c = 0U; c < k; ++c) {
+        weights[c] = 1.0 / (double)usable;
+        if (load_rows(model, set, cand, c, rows_store, ws, &st)) {
+            info_add(ws, weights[c]);
+        } else if (st != DHC_OK) {
+            return st;
+        } else {
+            weights[c] = -1.0;
+        }
     }
+    double total = 1.0;
     for (size_t it = 0U; it < DHC_PLAN_MAX_WEIGHT_ITERATIONS; ++it) {
         if (factor_info(ws) != DHC_OK) {
             return DHC_ERR_UNDERDETERMINED;
@@ -501,12 +518,8 @@ dhc_status dhc_plan_weighting(const dhc_model *model, const dhc_param_set *set,
             if (!(weights[c] >= 0.0)) {
                 continue;
             }
-            if (!load_rows(model, set, read, ctx, c, rows_store, ws, &st)) {
-                if (st != DHC_OK) {
-                    return st;
-                }
-                weights[c] = -1.0;
-                continue;
+            if (!load_rows(model, set, cand, c, rows_store, ws, &st)) {
+                return st != DHC_OK ? st : DHC_ERR_NONFINITE; /* it was usable above */
             }
             const double d = pull(ws);
             most = fmax(most, d);
@@ -539,21 +552,20 @@ dhc_status dhc_plan_weighting(const dhc_model *model, const dhc_param_set *set,
 #else /* the feature left out of this build (dhc_config.h) */
 
 dhc_status dhc_plan_weighting(const dhc_model *model, const dhc_param_set *set,
-                              dhc_sample_reader read, void *ctx, size_t k, size_t n,
-                              double *rows_store, double *weights, dhc_plan_workspace *ws,
+                              const dhc_plan_candidates *cand, size_t n, double *rows_store,
+                              double *weights, dhc_plan_workspace *ws,
                               dhc_plan_weighting_report *rep)
 {
-    (void)model, (void)set, (void)read, (void)ctx, (void)k, (void)n, (void)rows_store;
+    (void)model, (void)set, (void)cand, (void)n, (void)rows_store;
     (void)weights, (void)ws, (void)rep;
     return DHC_ERR_ARGUMENT;
 }
 
 dhc_status dhc_plan_select(const dhc_model *model, const dhc_param_set *set,
-                           dhc_sample_reader read, void *ctx, size_t k, size_t n,
-                           double *rows_store, dhc_plan_workspace *ws, size_t *chosen,
-                           dhc_plan_report *rep)
+                           const dhc_plan_candidates *cand, size_t n, double *rows_store,
+                           dhc_plan_workspace *ws, size_t *chosen, dhc_plan_report *rep)
 {
-    (void)model, (void)set, (void)read, (void)ctx, (void)k, (void)n, (void)rows_store;
+    (void)model, (void)set, (void)cand, (void)n, (void)rows_store;
     (void)ws, (void)chosen, (void)rep;
     return DHC_ERR_ARGUMENT;
 }

@@ -158,9 +158,10 @@ static void test_pose_selection_is_refused_its_score_kept(void)
     const dhc_model model = test_paper3_model();
     size_t chosen[5];
     dhc_plan_report rep;
+    const dhc_plan_candidates plan_cand = {test_read_sample, &paper.data, paper.data.n, 0U};
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
-                      dhc_plan_select(&model, &paper.set, test_read_sample, &paper.data,
-                                      paper.data.n, 5U, NULL, &plan_ws, chosen, &rep));
+                      dhc_plan_select(&model, &paper.set, &plan_cand, 5U, NULL, &plan_ws,
+                                      chosen, &rep));
     double o1 = 0.0;
     size_t rank = 0U;
     TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_observability(&model, &paper.set, test_read_sample,

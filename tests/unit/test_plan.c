@@ -30,6 +30,14 @@ static dhc_status read_pool(void *ctx, size_t index, dhc_sample *out)
     return DHC_OK;
 }
 
+/* The first k candidates of the pool, every one where the arm works. */
+static const dhc_plan_candidates *pool_of(size_t k)
+{
+    static dhc_plan_candidates c;
+    c = (dhc_plan_candidates){read_pool, NULL, k, 0U};
+    return &c;
+}
+
 /* Random candidates of one kind for the model, each joint approached from dir. */
 static void fill_pool(const dhc_model *m, dhc_meas_kind kind, int8_t dir, uint64_t seed)
 {
@@ -179,19 +187,26 @@ static void small_pool(const dhc_model *m, dhc_param_set *set)
     fill_pool(m, DHC_MEAS_POSITION, 1, 5U);
 }
 
-/* 10 candidates, 4 poses: all 210 plans scored here by their prediction variance averaged
- * over the candidates, trace(M^-1 W). An exchange finds a local optimum: the selection must
- * be within 2 % of the best plan and better than all but a few of the 210. */
-static void test_small_pool_gets_the_best_plan(void)
+/* The first k candidates, the first `workspace` of them where the arm works. */
+static const dhc_plan_candidates *pool_part(size_t k, size_t workspace)
+{
+    static dhc_plan_candidates c;
+    c = (dhc_plan_candidates){read_pool, NULL, k, workspace};
+    return &c;
+}
+
+/* k candidates, 4 poses: every plan scored here by its prediction variance averaged over
+ * the first `workspace` candidates, trace(M^-1 W). An exchange finds a local optimum: the
+ * selection must be within 2 % of the best plan and better than all but a few. */
+static void small_pool_gets_the_best_plan(size_t k, size_t workspace)
 {
     const dhc_model m = test_paper3_as_built();
     dhc_param_set set;
     small_pool(&m, &set);
-    const size_t k = 10U;
     const size_t n = 4U;
     size_t chosen[4];
     dhc_plan_report rep;
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_select(&m, &set, read_pool, NULL, k, n, NULL, &ws,
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_select(&m, &set, pool_part(k, workspace), n, NULL, &ws,
                                               chosen, &rep));
     const size_t p = set.count;
     TEST_ASSERT_EQUAL_size_t(p, rep.identifiable);
@@ -202,13 +217,13 @@ static void test_small_pool_gets_the_best_plan(void)
     for (size_t i = 0U; i < p; ++i) {
         unit[i] = 1.0;
     }
-    information(&m, &set, NULL, k, unit, w);
+    information(&m, &set, NULL, workspace, unit, w);
     for (size_t i = 0U; i < p * p; ++i) {
-        w[i] /= (double)k;
+        w[i] /= (double)workspace;
     }
     static double info[DHC_MAX_PARAMS * DHC_MAX_PARAMS];
     double best = HUGE_VAL;
-    double scores[210];
+    static double scores[1000];
     size_t n_scores = 0U;
     size_t idx[4];
     for (idx[0] = 0U; idx[0] < k; ++idx[0]) {
@@ -216,6 +231,7 @@ static void test_small_pool_gets_the_best_plan(void)
             for (idx[2] = idx[1] + 1U; idx[2] < k; ++idx[2]) {
                 for (idx[3] = idx[2] + 1U; idx[3] < k; ++idx[3]) {
                     information(&m, &set, idx, n, unit, info);
+                    TEST_ASSERT_TRUE(n_scores < sizeof scores / sizeof scores[0]);
                     scores[n_scores++] = trace_inv_times(info, w, p);
                     best = fmin(best, scores[n_scores - 1U]);
                 }
@@ -239,21 +255,26 @@ static void test_small_pool_gets_the_best_plan(void)
     }
 }
 
+static void test_small_pool_gets_the_best_plan(void)
+{
+    small_pool_gets_the_best_plan(10U, 10U);
+}
+
 /* The best weighting of 10 candidates for 4 poses, and the floor under every plan: checked
  * against all 715 plans of 4 poses with repeats (every multiset, scored here by Gauss-Jordan)
  * and the weighting's own value recomputed here from its weights. */
-static void test_floor_is_under_every_plan(void)
+static void floor_is_under_every_plan(size_t k, size_t workspace)
 {
     const dhc_model m = test_paper3_as_built();
     dhc_param_set set;
     small_pool(&m, &set);
-    const size_t k = 10U;
     const size_t n = 4U;
     const size_t p = set.count;
-    double weights[10];
+    double weights[16];
+    TEST_ASSERT_TRUE(k <= 16U);
     dhc_plan_weighting_report best;
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_weighting(&m, &set, read_pool, NULL, k, n, NULL, weights,
-                                                 &ws, &best));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_weighting(&m, &set, pool_part(k, workspace), n, NULL,
+                                                 weights, &ws, &best));
     double unit[DHC_MAX_PARAMS];
     for (size_t i = 0U; i < p; ++i) {
         unit[i] = 1.0;
@@ -261,9 +282,9 @@ static void test_floor_is_under_every_plan(void)
     static double w[DHC_MAX_PARAMS * DHC_MAX_PARAMS];
     static double info[DHC_MAX_PARAMS * DHC_MAX_PARAMS];
     static double one[DHC_MAX_PARAMS * DHC_MAX_PARAMS];
-    information(&m, &set, NULL, k, unit, w);
+    information(&m, &set, NULL, workspace, unit, w);
     for (size_t i = 0U; i < p * p; ++i) {
-        w[i] /= (double)k;
+        w[i] /= (double)workspace;
     }
     double sum = 0.0;
     memset(info, 0, sizeof info);
@@ -302,6 +323,19 @@ static void test_floor_is_under_every_plan(void)
     TEST_ASSERT_TRUE(best.support >= 2U && best.support <= k);
 }
 
+static void test_floor_is_under_every_plan(void)
+{
+    floor_is_under_every_plan(10U, 10U);
+}
+
+/* Candidates beyond the workspace: any may be chosen, W is the workspace's alone (the
+ * scores here average over the first 7 only). */
+static void test_candidates_beyond_the_workspace(void)
+{
+    small_pool_gets_the_best_plan(12U, 7U);
+    floor_is_under_every_plan(12U, 7U);
+}
+
 /* 15 planned poses of 200 candidates observe the paper arm's parameters better than any of
  * 20 random 15-pose plans from the same candidates (O1), 10 % better than their mean, and
  * the store changes nothing. */
@@ -315,10 +349,10 @@ static void test_plan_beats_random_plans(void)
     size_t again[15];
     dhc_plan_report rep;
     dhc_plan_report rep2;
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_select(&m, &set, read_pool, NULL, POOL, n, NULL, &ws,
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_select(&m, &set, pool_of(POOL), n, NULL, &ws,
                                               chosen, &rep));
     TEST_ASSERT_TRUE(set.count <= STORE_PARAMS);
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_select(&m, &set, read_pool, NULL, POOL, n, store, &ws,
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_select(&m, &set, pool_of(POOL), n, store, &ws,
                                               again, &rep2));
     TEST_ASSERT_EQUAL_MEMORY(chosen, again, sizeof chosen);
     TEST_ASSERT_EQUAL_DOUBLE(rep.o1, rep2.o1);
@@ -366,7 +400,7 @@ static void test_unidentifiable_parameters_are_left_out(void)
     fill_pool(&m, DHC_MEAS_WIRES, 1, 31U);
     size_t chosen[12];
     dhc_plan_report rep;
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_select(&m, &set, read_pool, NULL, 100U, 12U, NULL, &ws,
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_select(&m, &set, pool_of(100U), 12U, NULL, &ws,
                                               chosen, &rep));
     TEST_ASSERT_EQUAL_size_t(set.count - 1U, rep.identifiable);
     TEST_ASSERT_EQUAL_size_t(set.count - 1U, rep.rank);
@@ -375,7 +409,7 @@ static void test_unidentifiable_parameters_are_left_out(void)
     for (size_t i = 0U; i < 100U; ++i) {
         pool[i].dir[1] = test_uniform(&rng) < 0.5 ? (int8_t)-1 : (int8_t)1;
     }
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_select(&m, &set, read_pool, NULL, 100U, 12U, NULL, &ws,
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_select(&m, &set, pool_of(100U), 12U, NULL, &ws,
                                               chosen, &rep));
     TEST_ASSERT_EQUAL_size_t(set.count, rep.identifiable);
 }
@@ -387,16 +421,16 @@ static void test_bad_requests_are_refused(void)
     fill_pool(&m, DHC_MEAS_WIRES, 1, 41U);
     size_t chosen[POOL];
     dhc_plan_report rep;
-    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_plan_select(&m, &set, read_pool, NULL, 10U, 11U,
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_plan_select(&m, &set, pool_of(10U), 11U,
                                                         NULL, &ws, chosen, &rep));
-    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_plan_select(&m, &set, read_pool, NULL, 10U, 0U,
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_plan_select(&m, &set, pool_of(10U), 0U,
                                                         NULL, &ws, chosen, &rep));
     /* the reader's own error comes back */
-    TEST_ASSERT_EQUAL(DHC_ERR_NO_DATA, dhc_plan_select(&m, &set, read_pool, NULL, POOL + 1U,
-                                                       5U, NULL, &ws, chosen, &rep));
+    TEST_ASSERT_EQUAL(DHC_ERR_NO_DATA, dhc_plan_select(&m, &set, pool_of(POOL + 1U), 5U,
+                                                       NULL, &ws, chosen, &rep));
     /* a candidate of another kind (a tool pose among wire samples) */
     dhc_model_sample_at(&m, pool[3].q_rad, pool[3].dir, DHC_MEAS_POSE, &pool[3]);
-    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_plan_select(&m, &set, read_pool, NULL, 10U, 5U,
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_plan_select(&m, &set, pool_of(10U), 5U,
                                                         NULL, &ws, chosen, &rep));
 }
 
@@ -406,6 +440,7 @@ int main(void)
     RUN_TEST(test_observability_is_the_scaled_determinant);
     RUN_TEST(test_small_pool_gets_the_best_plan);
     RUN_TEST(test_floor_is_under_every_plan);
+    RUN_TEST(test_candidates_beyond_the_workspace);
     RUN_TEST(test_plan_beats_random_plans);
     RUN_TEST(test_unidentifiable_parameters_are_left_out);
     RUN_TEST(test_bad_requests_are_refused);

@@ -1,8 +1,9 @@
-/* dhcal_plan_cmd.c - `dhcal plan`: the poses to measure (docs/cli.md, section 1.6). The
- * candidates are random poses inside the model's joint ranges with the tool above --min-z;
- * lib's dhc_plan_select keeps the --poses of them that observe the base model and --effects
- * best, and the report sets the plan's O1 beside that of a random plan of the same size
- * from the same candidates. */
+/* dhcal_plan_cmd.c - `dhcal plan`: the poses to measure (docs/cli.md, section 1.7). The
+ * candidates are random poses inside the model's joint ranges with the tool above --min-z
+ * (where the arm works) and as many again with joints at the ends of their ranges; lib's
+ * dhc_plan_select keeps the --poses of them that observe the base model and --effects
+ * best where the arm works, and the report sets the plan beside a random plan of the same
+ * size. */
 #ifndef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 200809L
 #endif
@@ -30,15 +31,18 @@
 
 static const char *const plan_usage =
     "usage: dhcal plan --model M.json --poses N [--effects LIST] [--candidates K]\n"
-    "                  [--seed S] [--min-z MM] --out P.csv [--json]\n"
-    "Chooses the N poses of K random candidates (inside the model's joint ranges, the tool\n"
-    "above --min-z in the world frame) from which a fit of the model's joint offsets and\n"
-    "link geometry plus LIST predicts the tool best over the candidates' poses (the\n"
-    "prediction variance averaged over them, least: I-optimal), parameters that no\n"
-    "candidate identifies left out. P.csv has q1..qN in degrees (dhcal-sim --plan measures\n"
-    "it). The report gives the plan's observability index O1 and prediction variance next\n"
-    "to those of a random plan of N of the same candidates.\n"
+    "                  [--end-candidates E] [--seed S] [--min-z MM] --out P.csv [--json]\n"
+    "Chooses the N poses, of K random candidates (inside the model's joint ranges, the tool\n"
+    "above --min-z in the world frame: where the arm works) and E more with joints at the\n"
+    "ends of their ranges, from which a fit of the model's joint offsets and link geometry\n"
+    "plus LIST predicts the tool best where the arm works (the prediction variance averaged\n"
+    "over the K poses, least: I-optimal), parameters that no candidate identifies left out.\n"
+    "P.csv has q1..qN in degrees (dhcal-sim --plan measures it). The report gives the plan's\n"
+    "observability index O1 and prediction variance next to those of a random plan of N of\n"
+    "the K.\n"
     "  --candidates K     default 10 N (at least 200); at most 100000\n"
+    "  --end-candidates E each joint at an end of its range with probability 1/2, else\n"
+    "                     anywhere in it (default K; 0: none); at most 100000\n"
     "  --seed S           the candidates' random generator (default 1)\n"
     "  --min-z MM         lowest tool height accepted (default: none)\n"
     "  --json             one JSON object on stdout instead of text\n"
@@ -89,19 +93,25 @@ static dhc_status read_candidate(void *ctx, size_t index, dhc_sample *out)
     return DHC_OK;
 }
 
-/* k poses uniform in the joint ranges with the tool at or above min_z; 0 when fewer than k
- * pass within 1000 k draws. */
-static size_t draw_candidates(const dhc_model *m, size_t k, uint64_t seed, double min_z,
-                              double *q_rad)
+/* k poses with the tool at or above min_z, each joint uniform in its range or (at_ends)
+ * with probability 1/2 at one of its ends; fewer than k when fewer pass within 1000 k
+ * draws. The two kinds draw from their own streams: the first K poses of a seed do not
+ * depend on the end candidates. */
+static size_t draw_candidates(const dhc_model *m, size_t k, uint64_t seed, int at_ends,
+                              double min_z, double *q_rad)
 {
     const size_t nj = m->arm.n_joints;
-    uint64_t s = seed * 0x9E3779B97F4A7C15ULL + 0x2545F4914F6CDD1DULL;
+    uint64_t s = seed * 0x9E3779B97F4A7C15ULL + (at_ends ? 0x5851F42D4C957F2DULL
+                                                          : 0x2545F4914F6CDD1DULL);
     size_t got = 0U;
     for (size_t tries = 0U; got < k && tries < 1000U * k; ++tries) {
         double *q = q_rad + got * nj;
         for (size_t j = 0U; j < nj; ++j) {
             const dhc_joint *jt = &m->arm.joint[j];
             q[j] = jt->min_rad + uniform(&s) * (jt->max_rad - jt->min_rad);
+            if (at_ends && uniform(&s) < 0.5) {
+                q[j] = uniform(&s) < 0.5 ? jt->min_rad : jt->max_rad;
+            }
         }
         double p[3];
         if (dhc_model_tool_point(m, q, NULL, p) == DHC_OK && p[2] >= min_z) {
@@ -141,6 +151,8 @@ typedef struct {
     const char *out;
     unsigned long poses;
     unsigned long candidates;
+    unsigned long end_candidates;
+    int end_candidates_given;
     unsigned long seed;
     double min_z;
     int json;
@@ -149,13 +161,14 @@ typedef struct {
 /* 0, 2 (usage) or -1 (help printed). */
 static int parse_plan_args(int argc, char **argv, plan_options *o)
 {
-    enum { OPT_MODEL = 1, OPT_POSES, OPT_EFFECTS, OPT_CANDIDATES, OPT_SEED, OPT_MIN_Z,
-           OPT_OUT, OPT_JSON, OPT_HELP };
+    enum { OPT_MODEL = 1, OPT_POSES, OPT_EFFECTS, OPT_CANDIDATES, OPT_END_CANDIDATES,
+           OPT_SEED, OPT_MIN_Z, OPT_OUT, OPT_JSON, OPT_HELP };
     static const struct option long_options[] = {
         {"model", required_argument, NULL, OPT_MODEL},
         {"poses", required_argument, NULL, OPT_POSES},
         {"effects", required_argument, NULL, OPT_EFFECTS},
         {"candidates", required_argument, NULL, OPT_CANDIDATES},
+        {"end-candidates", required_argument, NULL, OPT_END_CANDIDATES},
         {"seed", required_argument, NULL, OPT_SEED},
         {"min-z", required_argument, NULL, OPT_MIN_Z},
         {"out", required_argument, NULL, OPT_OUT},
@@ -194,6 +207,14 @@ static int parse_plan_args(int argc, char **argv, plan_options *o)
                 return plan_usage_error(msg);
             }
             break;
+        case OPT_END_CANDIDATES:
+            if (parse_count(optarg, 0UL, PLAN_MAX_CANDIDATES, &o->end_candidates) != 0) {
+                snprintf(msg, sizeof msg, "--end-candidates: '%.200s' is not a count in "
+                                          "0..%lu", optarg, PLAN_MAX_CANDIDATES);
+                return plan_usage_error(msg);
+            }
+            o->end_candidates_given = 1;
+            break;
         case OPT_SEED:
             if (parse_count(optarg, 0UL, 0xFFFFFFFFUL, &o->seed) != 0) {
                 snprintf(msg, sizeof msg, "--seed: '%.200s' is not a count in 0..4294967295",
@@ -229,6 +250,9 @@ static int parse_plan_args(int argc, char **argv, plan_options *o)
     if (o->candidates <= o->poses) {
         return plan_usage_error("--candidates must be more than --poses");
     }
+    if (!o->end_candidates_given) {
+        o->end_candidates = o->candidates;
+    }
     return 0;
 }
 
@@ -244,6 +268,7 @@ static void report(const plan_options *o, const dhc_param_set *set, const dhc_pl
         cJSON *obj = cJSON_CreateObject();
         cJSON_AddNumberToObject(obj, "poses", (double)o->poses);
         cJSON_AddNumberToObject(obj, "candidates", (double)o->candidates);
+        cJSON_AddNumberToObject(obj, "end_candidates", (double)o->end_candidates);
         cJSON_AddStringToObject(obj, "measured", kind == DHC_MEAS_WIRES ? "wires" : "position");
         cJSON_AddNumberToObject(obj, "parameters", (double)set->count);
         cJSON_AddNumberToObject(obj, "identifiable", (double)rep->identifiable);
@@ -274,8 +299,10 @@ static void report(const plan_options *o, const dhc_param_set *set, const dhc_pl
         }
         return;
     }
-    printf("plan: %lu poses of %lu candidates (%s measured), written to %s\n", o->poses,
-           o->candidates, kind == DHC_MEAS_WIRES ? "wire lengths" : "tool positions", o->out);
+    printf("plan: %lu poses of %lu candidates where the arm works and %lu at the ends of the "
+           "joint ranges (%s measured), written to %s\n", o->poses, o->candidates,
+           o->end_candidates, kind == DHC_MEAS_WIRES ? "wire lengths" : "tool positions",
+           o->out);
     printf("parameters: %zu of %zu identifiable from the candidates", rep->identifiable,
            set->count);
     const char *sep = "; left out: ";
@@ -290,7 +317,7 @@ static void report(const plan_options *o, const dhc_param_set *set, const dhc_pl
     printf("\nobservability O1: planned %.4g (rank %zu), random plan of the same size %.4g "
            "(rank %zu): %.2fx\n", rep->o1, rep->rank, o1_random, rank_random,
            o1_random > 0.0 ? rep->o1 / o1_random : HUGE_VAL);
-    printf("prediction variance over the candidates' poses, per unit measurement variance: "
+    printf("prediction variance where the arm works, per unit measurement variance: "
            "planned %.4g, random plan %.4g: %.2fx less\n", rep->variance, rep->variance_first,
            rep->variance > 0.0 ? rep->variance_first / rep->variance : HUGE_VAL);
     printf("no plan of %lu poses from these candidates predicts below %.4g (their best "
@@ -328,11 +355,12 @@ int dhcal_plan_command(int argc, char **argv)
     }
     const size_t nj = model.arm.n_joints;
     const size_t k = o.candidates;
+    const size_t all = k + o.end_candidates;
     const dhc_meas_kind kind = model.measurer.present ? DHC_MEAS_WIRES : DHC_MEAS_POSITION;
-    double *q = malloc(k * nj * sizeof *q);
+    double *q = malloc(all * nj * sizeof *q);
     size_t *chosen = malloc(o.poses * sizeof *chosen);
-    double *weights = malloc(k * sizeof *weights);
-    const size_t store_doubles = k * 3U * set.count;
+    double *weights = malloc(all * sizeof *weights);
+    const size_t store_doubles = all * 3U * set.count;
     double *store = store_doubles * sizeof(double) <= PLAN_STORE_BYTES
                         ? malloc(store_doubles * sizeof *store)
                         : NULL; /* optional: the same plan, slower */
@@ -342,16 +370,18 @@ int dhcal_plan_command(int argc, char **argv)
         fprintf(stderr, "dhcal: plan: out of memory\n");
         goto done;
     }
-    const size_t got = draw_candidates(&model, k, o.seed, o.min_z, q);
+    const size_t got = draw_candidates(&model, k, o.seed, 0, o.min_z, q);
     if (got < k) {
         fprintf(stderr, "dhcal: plan: %s: only %zu of %zu random poses put the tool at or above "
                         "--min-z %g mm\n", o.model, got, k, o.min_z);
         goto done;
     }
+    /* fewer end candidates than asked when the ends of the ranges put the tool below --min-z */
+    const size_t ends = draw_candidates(&model, o.end_candidates, o.seed, 1, o.min_z, q + k * nj);
     candidates c = {&model, q, kind};
+    const dhc_plan_candidates cand = {read_candidate, &c, k + ends, k};
     dhc_plan_report rep;
-    dhc_status st = dhc_plan_select(&model, &set, read_candidate, &c, k, o.poses, store, &ws,
-                                    chosen, &rep);
+    dhc_status st = dhc_plan_select(&model, &set, &cand, o.poses, store, &ws, chosen, &rep);
     if (st != DHC_OK) {
         fprintf(stderr, "dhcal: plan: no plan: %s%s\n", dhc_status_str(st),
                 st == DHC_ERR_ARGUMENT ? " (fewer usable candidates than poses?)" : "");
@@ -372,12 +402,12 @@ int dhcal_plan_command(int argc, char **argv)
     }
     /* how good any plan of these candidates can be: after the plan, its scratch reused */
     dhc_plan_weighting_report best;
-    st = dhc_plan_weighting(&model, &set, read_candidate, &c, k, o.poses, store, weights, &ws,
-                            &best);
+    st = dhc_plan_weighting(&model, &set, &cand, o.poses, store, weights, &ws, &best);
     if (st != DHC_OK) {
         fprintf(stderr, "dhcal: plan: the candidates' best weighting: %s\n", dhc_status_str(st));
         goto done;
     }
+    o.end_candidates = ends;
     report(&o, &set, &rep, &best, o1_random, rank_random, &ws, kind);
     rc = 0;
 done:

@@ -1,19 +1,20 @@
 /* dhc_plan.h - calibration pose plans: which poses to measure so that few measurements
  * identify the parameters well.
  *
- * dhc_plan_select chooses n poses out of k candidates (the caller's: random poses inside the
- * joint ranges and its workspace limits, handed out by a dhc_sample_reader) so that the
- * calibration predicts the tool best where the arm works: it minimises
+ * dhc_plan_select chooses n poses out of the caller's candidates (dhc_plan_candidates: random
+ * poses inside the joint ranges and its workspace limits, and optionally poses at the ends
+ * of the ranges, handed out by a dhc_sample_reader) so that the calibration predicts the
+ * tool best where the arm works: it minimises
  *     trace(M^-1 W),
- * M the plan's information J^T J over the parameters of the set and W one candidate pose's
- * average information, i.e. the variance of the predicted tool point (summed over a
- * sample's rows, per unit measurement variance) averaged over the candidates' poses
- * (I-optimality; a random plan of n poses has about r / n for r parameters). That is what a
- * held-out error measures; the determinant of M (D-optimality) shrinks the parameters'
+ * M the plan's information J^T J over the parameters of the set and W one pose's average
+ * information where the arm works, i.e. the variance of the predicted tool point (summed
+ * over a sample's rows, per unit measurement variance) averaged over the workspace
+ * candidates' poses (I-optimality; a random plan of n poses has about r / n for r
+ * parameters). That is what a held-out error measures; the determinant of M (D-optimality) shrinks the parameters'
  * confidence volume instead and measured worse there (tests/acceptance/test_plan_poses.py).
- * First every candidate's Jacobian is accumulated: the parameters that no plan drawn from
- * these candidates can identify (a pivot of the candidates' joint information below 1e-10,
- * dhc_lsq_analyse) are left out, the columns are scaled so that one pose contributes about
+ * First every workspace candidate's Jacobian is accumulated: the parameters that no plan
+ * drawn from these candidates can identify (a pivot of their joint information below
+ * 1e-10, dhc_lsq_analyse) are left out, the columns are scaled so that one pose contributes about
  * 1 to each diagonal entry, and W is factored (W = C C^T; rows transformed by C^-1 turn the
  * criterion into trace(M^-1)). Then a greedy start adds, n times, the candidate that lowers
  * the criterion most (a small ridge, 1e-6 of one pose, keeps the first steps defined), and
@@ -101,18 +102,31 @@ typedef struct {
     size_t rank;         /* parameters the plan identifies */
 } dhc_plan_report;
 
-/* Chooses n of the k candidates read(ctx, 0 .. k-1, ...) (samples of one kind: position,
- * wires or pose; their measured values are not read) into chosen[0 .. n-1] (indices, in
- * the order chosen). rows_store: NULL, or k R set->count doubles of the caller's (R = the
- * candidates' rows per sample, 3 or 6) that keep the Jacobians between passes.
+/* The candidates a plan is chosen from: read(ctx, 0 .. count-1) (samples of one kind:
+ * position, wires or pose; their measured values are not read). The first `workspace` of
+ * them are random poses where the arm works: their average information is W, where the
+ * plan predicts best, and their first n the random plan it is compared with. The others
+ * may be chosen but weigh nothing in W: poses at the ends of the joint ranges, where a fit
+ * over a small working region learns most (its Jacobian is nearly linear in the angles
+ * there, and a line is fixed best by its ends). workspace 0 or above count: all of them. */
+typedef struct {
+    dhc_sample_reader read;
+    void *ctx;
+    size_t count;
+    size_t workspace;
+} dhc_plan_candidates;
+
+/* Chooses n of the candidates into chosen[0 .. n-1] (indices, in the order chosen).
+ * rows_store: NULL, or count R set->count doubles of the caller's (R = the candidates'
+ * rows per sample, 3 or 6) that keep the Jacobians between passes.
  * Errors: DHC_ERR_ARGUMENT (NULL, n = 0, n above the usable candidates, candidates of
- * different row counts), DHC_ERR_CAPACITY (set larger than DHC_MAX_PARAMS), the reader's
- * error, DHC_ERR_UNDERDETERMINED (no parameter identifiable from all candidates). A
- * candidate whose Jacobian is not finite is never chosen. */
+ * different row counts, no usable candidate where the arm works), DHC_ERR_CAPACITY (set
+ * larger than DHC_MAX_PARAMS), the reader's error, DHC_ERR_UNDERDETERMINED (no parameter
+ * identifiable from the workspace's candidates). A candidate whose Jacobian is not finite
+ * is never chosen. */
 dhc_status dhc_plan_select(const dhc_model *model, const dhc_param_set *set,
-                           dhc_sample_reader read, void *ctx, size_t k, size_t n,
-                           double *rows_store, dhc_plan_workspace *ws, size_t *chosen,
-                           dhc_plan_report *rep);
+                           const dhc_plan_candidates *cand, size_t n, double *rows_store,
+                           dhc_plan_workspace *ws, size_t *chosen, dhc_plan_report *rep);
 
 typedef struct {
     double variance;   /* what n poses weighted by the weights would predict: trace(M^-1 W)
@@ -124,15 +138,15 @@ typedef struct {
     size_t support;    /* candidates whose weight is a hundredth of a pose or more */
 } dhc_plan_weighting_report;
 
-/* The candidates' best weighting for n poses (weights[0 .. k-1], the caller's: the
+/* The candidates' best weighting for n poses (weights[0 .. count-1], the caller's: the
  * weighting the iteration reached, summing to 1; a candidate whose Jacobian is not finite
  * weighs 0) and the floor under any n-pose
  * plan's variance, over the parameters dhc_plan_select keeps. rows_store as for
  * dhc_plan_select (NULL: the model is evaluated k times per iteration). Errors as
  * dhc_plan_select's; DHC_ERR_ARGUMENT also when the build leaves plans out. */
 dhc_status dhc_plan_weighting(const dhc_model *model, const dhc_param_set *set,
-                              dhc_sample_reader read, void *ctx, size_t k, size_t n,
-                              double *rows_store, double *weights, dhc_plan_workspace *ws,
+                              const dhc_plan_candidates *cand, size_t n, double *rows_store,
+                              double *weights, dhc_plan_workspace *ws,
                               dhc_plan_weighting_report *rep);
 
 /* O1 of the plan made of read(ctx, index[i]) for i < n (index NULL: 0 .. n-1) for the
