@@ -94,6 +94,7 @@ fw_fault fw_autocal(dhc_model *model, const dhc_sample *samples, size_t n,
     return fw_autocal_configured(&cfg, model, samples, n, nv, ws, geo_out, res);
 }
 
+#if DHC_WITH_NAMES
 char *fw_autocal_effect_label(const fw_autocal_result *res, char *buf, size_t cap)
 {
     if (cap == 0U) {
@@ -115,6 +116,7 @@ char *fw_autocal_effect_label(const fw_autocal_result *res, char *buf, size_t ca
     }
     return buf;
 }
+#endif
 
 fw_fault fw_fault_of_status(dhc_status st)
 {

@@ -126,6 +126,7 @@ int dhc_effect_is_per_joint(dhc_effect effect)
     return fx != NULL && fx->per_joint;
 }
 
+#if DHC_WITH_NAMES
 /* The 1-based joint number after "name:", no sign, no leading zero; 0 when malformed. */
 static size_t joint_number(const char *digits, size_t len)
 {
@@ -216,3 +217,11 @@ size_t dhc_effect_label(dhc_effect effect, size_t joint, char *buf, size_t cap)
     }
     return len;
 }
+#else
+dhc_status dhc_effect_parse(const char *text, size_t len, size_t n_joints, dhc_effect *effect,
+                            size_t *joint)
+{
+    (void)text; (void)len; (void)n_joints; (void)effect; (void)joint;
+    return DHC_ERR_ARGUMENT; /* left out of this build (DHC_WITH_NAMES 0) */
+}
+#endif /* DHC_WITH_NAMES */

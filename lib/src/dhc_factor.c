@@ -127,6 +127,7 @@ dhc_status dhc_chol_pivoted(dhc_mat *a, size_t *perm, size_t perm_len, double re
     return DHC_OK;
 }
 
+#if DHC_WITH_MATRIX_OPS
 /* Shape checks shared by the triangular routines: l square and k within it. */
 static dhc_status check_lower_shape(const dhc_mat *l, size_t k)
 {
@@ -218,7 +219,30 @@ dhc_status dhc_chol_solve(const dhc_mat *l, size_t k, const double *b, double *x
 {
     return checked_solve(l, k, b, x, len, 1, 1);
 }
+#else
+/* Left out of this build (DHC_WITH_MATRIX_OPS 0): the fit solves on its kernels. */
+dhc_status dhc_tri_lower_solve(const dhc_mat *l, size_t k, const double *b, double *y,
+                               size_t len)
+{
+    (void)l; (void)k; (void)b; (void)y; (void)len;
+    return DHC_ERR_ARGUMENT;
+}
 
+dhc_status dhc_tri_lower_t_solve(const dhc_mat *l, size_t k, const double *y, double *x,
+                                 size_t len)
+{
+    (void)l; (void)k; (void)y; (void)x; (void)len;
+    return DHC_ERR_ARGUMENT;
+}
+
+dhc_status dhc_chol_solve(const dhc_mat *l, size_t k, const double *b, double *x, size_t len)
+{
+    (void)l; (void)k; (void)b; (void)x; (void)len;
+    return DHC_ERR_ARGUMENT;
+}
+#endif /* DHC_WITH_MATRIX_OPS */
+
+#if DHC_WITH_REPORT_EXTRAS
 double dhc_chol_condition_estimate(const dhc_mat *l, size_t k)
 {
     if (!mat_valid(l) || l->cols != l->rows || k > l->rows) {
@@ -240,6 +264,7 @@ double dhc_chol_condition_estimate(const dhc_mat *l, size_t k)
     const double r = dmax / dmin;
     return r * r;
 }
+#endif /* DHC_WITH_REPORT_EXTRAS */
 
 /* ---------------------------------------------------------------- kernels on a strided triangle */
 

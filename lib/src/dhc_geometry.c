@@ -49,12 +49,14 @@ void dhc_vec3_scale(const double a[3], double s, double out[3])
     out[2] = s * a[2];
 }
 
+#if DHC_WITH_DESK_KINEMATICS
 void dhc_vec3_axpy(const double a[3], double s, const double b[3], double out[3])
 {
     out[0] = a[0] + s * b[0];
     out[1] = a[1] + s * b[1];
     out[2] = a[2] + s * b[2];
 }
+#endif
 
 double dhc_vec3_dot(const double a[3], const double b[3])
 {
@@ -127,6 +129,7 @@ void dhc_rot_mul(const dhc_mat3 *a, const dhc_mat3 *b, dhc_mat3 *out)
     }
 }
 
+#if DHC_WITH_DESK_KINEMATICS
 void dhc_rot_tmul(const dhc_mat3 *a, const dhc_mat3 *b, dhc_mat3 *out)
 {
     for (size_t i = 0U; i < 3U; ++i) {
@@ -136,7 +139,9 @@ void dhc_rot_tmul(const dhc_mat3 *a, const dhc_mat3 *b, dhc_mat3 *out)
         }
     }
 }
+#endif
 
+#if DHC_WITH_DESK_KINEMATICS || DHC_WITH_POSE_SAMPLES
 void dhc_rot_mul_t(const dhc_mat3 *a, const dhc_mat3 *b, dhc_mat3 *out)
 {
     for (size_t i = 0U; i < 3U; ++i) {
@@ -146,6 +151,7 @@ void dhc_rot_mul_t(const dhc_mat3 *a, const dhc_mat3 *b, dhc_mat3 *out)
         }
     }
 }
+#endif
 
 void dhc_rot_apply(const dhc_mat3 *r, const double v[3], double out[3])
 {
@@ -171,6 +177,7 @@ void dhc_rot_column(const dhc_mat3 *r, size_t c, double out[3])
     dhc_vec3_set(out, r->m[0][c], r->m[1][c], r->m[2][c]);
 }
 
+#if DHC_WITH_CONVERSIONS || DHC_WITH_EFFECT_BASE_FRAME
 void dhc_rot_exp(const double w_rad[3], dhc_mat3 *r)
 {
     const double t2 = dhc_vec3_dot(w_rad, w_rad);
@@ -199,6 +206,7 @@ void dhc_rot_exp(const double w_rad[3], dhc_mat3 *r)
     r->m[2][0] -= a * w_rad[1];
     r->m[2][1] += a * w_rad[0];
 }
+#endif /* DHC_WITH_CONVERSIONS || DHC_WITH_EFFECT_BASE_FRAME */
 
 #if DHC_WITH_POSE_SAMPLES || DHC_WITH_CONVERSIONS
 void dhc_rot_log(const dhc_mat3 *r, double w_rad[3])
@@ -318,6 +326,7 @@ void dhc_frame_identity(dhc_frame *f)
     dhc_vec3_set(f->pos, 0.0, 0.0, 0.0);
 }
 
+#if DHC_WITH_DESK_KINEMATICS
 void dhc_frame_mul(const dhc_frame *a, const dhc_frame *b, dhc_frame *out)
 {
     double p[3];
@@ -325,6 +334,7 @@ void dhc_frame_mul(const dhc_frame *a, const dhc_frame *b, dhc_frame *out)
     dhc_rot_apply(&a->rot, b->pos, p);
     dhc_vec3_add(p, a->pos, out->pos);
 }
+#endif
 
 void dhc_frame_inverse(const dhc_frame *a, dhc_frame *out)
 {

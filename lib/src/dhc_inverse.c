@@ -6,6 +6,7 @@
 
 #include "dhcal/dhc_factor.h"
 #include "dhcal/dhc_geometry.h"
+#include "dhcal/dhc_jacobian.h"
 
 void dhc_inverse_default_options(dhc_inverse_options *opt)
 {
@@ -54,30 +55,21 @@ static dhc_status command_jacobian(const dhc_model *model, const dhc_sample *s,
                                    double weight_mm_per_rad, dhc_inverse_workspace *ws,
                                    dhc_mat *jac, dhc_prediction *pred)
 {
-    const dhc_status st = dhc_model_evaluate_prepared(model, &ws->trig, s, NULL, 0, &ws->ev, pred);
+    /* the arm's joint columns at q_eff are the identification Jacobian's columns of the
+     * joint offsets (theta_i): the same turn about z_i, scaled by the session's drift */
+    const size_t n = model->arm.n_joints;
+    dhc_param_set offsets;
+    offsets.count = n;
+    for (size_t i = 0U; i < n; ++i) {
+        const dhc_param_id theta = {(uint8_t)DHC_P_THETA, (uint8_t)i, 0U};
+        offsets.id[i] = theta;
+    }
+    const dhc_status st = dhc_model_jacobian_prepared(model, &ws->trig, &offsets, s, NULL,
+                                                      weight_mm_per_rad, jac, pred, &ws->ev);
     if (st != DHC_OK) {
         return st;
     }
-    const size_t n = model->arm.n_joints;
     const size_t rows = jac->rows;
-    /* the arm's joint columns at q_eff: a turn about z_i through o_i moves the tool point by
-     * z_i x (p - o_i) and turns the last link about z_i; the session's drift scales the
-     * point's moves about the base */
-    const double drift = dhc_model_drift_factor(model, s->t_s);
-    for (size_t i = 0U; i < n; ++i) {
-        double z[3];
-        double lever[3];
-        double dp[3];
-        dhc_rot_column(&ws->ev.frames[i].rot, 2U, z);
-        dhc_vec3_sub(pred->p_arm_mm, ws->ev.frames[i].pos, lever);
-        dhc_vec3_cross(z, lever, dp);
-        for (size_t r = 0U; r < 3U; ++r) {
-            DHC_MAT_AT(jac, r, i) = drift * dp[r];
-            if (rows == 6U) {
-                DHC_MAT_AT(jac, r + 3U, i) = weight_mm_per_rad * z[r];
-            }
-        }
-    }
     /* times dq_eff/dq (backlash and drift are constants in q) */
     double slope[DHC_MAX_JOINTS * DHC_MAX_JOINTS];
     memset(slope, 0, sizeof slope);

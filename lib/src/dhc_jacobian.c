@@ -83,37 +83,6 @@ static void put_column(dhc_mat *jac, size_t col, const double dp[3], const doubl
     }
 }
 
-/* The chain's frames and intermediate axes at q (n_joints entries, checked by the caller's
- * check_arm), and the tool point. */
-static dhc_status frames_with_axes(const dhc_arm *arm, const double *q_rad, dhc_frame *f,
-                                   double axes[][2][3], double p[3])
-{
-    double sin_q[DHC_MAX_JOINTS];
-    double cos_q[DHC_MAX_JOINTS];
-    for (size_t i = 0U; i < arm->n_joints; ++i) {
-        if (!dhc_is_finite(q_rad[i])) {
-            return DHC_ERR_NONFINITE;
-        }
-        sin_q[i] = sin(q_rad[i]);
-        cos_q[i] = cos(q_rad[i]);
-    }
-    dhc_arm_trig trig;
-    dhc_arm_prepare(arm, &trig);
-    dhc_forward_frames_trig(arm, &trig, 1.0, sin_q, cos_q, f, axes, p);
-    return DHC_OK;
-}
-
-static dhc_status check_arm(const dhc_arm *arm)
-{
-    if (arm == NULL) {
-        return DHC_ERR_ARGUMENT;
-    }
-    if (arm->n_joints == 0U || arm->n_joints > DHC_MAX_JOINTS) {
-        return DHC_ERR_CAPACITY;
-    }
-    return DHC_OK;
-}
-
 static int jac_finite(const dhc_mat *jac)
 {
     return dhc_all_finite(jac->data, jac->rows * jac->cols);
@@ -125,65 +94,6 @@ static dhc_status check_jac(const dhc_mat *jac, size_t rows, size_t cols)
         return DHC_ERR_ARGUMENT;
     }
     return jac->rows == rows && jac->cols == cols ? DHC_OK : DHC_ERR_DIMENSION;
-}
-
-dhc_status dhc_identification_jacobian(const dhc_arm *arm, const dhc_param_set *set,
-                                       const double *q_rad, size_t q_len, int with_orientation,
-                                       dhc_mat *jac, double tool_world_mm[3],
-                                       dhc_mat3 *tool_rot)
-{
-    if (set == NULL || q_rad == NULL) {
-        return DHC_ERR_ARGUMENT;
-    }
-    dhc_status st = check_arm(arm);
-    if (st == DHC_OK) {
-        st = check_jac(jac, with_orientation ? 6U : 3U, set->count);
-    }
-    if (st != DHC_OK) {
-        return st;
-    }
-    if (q_len < arm->n_joints) {
-        return DHC_ERR_DIMENSION;
-    }
-    for (size_t k = 0U; k < set->count; ++k) {
-        const dhc_param_id *id = &set->id[k];
-        if (!is_geometric(id->kind) ||
-            (id->kind <= (uint8_t)DHC_P_BETA && id->joint >= arm->n_joints)) {
-            return DHC_ERR_ARGUMENT;
-        }
-    }
-    dhc_frame f[DHC_MAX_JOINTS + 1U];
-    double axes[DHC_MAX_JOINTS][2][3];
-    double p[3];
-    st = frames_with_axes(arm, q_rad, f, axes, p);
-    if (st != DHC_OK) {
-        return st;
-    }
-    for (size_t k = 0U; k < set->count; ++k) {
-        double dp[3];
-        double dw[3];
-        geometric_column(arm, f, axes, p, &set->id[k], dp, dw);
-        put_column(jac, k, dp, dw, with_orientation, 1.0);
-    }
-    /* Finite angles on non-finite or overflowing geometry (found by fuzzing). */
-    int finite = jac_finite(jac);
-    for (size_t r = 0U; r < 3U; ++r) {
-        finite = finite && dhc_is_finite(p[r]);
-        for (size_t c = 0U; c < 3U; ++c) {
-            finite = finite && dhc_is_finite(f[arm->n_joints].rot.m[r][c]);
-        }
-    }
-    if (!finite) {
-        dhc_mat_fill(jac, 0.0);
-        return DHC_ERR_NONFINITE;
-    }
-    if (tool_world_mm != NULL) {
-        dhc_vec3_copy(p, tool_world_mm);
-    }
-    if (tool_rot != NULL) {
-        *tool_rot = f[arm->n_joints].rot;
-    }
-    return DHC_OK;
 }
 
 static int set_has_compliance(const dhc_param_set *set)
@@ -256,29 +166,6 @@ static dhc_status jacobian_prepared(const dhc_model *model, const dhc_arm_trig *
                                     const dhc_param_set *set, const dhc_sample *s,
                                     const double *sincos_q, double weight_mm_per_rad,
                                     dhc_mat *jac, dhc_prediction *pr, dhc_model_eval *ev);
-
-dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set,
-                              const dhc_sample *s, double weight_mm_per_rad, dhc_mat *jac,
-                              dhc_prediction *pred)
-{
-    if (model == NULL || set == NULL || s == NULL) {
-        return DHC_ERR_ARGUMENT;
-    }
-    dhc_status st = check_jac(jac, dhc_sample_rows(s), set->count);
-    if (st == DHC_OK) {
-        st = check_arm(&model->arm);
-    }
-    if (st != DHC_OK) {
-        return st;
-    }
-    dhc_prediction local;
-    memset(&local, 0, sizeof local); /* written before read; zeroed so no tool has to see it */
-    dhc_arm_trig trig;
-    dhc_arm_prepare(&model->arm, &trig);
-    dhc_model_eval ev;
-    return jacobian_prepared(model, &trig, set, s, NULL, weight_mm_per_rad, jac,
-                             pred != NULL ? pred : &local, &ev);
-}
 
 dhc_status dhc_model_jacobian_prepared(const dhc_model *model, const dhc_arm_trig *trig,
                                        const dhc_param_set *set, const dhc_sample *s,
@@ -365,39 +252,6 @@ static dhc_status jacobian_prepared(const dhc_model *model, const dhc_arm_trig *
     return DHC_OK;
 }
 
-dhc_status dhc_joint_jacobian(const dhc_arm *arm, const double *q_rad, size_t q_len,
-                              int with_orientation, dhc_mat *jac)
-{
-    dhc_status st = check_arm(arm);
-    if (st == DHC_OK) {
-        st = check_jac(jac, with_orientation ? 6U : 3U, arm->n_joints);
-    }
-    if (st != DHC_OK) {
-        return st;
-    }
-    if (q_rad == NULL) {
-        return DHC_ERR_ARGUMENT;
-    }
-    if (q_len < arm->n_joints) {
-        return DHC_ERR_DIMENSION;
-    }
-    dhc_frame f[DHC_MAX_JOINTS + 1U];
-    double axes[DHC_MAX_JOINTS][2][3];
-    double p[3];
-    st = frames_with_axes(arm, q_rad, f, axes, p);
-    if (st != DHC_OK) {
-        return st;
-    }
-    for (size_t i = 0U; i < arm->n_joints; ++i) {
-        const dhc_param_id theta = {(uint8_t)DHC_P_THETA, (uint8_t)i, 0U};
-        double dp[3];
-        double dw[3];
-        geometric_column(arm, f, axes, p, &theta, dp, dw);
-        put_column(jac, i, dp, dw, with_orientation, 1.0);
-    }
-    return DHC_OK;
-}
-
 dhc_status dhc_model_linearize_prepared(const dhc_model *model, const dhc_arm_trig *trig,
                                        const dhc_param_set *set, const dhc_sample *s,
                                        const double *sincos_q, double weight_mm_per_rad,
@@ -422,6 +276,138 @@ dhc_status dhc_model_linearize_prepared(const dhc_model *model, const dhc_arm_tr
     return st;
 }
 
+#if DHC_WITH_DESK_KINEMATICS
+/* The chain's frames and intermediate axes at q (n_joints entries, checked by the caller's
+ * check_arm), and the tool point. */
+static dhc_status frames_with_axes(const dhc_arm *arm, const double *q_rad, dhc_frame *f,
+                                   double axes[][2][3], double p[3])
+{
+    double sin_q[DHC_MAX_JOINTS];
+    double cos_q[DHC_MAX_JOINTS];
+    for (size_t i = 0U; i < arm->n_joints; ++i) {
+        if (!dhc_is_finite(q_rad[i])) {
+            return DHC_ERR_NONFINITE;
+        }
+        sin_q[i] = sin(q_rad[i]);
+        cos_q[i] = cos(q_rad[i]);
+    }
+    dhc_arm_trig trig;
+    dhc_arm_prepare(arm, &trig);
+    dhc_forward_frames_trig(arm, &trig, 1.0, sin_q, cos_q, f, axes, p);
+    return DHC_OK;
+}
+
+static dhc_status check_arm(const dhc_arm *arm)
+{
+    if (arm == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    if (arm->n_joints == 0U || arm->n_joints > DHC_MAX_JOINTS) {
+        return DHC_ERR_CAPACITY;
+    }
+    return DHC_OK;
+}
+
+dhc_status dhc_identification_jacobian(const dhc_arm *arm, const dhc_param_set *set,
+                                       const double *q_rad, size_t q_len, int with_orientation,
+                                       dhc_mat *jac, double tool_world_mm[3],
+                                       dhc_mat3 *tool_rot)
+{
+    if (set == NULL || q_rad == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    dhc_status st = check_arm(arm);
+    if (st == DHC_OK) {
+        st = check_jac(jac, with_orientation ? 6U : 3U, set->count);
+    }
+    if (st != DHC_OK) {
+        return st;
+    }
+    if (q_len < arm->n_joints) {
+        return DHC_ERR_DIMENSION;
+    }
+    for (size_t k = 0U; k < set->count; ++k) {
+        const dhc_param_id *id = &set->id[k];
+        if (!is_geometric(id->kind) ||
+            (id->kind <= (uint8_t)DHC_P_BETA && id->joint >= arm->n_joints)) {
+            return DHC_ERR_ARGUMENT;
+        }
+    }
+    dhc_frame f[DHC_MAX_JOINTS + 1U];
+    double axes[DHC_MAX_JOINTS][2][3];
+    double p[3];
+    st = frames_with_axes(arm, q_rad, f, axes, p);
+    if (st != DHC_OK) {
+        return st;
+    }
+    for (size_t k = 0U; k < set->count; ++k) {
+        double dp[3];
+        double dw[3];
+        geometric_column(arm, f, axes, p, &set->id[k], dp, dw);
+        put_column(jac, k, dp, dw, with_orientation, 1.0);
+    }
+    /* Finite angles on non-finite or overflowing geometry (found by fuzzing). */
+    int finite = jac_finite(jac);
+    for (size_t r = 0U; r < 3U; ++r) {
+        finite = finite && dhc_is_finite(p[r]);
+        for (size_t c = 0U; c < 3U; ++c) {
+            finite = finite && dhc_is_finite(f[arm->n_joints].rot.m[r][c]);
+        }
+    }
+    if (!finite) {
+        dhc_mat_fill(jac, 0.0);
+        return DHC_ERR_NONFINITE;
+    }
+    if (tool_world_mm != NULL) {
+        dhc_vec3_copy(p, tool_world_mm);
+    }
+    if (tool_rot != NULL) {
+        *tool_rot = f[arm->n_joints].rot;
+    }
+    return DHC_OK;
+}
+
+dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set,
+                              const dhc_sample *s, double weight_mm_per_rad, dhc_mat *jac,
+                              dhc_prediction *pred)
+{
+    if (model == NULL || set == NULL || s == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    dhc_status st = check_jac(jac, dhc_sample_rows(s), set->count);
+    if (st == DHC_OK) {
+        st = check_arm(&model->arm);
+    }
+    if (st != DHC_OK) {
+        return st;
+    }
+    dhc_prediction local;
+    memset(&local, 0, sizeof local); /* written before read; zeroed so no tool has to see it */
+    dhc_arm_trig trig;
+    dhc_arm_prepare(&model->arm, &trig);
+    dhc_model_eval ev;
+    return jacobian_prepared(model, &trig, set, s, NULL, weight_mm_per_rad, jac,
+                             pred != NULL ? pred : &local, &ev);
+}
+
+dhc_status dhc_joint_jacobian(const dhc_arm *arm, const double *q_rad, size_t q_len,
+                              int with_orientation, dhc_mat *jac)
+{
+    const dhc_status st = check_arm(arm);
+    if (st != DHC_OK) {
+        return st;
+    }
+    /* a joint's column is the identification Jacobian's column of its offset theta */
+    dhc_param_set offsets;
+    offsets.count = arm->n_joints;
+    for (size_t i = 0U; i < arm->n_joints; ++i) {
+        const dhc_param_id theta = {(uint8_t)DHC_P_THETA, (uint8_t)i, 0U};
+        offsets.id[i] = theta;
+    }
+    return dhc_identification_jacobian(arm, &offsets, q_rad, q_len, with_orientation, jac,
+                                       NULL, NULL);
+}
+
 dhc_status dhc_model_linearize(const dhc_model *model, const dhc_param_set *set,
                                const dhc_sample *s, double weight_mm_per_rad,
                                double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows, dhc_mat *jac)
@@ -437,3 +423,39 @@ dhc_status dhc_model_linearize(const dhc_model *model, const dhc_param_set *set,
     }
     return st;
 }
+#else
+/* Left out of this build (DHC_WITH_DESK_KINEMATICS 0): the fit and the inverse kinematics
+ * take their Jacobians at the prepared trigonometry (dhc_model_jacobian_prepared). */
+dhc_status dhc_identification_jacobian(const dhc_arm *arm, const dhc_param_set *set,
+                                       const double *q_rad, size_t q_len, int with_orientation,
+                                       dhc_mat *jac, double tool_world_mm[3],
+                                       dhc_mat3 *tool_rot)
+{
+    (void)arm; (void)set; (void)q_rad; (void)q_len; (void)with_orientation; (void)jac;
+    (void)tool_world_mm; (void)tool_rot;
+    return DHC_ERR_ARGUMENT;
+}
+
+dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set,
+                              const dhc_sample *s, double weight_mm_per_rad, dhc_mat *jac,
+                              dhc_prediction *pred)
+{
+    (void)model; (void)set; (void)s; (void)weight_mm_per_rad; (void)jac; (void)pred;
+    return DHC_ERR_ARGUMENT;
+}
+
+dhc_status dhc_joint_jacobian(const dhc_arm *arm, const double *q_rad, size_t q_len,
+                              int with_orientation, dhc_mat *jac)
+{
+    (void)arm; (void)q_rad; (void)q_len; (void)with_orientation; (void)jac;
+    return DHC_ERR_ARGUMENT;
+}
+
+dhc_status dhc_model_linearize(const dhc_model *model, const dhc_param_set *set,
+                               const dhc_sample *s, double weight_mm_per_rad,
+                               double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows, dhc_mat *jac)
+{
+    (void)model; (void)set; (void)s; (void)weight_mm_per_rad; (void)r; (void)rows; (void)jac;
+    return DHC_ERR_ARGUMENT;
+}
+#endif /* DHC_WITH_DESK_KINEMATICS */

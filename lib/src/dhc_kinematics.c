@@ -50,6 +50,7 @@ void dhc_arm_choose_conventions(dhc_arm *arm, double parallel_tol)
     }
 }
 
+#if DHC_WITH_DESK_KINEMATICS
 static void joint_transform(const dhc_joint *j, double q_rad, double length_scale,
                             dhc_frame *out)
 {
@@ -117,6 +118,54 @@ dhc_status dhc_forward_frames_scaled(const dhc_arm *arm, double length_scale,
     return DHC_OK;
 }
 
+dhc_status dhc_forward(const dhc_arm *arm, const double *q_rad, size_t q_len, dhc_frame *tool)
+{
+    if (tool == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    dhc_frame frames[DHC_MAX_JOINTS + 1U];
+    double p[3];
+    const dhc_status st = dhc_forward_frames(arm, q_rad, q_len, frames, DHC_MAX_JOINTS + 1U, p);
+    if (st != DHC_OK) {
+        return st;
+    }
+    tool->rot = frames[arm->n_joints].rot;
+    dhc_vec3_copy(p, tool->pos);
+    return DHC_OK;
+}
+
+#else
+/* Left out of this build (DHC_WITH_DESK_KINEMATICS 0): the model's chain runs on the
+ * prepared trigonometry (dhc_arm_prepare, dhc_forward_frames_trig). */
+dhc_status dhc_joint_transform(const dhc_arm *arm, size_t i, double q_rad, dhc_frame *out)
+{
+    (void)arm; (void)i; (void)q_rad; (void)out;
+    return DHC_ERR_ARGUMENT;
+}
+
+dhc_status dhc_forward_frames(const dhc_arm *arm, const double *q_rad, size_t q_len,
+                              dhc_frame *frames, size_t frames_len, double tool_world_mm[3])
+{
+    (void)arm; (void)q_rad; (void)q_len; (void)frames; (void)frames_len; (void)tool_world_mm;
+    return DHC_ERR_ARGUMENT;
+}
+
+dhc_status dhc_forward_frames_scaled(const dhc_arm *arm, double length_scale,
+                                     const double *q_rad, size_t q_len, dhc_frame *frames,
+                                     size_t frames_len, double tool_world_mm[3])
+{
+    (void)arm; (void)length_scale; (void)q_rad; (void)q_len; (void)frames; (void)frames_len;
+    (void)tool_world_mm;
+    return DHC_ERR_ARGUMENT;
+}
+
+dhc_status dhc_forward(const dhc_arm *arm, const double *q_rad, size_t q_len, dhc_frame *tool)
+{
+    (void)arm; (void)q_rad; (void)q_len; (void)tool;
+    return DHC_ERR_ARGUMENT;
+}
+#endif /* DHC_WITH_DESK_KINEMATICS */
+
 void dhc_arm_prepare(const dhc_arm *arm, dhc_arm_trig *trig)
 {
     trig->n_joints = arm->n_joints;
@@ -167,22 +216,6 @@ void dhc_forward_frames_trig(const dhc_arm *arm, const dhc_arm_trig *trig, doubl
         dhc_vec3_scale(arm->tool_mm, length_scale, tool);
         dhc_frame_apply(&frames[n], tool, tool_world_mm);
     }
-}
-
-dhc_status dhc_forward(const dhc_arm *arm, const double *q_rad, size_t q_len, dhc_frame *tool)
-{
-    if (tool == NULL) {
-        return DHC_ERR_ARGUMENT;
-    }
-    dhc_frame frames[DHC_MAX_JOINTS + 1U];
-    double p[3];
-    const dhc_status st = dhc_forward_frames(arm, q_rad, q_len, frames, DHC_MAX_JOINTS + 1U, p);
-    if (st != DHC_OK) {
-        return st;
-    }
-    tool->rot = frames[arm->n_joints].rot;
-    dhc_vec3_copy(p, tool->pos);
-    return DHC_OK;
 }
 
 #if DHC_WITH_CONVERSIONS

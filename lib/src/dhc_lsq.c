@@ -359,7 +359,11 @@ dhc_status dhc_lsq_analyse(const dhc_normal_eq *ne, double rel_tol, dhc_lsq_fact
     }
     fac->n = n;
     fac->rank = rank;
-    fac->condition = DHC_WITH_REPORT_EXTRAS ? dhc_chol_condition_estimate(&m, rank) : 0.0;
+#if DHC_WITH_REPORT_EXTRAS
+    fac->condition = dhc_chol_condition_estimate(&m, rank);
+#else
+    fac->condition = 0.0;
+#endif
     return DHC_OK;
 }
 
@@ -528,6 +532,7 @@ dhc_status dhc_lsq_prediction_variance(const dhc_lsq_factor *fac, double sigma2,
 }
 #endif /* DHC_WITH_UNCERTAINTY */
 
+#if DHC_WITH_REPORT_EXTRAS
 dhc_status dhc_lsq_confounded(const dhc_normal_eq *ne, const dhc_lsq_factor *fac, size_t j,
                               uint8_t *partner, size_t len, size_t *count)
 {
@@ -564,3 +569,11 @@ dhc_status dhc_lsq_confounded(const dhc_normal_eq *ne, const dhc_lsq_factor *fac
     *count = c;
     return DHC_OK;
 }
+#else
+dhc_status dhc_lsq_confounded(const dhc_normal_eq *ne, const dhc_lsq_factor *fac, size_t j,
+                              uint8_t *partner, size_t len, size_t *count)
+{
+    (void)ne; (void)fac; (void)j; (void)partner; (void)len; (void)count;
+    return DHC_ERR_ARGUMENT; /* left out of this build (DHC_WITH_REPORT_EXTRAS 0) */
+}
+#endif /* DHC_WITH_REPORT_EXTRAS */

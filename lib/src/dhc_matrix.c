@@ -26,11 +26,6 @@ static int mat_valid(const dhc_mat *m)
     return m != NULL && m->data != NULL;
 }
 
-static int mat_finite(const dhc_mat *m)
-{
-    return dhc_all_finite(m->data, m->rows * m->cols);
-}
-
 dhc_status dhc_mat_init(dhc_mat *m, size_t rows, size_t cols, double *buf, size_t buf_len)
 {
     if (m == NULL || buf == NULL) {
@@ -56,6 +51,12 @@ void dhc_mat_fill(dhc_mat *m, double value)
     for (size_t i = 0U; i < n; ++i) {
         m->data[i] = value;
     }
+}
+
+#if DHC_WITH_MATRIX_OPS
+static int mat_finite(const dhc_mat *m)
+{
+    return dhc_all_finite(m->data, m->rows * m->cols);
 }
 
 dhc_status dhc_mat_mul(const dhc_mat *a, const dhc_mat *b, dhc_mat *out)
@@ -142,3 +143,30 @@ dhc_status dhc_mat_vec(const dhc_mat *a, const double *x, size_t x_len, double *
     }
     return DHC_OK;
 }
+#else
+/* Left out of this build (DHC_WITH_MATRIX_OPS 0): the core's own algebra runs on its
+ * kernels (dhc_normal_eq_add, dhc_tri_*), never on these. */
+dhc_status dhc_mat_mul(const dhc_mat *a, const dhc_mat *b, dhc_mat *out)
+{
+    (void)a; (void)b; (void)out;
+    return DHC_ERR_ARGUMENT;
+}
+
+dhc_status dhc_mat_tmul(const dhc_mat *a, const dhc_mat *b, dhc_mat *out)
+{
+    (void)a; (void)b; (void)out;
+    return DHC_ERR_ARGUMENT;
+}
+
+dhc_status dhc_mat_transpose(const dhc_mat *a, dhc_mat *out)
+{
+    (void)a; (void)out;
+    return DHC_ERR_ARGUMENT;
+}
+
+dhc_status dhc_mat_vec(const dhc_mat *a, const double *x, size_t x_len, double *y, size_t y_len)
+{
+    (void)a; (void)x; (void)x_len; (void)y; (void)y_len;
+    return DHC_ERR_ARGUMENT;
+}
+#endif /* DHC_WITH_MATRIX_OPS */

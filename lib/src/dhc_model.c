@@ -98,6 +98,7 @@ static void moments_from_frames(const dhc_model *model, const dhc_frame *f,
     }
 }
 
+#if DHC_WITH_DESK_KINEMATICS
 dhc_status dhc_model_gravity_moments(const dhc_model *model, double length_scale,
                                      const double *q_rad,
                                      double tau[DHC_MAX_JOINTS][DHC_MAX_JOINTS])
@@ -113,6 +114,15 @@ dhc_status dhc_model_gravity_moments(const dhc_model *model, double length_scale
     }
     return st;
 }
+#else
+dhc_status dhc_model_gravity_moments(const dhc_model *model, double length_scale,
+                                     const double *q_rad,
+                                     double tau[DHC_MAX_JOINTS][DHC_MAX_JOINTS])
+{
+    (void)model; (void)length_scale; (void)q_rad; (void)tau;
+    return DHC_ERR_ARGUMENT; /* left out (DHC_WITH_DESK_KINEMATICS 0): dhc_model_evaluate's */
+}
+#endif /* DHC_WITH_DESK_KINEMATICS */
 
 double dhc_model_drift_factor(const dhc_model *model, double t_s)
 {

@@ -260,16 +260,19 @@ dhc_status dhc_params_apply(const dhc_param_set *set, dhc_model *model, const do
     /* The Jacobian treats the three base rotations as one small rotation vector about the
      * base origin in world axes; composing it exactly keeps the rotation orthonormal. (A
      * build without base_frame has no such parameter: nothing to compose.) */
-    if (DHC_WITH_EFFECT_BASE_FRAME) {
-        dhc_mat3 r;
-        dhc_mat3 rotated;
-        dhc_rot_exp(base_rot, &r);
-        dhc_rot_mul(&r, &model->arm.base.rot, &rotated);
-        model->arm.base.rot = rotated;
-    }
+#if DHC_WITH_EFFECT_BASE_FRAME
+    dhc_mat3 r;
+    dhc_mat3 rotated;
+    dhc_rot_exp(base_rot, &r);
+    dhc_rot_mul(&r, &model->arm.base.rot, &rotated);
+    model->arm.base.rot = rotated;
+#else
+    (void)base_rot;
+#endif
     return DHC_OK;
 }
 
+#if DHC_WITH_NAMES
 static size_t put_str(char *buf, size_t cap, size_t pos, const char *s)
 {
     while (*s != '\0') {
@@ -374,3 +377,4 @@ int dhc_params_in_degrees(const dhc_param_set *set, size_t k)
 {
     return dhc_params_is_angle(set, k) || set->id[k].kind == (uint8_t)DHC_P_COMPLIANCE;
 }
+#endif /* DHC_WITH_NAMES */

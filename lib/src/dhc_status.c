@@ -1,6 +1,8 @@
 /* dhc_status.c - English phrases for the status codes. */
 #include "dhcal/dhc_status.h"
 
+#if DHC_WITH_NAMES
+
 const char *dhc_status_str(dhc_status status)
 {
     /* No default label: -Wswitch then names any enumerator added without a phrase. */
@@ -31,3 +33,8 @@ const char *dhc_status_str(dhc_status status)
     /* A value cast from an integer outside the enumeration (a corrupted or foreign code). */
     return "unknown status";
 }
+#else
+/* Left out (DHC_WITH_NAMES 0): a controller reports the code. ISO C wants a declaration in
+ * every translation unit. */
+typedef dhc_status dhc_status_without_names;
+#endif

@@ -13,6 +13,7 @@
 
 #include <math.h>
 
+#if DHC_WITH_TRILATERATION
 /* The closed form divides by b and by a - c. At or below this share of the anchor scale
  * (1 nm on a 1 m measurer) no drawing or survey tells them from 0: P2 = P3, or P1 on the
  * line P2 P3, and the quotients would be noise. dhc_trilat.h quotes the value. */
@@ -187,3 +188,33 @@ dhc_status dhc_model_wire_point(const dhc_model *model, const double wire_mm[3],
     }
     return dhc_trilat_world(&m, len, tol_mm2, p_world_mm);
 }
+#else
+/* Left out of this build (DHC_WITH_TRILATERATION 0): the controller checks wires against
+ * the model's predicted lengths and never solves for the point. */
+dhc_status dhc_trilat_local(const dhc_measurer *m, const double len_mm[3], double tol_mm2,
+                            double q_meas_mm[3])
+{
+    (void)m; (void)len_mm; (void)tol_mm2; (void)q_meas_mm;
+    return DHC_ERR_ARGUMENT;
+}
+
+dhc_status dhc_trilat_world(const dhc_measurer *m, const double len_mm[3], double tol_mm2,
+                            double q_world_mm[3])
+{
+    (void)m; (void)len_mm; (void)tol_mm2; (void)q_world_mm;
+    return DHC_ERR_ARGUMENT;
+}
+
+dhc_status dhc_measurer_of_model(const dhc_measurer_model *mm, dhc_measurer *out)
+{
+    (void)mm; (void)out;
+    return DHC_ERR_ARGUMENT;
+}
+
+dhc_status dhc_model_wire_point(const dhc_model *model, const double wire_mm[3], double tol_mm2,
+                                double p_world_mm[3])
+{
+    (void)model; (void)wire_mm; (void)tol_mm2; (void)p_world_mm;
+    return DHC_ERR_ARGUMENT;
+}
+#endif /* DHC_WITH_TRILATERATION */

@@ -13,11 +13,13 @@
 #include "dhcal/dhc_uncertainty.h"
 #include "dhcal/dhc_inverse.h"
 #include "dhcal/dhc_plan.h"
+#include "dhcal/dhc_trilat.h"
 #include "unity.h"
 
 #if DHC_WITH_DIAGNOSE || DHC_WITH_SESSION_TESTS || DHC_WITH_UNCERTAINTY || DHC_WITH_EIV ||   \
     DHC_WITH_POSE_SAMPLES || DHC_WITH_ROBUST_START || DHC_WITH_EFFECT_SUMMARIES ||              \
-    DHC_WITH_CONVERSIONS || DHC_WITH_INVERSE || DHC_WITH_PLAN || DHC_WITH_REPORT_EXTRAS
+    DHC_WITH_CONVERSIONS || DHC_WITH_INVERSE || DHC_WITH_PLAN || DHC_WITH_REPORT_EXTRAS ||    \
+    DHC_WITH_NAMES || DHC_WITH_MATRIX_OPS || DHC_WITH_DESK_KINEMATICS || DHC_WITH_TRILATERATION
 #error "this test is built with every DHC_WITH_* feature 0"
 #endif
 #if DHC_WITH_EFFECT_BASE_FRAME || DHC_WITH_EFFECT_JOINT_SCALE ||                             \
@@ -206,10 +208,6 @@ static void test_effects_left_out_are_not_in_the_catalogue(void)
     TEST_ASSERT_EQUAL_size_t(2U, n);
     TEST_ASSERT_NULL(dhc_effect_info_of(DHC_EFFECT_JOINT_SCALE));
     TEST_ASSERT_NULL(dhc_effect_name(DHC_EFFECT_THERMAL_SCALE));
-    dhc_effect e;
-    size_t joint;
-    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_effect_parse("joint_scale:1", 13U, 3U, &e, &joint));
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_effect_parse("joint_compliance:2", 18U, 3U, &e, &joint));
 }
 
 /* No parameter of an effect left out joins a set; the one built does. */
@@ -260,7 +258,7 @@ static void test_a_model_with_an_effect_left_out_is_refused(void)
 }
 
 /* The effect built works: joint 2 bending under gravity moves the tool as the rigid arm at
- * the bent angle (q2 + c22 tau22 + c23 tau23, the moments from dhc_model_gravity_moments),
+ * the bent angle (q2 + c22 tau22 + c23 tau23, the moments dhc_model_evaluate leaves),
  * and a fit of noise-free samples of the compliant arm finds c22 and c23 again. */
 static void test_the_compliance_built_predicts_and_fits(void)
 {
@@ -268,9 +266,12 @@ static void test_the_compliance_built_predicts_and_fits(void)
     truth.effect[1].compliance[1] = 2.0e-6;
     truth.effect[1].compliance[2] = 1.0e-6;
     const double q[3] = {0.3, 0.9, -0.6};
-    double tau[DHC_MAX_JOINTS][DHC_MAX_JOINTS];
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_model_gravity_moments(&truth, 1.0, q, tau));
-    const double bent[3] = {q[0], q[1] + 2.0e-6 * tau[1][1] + 1.0e-6 * tau[1][2], q[2]};
+    dhc_sample at;
+    dhc_model_sample_at(&truth, q, NULL, DHC_MEAS_POSITION, &at);
+    static dhc_model_eval ev;
+    dhc_prediction pred;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_model_evaluate(&truth, &at, 1, &ev, &pred));
+    const double bent[3] = {q[0], q[1] + 2.0e-6 * ev.tau[1][1] + 1.0e-6 * ev.tau[1][2], q[2]};
     const dhc_model rigid = test_paper3_model();
     double p[3];
     double p_rigid[3];
@@ -297,6 +298,145 @@ static void test_the_compliance_built_predicts_and_fits(void)
     TEST_ASSERT_DOUBLE_WITHIN(1e-11, 1.0e-6, model.effect[1].compliance[2]);
 }
 
+/* Names are for people and files: a controller reports the numbers. Parsing answers with a
+ * status, even for an effect the build has. */
+static void test_names_are_refused(void)
+{
+    dhc_effect e = DHC_EFFECT_TOOL_OFFSET;
+    size_t joint = 7U;
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
+                      dhc_effect_parse("joint_compliance:2", 18U, 3U, &e, &joint));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_effect_parse("tool_offset", 11U, 3U, &e, &joint));
+    TEST_ASSERT_EQUAL(DHC_EFFECT_TOOL_OFFSET, e);
+    TEST_ASSERT_EQUAL_size_t(7U, joint);
+    TEST_ASSERT_NOT_NULL(dhc_effect_info_of(DHC_EFFECT_JOINT_COMPLIANCE));
+}
+
+/* The checked dense algebra is refused on well-formed arguments; the fit's own kernels stay
+ * (test_the_core_fit_reaches_the_true_arm). */
+static void test_the_matrix_operations_are_refused(void)
+{
+    double a_buf[4] = {4.0, 1.0, 1.0, 3.0};
+    double b_buf[4] = {1.0, 2.0, 3.0, 4.0};
+    double out_buf[4] = {-1.0, -1.0, -1.0, -1.0};
+    dhc_mat a;
+    dhc_mat b;
+    dhc_mat out;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&a, 2U, 2U, a_buf, 4U));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&b, 2U, 2U, b_buf, 4U));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&out, 2U, 2U, out_buf, 4U));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_mat_mul(&a, &b, &out));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_mat_tmul(&a, &b, &out));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_mat_transpose(&a, &out));
+    double x[2] = {1.0, 2.0};
+    double y[2] = {-1.0, -1.0};
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_mat_vec(&a, x, 2U, y, 2U));
+    /* a = L L^T with L = [2 0; 0.5 sqrt(2.75)] */
+    double l_buf[4] = {2.0, 0.0, 0.5, sqrt(2.75)};
+    dhc_mat l;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&l, 2U, 2U, l_buf, 4U));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_chol_solve(&l, 2U, x, y, 2U));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_tri_lower_solve(&l, 2U, x, y, 2U));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_tri_lower_t_solve(&l, 2U, x, y, 2U));
+    TEST_ASSERT_EQUAL_DOUBLE(-1.0, y[0]);
+    TEST_ASSERT_EQUAL_DOUBLE(-1.0, out_buf[0]);
+}
+
+/* The desk's one-call kinematics are refused; the prepared chain gives the model's tool
+ * point, as dhc_model_tool_point does. */
+static void test_the_desk_kinematics_are_refused(void)
+{
+    const dhc_model model = test_paper3_model();
+    const dhc_arm *arm = &model.arm;
+    const double q[3] = {0.3, 0.9, -0.6};
+    dhc_frame tool;
+    dhc_frame frames[DHC_MAX_JOINTS + 1U];
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_forward(arm, q, 3U, &tool));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
+                      dhc_forward_frames(arm, q, 3U, frames, DHC_MAX_JOINTS + 1U, NULL));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_joint_transform(arm, 1U, 0.5, &tool));
+    double jac_buf[6 * DHC_MAX_PARAMS];
+    dhc_mat jac;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&jac, 3U, 3U, jac_buf, 6U * DHC_MAX_PARAMS));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_joint_jacobian(arm, q, 3U, 0, &jac));
+    dhc_param_set set;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &model));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&jac, 3U, set.count, jac_buf, 6U * DHC_MAX_PARAMS));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
+                      dhc_identification_jacobian(arm, &set, q, 3U, 0, &jac, NULL, NULL));
+    dhc_sample s;
+    dhc_model_sample_at(&model, q, NULL, DHC_MEAS_POSITION, &s);
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_model_jacobian(&model, &set, &s, 1000.0, &jac, NULL));
+    double r[DHC_MAX_ROWS_PER_SAMPLE];
+    size_t rows = 0U;
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
+                      dhc_model_linearize(&model, &set, &s, 1000.0, r, &rows, &jac));
+    double tau[DHC_MAX_JOINTS][DHC_MAX_JOINTS];
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_model_gravity_moments(&model, 1.0, q, tau));
+    /* what the controller calls instead */
+    static dhc_model_eval ev;
+    dhc_arm_trig trig;
+    dhc_prediction pred;
+    dhc_arm_prepare(arm, &trig);
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_model_jacobian_prepared(&model, &trig, &set, &s, NULL, 1000.0,
+                                                          &jac, &pred, &ev));
+    double p[3];
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_model_tool_point(&model, q, NULL, p));
+    test_tool_frame(arm, q, &tool);
+    for (size_t k = 0U; k < 3U; ++k) {
+        TEST_ASSERT_DOUBLE_WITHIN(1e-9, p[k], tool.pos[k]);
+        TEST_ASSERT_DOUBLE_WITHIN(1e-9, p[k], pred.p_mm[k]);
+    }
+}
+
+/* Trilateration is refused on the paper's measurer and a point's true wire lengths; the
+ * model's predicted wires, what the controller checks samples against, stay. */
+static void test_trilateration_is_refused(void)
+{
+    dhc_model model = test_paper3_model();
+    test_put_paper_measurer(&model);
+    const double q[3] = {0.3, 0.9, -0.6};
+    dhc_sample s;
+    dhc_model_sample_at(&model, q, NULL, DHC_MEAS_WIRES, &s);
+    dhc_prediction wires;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_model_predict(&model, &s, &wires));
+    TEST_ASSERT_TRUE(wires.wire_mm[0] > 0.0 && wires.wire_mm[1] > 0.0 && wires.wire_mm[2] > 0.0);
+    dhc_measurer m;
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_measurer_of_model(&model.measurer, &m));
+    double p[3] = {-1.0, -1.0, -1.0};
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_model_wire_point(&model, wires.wire_mm, 1e-6, p));
+    TEST_ASSERT_EQUAL_DOUBLE(-1.0, p[0]);
+    m.a_mm = 1200.0;
+    m.b_mm = 600.0;
+    m.c_mm = 300.0;
+    m.x_sign = 1.0;
+    dhc_frame_identity(&m.frame);
+    const double len[3] = {1300.0, 1400.0, 1350.0};
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_trilat_local(&m, len, 1e-6, p));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_trilat_world(&m, len, 1e-6, p));
+    TEST_ASSERT_EQUAL_DOUBLE(-1.0, p[0]);
+}
+
+/* The report's explanations: a parameter no sample moves has no partners to name. */
+static void test_the_confounded_partners_are_refused(void)
+{
+    dhc_arm cal;
+    TEST_ASSERT_EQUAL(DHC_OK, calibrate(3U, 20U, 9ULL, &cal));
+    uint8_t partner[DHC_MAX_PARAMS];
+    size_t count = 99U;
+    size_t unidentifiable = paper.set.count;
+    for (size_t k = 0U; k < paper.set.count; ++k) {
+        if (!paper.rep.identifiable[k]) {
+            unidentifiable = k;
+        }
+    }
+    TEST_ASSERT_TRUE(unidentifiable < paper.set.count); /* the paper's arm has some */
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
+                      dhc_lsq_confounded(&paper.ws.ne, &paper.ws.fac, unidentifiable, partner,
+                                         DHC_MAX_PARAMS, &count));
+    TEST_ASSERT_EQUAL_size_t(99U, count);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -311,5 +451,10 @@ int main(void)
     RUN_TEST(test_parameters_of_effects_left_out_are_refused);
     RUN_TEST(test_a_model_with_an_effect_left_out_is_refused);
     RUN_TEST(test_the_compliance_built_predicts_and_fits);
+    RUN_TEST(test_names_are_refused);
+    RUN_TEST(test_the_matrix_operations_are_refused);
+    RUN_TEST(test_the_desk_kinematics_are_refused);
+    RUN_TEST(test_trilateration_is_refused);
+    RUN_TEST(test_the_confounded_partners_are_refused);
     return UNITY_END();
 }

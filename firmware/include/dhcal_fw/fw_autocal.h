@@ -131,10 +131,12 @@ fw_fault fw_autocal(dhc_model *model, const dhc_sample *samples, size_t n,
                     const fw_nvstore *nv, fw_autocal_workspace *ws, dhc_model *geo_out,
                     fw_autocal_result *res);
 
+#if DHC_WITH_NAMES
 /* The effect the diagnosis added, as the effect table names it (docs/effects.md):
  * "joint_compliance:2" (joints 1-based), "measurer_scale", or "none" when it found none;
  * cut to fit cap (including the terminator; cap 0: nothing written). Returns buf. */
 char *fw_autocal_effect_label(const fw_autocal_result *res, char *buf, size_t cap);
+#endif
 
 /* The controller's fault for a lib failure: DHC_ERR_NOT_CONVERGED -> FW_FAULT_NOT_CONVERGED;
  * DHC_ERR_UNDERDETERMINED, DHC_ERR_NO_DATA -> FW_FAULT_UNDERDETERMINED (too few or too

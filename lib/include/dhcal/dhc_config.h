@@ -35,11 +35,18 @@ DHC_STATIC_ASSERT(DHC_MAX_PARAMS <= 256U, "DHC_MAX_PARAMS too large for the inde
  * The whole build, callers included, must agree. A feature left out answers with a
  * status, never with a silently different result: its entry points return
  * DHC_ERR_ARGUMENT (dhc_diagnose, dhc_uncertainty_*, dhc_lsq_prediction_variance,
- * dhc_arm_to_standard_dh, dhc_plan_select, dhc_plan_weighting, dhc_model_inverse, dhc_model_command_jacobian),
- * options and samples that need it are refused (a noise model that is on, robust_start, pose
- * samples: dhc_calib_fit, dhc_sample_check), and functions that return a value rather than
- * a status (dhc_diagnose_candidates, dhc_chi2_log10_sf, dhc_f_log10_sf, dhc_rot_log, the
- * quaternion and roll-pitch-yaw conversions) are not declared: a caller fails to compile.
+ * dhc_arm_to_standard_dh, dhc_plan_select, dhc_plan_weighting, dhc_model_inverse,
+ * dhc_model_command_jacobian, dhc_lsq_confounded, dhc_effect_parse, dhc_mat_mul and the
+ * other matrix operations, dhc_forward and the other one-call kinematics, dhc_trilat_local,
+ * dhc_trilat_world, dhc_measurer_of_model, dhc_model_wire_point), options and samples that
+ * need it are refused (a noise model that is on, robust_start, pose samples: dhc_calib_fit,
+ * dhc_sample_check), and functions that return a value rather than a status
+ * (dhc_diagnose_candidates, dhc_chi2_log10_sf, dhc_f_log10_sf, dhc_rot_log, the quaternion
+ * and roll-pitch-yaw conversions, dhc_chol_condition_estimate, dhc_status_str,
+ * dhc_params_name, dhc_effect_label, dhc_params_is_angle, dhc_params_in_degrees,
+ * dhc_frame_mul, dhc_rot_tmul, dhc_rot_mul_t, dhc_vec3_axpy, dhc_trilat_lengths; dhc_rot_exp
+ * without the conversions and base_frame) are not declared: a caller fails to compile.
+ * A feature built on another that is left out fails to compile too (#error below).
  * scripts/target-report --features lists each one's bytes on the Cortex-M4. */
 #ifndef DHC_WITH_DIAGNOSE        /* dhc_diagnose.h: the score test of missing effects */
 #define DHC_WITH_DIAGNOSE 1
@@ -70,10 +77,47 @@ DHC_STATIC_ASSERT(DHC_MAX_PARAMS <= 256U, "DHC_MAX_PARAMS too large for the inde
 #define DHC_WITH_PLAN 1
 #endif
 #ifndef DHC_WITH_REPORT_EXTRAS   /* what a fit's report explains for people: the condition
-                                    estimate (dhc_lsq_factor.condition, dhc_calib_report
-                                    .condition: 0 when left out) and the parameters each
-                                    unidentifiable one trades off with (.confounded: none) */
+                                    estimate (dhc_chol_condition_estimate, dhc_lsq_factor
+                                    .condition, dhc_calib_report.condition: 0 when left out)
+                                    and the parameters each unidentifiable one trades off
+                                    with (dhc_lsq_confounded, .confounded: none) */
 #define DHC_WITH_REPORT_EXTRAS 1
+#endif
+#ifndef DHC_WITH_NAMES           /* what front ends show people and read from files: the
+                                    names dhc_status_str, dhc_params_name, dhc_effect_label,
+                                    dhc_effect_parse, and the units dhc_params_is_angle,
+                                    dhc_params_in_degrees (a controller reports numbers; the
+                                    catalogue keeps its entries' names) */
+#define DHC_WITH_NAMES 1
+#endif
+#ifndef DHC_WITH_MATRIX_OPS      /* the checked dense algebra offered to callers: dhc_mat_mul,
+                                    _tmul, _transpose, _vec, dhc_chol_solve, dhc_tri_lower_solve,
+                                    _t_solve (the fit runs on its own kernels; the diagnosis
+                                    needs the solves) */
+#define DHC_WITH_MATRIX_OPS 1
+#endif
+#if DHC_WITH_DIAGNOSE && !DHC_WITH_MATRIX_OPS
+#error "DHC_WITH_DIAGNOSE needs DHC_WITH_MATRIX_OPS: the score test solves with dhc_chol_solve"
+#endif
+#ifndef DHC_WITH_DESK_KINEMATICS /* what the desk's tools call one pose at a time (URDF import
+                                    and export, the simulation, analyses): the bare arm's
+                                    frames and Jacobians (dhc_forward, dhc_forward_frames,
+                                    _scaled, dhc_joint_transform, dhc_identification_jacobian,
+                                    dhc_joint_jacobian), the model's in one call
+                                    (dhc_model_jacobian, dhc_model_linearize,
+                                    dhc_model_gravity_moments) and the frame algebra
+                                    (dhc_frame_mul, dhc_rot_tmul, dhc_rot_mul_t, dhc_vec3_axpy).
+                                    A controller's loops prepare the arm once: dhc_arm_prepare,
+                                    dhc_forward_frames_trig and the *_prepared forms stay */
+#define DHC_WITH_DESK_KINEMATICS 1
+#endif
+#if (DHC_WITH_UNCERTAINTY || DHC_WITH_CONVERSIONS) && !DHC_WITH_DESK_KINEMATICS
+#error "DHC_WITH_UNCERTAINTY and DHC_WITH_CONVERSIONS need DHC_WITH_DESK_KINEMATICS"
+#endif
+#ifndef DHC_WITH_TRILATERATION   /* dhc_trilat.h: the point three wire lengths meet at (the
+                                    desk's view of samples; a controller checks the wires
+                                    against the model's predicted lengths instead) */
+#define DHC_WITH_TRILATERATION 1
 #endif
 #ifndef DHC_WITH_INVERSE         /* dhc_inverse.h: commanded angles for a target on the full
                                     model (the controller's IK, dhcal compensate) */

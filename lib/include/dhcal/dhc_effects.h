@@ -92,13 +92,16 @@ const char *dhc_effect_name(dhc_effect effect);
 /* 1 when the effect is written "name:i" (per joint). */
 int dhc_effect_is_per_joint(dhc_effect effect);
 /* Parses "name" or "name:i" (i 1-based) of length len. DHC_ERR_ARGUMENT for an unknown
- * name, a missing or extra ":i", or i outside 1..n_joints. joint is 0-based. */
+ * name, a missing or extra ":i", or i outside 1..n_joints, and for any text in a build
+ * without names (DHC_WITH_NAMES 0). joint is 0-based. */
 dhc_status dhc_effect_parse(const char *text, size_t len, size_t n_joints, dhc_effect *effect,
                             size_t *joint);
+#if DHC_WITH_NAMES
 /* The inverse of dhc_effect_parse: "joint_compliance:2" (joint 0-based in, 1-based out;
  * ignored when the effect is not per joint) or "measurer_scale", cut to fit cap with its
  * terminator. Returns the length written; 0 and "" for an unknown effect. */
 size_t dhc_effect_label(dhc_effect effect, size_t joint, char *buf, size_t cap);
+#endif
 
 #ifdef __cplusplus
 }

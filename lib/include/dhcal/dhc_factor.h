@@ -55,10 +55,12 @@ dhc_status dhc_tri_lower_solve(const dhc_mat *l, size_t k, const double *b, doub
 dhc_status dhc_tri_lower_t_solve(const dhc_mat *l, size_t k, const double *y, double *x,
                                  size_t len);
 
+#if DHC_WITH_REPORT_EXTRAS
 /* Estimate of the 1-norm condition number of L L^T (leading k x k block) from the ratio of
  * the largest to smallest squared diagonal of L; a cheap lower bound, reported not used.
  * 1 for k = 0; HUGE_VAL for a zero diagonal or arguments that do not fit. */
 double dhc_chol_condition_estimate(const dhc_mat *l, size_t k);
+#endif
 
 /* ---------------------------------------------------------------- kernels on a strided triangle */
 

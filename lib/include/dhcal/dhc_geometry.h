@@ -27,8 +27,10 @@ void dhc_vec3_copy(const double a[3], double out[3]);
 void dhc_vec3_add(const double a[3], const double b[3], double out[3]);
 void dhc_vec3_sub(const double a[3], const double b[3], double out[3]);
 void dhc_vec3_scale(const double a[3], double s, double out[3]);
+#if DHC_WITH_DESK_KINEMATICS
 /* out = a + s * b */
 void dhc_vec3_axpy(const double a[3], double s, const double b[3], double out[3]);
+#endif
 double dhc_vec3_dot(const double a[3], const double b[3]);
 /* out may alias neither a nor b. */
 void dhc_vec3_cross(const double a[3], const double b[3], double out[3]);
@@ -54,18 +56,25 @@ void dhc_rot_y(double angle_rad, dhc_mat3 *r);
 void dhc_rot_z(double angle_rad, dhc_mat3 *r);
 /* out = a b; out may alias neither input. */
 void dhc_rot_mul(const dhc_mat3 *a, const dhc_mat3 *b, dhc_mat3 *out);
+#if DHC_WITH_DESK_KINEMATICS
 /* out = a^T b; out may alias neither input. */
 void dhc_rot_tmul(const dhc_mat3 *a, const dhc_mat3 *b, dhc_mat3 *out);
+#endif
+#if DHC_WITH_DESK_KINEMATICS || DHC_WITH_POSE_SAMPLES
 /* out = a b^T; out may alias neither input. */
 void dhc_rot_mul_t(const dhc_mat3 *a, const dhc_mat3 *b, dhc_mat3 *out);
+#endif
 /* out = r v; out may not alias v. */
 void dhc_rot_apply(const dhc_mat3 *r, const double v[3], double out[3]);
 /* out = r^T v; out may not alias v. */
 void dhc_rot_apply_t(const dhc_mat3 *r, const double v[3], double out[3]);
 /* Column c (0..2) of r: the image of the c-th unit vector. */
 void dhc_rot_column(const dhc_mat3 *r, size_t c, double out[3]);
-/* Rotation by the vector w (axis w/|w|, angle |w|), Rodrigues' formula; exact for any size. */
+#if DHC_WITH_CONVERSIONS || DHC_WITH_EFFECT_BASE_FRAME
+/* Rotation by the vector w (axis w/|w|, angle |w|), Rodrigues' formula; exact for any size.
+ * A conversion, and how a fit turns the base frame: left out with both. */
 void dhc_rot_exp(const double w_rad[3], dhc_mat3 *r);
+#endif
 #if DHC_WITH_POSE_SAMPLES || DHC_WITH_CONVERSIONS
 /* Rotation vector of r (inverse of dhc_rot_exp, angle in [0, pi]); accurate near 0 and pi. */
 void dhc_rot_log(const dhc_mat3 *r, double w_rad[3]);
@@ -83,8 +92,10 @@ void dhc_quat_from_rot(const dhc_mat3 *r, double q[4]);
 #endif
 
 void dhc_frame_identity(dhc_frame *f);
+#if DHC_WITH_DESK_KINEMATICS
 /* out = a b (apply b, then a); out may alias neither input. */
 void dhc_frame_mul(const dhc_frame *a, const dhc_frame *b, dhc_frame *out);
+#endif
 /* out = a^-1; out may not alias a. */
 void dhc_frame_inverse(const dhc_frame *a, dhc_frame *out);
 /* out = f p (a point); out may not alias p. */

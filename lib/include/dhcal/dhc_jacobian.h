@@ -55,7 +55,8 @@ dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set,
                               dhc_prediction *pred);
 
 /* d(tool point)/d(q_i) and d(rotation)/d(q_i) for every joint: the ordinary manipulator
- * Jacobian, (3 or 6) x n_joints. */
+ * Jacobian, (3 or 6) x n_joints: dhc_identification_jacobian's columns of the joint
+ * offsets, with its errors. */
 dhc_status dhc_joint_jacobian(const dhc_arm *arm, const double *q_rad, size_t q_len,
                               int with_orientation, dhc_mat *jac);
 

@@ -128,7 +128,8 @@ dhc_status dhc_lsq_prediction_variance(const dhc_lsq_factor *fac, double sigma2,
  * way: the caller asks for each); every other entry of partner[0..n-1] is set to 0. A
  * coefficient counts when |v_k| > 1e-4. Returns the number of partners in *count; 0 partners
  * means the parameter does not affect the measurements at all. ne must be the accumulator fac
- * was analysed from. DHC_ERR_ARGUMENT when j is identifiable or out of range (or NULL),
+ * was analysed from. DHC_ERR_ARGUMENT when j is identifiable or out of range (or NULL), or
+ * in a build without DHC_WITH_REPORT_EXTRAS,
  * DHC_ERR_DIMENSION (fac->n != ne->n, len < n). O(r^2), one n-double stack array. */
 dhc_status dhc_lsq_confounded(const dhc_normal_eq *ne, const dhc_lsq_factor *fac, size_t j,
                               uint8_t *partner, size_t len, size_t *count);

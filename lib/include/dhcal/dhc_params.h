@@ -98,6 +98,7 @@ dhc_status dhc_params_set_value(const dhc_param_set *set, dhc_model *model, size
 dhc_status dhc_params_apply(const dhc_param_set *set, dhc_model *model, const double *delta,
                             size_t len);
 
+#if DHC_WITH_NAMES
 /* A stable name for reports, e.g. "theta3", "beta2", "base_rx", "tool_z", "scale2",
  * "harmonic_sin2", "harmonic3_cos2" (order 3), "backlash1", "compliance2_3",
  * "measurer_scale", "measurer_offset1", "anchor2_y", "thermal_scale", "drift_scale",
@@ -111,6 +112,7 @@ int dhc_params_is_angle(const dhc_param_set *set, size_t k);
 /* 1 when reports and model files give the parameter in degrees: the angles, and compliances
  * (degrees per mm of moment arm); 0 for the others (mm, 1, 1/K, 1/s, mm/s). */
 int dhc_params_in_degrees(const dhc_param_set *set, size_t k);
+#endif /* DHC_WITH_NAMES */
 #ifdef __cplusplus
 }
 #endif

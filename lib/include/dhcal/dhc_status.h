@@ -2,6 +2,8 @@
 #ifndef DHC_STATUS_H
 #define DHC_STATUS_H
 
+#include "dhc_config.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -20,8 +22,10 @@ typedef enum {
     DHC_ERR_NO_DATA         /* nothing to work on (no samples, all excluded) */
 } dhc_status;
 
+#if DHC_WITH_NAMES
 /* A short constant English phrase for a status ("ok", "singular", ...). Never NULL. */
 const char *dhc_status_str(dhc_status status);
+#endif
 
 #ifdef __cplusplus
 }

@@ -48,9 +48,11 @@ dhc_status dhc_trilat_local(const dhc_measurer *m, const double len_mm[3], doubl
 dhc_status dhc_trilat_world(const dhc_measurer *m, const double len_mm[3], double tol_mm2,
                             double q_world_mm[3]);
 
+#if DHC_WITH_TRILATERATION
 /* Wire lengths from a world point (the forward model the measurer calibration uses).
  * Total on finite inputs; no status. O(1). */
 void dhc_trilat_lengths(const dhc_measurer *m, const double q_world_mm[3], double len_mm[3]);
+#endif
 
 /* The closed form's measurer of a model's draw-wire measurer, whose anchors must lie as the
  * paper's: P1 = (0, 0, a), P2 = (0, b, c), P3 = (0, -b, c) in the measurer frame (to 1e-9 of
