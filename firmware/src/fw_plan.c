@@ -98,8 +98,8 @@ size_t fw_plan_select(const dhc_model *model, const dhc_param_set *set, size_t n
     }
     const size_t k = fw_plan_poses(model, candidates, seed, mixed_dirs, ws->candidates);
     pose_list list = {model, ws->candidates};
-    /* the controller's arm moves over its whole ranges: poses at their ends gain nothing
-     * there (dhc_plan.h), so every candidate is one where the arm works */
+    /* the controller's arm moves over its whole ranges, where poses at their ends gain
+     * nothing (docs/cli.md 1.7): every candidate is one where the arm works */
     const dhc_plan_candidates cand = {read_pose, &list, k, k};
     dhc_plan_report rep;
     if (k < n || dhc_plan_select(model, set, &cand, n, NULL, &ws->lib, ws->chosen, &rep) !=

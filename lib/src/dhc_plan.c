@@ -252,8 +252,22 @@ static size_t workspace_count(const dhc_plan_candidates *cand)
                                                                    : cand->workspace;
 }
 
-/* Every candidate once: the rows per pose, the store, the workspace candidates' joint
- * information and from it the parameters kept, their scales and W. */
+/* ws->info (lower triangle, row stride DHC_MAX_PARAMS) += the candidate's J^T J. */
+static void gather_workspace(dhc_plan_workspace *ws, size_t p)
+{
+    for (size_t row = 0U; row < ws->rows_per_pose; ++row) {
+        const double *y = ws->jac + row * p;
+        for (size_t i = 0U; i < p; ++i) {
+            for (size_t j = 0U; j <= i; ++j) {
+                ws->info[i * DHC_MAX_PARAMS + j] += y[i] * y[j];
+            }
+        }
+    }
+}
+
+/* Every candidate once: the rows per pose, the store, the joint information of all of them
+ * and from it the parameters kept (what a plan of any of them can identify, as its fit
+ * will), and the workspace candidates' information: the columns' scales and W. */
 static dhc_status survey(const dhc_model *model, const dhc_param_set *set,
                          const dhc_plan_candidates *cand, double *store,
                          dhc_plan_workspace *ws, size_t *usable)
@@ -266,6 +280,7 @@ static dhc_status survey(const dhc_model *model, const dhc_param_set *set,
     const double zero[DHC_MAX_ROWS_PER_SAMPLE] = {0.0};
     const size_t in_workspace = workspace_count(cand);
     size_t usable_workspace = 0U;
+    memset(ws->info, 0, sizeof ws->info); /* the workspace's information, until the plan */
     dhc_arm_prepare(&model->arm, &ws->trig);
     ws->rows_per_pose = 0U;
     *usable = 0U;
@@ -288,12 +303,15 @@ static dhc_status survey(const dhc_model *model, const dhc_param_set *set,
             st = dhc_mat_init(&jac, ws->rows_per_pose, p, ws->jac,
                               sizeof ws->jac / sizeof ws->jac[0]);
         }
-        if (st == DHC_OK && c < in_workspace) {
+        if (st == DHC_OK) {
             st = dhc_normal_eq_add(&ws->ne, &jac, zero, NULL, ws->rows_per_pose);
-            usable_workspace += st == DHC_OK ? 1U : 0U;
         }
         if (st == DHC_OK) {
             ++*usable;
+            if (c < in_workspace) {
+                gather_workspace(ws, p);
+                ++usable_workspace;
+            }
             if (store != NULL) {
                 memcpy(store + c * cells, ws->jac, cells * sizeof ws->jac[0]);
             }
@@ -311,22 +329,26 @@ static dhc_status survey(const dhc_model *model, const dhc_param_set *set,
     const double per_pose = (double)usable_workspace;
     ws->n_kept = 0U;
     for (size_t j = 0U; j < p; ++j) {
-        /* one pose's average information in the column becomes 1 */
-        ws->scale[j] = sqrt(per_pose / ws->ne.jtj[j * p + j]);
         if (ws->fac.identifiable[j]) {
+            /* one workspace pose's average information in the column becomes 1 */
+            const double diag = ws->info[j * (DHC_MAX_PARAMS + 1U)];
+            if (!(diag > 0.0)) {
+                return DHC_ERR_UNDERDETERMINED; /* moves nothing where the arm works */
+            }
+            ws->scale[j] = sqrt(per_pose / diag);
             ws->kept[ws->n_kept++] = j;
         }
     }
     if (ws->n_kept == 0U) {
         return DHC_ERR_UNDERDETERMINED;
     }
-    /* W: one pose's average information over the kept parameters (unit diagonal) */
+    /* W: one workspace pose's average information over the kept parameters (unit diagonal) */
     for (size_t a = 0U; a < ws->n_kept; ++a) {
         for (size_t b = 0U; b <= a; ++b) {
             const size_t i = ws->kept[a];
             const size_t j = ws->kept[b];
             ws->wchol[a * DHC_MAX_PARAMS + b] =
-                ws->ne.jtj[i * p + j] * ws->scale[i] * ws->scale[j] / per_pose;
+                ws->info[i * DHC_MAX_PARAMS + j] * ws->scale[i] * ws->scale[j] / per_pose;
         }
     }
     const dhc_tri w = {ws->wchol, DHC_MAX_PARAMS, 1U, ws->wchol, DHC_MAX_PARAMS + 1U};
@@ -336,7 +358,7 @@ static dhc_status survey(const dhc_model *model, const dhc_param_set *set,
 }
 
 /* trace(M^-1) of the factored transformed information: the plan's prediction variance
- * summed over the kept parameters' directions, averaged over the candidates' poses. */
+ * summed over the kept parameters' directions, averaged over the workspace's poses. */
 static double trace_of_inverse(dhc_plan_workspace *ws)
 {
     const dhc_tri t = chol_tri(ws);

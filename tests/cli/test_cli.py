@@ -228,6 +228,8 @@ class Cli(unittest.TestCase):
     def test_plan_bad_input_exits_2_and_leaves_out_untouched(self):
         cases = [(('--poses', '0'), '--poses'), (('--poses', 'x'), '--poses'),
                  (('--poses', '10', '--candidates', '10'), '--candidates'),
+                 (('--poses', '10', '--end-candidates', '-1'), '--end-candidates'),
+                 (('--poses', '10', '--end-candidates', '100001'), '--end-candidates'),
                  (('--poses', '10', '--min-z', 'nan'), '--min-z'),
                  (('--poses', '10', '--min-z', '1e300'), '--min-z'),
                  (('--poses', '10', '--effects', 'warp_drive'), 'warp_drive'),
@@ -254,11 +256,13 @@ class Cli(unittest.TestCase):
         r = self.plan('--poses', '12', '--candidates', '150', '--seed', '3', '--json')
         self.assertEqual(r.returncode, 0, r.stderr)
         rep = json.loads(r.stdout)
-        for key in ('poses', 'candidates', 'measured', 'parameters', 'identifiable', 'left_out',
-                    'o1', 'rank', 'o1_random', 'rank_random', 'variance', 'variance_random',
-                    'exchanges', 'out'):
+        for key in ('poses', 'candidates', 'end_candidates', 'measured', 'parameters',
+                    'identifiable', 'left_out', 'o1', 'rank', 'o1_random', 'rank_random',
+                    'variance', 'variance_random', 'variance_floor', 'variance_weighted',
+                    'weighting_iterations', 'exchanges', 'out'):
             self.assertIn(key, rep)
-        self.assertEqual((rep['poses'], rep['candidates']), (12, 150))
+        self.assertEqual((rep['poses'], rep['candidates'], rep['end_candidates']),
+                         (12, 150, 150))
         self.assertGreater(rep['o1'], rep['o1_random'])
         self.assertLess(rep['variance'], rep['variance_random'])
         with open(self.out) as f:
@@ -279,6 +283,15 @@ class Cli(unittest.TestCase):
                          .returncode, 0)
         with open(self.out) as f:
             self.assertEqual(f.read(), first)
+        # without end candidates: the same random plan (the first 150 do not depend on
+        # them), a plan chosen from fewer poses
+        r = self.plan('--poses', '12', '--candidates', '150', '--seed', '3',
+                      '--end-candidates', '0', '--json')
+        self.assertEqual(r.returncode, 0, r.stderr)
+        alone = json.loads(r.stdout)
+        self.assertEqual(alone['end_candidates'], 0)
+        self.assertEqual(alone['variance_random'], rep['variance_random'])
+        self.assertGreaterEqual(alone['variance_floor'], rep['variance_floor'] * (1 - 1e-2))
 
     def test_help_on_every_command(self):
         for cmd in ('compare', 'fit', 'diagnose', 'plot', 'plan'):

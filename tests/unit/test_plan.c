@@ -336,6 +336,46 @@ static void test_candidates_beyond_the_workspace(void)
     floor_is_under_every_plan(12U, 7U);
 }
 
+/* What the workspace cannot do is refused, not scored: a workspace without a usable pose,
+ * and one pose where the arm works (3 rows) against 6 parameters that the other candidates
+ * identify (W would be singular: the plan's error there is undefined). A candidate that
+ * cannot be evaluated weighs nothing and the rest still bound every plan. */
+static void test_what_the_workspace_cannot_weigh_is_refused(void)
+{
+    const dhc_model m = test_paper3_as_built();
+    dhc_param_set set;
+    small_pool(&m, &set);
+    size_t chosen[4];
+    dhc_plan_report rep;
+    TEST_ASSERT_EQUAL(DHC_ERR_UNDERDETERMINED,
+                      dhc_plan_select(&m, &set, pool_part(12U, 1U), 4U, NULL, &ws, chosen,
+                                      &rep));
+    double weights[12];
+    dhc_plan_weighting_report best;
+    TEST_ASSERT_EQUAL(DHC_ERR_UNDERDETERMINED,
+                      dhc_plan_weighting(&m, &set, pool_part(12U, 1U), 4U, NULL, weights, &ws,
+                                         &best));
+    for (size_t i = 0U; i < 3U; ++i) {
+        pool[i].q_rad[1] = HUGE_VAL * 0.0; /* NaN: not usable */
+    }
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_plan_select(&m, &set, pool_part(12U, 3U), 4U, NULL,
+                                                        &ws, chosen, &rep));
+    /* the three NaN candidates among ten where the arm works */
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_select(&m, &set, pool_part(10U, 10U), 4U, NULL, &ws,
+                                              chosen, &rep));
+    TEST_ASSERT_EQUAL_size_t(7U, rep.usable);
+    for (size_t i = 0U; i < 4U; ++i) {
+        TEST_ASSERT_TRUE(chosen[i] >= 3U);
+    }
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_weighting(&m, &set, pool_part(10U, 10U), 4U, NULL,
+                                                 weights, &ws, &best));
+    for (size_t i = 0U; i < 3U; ++i) {
+        TEST_ASSERT_EQUAL_DOUBLE(0.0, weights[i]);
+    }
+    TEST_ASSERT_TRUE(best.floor <= rep.variance * (1.0 + 1e-9));
+    TEST_ASSERT_TRUE(best.floor >= (1.0 - DHC_PLAN_WEIGHT_TOL) * best.variance);
+}
+
 /* 15 planned poses of 200 candidates observe the paper arm's parameters better than any of
  * 20 random 15-pose plans from the same candidates (O1), 10 % better than their mean, and
  * the store changes nothing. */
@@ -441,6 +481,7 @@ int main(void)
     RUN_TEST(test_small_pool_gets_the_best_plan);
     RUN_TEST(test_floor_is_under_every_plan);
     RUN_TEST(test_candidates_beyond_the_workspace);
+    RUN_TEST(test_what_the_workspace_cannot_weigh_is_refused);
     RUN_TEST(test_plan_beats_random_plans);
     RUN_TEST(test_unidentifiable_parameters_are_left_out);
     RUN_TEST(test_bad_requests_are_refused);

@@ -16,7 +16,7 @@
  * from the scaled normal matrix N = D^-1/2 J^T J D^-1/2 as prod sigma_k = sqrt(det N), det N
  * from lib's pivoted Cholesky (dhc_plan_observability); parameters whose pivot falls below
  * 1e-10 (not identifiable from the plan) are left out and counted in *rank. J is lib's
- * analytic model Jacobian of the predicted wire lengths (dhc_model_jacobian): no
+ * analytic model Jacobian of the predicted wire lengths (dhc_model_jacobian_prepared): no
  * measurement is needed, a plan is scored before it runs. Portable C11: no heap, no I/O, no
  * hidden state.
  */

@@ -36,8 +36,8 @@
  * scaled to unit norm), over the r parameters the plan identifies (pivot >= 1e-10), computed
  * as sqrt(det) of the scaled normal matrix from its pivoted Cholesky factor.
  *
- * Both read each candidate through the model's analytic Jacobian (dhc_model_jacobian):
- * nothing is measured, a plan is scored before it runs. No heap; the scratch is the
+ * Both read each candidate through the model's analytic Jacobian
+ * (dhc_model_jacobian_prepared): nothing is measured, a plan is scored before it runs. No heap; the scratch is the
  * workspace's (about 40 DHC_MAX_PARAMS^2 bytes: static storage, not a stack). Optional
  * storage of the caller's for the candidates' Jacobian rows spares evaluating the model
  * again on every pass (the same plan either way). A build with DHC_WITH_PLAN 0 leaves the
@@ -91,8 +91,8 @@ typedef struct {
 
 typedef struct {
     size_t usable;       /* candidates whose Jacobian could be evaluated */
-    size_t identifiable; /* parameters some plan from the candidates identifies: the
-                            criterion's; the set's others are left out */
+    size_t identifiable; /* parameters some plan from the candidates identifies (as its
+                            fit will): the criterion's; the set's others are left out */
     double variance;     /* the criterion at the plan: trace(M^-1 W) (about r / n for a
                             random plan of n poses) */
     double variance_first; /* the criterion for candidates 0 .. n-1: the random plan of the
@@ -105,7 +105,8 @@ typedef struct {
 /* The candidates a plan is chosen from: read(ctx, 0 .. count-1) (samples of one kind:
  * position, wires or pose; their measured values are not read). The first `workspace` of
  * them are random poses where the arm works: their average information is W, where the
- * plan predicts best, and their first n the random plan it is compared with. The others
+ * plan predicts best, and their first n the random plan it is compared with (when there
+ * are fewer than n, that plan takes the first candidates after them too). The others
  * may be chosen but weigh nothing in W: poses at the ends of the joint ranges, where a fit
  * over a small working region learns most (its Jacobian is nearly linear in the angles
  * there, and a line is fixed best by its ends). workspace 0 or above count: all of them. */
@@ -122,7 +123,8 @@ typedef struct {
  * Errors: DHC_ERR_ARGUMENT (NULL, n = 0, n above the usable candidates, candidates of
  * different row counts, no usable candidate where the arm works), DHC_ERR_CAPACITY (set
  * larger than DHC_MAX_PARAMS), the reader's error, DHC_ERR_UNDERDETERMINED (no parameter
- * identifiable from the workspace's candidates). A candidate whose Jacobian is not finite
+ * identifiable from the candidates, or one that is but moves nothing where the arm works:
+ * its share of the prediction there is undefined). A candidate whose Jacobian is not finite
  * is never chosen. */
 dhc_status dhc_plan_select(const dhc_model *model, const dhc_param_set *set,
                            const dhc_plan_candidates *cand, size_t n, double *rows_store,
@@ -142,7 +144,7 @@ typedef struct {
  * weighting the iteration reached, summing to 1; a candidate whose Jacobian is not finite
  * weighs 0) and the floor under any n-pose
  * plan's variance, over the parameters dhc_plan_select keeps. rows_store as for
- * dhc_plan_select (NULL: the model is evaluated k times per iteration). Errors as
+ * dhc_plan_select (NULL: the model is evaluated count times per iteration). Errors as
  * dhc_plan_select's; DHC_ERR_ARGUMENT also when the build leaves plans out. */
 dhc_status dhc_plan_weighting(const dhc_model *model, const dhc_param_set *set,
                               const dhc_plan_candidates *cand, size_t n, double *rows_store,
@@ -151,7 +153,7 @@ dhc_status dhc_plan_weighting(const dhc_model *model, const dhc_param_set *set,
 
 /* O1 of the plan made of read(ctx, index[i]) for i < n (index NULL: 0 .. n-1) for the
  * set, and in *rank (may be NULL) the parameters it identifies. Errors of the reader and of
- * dhc_model_jacobian; DHC_ERR_ARGUMENT for NULL or n = 0. */
+ * dhc_model_jacobian_prepared; DHC_ERR_ARGUMENT for NULL or n = 0. */
 dhc_status dhc_plan_observability(const dhc_model *model, const dhc_param_set *set,
                                   dhc_sample_reader read, void *ctx, const size_t *index,
                                   size_t n, dhc_plan_workspace *ws, double *o1, size_t *rank);
