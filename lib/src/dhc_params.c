@@ -33,23 +33,6 @@ static scope kind_scope(unsigned kind)
     }
 }
 
-/* 0 for the parameters of an effect the build leaves out (dhc_config.h). */
-static int kind_built(unsigned kind)
-{
-    return (DHC_WITH_EFFECT_BASE_FRAME ||
-            kind < (unsigned)DHC_P_BASE_X || kind > (unsigned)DHC_P_BASE_RZ) &&
-           (DHC_WITH_EFFECT_JOINT_SCALE || kind != (unsigned)DHC_P_JOINT_SCALE) &&
-           (DHC_WITH_EFFECT_JOINT_HARMONIC ||
-            (kind != (unsigned)DHC_P_HARMONIC_SIN && kind != (unsigned)DHC_P_HARMONIC_COS)) &&
-           (DHC_WITH_EFFECT_JOINT_BACKLASH || kind != (unsigned)DHC_P_BACKLASH) &&
-           (DHC_WITH_EFFECT_JOINT_COMPLIANCE || kind != (unsigned)DHC_P_COMPLIANCE) &&
-           (DHC_WITH_EFFECT_MEASURER ||
-            kind < (unsigned)DHC_P_MEAS_SCALE || kind > (unsigned)DHC_P_MEAS_ANCHOR) &&
-           (DHC_WITH_EFFECT_THERMAL || kind != (unsigned)DHC_P_THERMAL) &&
-           (DHC_WITH_EFFECT_DRIFT ||
-            (kind != (unsigned)DHC_P_DRIFT_SCALE && kind != (unsigned)DHC_P_DRIFT_OFFSET));
-}
-
 static int needs_measurer(unsigned kind)
 {
     return kind == (unsigned)DHC_P_MEAS_SCALE || kind == (unsigned)DHC_P_MEAS_OFFSET ||
@@ -81,8 +64,14 @@ dhc_status dhc_params_add(dhc_param_set *set, const dhc_model *model, dhc_param_
                           size_t joint, size_t aux)
 {
     if (set == NULL || model == NULL || (unsigned)kind >= (unsigned)DHC_P_KIND_COUNT ||
-        !kind_built((unsigned)kind) || !indices_fit(model, (unsigned)kind, joint, aux) ||
+        !indices_fit(model, (unsigned)kind, joint, aux) ||
         (needs_measurer((unsigned)kind) && !model->measurer.present)) {
+        return DHC_ERR_ARGUMENT;
+    }
+    /* beyond the base model, a parameter of an effect in the build's catalogue: those of an
+     * effect the build leaves out (dhc_config.h) are refused */
+    const dhc_param_id id_new = {(uint8_t)kind, (uint8_t)joint, (uint8_t)aux};
+    if (kind > DHC_P_BETA && dhc_params_effect_of(&id_new) == DHC_EFFECT_COUNT) {
         return DHC_ERR_ARGUMENT;
     }
     for (size_t k = 0U; k < set->count; ++k) {
@@ -94,10 +83,7 @@ dhc_status dhc_params_add(dhc_param_set *set, const dhc_model *model, dhc_param_
     if (set->count >= DHC_MAX_PARAMS) {
         return DHC_ERR_CAPACITY;
     }
-    set->id[set->count].kind = (uint8_t)kind;
-    set->id[set->count].joint = (uint8_t)joint;
-    set->id[set->count].aux = (uint8_t)aux;
-    set->count++;
+    set->id[set->count++] = id_new;
     return DHC_OK;
 }
 

@@ -256,8 +256,10 @@ static int parse_plan_args(int argc, char **argv, plan_options *o)
     return 0;
 }
 
-static void report(const plan_options *o, const dhc_param_set *set, const dhc_plan_report *rep,
-                   const dhc_plan_weighting_report *best, double o1_random, size_t rank_random, const dhc_plan_workspace *ws,
+/* ends: the end candidates drawn (fewer than asked when --min-z rejects some). */
+static void report(const plan_options *o, size_t ends, const dhc_param_set *set,
+                   const dhc_plan_report *rep, const dhc_plan_weighting_report *best,
+                   double o1_random, size_t rank_random, const dhc_plan_workspace *ws,
                    dhc_meas_kind kind)
 {
     uint8_t kept[DHC_MAX_PARAMS] = {0};
@@ -268,7 +270,7 @@ static void report(const plan_options *o, const dhc_param_set *set, const dhc_pl
         cJSON *obj = cJSON_CreateObject();
         cJSON_AddNumberToObject(obj, "poses", (double)o->poses);
         cJSON_AddNumberToObject(obj, "candidates", (double)o->candidates);
-        cJSON_AddNumberToObject(obj, "end_candidates", (double)o->end_candidates);
+        cJSON_AddNumberToObject(obj, "end_candidates", (double)ends);
         cJSON_AddStringToObject(obj, "measured", kind == DHC_MEAS_WIRES ? "wires" : "position");
         cJSON_AddNumberToObject(obj, "parameters", (double)set->count);
         cJSON_AddNumberToObject(obj, "identifiable", (double)rep->identifiable);
@@ -299,9 +301,9 @@ static void report(const plan_options *o, const dhc_param_set *set, const dhc_pl
         }
         return;
     }
-    printf("plan: %lu poses of %lu candidates where the arm works and %lu at the ends of the "
+    printf("plan: %lu poses of %lu candidates where the arm works and %zu at the ends of the "
            "joint ranges (%s measured), written to %s\n", o->poses, o->candidates,
-           o->end_candidates, kind == DHC_MEAS_WIRES ? "wire lengths" : "tool positions",
+           ends, kind == DHC_MEAS_WIRES ? "wire lengths" : "tool positions",
            o->out);
     printf("parameters: %zu of %zu identifiable from the candidates", rep->identifiable,
            set->count);
@@ -407,8 +409,7 @@ int dhcal_plan_command(int argc, char **argv)
         fprintf(stderr, "dhcal: plan: the candidates' best weighting: %s\n", dhc_status_str(st));
         goto done;
     }
-    o.end_candidates = ends;
-    report(&o, &set, &rep, &best, o1_random, rank_random, &ws, kind);
+    report(&o, ends, &set, &rep, &best, o1_random, rank_random, &ws, kind);
     rc = 0;
 done:
     free(q);
