@@ -73,7 +73,11 @@ dhc_status dhs_dataset_at(dhs_dataset *d, const double *target_rad, const int8_t
         }
         const dhs_joint_params *jp = &sc->joint[j];
         const double cpr_nom = dhs_nominal_counts_per_rad(jp);
-        const int64_t counts = (int64_t)floor(target_rad[j] * cpr_nom + 0.5);
+        const double count_f = floor(target_rad[j] * cpr_nom + 0.5);
+        if (!(fabs(count_f) < 9.2e18)) { /* no 64-bit count: as good as infinite */
+            return DHC_ERR_NONFINITE;
+        }
+        const int64_t counts = (int64_t)count_f;
         /* The shaft rests somewhere inside the count the servo holds (exact: on the
          * commanded angle itself, between counts if need be). */
         const double inside = d->exact ? target_rad[j] * cpr_nom - (double)counts

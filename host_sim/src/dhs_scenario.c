@@ -121,8 +121,11 @@ static dhc_status check_joint(const dhs_joint_params *j, const char **what)
     CHECK(j->amp_gain_v_per_v > 0.0, "amp_gain_v_per_v must be > 0");
     CHECK(j->supply_v > 0.0, "supply_v must be > 0");
     CHECK(j->current_limit_a > 0.0, "current_limit_a must be > 0");
-    CHECK(j->gear_ratio > 0.0, "gear_ratio must be > 0");
-    CHECK(j->nominal_gear_ratio > 0.0, "nominal_gear_ratio must be > 0");
+    /* no gearbox reduces more than 10^4 (harmonic drives ~160, stacked stages a few 1000);
+     * beyond, the encoder counts of a joint angle outgrow what the plant counts in */
+    CHECK(j->gear_ratio > 0.0 && j->gear_ratio <= 1e4, "gear_ratio must be in (0, 10000]");
+    CHECK(j->nominal_gear_ratio > 0.0 && j->nominal_gear_ratio <= 1e4,
+          "nominal_gear_ratio must be in (0, 10000]");
     CHECK(j->backlash_rad >= 0.0 && j->backlash_rad < 0.5, "backlash must be in [0, 0.5) rad");
     CHECK(j->stiffness_nm_per_rad >= 0.0, "stiffness_nm_per_rad must be > 0 (0: rigid)");
     CHECK(j->damping_nms_per_rad >= 0.0, "damping_nms_per_rad must be >= 0");

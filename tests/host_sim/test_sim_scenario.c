@@ -46,6 +46,8 @@ typedef void (*breaker)(dhs_scenario *s);
 static void neg_mass(dhs_scenario *s) { s->joint[1].mass_kg = -1.0; }
 static void neg_stiffness(dhs_scenario *s) { s->joint[2].stiffness_nm_per_rad = -5.0; }
 static void nan_ratio(dhs_scenario *s) { s->joint[0].gear_ratio = (double)NAN; }
+/* a fuzzer's 2.2e105: its encoder counts outgrew 64 bits */
+static void huge_ratio(dhs_scenario *s) { s->joint[1].gear_ratio = 2.2e105; }
 static void zero_r(dhs_scenario *s) { s->joint[0].r_ohm = 0.0; }
 static void rigid_backlash(dhs_scenario *s) { s->joint[1].backlash_rad = 0.001; }
 static void rigid_te(dhs_scenario *s)
@@ -71,6 +73,7 @@ static void test_bad_values_are_refused_and_named(void)
     } cases[] = {
         {neg_mass, 2U, "mass_kg"},          {neg_stiffness, 3U, "stiffness"},
         {nan_ratio, 1U, "finite"},          {zero_r, 1U, "r_ohm"},
+        {huge_ratio, 2U, "gear_ratio"},
         {rigid_backlash, 2U, "backlash"},   {rigid_te, 3U, "transmission"},
         {slow_step, 0U, "step"},            {odd_step, 0U, "step"},
         {bad_gravity, 0U, "gravity"},       {neg_noise, 0U, "noise"},

@@ -73,7 +73,8 @@ dhc_status dhs_dataset_init(dhs_dataset *d, const dhs_scenario *sc, uint64_t run
 dhc_status dhs_dataset_next(dhs_dataset *d, dhs_sample_row *row);
 
 /* A given target (rad, nominal joint angles) and approach directions (+1/-1). The pose
- * limits are not applied. DHC_ERR_ARGUMENT for a bad direction, DHC_ERR_NONFINITE. */
+ * limits are not applied. DHC_ERR_ARGUMENT for a bad direction, DHC_ERR_NONFINITE for a
+ * target not finite or so large that its encoder count outgrows 64 bits. */
 dhc_status dhs_dataset_at(dhs_dataset *d, const double *target_rad, const int8_t *dir,
                           dhs_sample_row *row);
 
