@@ -904,6 +904,33 @@ typedef struct {
 static dhc_status free_identifiable(const fit_context *fc, dhc_calib_report *rep,
                                     uint8_t *mark, size_t *freed);
 
+/* A step that turns a link angle (theta, alpha, beta) by more than this corrects no drawing
+ * (the plausible bound is 30 deg): along a direction the data barely see (theta of the last
+ * joint beside an unknown tool) the Gauss-Newton step runs off by 1e14 deg and lands where
+ * the angle is noise. Such a step is damped as a rejected one is. */
+#define MAX_LINK_ANGLE_STEP_RAD 1.0
+
+#if DHC_WITH_ROBUST_START
+static int link_angle_step_too_far(const dhc_param_set *set, const double *delta, size_t p)
+{
+    for (size_t k = 0U; k < p; ++k) {
+        const uint8_t kind = set->id[k].kind;
+        if ((kind == (uint8_t)DHC_P_THETA || kind == (uint8_t)DHC_P_ALPHA ||
+             kind == (uint8_t)DHC_P_BETA) &&
+            !(fabs(delta[k]) <= MAX_LINK_ANGLE_STEP_RAD)) {
+            return 1;
+        }
+    }
+    return 0;
+}
+#else
+static int link_angle_step_too_far(const dhc_param_set *set, const double *delta, size_t p)
+{
+    (void)set; (void)delta; (void)p;
+    return 0; /* the controller's planned poses: no guard */
+}
+#endif
+
 /* Levenberg-Marquardt from ws->current until the SSR stops falling. The damping follows
  * the gain ratio rho (actual over predicted decrease; Nielsen's update, as in Madsen,
  * Nielsen and Tingleff's notes): a good model shrinks lambda, a poor one grows it
@@ -936,6 +963,15 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
         st = dhc_lsq_step(&ws->ne, &ws->fac, lambda, ws->delta, p);
         if (st != DHC_OK) {
             break;
+        }
+        if (link_angle_step_too_far(fc->set, ws->delta, p)) {
+            lambda *= nu; /* ws->ne and ws->fac still hold the current estimate's pass */
+            nu *= 2.0;
+            if (lambda > LAMBDA_MAX) {
+                *converged = 1;
+                break;
+            }
+            continue;
         }
         ws->trial = ws->current;
         st = dhc_params_apply(fc->set, &ws->trial, ws->delta, p);
@@ -1159,6 +1195,31 @@ static dhc_status roll_back_early(const fit_context *fc, dhc_calib_report *rep, 
     return st;
 }
 
+/* When parameters were freed between LM's steps: all of them out of the set again and the
+ * estimate back at the input (*fc->input); returns 1 then, 0 when none was. */
+static int undo_early_freeing(const fit_context *fc, dhc_calib_report *rep)
+{
+#if !DHC_WITH_ROBUST_START
+    (void)fc; (void)rep;
+    return 0; /* the controller's planned poses: no guard */
+#else
+    dhc_calib_workspace *const ws = fc->ws;
+    int any = 0;
+    for (size_t k = 0U; k < fc->set->count; ++k) {
+        if (ws->freed_early[k]) {
+            rep->identifiable[k] = 0U;
+            rep->freed--;
+            ws->freed_early[k] = 0U;
+            any = 1;
+        }
+    }
+    if (any) {
+        ws->current = *fc->input;
+    }
+    return any;
+#endif
+}
+
 /* Levenberg-Marquardt (freeing parameters between its steps), then identifiability judged
  * at the converged estimate (again while that frees parameters, at most
  * max_identifiability_checks times), then the worst unsupported link parameter held and the
@@ -1172,6 +1233,13 @@ static dhc_status fit_to_convergence(const fit_context *fc, dhc_calib_report *re
         dhc_status st = levenberg_marquardt(fc, rep, tot, accumulated, &fr, converged);
         if (st != DHC_OK) {
             return st;
+        }
+        if (!*converged && fr.early && undo_early_freeing(fc, rep)) {
+            /* LM wandered off after freeing a parameter on an estimate's evidence: from
+             * the input again, freeing only at a converged estimate */
+            fr.early = 0;
+            accumulated = 0;
+            continue;
         }
         int rolled = 0;
         st = roll_back_early(fc, rep, &rolled);

@@ -64,7 +64,10 @@ DHC_STATIC_ASSERT(DHC_MAX_PARAMS <= 256U, "DHC_MAX_PARAMS too large for the inde
 #ifndef DHC_WITH_POSE_SAMPLES    /* DHC_MEAS_POSE samples (orientation rows) */
 #define DHC_WITH_POSE_SAMPLES 1
 #endif
-#ifndef DHC_WITH_ROBUST_START    /* dhc_calib_options.robust_start */
+#ifndef DHC_WITH_ROBUST_START    /* dhc_calib_options.robust_start, and the fit's guards for
+                                    data no plan chose (a link angle's runaway step damped,
+                                    early freeing undone when LM wanders off): a controller
+                                    fits poses its plan chose for what they identify */
 #define DHC_WITH_ROBUST_START 1
 #endif
 #ifndef DHC_WITH_EFFECT_SUMMARIES /* dhc_effect_info.summary text ("" when 0) */
