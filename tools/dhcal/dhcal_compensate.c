@@ -25,6 +25,7 @@
 #include "dhcal_io.h"
 #include "dhcal_options.h"
 #include "dhcal_text.h"
+#include "dhcal_units.h"
 
 #define EXIT_COMPUTE 1
 #define EXIT_USAGE 2
@@ -35,7 +36,7 @@
 
 static const char *const compensate_help =
     "usage: dhcal compensate --model C.json --targets T.csv --out J.csv [--nominal N.json]\n"
-    "                        [--json]\n"
+    "                        [--json] [--no-units-check]\n"
     "The joint angles to command so that the calibrated model's tool reaches each target:\n"
     "inverse kinematics on the model with every fitted effect (compliance, scale,\n"
     "harmonics, backlash), started from the target's q1..qN (today's command: it picks the\n"
@@ -51,6 +52,9 @@ static const char *const compensate_help =
     "  --nominal N.json   the model the controller computes with: xn.. is its forward\n"
     "                     kinematics at the compensated angles, the target to send it\n"
     "  --json             one JSON object on stdout instead of text\n"
+    "  --no-units-check   go on when the model's lengths or the targets look like metres,\n"
+    "                     the start angles like radians or two columns swapped\n"
+    "                     (docs/cli.md, 1.11)\n"
     "A target out of reach (or not met) keeps its input angles and its error_mm there; every\n"
     "row is written and the exit code is 1.\n"
     "exit codes: 0 success, 1 a target out of reach, 2 bad input or usage\n";
@@ -61,6 +65,7 @@ typedef struct {
     const char *out;
     const char *nominal;
     int json;
+    int no_units_check;
 } compensate_options;
 
 /* One target's answer. */
@@ -85,13 +90,14 @@ static int usage(const char *fmt, const char *arg)
 static int parse_options(int argc, char **argv, compensate_options *o)
 {
     memset(o, 0, sizeof *o);
-    enum { OPT_JSON = 1, OPT_HELP, OPT_MODEL, OPT_TARGETS, OPT_OUT, OPT_NOMINAL };
+    enum { OPT_JSON = 1, OPT_HELP, OPT_MODEL, OPT_TARGETS, OPT_OUT, OPT_NOMINAL, OPT_NO_UNITS };
     static const struct option longs[] = {{"json", no_argument, NULL, OPT_JSON},
                                           {"help", no_argument, NULL, OPT_HELP},
                                           {"model", required_argument, NULL, OPT_MODEL},
                                           {"targets", required_argument, NULL, OPT_TARGETS},
                                           {"out", required_argument, NULL, OPT_OUT},
                                           {"nominal", required_argument, NULL, OPT_NOMINAL},
+                                          {"no-units-check", no_argument, NULL, OPT_NO_UNITS},
                                           {NULL, 0, NULL, 0}};
     dhcal_options opts;
     dhcal_options_begin(&opts, argc, argv);
@@ -105,6 +111,7 @@ static int parse_options(int argc, char **argv, compensate_options *o)
         const char **slot = NULL;
         switch (c) {
         case OPT_JSON: o->json = 1; continue;
+        case OPT_NO_UNITS: o->no_units_check = 1; continue;
         case 'h':
         case OPT_HELP: fputs(compensate_help, stdout); return -1;
         case OPT_MODEL: slot = &o->model; break;
@@ -368,6 +375,11 @@ int dhcal_compensate_main(int argc, char **argv)
     }
     if (rc == DHCAL_IO_OK) {
         rc = dhcal_csv_load_targets(o.targets, model.arm.n_joints, &t, &err);
+    }
+    if (rc == DHCAL_IO_OK && !o.no_units_check) { /* targets against the model, not its frame */
+        const dhcal_units_ask ask = {NULL, -1, "use --no-units-check if they are right", NULL};
+        rc = dhcal_units_check_files(&model, o.model, &t, o.targets, NULL, NULL, &ask, NULL,
+                                     &err);
     }
     if (rc != DHCAL_IO_OK) {
         fprintf(stderr, "dhcal: %s\n", err.msg);
