@@ -35,6 +35,7 @@
 #include "fw_linux_can.h"
 #include "fw_linux_gpio.h"
 #include "fw_linux_nv.h"
+#include "fw_plan_file.h"
 #include "fw_sim_port.h"
 
 #define EXIT_FAULT 1
@@ -71,6 +72,10 @@ static const char *const help_text =
     "  --plan-candidates K   measure the N poses of K random candidates that the fit\n"
     "                        predicts the tool best from (K > N, at most 512; default 0:\n"
     "                        N random poses)\n"
+    "  --plan FILE           measure these poses instead, in this order (q1..qN in degrees,\n"
+    "                        as `dhcal plan` writes them, optionally dir1..dirN; 10..128\n"
+    "                        poses inside the machine's joint ranges); not with --samples\n"
+    "                        or --plan-candidates\n"
     "  --run-seed N          sim port: the plant's run seed (default 7, as dhcal-sim bus)\n"
     "  --hold-ticks N        ticks averaged per sample (default 200)\n"
     "  --params-out FILE     the calibrated parameters, one 'name value' line each\n"
@@ -92,6 +97,7 @@ typedef struct {
     const char *nv;
     const char *params_out;
     const char *gpio_chip;
+    const char *plan;
     unsigned long long reply_timeout_us;
     unsigned long long can_id_offset;
     unsigned long long start_timeout_ms;
@@ -106,6 +112,8 @@ typedef struct {
     unsigned enc_line[2];
     int have_lines;
     int have_can_id_offset;
+    int have_samples;
+    int have_candidates;
 } options;
 
 /* Config file values live here: options point into it. */
@@ -162,6 +170,8 @@ static int set_option(options *o, const char *key, const char *val)
                 return EXIT_USAGE;
             }
             o->have_can_id_offset |= nums[i].dst == &o->can_id_offset;
+            o->have_samples |= nums[i].dst == &o->samples;
+            o->have_candidates |= nums[i].dst == &o->plan_candidates;
             return 0;
         }
     }
@@ -171,7 +181,8 @@ static int set_option(options *o, const char *key, const char *val)
     } strs[] = {{"port", &o->port},           {"machine", &o->machine},
                 {"scenario", &o->scenario},
                 {"can", &o->can},             {"nv", &o->nv},
-                {"params-out", &o->params_out}, {"gpio-chip", &o->gpio_chip}};
+                {"params-out", &o->params_out}, {"gpio-chip", &o->gpio_chip},
+                {"plan", &o->plan}};
     for (size_t i = 0U; i < sizeof strs / sizeof strs[0]; ++i) {
         if (strcmp(key, strs[i].name) == 0) {
             if (val == NULL || val[0] == '\0') {
@@ -272,7 +283,7 @@ static const struct option long_options[] = {
     {"start-timeout-ms", required_argument, NULL, 0},
     {"nv", required_argument, NULL, 0},              {"samples", required_argument, NULL, 0},
     {"plan-seed", required_argument, NULL, 0},       {"run-seed", required_argument, NULL, 0},
-    {"plan-candidates", required_argument, NULL, 0},
+    {"plan-candidates", required_argument, NULL, 0}, {"plan", required_argument, NULL, 0},
     {"hold-ticks", required_argument, NULL, 0},      {"params-out", required_argument, NULL, 0},
     {"gpio-chip", required_argument, NULL, 0},       {"enc-lines", required_argument, NULL, 0},
     {"gpio-watch", required_argument, NULL, 0},      {"gpio-timeout-ms", required_argument, NULL, 0},
@@ -351,7 +362,10 @@ static int parse_args(int argc, char **argv, options *o)
     if (o->gpio_watch == 0U && o->samples < 10U) {
         return usage("%s", "--samples: 10..128");
     }
-    if (o->plan_candidates != 0U && o->plan_candidates <= o->samples) {
+    if (o->plan != NULL && (o->have_samples || o->have_candidates)) {
+        return usage("%s", "--plan gives the poses: not with --samples or --plan-candidates");
+    }
+    if (o->plan == NULL && o->plan_candidates != 0U && o->plan_candidates <= o->samples) {
         return usage("%s", "--plan-candidates: more candidates than --samples, or 0");
     }
     if ((o->gpio_chip != NULL) != (o->have_lines != 0)) {
@@ -497,6 +511,7 @@ static fw_port port;
 static fw_io_config io;
 static fw_job job;
 static fw_port device_port; /* the port's own table; `port` checks for a stop first */
+static fw_pose given_plan[FW_ACQ_MAX_SAMPLES]; /* --plan */
 
 /* A stop request ends the run at a tick boundary: the controller latches FW_FAULT_STOPPED,
  * which commands 0 V to every drive, and the tick fails so that every step returns. */
@@ -667,6 +682,15 @@ static int run_calibration(options *o)
     }
     apply_machine(o, &machine);
     machine_io_config(&machine, &io);
+    size_t n_given = 0U;
+    if (o->plan != NULL) { /* the desk's poses, checked against the machine's joint ranges */
+        char why[1200];
+        if (fw_plan_file_load(o->plan, &machine.model, 10U, FW_ACQ_MAX_SAMPLES, given_plan,
+                              &n_given, why, sizeof why) != 0) {
+            fprintf(stderr, "dhcal-fw: --plan: %s\n", why);
+            return EXIT_USAGE;
+        }
+    }
     if (strcmp(o->port, "sim") == 0) {
         if (dhs_scenario_load(o->scenario, &sf, &err) != DHCAL_IO_OK) {
             fprintf(stderr, "dhcal-fw: %s\n", err.msg);
@@ -719,9 +743,10 @@ static int run_calibration(options *o)
     if (machine.has_accel_limit) {
         jc.ctrl.a_max_rad_s2 = machine.max_accel_rad_s2;
     }
-    jc.n_samples = (size_t)o->samples;
+    jc.n_samples = o->plan != NULL ? n_given : (size_t)o->samples;
     jc.plan_seed = (uint32_t)o->plan_seed;
-    jc.plan_candidates = (size_t)o->plan_candidates;
+    jc.plan_candidates = o->plan != NULL ? 0U : (size_t)o->plan_candidates;
+    jc.poses = o->plan != NULL ? given_plan : NULL;
     jc.hold_ticks = (uint32_t)o->hold_ticks;
     fw_fault fault = FW_FAULT_NONE;
     if (strcmp(o->port, "linux") == 0) {

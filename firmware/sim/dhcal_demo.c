@@ -34,6 +34,7 @@
 #include "dhcal_io.h"
 #include "dhcal_model_map.h"
 #include "dhcal_sim/dhs_scenario_json.h"
+#include "fw_plan_file.h"
 #include "fw_sim_port.h"
 
 #define MAX_TARGETS 64U
@@ -46,6 +47,7 @@ static fw_job job;
 static fw_pose targets_pose[MAX_TARGETS];
 static dhc_model nominal;
 static dhc_model final_model;
+static fw_pose given_plan[FW_ACQ_MAX_SAMPLES]; /* --plan */
 
 typedef struct {
     double rms_mm;
@@ -251,7 +253,7 @@ static int write_outputs(const char *dir, size_t n, const char *effect)
 static const char *const usage_text =
     "usage: dhcal-demo --scenario S.json [--json] [--out DIR] [--samples N] [--targets N]\n"
     "                  [--mixed-directions] [--effects LIST] [--no-diagnose] [--unweighted]\n"
-    "                  [--start-deg Q1,...,QN] [--plan-candidates K]\n"
+    "                  [--start-deg Q1,...,QN] [--plan-candidates K | --plan P.csv]\n"
     "  --start-deg LIST where the arm stands when the controller starts, one angle per joint\n"
     "                   (default for the paper's 3-joint arm: 0,60,-60)\n"
     "  --effects LIST   the controller's configured effects, fitted in every calibration\n"
@@ -262,7 +264,11 @@ static const char *const usage_text =
     "  --samples N      samples to collect (10..128, default 40)\n"
     "  --plan-candidates K  measure the N poses of K random candidates from which the fit\n"
     "                   (and the diagnosis' candidate effects) predicts the tool best (K > N,\n"
-    "                   at most 512; default 160); 0: N random poses\n";
+    "                   at most 512; default 160); 0: N random poses\n"
+    "  --plan P.csv     measure these poses instead, in this order (q1..qN in degrees, as\n"
+    "                   `dhcal plan` writes them, optionally dir1..dirN; 10..128 poses inside\n"
+    "                   the joint ranges); not with --samples, --plan-candidates or\n"
+    "                   --mixed-directions\n";
 
 /* A count in 0..max, digits only. */
 static int parse_count(const char *s, size_t max, size_t *out)
@@ -290,7 +296,8 @@ enum {
     OPT_NO_DIAGNOSE,
     OPT_UNWEIGHTED,
     OPT_START,
-    OPT_PLAN
+    OPT_PLAN,
+    OPT_PLAN_FILE
 };
 
 /* "a,b,c" into q_deg (at most DHC_MAX_JOINTS finite angles in [-720, 720]); the count, or 0
@@ -311,7 +318,24 @@ static size_t parse_angles(const char *s, double q_deg[DHC_MAX_JOINTS])
     return n;
 }
 
-int main(int argc, char **argv)
+typedef struct {
+    const char *scenario;
+    const char *out_dir;
+    int json;
+    int mixed_dirs;
+    size_t n_samples;
+    size_t n_targets;
+    size_t n_candidates;
+    fw_autocal_config autocal;
+    const char *effects;
+    int weighted;
+    double start_deg[DHC_MAX_JOINTS];
+    size_t n_start;
+    const char *plan_file;
+} demo_options;
+
+/* The command line: 0, 2 (usage, said on standard error) or -1 (--help printed). */
+static int parse_options(int argc, char **argv, demo_options *o)
 {
     static const struct option long_options[] = {
         {"json", no_argument, NULL, OPT_JSON},
@@ -325,63 +349,64 @@ int main(int argc, char **argv)
         {"unweighted", no_argument, NULL, OPT_UNWEIGHTED},
         {"start-deg", required_argument, NULL, OPT_START},
         {"plan-candidates", required_argument, NULL, OPT_PLAN},
+        {"plan", required_argument, NULL, OPT_PLAN_FILE},
         {"help", no_argument, NULL, 'h'},
         {NULL, 0, NULL, 0}};
-    const char *scenario = NULL;
-    const char *out_dir = NULL;
-    int json = 0;
-    int mixed_dirs = 0;
-    size_t n_samples = 40U;
-    size_t n_targets = 20U;
-    size_t n_candidates = 160U;
-    fw_autocal_config autocal;
-    fw_autocal_default_config(&autocal);
-    const char *effects = NULL;
-    int weighted = 1;
-    double start_deg[DHC_MAX_JOINTS] = {0.0};
-    size_t n_start = 0U;
+    memset(o, 0, sizeof *o);
+    o->n_samples = 40U;
+    o->n_targets = 20U;
+    o->n_candidates = 160U;
+    fw_autocal_default_config(&o->autocal);
+    o->weighted = 1;
+    int planned_given = 0; /* --samples, --plan-candidates or --mixed-directions given */
     opterr = 0;
     int c;
     while ((c = getopt_long(argc, argv, ":h", long_options, NULL)) != -1) {
         int bad = 0;
         switch (c) {
         case OPT_JSON:
-            json = 1;
+            o->json = 1;
             break;
         case OPT_SCENARIO:
-            scenario = optarg;
+            o->scenario = optarg;
             break;
         case OPT_MIXED:
-            mixed_dirs = 1;
+            o->mixed_dirs = 1;
+            planned_given = 1;
+            break;
+        case OPT_PLAN_FILE:
+            o->plan_file = optarg;
             break;
         case OPT_OUT:
-            out_dir = optarg;
+            o->out_dir = optarg;
             break;
         case OPT_SAMPLES:
-            bad = parse_count(optarg, FW_ACQ_MAX_SAMPLES, &n_samples);
+            bad = parse_count(optarg, FW_ACQ_MAX_SAMPLES, &o->n_samples);
+            planned_given = 1;
             break;
         case OPT_TARGETS:
-            bad = parse_count(optarg, MAX_TARGETS, &n_targets);
+            bad = parse_count(optarg, MAX_TARGETS, &o->n_targets);
             break;
         case OPT_PLAN:
-            bad = parse_count(optarg, FW_PLAN_MAX_CANDIDATES, &n_candidates);
+            planned_given = 1;
+            bad = parse_count(optarg, FW_PLAN_MAX_CANDIDATES, &o->n_candidates);
             if (bad) {
                 fprintf(stderr, "dhcal-demo: --plan-candidates: '%s' is not a count in 0..%u\n",
                         optarg, FW_PLAN_MAX_CANDIDATES);
             }
             break;
         case OPT_EFFECTS:
-            effects = optarg;
+            o->effects = optarg;
             break;
         case OPT_NO_DIAGNOSE:
-            autocal.diagnose = 0;
+            o->autocal.diagnose = 0;
             break;
         case OPT_UNWEIGHTED:
-            weighted = 0;
+            o->weighted = 0;
             break;
         case OPT_START:
-            n_start = parse_angles(optarg, start_deg);
-            if (n_start == 0U) {
+            o->n_start = parse_angles(optarg, o->start_deg);
+            if (o->n_start == 0U) {
                 fprintf(stderr, "dhcal-demo: --start-deg: '%s' is not a list of angles in "
                                 "[-720, 720] deg\n", optarg);
                 bad = 1;
@@ -389,7 +414,7 @@ int main(int argc, char **argv)
             break;
         case 'h':
             fputs(usage_text, stdout);
-            return 0;
+            return -1;
         case ':':
             fprintf(stderr, "dhcal-demo: %s needs a value\n", argv[optind - 1]);
             bad = 1;
@@ -413,17 +438,41 @@ int main(int argc, char **argv)
         fprintf(stderr, "dhcal-demo: unexpected argument '%s'\n%s", argv[optind], usage_text);
         return 2;
     }
-    if (n_candidates != 0U && n_candidates <= n_samples) {
-        fprintf(stderr, "dhcal-demo: --plan-candidates %zu: need more candidates than the %zu "
-                        "samples\n", n_candidates, n_samples);
+    if (o->plan_file != NULL && planned_given) {
+        fprintf(stderr, "dhcal-demo: --plan gives the poses and their directions: not with "
+                        "--samples, --plan-candidates or --mixed-directions\n%s", usage_text);
         return 2;
     }
-    if (scenario == NULL || n_samples < 10U || n_samples > FW_ACQ_MAX_SAMPLES ||
-        n_targets == 0U || n_targets > MAX_TARGETS) {
+    if (o->plan_file == NULL && o->n_candidates != 0U && o->n_candidates <= o->n_samples) {
+        fprintf(stderr, "dhcal-demo: --plan-candidates %zu: need more candidates than the %zu "
+                        "samples\n", o->n_candidates, o->n_samples);
+        return 2;
+    }
+    if (o->scenario == NULL || o->n_samples < 10U || o->n_samples > FW_ACQ_MAX_SAMPLES ||
+        o->n_targets == 0U || o->n_targets > MAX_TARGETS) {
         fprintf(stderr, "dhcal-demo: need --scenario; 10 <= samples <= %u, 1 <= targets <= %u\n",
                 FW_ACQ_MAX_SAMPLES, MAX_TARGETS);
         return 2;
     }
+    return 0;
+}
+
+/* The scenario's arm, the simulation port, the --plan file, the configured effects and
+ * the job booted: 0, 1 (the controller did not start) or 2 (bad input, said). o's sample
+ * count, candidates and effects become the job's. */
+static int set_up(demo_options *o)
+{
+    const char *scenario = o->scenario;
+    const int mixed_dirs = o->mixed_dirs;
+    size_t n_samples = o->n_samples;
+    size_t n_candidates = o->n_candidates;
+    fw_autocal_config autocal = o->autocal;
+    const char *effects = o->effects;
+    const int weighted = o->weighted;
+    double start_deg[DHC_MAX_JOINTS];
+    memcpy(start_deg, o->start_deg, sizeof start_deg);
+    size_t n_start = o->n_start;
+    const char *plan_file = o->plan_file;
     dhcal_error err;
     memset(&err, 0, sizeof err);
     if (dhs_scenario_load(scenario, &sf, &err) != DHCAL_IO_OK ||
@@ -451,6 +500,15 @@ int main(int argc, char **argv)
                 scenario);
         return 2;
     }
+    if (plan_file != NULL) { /* the desk's poses, checked against this arm's joint ranges */
+        char why[1200];
+        if (fw_plan_file_load(plan_file, &nominal, 10U, FW_ACQ_MAX_SAMPLES, given_plan,
+                              &n_samples, why, sizeof why) != 0) {
+            fprintf(stderr, "dhcal-demo: --plan: %s\n", why);
+            return 2;
+        }
+        n_candidates = 0U;
+    }
     /* The configured effects, comma separated, by their names in docs/effects.md. */
     for (const char *e = effects; e != NULL && *e != '\0';) {
         const char *comma = strchr(e, ',');
@@ -473,6 +531,7 @@ int main(int argc, char **argv)
     jc.n_samples = n_samples;
     jc.plan_seed = 4242U;
     jc.plan_candidates = n_candidates;
+    jc.poses = plan_file != NULL ? given_plan : NULL;
     jc.mixed_dirs = mixed_dirs;
     jc.hold_ticks = 200U;
     /* the calibration's noise model: encoder quantisation from the io configuration, the
@@ -484,6 +543,29 @@ int main(int argc, char **argv)
                 fw_fault_name(job.ctrl.fault));
         return 1;
     }
+    o->n_samples = n_samples;
+    o->n_candidates = n_candidates;
+    o->autocal = autocal;
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    static demo_options o;
+    int rc = parse_options(argc, argv, &o);
+    if (rc == 0) {
+        rc = set_up(&o);
+    }
+    if (rc != 0) {
+        return rc < 0 ? 0 : rc;
+    }
+    const char *out_dir = o.out_dir;
+    const int json = o.json;
+    const size_t n_targets = o.n_targets;
+    const size_t n_candidates = o.n_candidates;
+    const fw_autocal_config autocal = o.autocal;
+    const char *effects = o.effects;
+    const char *plan_file = o.plan_file;
     FILE *log = json ? stderr : stdout;
 
     /* (a) nominal */
@@ -500,10 +582,12 @@ int main(int argc, char **argv)
     }
     const size_t n_done = job.n_samples;
     const double o1 = job.o1;
-    fprintf(log, "(b) %zu samples (%s plan of %zu poses%s, observability O1 %.4g over %zu of "
-                 "%zu parameters)\n", n_done, n_candidates > 0U ? "optimal" : "random",
-            job.n_plan, n_candidates > 0U ? " out of the candidates" : "", o1, job.o1_rank,
-            job.o1_params);
+    fprintf(log, "(b) %zu samples (%s plan of %zu poses%s%s, observability O1 %.4g over %zu of "
+                 "%zu parameters)\n", n_done,
+            plan_file != NULL ? "the given" : n_candidates > 0U ? "optimal" : "random",
+            job.n_plan, plan_file != NULL ? " from " : n_candidates > 0U ? " out of the "
+                                                                          "candidates" : "",
+            plan_file != NULL ? plan_file : "", o1, job.o1_rank, job.o1_params);
     if (fa != FW_FAULT_NONE) {
         fprintf(stderr, "dhcal-demo: fault %s (index %zu) during acquisition\n",
                 fw_fault_name(fa), job.ctrl.fault_index);

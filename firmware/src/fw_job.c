@@ -63,6 +63,22 @@ fw_fault fw_job_boot(fw_job *job, const fw_job_config *cfg, const dhc_model *nom
     return fw_ctrl_init(&job->ctrl, port, io, &job->cfg.ctrl, start.q_rad, wires);
 }
 
+/* 1 when every given pose can be commanded as it is (fw_job_config.poses). */
+static int given_poses_ok(const dhc_model *m, const fw_pose *poses, size_t n)
+{
+    for (size_t i = 0U; i < n; ++i) {
+        for (size_t j = 0U; j < m->arm.n_joints; ++j) {
+            const double q = poses[i].q_rad[j];
+            const int8_t d = poses[i].dir[j];
+            if (!(q >= m->arm.joint[j].min_rad && q <= m->arm.joint[j].max_rad) ||
+                (d != 1 && d != -1)) {
+                return 0; /* NaN fails the range test too */
+            }
+        }
+    }
+    return 1;
+}
+
 fw_fault fw_job_plan(fw_job *job)
 {
     if (job->ctrl.fault != FW_FAULT_NONE) {
@@ -70,7 +86,14 @@ fw_fault fw_job_plan(fw_job *job)
     }
     dhc_param_set base;
     const int have_base = dhc_params_base_model(&base, &job->nominal) == DHC_OK;
-    if (job->cfg.plan_candidates > 0U) {
+    if (job->cfg.poses != NULL) {
+        /* the desk's plan, measured as given */
+        if (!given_poses_ok(&job->nominal, job->cfg.poses, job->cfg.n_samples)) {
+            return job_fault(job, FW_FAULT_ARGUMENT);
+        }
+        memcpy(job->plan, job->cfg.poses, job->cfg.n_samples * sizeof job->plan[0]);
+        job->n_plan = job->cfg.n_samples;
+    } else if (job->cfg.plan_candidates > 0U) {
         /* what the calibration will fit: the base model and the configured effects */
         dhc_param_set fitted = base;
         const fw_autocal_config *ac = &job->cfg.autocal;

@@ -3,7 +3,8 @@
  * (where the arm works) and as many again with joints at the ends of their ranges; lib's
  * dhc_plan_select keeps the --poses of them that observe the base model and --effects
  * best where the arm works, and the report sets the plan beside a random plan of the same
- * size. */
+ * size. With --discriminate A,B the same candidates are chosen from to tell two look-alike
+ * effects apart instead (dhcal_discriminate.h), optionally adding to the poses of --data. */
 #ifndef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 200809L
 #endif
@@ -20,10 +21,12 @@
 #include "dhcal/dhc_plan.h"
 #include "dhcal_analysis.h"
 #include "dhcal_csv.h"
+#include "dhcal_discriminate.h"
 #include "dhcal_file.h"
 #include "dhcal_model_file.h"
 #include "dhcal_model_map.h"
 #include "dhcal_options.h"
+#include "dhcal_units.h"
 
 #define PLAN_MAX_CANDIDATES 100000UL
 /* the candidates' Jacobians are kept when they take at most this much memory */
@@ -32,6 +35,7 @@
 static const char *const plan_usage =
     "usage: dhcal plan --model M.json --poses N [--effects LIST] [--candidates K]\n"
     "                  [--end-candidates E] [--seed S] [--min-z MM] --out P.csv [--json]\n"
+    "                  [--no-units-check] [--discriminate A,B [--data D.csv]]\n"
     "Chooses the N poses, of K random candidates (inside the model's joint ranges, the tool\n"
     "above --min-z in the world frame: where the arm works) and E more with joints at the\n"
     "ends of their ranges, from which a fit of the model's joint offsets and link geometry\n"
@@ -46,6 +50,16 @@ static const char *const plan_usage =
     "  --seed S           the candidates' random generator (default 1)\n"
     "  --min-z MM         lowest tool height accepted (default: none)\n"
     "  --json             one JSON object on stdout instead of text\n"
+    "  --no-units-check   go on with a model whose lengths look like metres, or a --min-z\n"
+    "                     that looks like metres (docs/cli.md, 1.11)\n"
+    "  --discriminate A,B instead: the N poses that tell the two effects apart (labels as\n"
+    "                     --effects takes them): the smaller of what of A's signature neither\n"
+    "                     the geometry (base model plus LIST) nor B absorbs, and the reverse,\n"
+    "                     is made largest; the report gives the two signatures' correlation\n"
+    "                     (diagnose's look-alikes: above 0.9) with the plan and with N random\n"
+    "                     poses\n"
+    "  --data D.csv       with --discriminate: the poses measured already; the plan adds N\n"
+    "                     poses to them, their geometry fit gives the effects' directions\n"
     "A plan made for the parameters named is no test of effects not named: it gathers the\n"
     "poses where those parameters show, where other effects may look alike. Measure random\n"
     "poses too when a diagnosis is to find what the model lacks.\n";
@@ -156,13 +170,17 @@ typedef struct {
     unsigned long seed;
     double min_z;
     int json;
+    int no_units_check;
+    const char *discriminate;
+    const char *data;
 } plan_options;
 
 /* 0, 2 (usage) or -1 (help printed). */
 static int parse_plan_args(int argc, char **argv, plan_options *o)
 {
     enum { OPT_MODEL = 1, OPT_POSES, OPT_EFFECTS, OPT_CANDIDATES, OPT_END_CANDIDATES,
-           OPT_SEED, OPT_MIN_Z, OPT_OUT, OPT_JSON, OPT_HELP };
+           OPT_SEED, OPT_MIN_Z, OPT_OUT, OPT_JSON, OPT_HELP, OPT_NO_UNITS, OPT_DISCRIMINATE,
+           OPT_DATA };
     static const struct option long_options[] = {
         {"model", required_argument, NULL, OPT_MODEL},
         {"poses", required_argument, NULL, OPT_POSES},
@@ -174,6 +192,9 @@ static int parse_plan_args(int argc, char **argv, plan_options *o)
         {"out", required_argument, NULL, OPT_OUT},
         {"json", no_argument, NULL, OPT_JSON},
         {"help", no_argument, NULL, OPT_HELP},
+        {"no-units-check", no_argument, NULL, OPT_NO_UNITS},
+        {"discriminate", required_argument, NULL, OPT_DISCRIMINATE},
+        {"data", required_argument, NULL, OPT_DATA},
         {NULL, 0, NULL, 0}};
     memset(o, 0, sizeof *o);
     o->seed = 1UL;
@@ -191,6 +212,9 @@ static int parse_plan_args(int argc, char **argv, plan_options *o)
         case OPT_EFFECTS: o->effects = optarg; break;
         case OPT_OUT: o->out = optarg; break;
         case OPT_JSON: o->json = 1; break;
+        case OPT_NO_UNITS: o->no_units_check = 1; break;
+        case OPT_DISCRIMINATE: o->discriminate = optarg; break;
+        case OPT_DATA: o->data = optarg; break;
         case 'h':
         case OPT_HELP: fputs(plan_usage, stdout); return -1;
         case OPT_POSES:
@@ -242,6 +266,10 @@ static int parse_plan_args(int argc, char **argv, plan_options *o)
     }
     if (o->model == NULL || o->out == NULL || o->poses == 0UL) {
         return plan_usage_error("--model, --poses and --out are required");
+    }
+    if (o->data != NULL && o->discriminate == NULL) {
+        return plan_usage_error("--data: the poses measured already count only with "
+                                "--discriminate");
     }
     if (o->candidates == 0UL) {
         o->candidates = o->poses * 10UL > 200UL ? o->poses * 10UL : 200UL;
@@ -327,6 +355,74 @@ static void report(const plan_options *o, size_t ends, const dhc_param_set *set,
            best->floor, best->variance, 100.0 * (rep->variance / best->floor - 1.0));
 }
 
+static const char *kind_name(dhc_meas_kind kind)
+{
+    return kind == DHC_MEAS_WIRES ? "wires" : kind == DHC_MEAS_POSE ? "pose" : "position";
+}
+
+/* --discriminate A,B (dhcal_discriminate.h): the labels and --data checked first (exit 2),
+ * then the candidates drawn as for the plan, measured like the data (else as the model
+ * measures), their Jacobians taken at the data's geometry fit (else at the model). */
+static int discriminate_plan(const plan_options *o, const dhc_model *model,
+                             const dhc_param_set *set)
+{
+    dhcal_error err;
+    memset(&err, 0, sizeof err);
+    dhcal_disc_pair pair;
+    static dhcal_disc_data data;
+    int rc = dhcal_disc_parse(o->discriminate, model, set, &pair, &err);
+    if (rc == DHCAL_IO_OK && o->data != NULL) {
+        rc = dhcal_disc_load_data(o->data, model, o->model, o->effects, o->no_units_check,
+                                  &data, &err);
+    }
+    if (rc != DHCAL_IO_OK) {
+        fprintf(stderr, "dhcal: plan: %s\n", err.msg);
+        dhcal_disc_data_free(&data);
+        return rc == DHCAL_IO_BAD_INPUT ? 2 : 1;
+    }
+    const size_t nj = model->arm.n_joints;
+    const size_t k = o->candidates;
+    double *q = malloc((k + o->end_candidates) * nj * sizeof *q + 1U);
+    size_t *chosen = malloc(o->poses * sizeof *chosen);
+    rc = 1;
+    if (q == NULL || chosen == NULL) {
+        fprintf(stderr, "dhcal: plan: out of memory\n");
+        goto done;
+    }
+    const size_t got = draw_candidates(model, k, o->seed, 0, o->min_z, q);
+    if (got < k) {
+        fprintf(stderr, "dhcal: plan: %s: only %zu of %zu random poses put the tool at or above "
+                        "--min-z %g mm\n", o->model, got, k, o->min_z);
+        goto done;
+    }
+    const size_t ends = draw_candidates(model, o->end_candidates, o->seed, 1, o->min_z,
+                                        q + k * nj);
+    dhc_meas_kind kind = model->measurer.present ? DHC_MEAS_WIRES : DHC_MEAS_POSITION;
+    if (data.have && data.samples.n > 0U) {
+        kind = (dhc_meas_kind)data.samples.samples[0].kind;
+    }
+    const dhcal_disc_problem pb = {data.fitted ? &data.fit->model : model, set, &pair, q,
+                                   k + ends, k, kind, data.have ? &data : NULL, o->poses};
+    dhcal_disc_result res;
+    if (dhcal_disc_select(&pb, chosen, &res, &err) != DHCAL_IO_OK) {
+        fprintf(stderr, "dhcal: plan: no plan: %s\n", err.msg);
+        goto done;
+    }
+    if (write_plan(o->out, model, q, chosen, o->poses, &err) != DHCAL_IO_OK) {
+        fprintf(stderr, "dhcal: plan: %s\n", err.msg);
+        goto done;
+    }
+    const dhcal_disc_report_info info = {o->json, o->out, o->data, o->poses, k, ends,
+                                         kind_name(kind)};
+    dhcal_disc_report(&info, &pb, &res);
+    rc = 0;
+done:
+    free(q);
+    free(chosen);
+    dhcal_disc_data_free(&data);
+    return rc;
+}
+
 int dhcal_plan_command(int argc, char **argv)
 {
     plan_options o;
@@ -343,6 +439,10 @@ int dhcal_plan_command(int argc, char **argv)
     if (rc == DHCAL_IO_OK) {
         rc = dhcal_model_to_lib(&file, o.model, &model, &err);
     }
+    if (rc == DHCAL_IO_OK && !o.no_units_check) { /* a model or a floor in metres */
+        rc = dhcal_units_check_height(&model, o.model, o.min_z, "--min-z",
+                                      "use --no-units-check if they are right", &err);
+    }
     if (rc == DHCAL_IO_OK && dhc_params_base_model(&set, &model) != DHC_OK) {
         snprintf(err.msg, sizeof err.msg, "%s: the base model does not fit the parameter limit",
                  o.model);
@@ -354,6 +454,9 @@ int dhcal_plan_command(int argc, char **argv)
     if (rc != DHCAL_IO_OK) {
         fprintf(stderr, "dhcal: plan: %s\n", err.msg);
         return rc == DHCAL_IO_BAD_INPUT ? 2 : 1;
+    }
+    if (o.discriminate != NULL) {
+        return discriminate_plan(&o, &model, &set);
     }
     const size_t nj = model.arm.n_joints;
     const size_t k = o.candidates;

@@ -41,6 +41,14 @@ typedef struct {
                                poses took joint_compliance:2 for joint_scale:2; with the
                                candidates, 40 planned poses find every hidden effect of
                                host_sim/scenarios as 60 random ones do) */
+    const fw_pose *poses;  /* NULL: the job plans its poses (plan_candidates, plan_seed,
+                              mixed_dirs); else the n_samples poses to measure, in this
+                              order, as given: a plan made at the desk (`dhcal plan`, e.g.
+                              --discriminate A,B: poses that tell two look-alike effects
+                              apart), read by the port. Each must have finite angles within
+                              the model's joint ranges and directions of -1 or +1, else
+                              fw_job_plan faults FW_FAULT_ARGUMENT. Not copied before
+                              fw_job_plan: it must live until then. */
     int mixed_dirs;        /* approach directions drawn +-1 (fw_plan.h) */
     uint32_t hold_ticks;   /* ticks averaged per sample */
     int noise_model;       /* 1: the fits weight by the encoders' quantisation and the
@@ -85,9 +93,10 @@ void fw_job_default_config(fw_job_config *cfg, const dhc_model *nominal);
 fw_fault fw_job_boot(fw_job *job, const fw_job_config *cfg, const dhc_model *nominal,
                      const fw_port *port, const fw_io_config *io);
 
-/* Plan: the poses (fw_plan_poses, or fw_plan_select with plan_candidates) and their
- * observability for the base model.
- * FW_FAULT_UNDERDETERMINED when the joint ranges leave no pose. */
+/* Plan: the poses (the configuration's own poses, else fw_plan_poses, or fw_plan_select
+ * with plan_candidates) and their observability for the base model.
+ * FW_FAULT_UNDERDETERMINED when the joint ranges leave no pose; FW_FAULT_ARGUMENT for given
+ * poses outside the joint ranges, not finite, or with a direction other than -1 or +1. */
 fw_fault fw_job_plan(fw_job *job);
 
 /* Acquire: one sample per planned pose (fw_acquire), the holds' noise counted afresh. */

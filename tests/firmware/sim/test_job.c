@@ -171,6 +171,49 @@ static void test_a_recorded_acquisition_calibrates_like_the_live_one(void)
     TEST_ASSERT_EQUAL_size_t(0U, job.n_samples);
 }
 
+/* A plan made at the desk (fw_job_config.poses): measured as given, in its order, each
+ * sample at its pose to the servo's settle band; a pose the arm cannot take is refused
+ * before anything moves. */
+static void test_given_poses_are_measured_as_given(void)
+{
+    static fw_pose given[12];
+    TEST_ASSERT_EQUAL_size_t(12U, fw_plan_poses(&nominal, 12U, 777U, 1, given));
+    given[4].q_rad[1] = nominal.arm.joint[1].max_rad; /* an end of a range is inside it */
+    cfg.n_samples = 12U;
+    cfg.poses = given;
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_job_boot(&job, &cfg, &nominal, &port, &io));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_job_plan(&job));
+    TEST_ASSERT_EQUAL_size_t(12U, job.n_plan);
+    TEST_ASSERT_EQUAL_MEMORY(given, job.plan, sizeof given);
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_job_acquire(&job));
+    TEST_ASSERT_EQUAL_size_t(12U, job.n_samples);
+    for (size_t i = 0U; i < 12U; ++i) {
+        for (size_t j = 0U; j < 3U; ++j) {
+            TEST_ASSERT_DOUBLE_WITHIN(2.0 * cfg.ctrl.settle_pos_tol_rad, given[i].q_rad[j],
+                                      job.samples[i].q_rad[j]);
+            TEST_ASSERT_EQUAL_INT8(given[i].dir[j], job.samples[i].dir[j]);
+        }
+    }
+    /* outside a range, not finite, no direction: refused, nothing moves */
+    const double bad_q[2] = {nominal.arm.joint[2].max_rad + 1e-6, (double)NAN};
+    for (size_t k = 0U; k < 3U; ++k) {
+        fresh_arm();
+        static fw_pose wrong[12];
+        memcpy(wrong, given, sizeof wrong);
+        if (k < 2U) {
+            wrong[7].q_rad[2] = bad_q[k];
+        } else {
+            wrong[7].dir[0] = 0;
+        }
+        cfg.n_samples = 12U;
+        cfg.poses = wrong;
+        TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_job_boot(&job, &cfg, &nominal, &port, &io));
+        TEST_ASSERT_EQUAL(FW_FAULT_ARGUMENT, fw_job_plan(&job));
+        TEST_ASSERT_EQUAL_UINT64(0U, sim.ticks);
+        TEST_ASSERT_EQUAL(FW_FAULT_ARGUMENT, fw_job_acquire(&job));
+    }
+}
+
 static void test_lib_failures_map_to_distinct_faults(void)
 {
     TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_fault_of_status(DHC_OK));
@@ -218,6 +261,7 @@ int main(void)
     RUN_TEST(test_boot_refuses_a_configuration_the_machine_cannot_run);
     RUN_TEST(test_too_few_samples_is_not_an_argument_error);
     RUN_TEST(test_a_recorded_acquisition_calibrates_like_the_live_one);
+    RUN_TEST(test_given_poses_are_measured_as_given);
     RUN_TEST(test_lib_failures_map_to_distinct_faults);
     RUN_TEST(test_the_effect_label_is_the_effect_table_name);
     return UNITY_END();
