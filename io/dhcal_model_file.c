@@ -193,7 +193,7 @@ static int load_effects(const dhcal_jctx *c, const cJSON *fx, dhcal_model *model
 }
 
 static const char *const TOP_KEYS[] = {"name",    "joints",   "tool_mm", "base",
-                                       "gravity", "measurer", "effects"};
+                                       "gravity", "measurer", "effects", "repeatability_mm"};
 
 static int load_root(dhcal_jctx *c, const cJSON *root, dhcal_model *model)
 {
@@ -256,6 +256,8 @@ static int load_root(dhcal_jctx *c, const cJSON *root, dhcal_model *model)
             return dhcal_jfail(c, "gravity", "norm %.6g is not 1 (tolerance 1e-3)", g);
         }
         dhc_vec3_scale(model->gravity, 1.0 / g, model->gravity);
+        rc = dhcal_jopt_number(c, root, "", "repeatability_mm", DHCAL_REPEATABILITY_MIN_MM,
+                               DHCAL_REPEATABILITY_MAX_MM, "mm", &model->repeatability_mm);
     }
     const cJSON *const meas = cJSON_GetObjectItemCaseSensitive(root, "measurer");
     if (rc == DHCAL_IO_OK && meas != NULL) {
@@ -398,6 +400,10 @@ static void format_model(dhcal_text *sb, const dhcal_model *m)
     put_frame(sb, &m->arm.base);
     dhcal_text_printf(sb, ",\n  \"gravity\": ");
     put_vec_mm(sb, m->gravity, 3U);
+    if (m->repeatability_mm > 0.0) {
+        dhcal_text_printf(sb, ",\n  \"repeatability_mm\": ");
+        put_exact(sb, m->repeatability_mm);
+    }
     if (m->has_measurer) {
         dhcal_text_printf(sb, ",\n  \"measurer\": {\n    \"anchors_mm\": [");
         for (size_t i = 0U; i < 3U; ++i) {
@@ -455,6 +461,8 @@ static int model_writable(const dhcal_model *m, char *where, size_t cap)
         bad = "base";
     } else if (!dhc_all_finite(m->gravity, 3U)) {
         bad = "gravity";
+    } else if (!dhc_is_finite(m->repeatability_mm)) {
+        bad = "repeatability_mm";
     } else if (m->has_measurer && !dhc_all_finite(&m->anchors_mm[0][0], 9U)) {
         bad = "measurer.anchors_mm";
     } else if (m->has_measurer && !frame_finite(&m->measurer_frame)) {

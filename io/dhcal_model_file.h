@@ -19,6 +19,9 @@
 #define DHCAL_MODEL_MAX_BYTES 1048576U
 
 #define DHCAL_MAX_EFFECTS 32U
+/* A repeatability (ISO 9283 RP) in mm: 0.1 um to 100 mm covers every arm there is. */
+#define DHCAL_REPEATABILITY_MIN_MM 1e-4
+#define DHCAL_REPEATABILITY_MAX_MM 100.0
 #define DHCAL_MAX_EFFECT_VALUES 32U
 
 /* One entry of the model's "effects" object, e.g. "joint_compliance:2": [1e-6, 2e-6]. */
@@ -33,6 +36,7 @@ typedef struct {
     dhc_arm arm;            /* joints (incl. beta_deg when given), base, tool_mm */
     int has_beta[DHC_MAX_JOINTS]; /* the file gave beta_deg for that joint */
     double gravity[3];      /* unit vector, world frame; default {0, 0, -1} */
+    double repeatability_mm; /* the arm's ISO 9283 pose repeatability RP; 0: not given */
     int has_measurer;
     double anchors_mm[3][3];   /* measurer anchors in the measurer frame */
     dhc_frame measurer_frame;  /* T_Meas: measurer frame in the world */

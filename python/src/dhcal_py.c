@@ -15,6 +15,7 @@
 #include "dhcal_model_map.h"
 #include "dhcal_refine.h"
 #include "dhcal_report.h"
+#include "dhcal_units.h"
 
 struct dhcal_py_model {
     char path[1024]; /* stands for the file in messages */
@@ -243,16 +244,12 @@ static int not_converged(const dhcal_fit *fit, const char *what, dhcal_error *e)
     return 1;
 }
 
-/* fit and diagnose: main.c's do_fit, then its report (cmd_fit, cmd_diagnose). */
-static int run_fit_or_diagnose(int diagnose, const dhcal_py_model *m, py_session *s,
-                               const char *effects, int cv, cJSON *obj, dhcal_fit **fit_out,
-                               dhcal_error *e)
+/* fit: main.c's do_fit, then its report (cmd_fit). */
+static int run_fit(const dhcal_py_model *m, py_session *s, const char *effects, int cv,
+                   cJSON *obj, dhcal_fit **fit_out, dhcal_error *e)
 {
     static dhcal_fit fit;
     static dhcal_fit_extras extras;
-    static dhc_diagnosis diag;
-    static dhcal_trials trials;
-    dhcal_covariates cov;
     int rc = dhcal_run_fit(&m->lib, effects, s->geometry, &s->noise, &s->samples,
                            s->have_held ? &s->held : NULL, &fit, e);
     if (rc != DHCAL_IO_OK) {
@@ -265,44 +262,36 @@ static int run_fit_or_diagnose(int diagnose, const dhcal_py_model *m, py_session
         free(row_err);
         return dhcal_error_set(e, DHCAL_IO_FAILED, "evaluation failed");
     }
-    if (diagnose) {
-        rc = dhcal_run_diagnose(&fit, &s->samples, &diag, &cov, e);
-    }
-    memset(&trials, 0, sizeof trials);
-    if (rc == DHCAL_IO_OK) {
-        dhcal_fit_extras_compute(&fit, &s->samples, s->have_held ? &s->held : NULL, &extras);
-        if (cv) {
-            extras.have_cv = dhcal_cross_validate(&fit.model, &fit.set, &s->noise, &s->samples,
-                                                  &extras.cv, e) == DHCAL_IO_OK;
-            rc = extras.have_cv ? DHCAL_IO_OK : DHCAL_IO_FAILED;
-        }
-        if (rc == DHCAL_IO_OK && cv && diagnose) {
-            rc = dhcal_try_candidates(&fit, &diag, &s->noise, &s->samples,
-                                      s->have_held ? &s->held : NULL, &trials, NULL, NULL, e);
-        }
+    dhcal_fit_extras_compute(&fit, &s->samples, s->have_held ? &s->held : NULL, &extras);
+    if (cv) {
+        extras.have_cv = dhcal_cross_validate(&fit.model, &fit.set, &s->noise, &s->samples,
+                                              &extras.cv, e) == DHCAL_IO_OK;
+        rc = extras.have_cv ? DHCAL_IO_OK : DHCAL_IO_FAILED;
     }
     if (rc == DHCAL_IO_OK) {
         dhcal_json_fit(obj, &fit, &m->lib, &s->samples, row_err);
         dhcal_json_extras(obj, &fit, &extras);
-        if (diagnose) {
-            dhcal_json_diagnosis(obj, &fit, &diag, &cov, cv ? &trials : NULL);
-        }
         *fit_out = &fit;
     }
     free(row_err);
     return rc;
 }
 
-/* refine: main.c's cmd_refine. */
+/* refine and diagnose (its first judgement): main.c's cmd_refine and cmd_diagnose. */
 static int run_refine(const dhcal_py_model *m, py_session *s, const char *effects,
-                      const char *geometry, cJSON *obj, dhcal_fit **fit_out, dhcal_error *e)
+                      const char *geometry, size_t max_steps, cJSON *obj, dhcal_fit **fit_out,
+                      dhcal_error *e)
 {
     static dhcal_refine_result res;
     static dhcal_fit_extras extras;
     int rc = dhcal_run_refine(&m->lib, effects, geometry != NULL ? &s->geometry : NULL,
-                              &s->noise, &s->samples, s->have_held ? &s->held : NULL, &res, e);
+                              &s->noise, m->file.repeatability_mm, max_steps, &s->samples,
+                              s->have_held ? &s->held : NULL, &res, e);
     if (rc != DHCAL_IO_OK) {
         return rc;
+    }
+    if (max_steps == 0U && !res.judged) {
+        return dhcal_error_set(e, DHCAL_IO_FAILED, "%s", res.stopped_why);
     }
     double *row_err = calloc(s->samples.n + 1U, sizeof *row_err);
     dhcal_error_stats es;
@@ -316,7 +305,11 @@ static int run_refine(const dhcal_py_model *m, py_session *s, const char *effect
     extras.cv = res.cv;
     dhcal_json_fit(obj, &res.fit, &m->lib, &s->samples, row_err);
     dhcal_json_extras(obj, &res.fit, &extras);
-    dhcal_json_refine(obj, &res);
+    if (max_steps == 0U) {
+        dhcal_json_diagnosis(obj, &res.fit, &res.diag, &res.cov, &res.trials);
+    } else {
+        dhcal_json_refine(obj, &res);
+    }
     free(row_err);
     *fit_out = &res.fit;
     return DHCAL_IO_OK;
@@ -345,8 +338,9 @@ int dhcal_py_run(const char *command, const dhcal_py_model *m, const dhcal_py_ro
         rc = dhcal_error_set(&e, DHCAL_IO_FAILED, "out of memory");
     }
     if (rc == DHCAL_IO_OK) {
-        rc = is_refine ? run_refine(m, &s, effects, geometry, obj, &fit, &e)
-                       : run_fit_or_diagnose(is_diagnose, m, &s, effects, cv, obj, &fit, &e);
+        rc = is_fit ? run_fit(m, &s, effects, cv, obj, &fit, &e)
+                    : run_refine(m, &s, effects, geometry,
+                                 is_refine ? DHCAL_REFINE_MAX_STEPS : 0U, obj, &fit, &e);
     }
     if (rc == DHCAL_IO_OK) {
         *report = cJSON_PrintUnformatted(obj);
@@ -366,6 +360,37 @@ int dhcal_py_run(const char *command, const dhcal_py_model *m, const dhcal_py_ro
     }
     cJSON_Delete(obj);
     close_session(&s);
+    return rc == DHCAL_IO_OK ? rc : fail(err, err_cap, rc, e.msg);
+}
+
+int dhcal_py_units_check(const dhcal_py_model *m, const dhcal_py_rows *train,
+                         const dhcal_py_rows *held, const char *effects, char *err,
+                         size_t err_cap)
+{
+    static dhcal_dataset sets[2];
+    const dhcal_py_rows *rows[2] = {train, held};
+    const char *names[2] = {"training data", "held-out data"};
+    dhcal_error e;
+    memset(&e, 0, sizeof e);
+    int rc = DHCAL_IO_OK;
+    for (size_t k = 0U; k < 2U && rc == DHCAL_IO_OK; ++k) {
+        if (rows[k] != NULL) {
+            const dhcal_py_rows *r = rows[k];
+            const dhcal_arrays a = {names[k], r->n_rows,  m->lib.arm.n_joints,
+                                    r->q_deg, r->xyz_mm,  r->dir,
+                                    r->temp_c, r->t_s,    r->wires_mm};
+            rc = dhcal_dataset_from_arrays(&a, &sets[k], &e);
+        }
+    }
+    if (rc == DHCAL_IO_OK) {
+        /* worded for Python: the keyword that goes on, the effect that fits the frame */
+        const dhcal_units_ask ask = {effects, 1, "pass check_units=False if they are right",
+                                     "add 'base_frame' to effects"};
+        rc = dhcal_units_check_files(&m->lib, m->path, &sets[0], names[0],
+                                     held != NULL ? &sets[1] : NULL, names[1], &ask, NULL, &e);
+    }
+    dhcal_dataset_free(&sets[0]);
+    dhcal_dataset_free(&sets[1]);
     return rc == DHCAL_IO_OK ? rc : fail(err, err_cap, rc, e.msg);
 }
 

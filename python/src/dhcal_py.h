@@ -81,6 +81,16 @@ DHCAL_PY_API int dhcal_py_run(const char *command, const dhcal_py_model *m,
                               int cv, char **report, dhcal_py_model **fitted, char *err,
                               size_t err_cap);
 
+/* The program's units-and-frames check (tools/dhcal/dhcal_units.h) before any fit: the
+ * model's reach, then the rows train and held (NULL: none) against the nominal model m:
+ * positions or wire lengths in another unit (metres), angles in radians, two columns
+ * swapped, and, unless effects (comma-separated, NULL: none) names base_frame, points in
+ * another frame than the model's base. Returns 0, or 2 with the cause in err (worded for
+ * Python: check_units=False goes on), or 1 when out of memory. */
+DHCAL_PY_API int dhcal_py_units_check(const dhcal_py_model *m, const dhcal_py_rows *train,
+                                      const dhcal_py_rows *held, const char *effects,
+                                      char *err, size_t err_cap);
+
 /* Frees text this library returned. */
 DHCAL_PY_API void dhcal_py_free(char *text);
 

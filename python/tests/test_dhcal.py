@@ -111,22 +111,23 @@ def test_diagnose_names_the_hidden_effect_as_the_program(model, train, heldout,
     report = run_cli("diagnose", "--model", MODEL, "--data", TRAIN, "--heldout", HELDOUT,
                      "--cv")
     assert_fit_equal(result, report)
-    assert report["candidates"][0]["significant"]
-    named = f'{report["candidates"][0]["effect"]}:{report["candidates"][0]["joint"]}'
+    assert report["candidates"][0]["significant"] and report["candidates"][0]["verdict"] == "named"
+    named = report["named"]
     assert named == truth["effect"] == "joint_compliance:2"
     assert result.named is not None and result.named.label == named
     assert close(result.time_pose_r2, report["time_pose_r2"])
     assert len(result.candidates) == len(report["candidates"]) > 5
     for c, d in zip(result.candidates, report["candidates"]):
-        assert (c.effect, c.joint, c.significant, c.dof, c.lookalike) == \
-            (d["effect"], d["joint"], d["significant"], d["dof"], d.get("lookalike"))
+        assert (c.effect, c.joint, c.significant, c.dof, c.verdict, c.look_alikes) == \
+            (d["effect"], d["joint"], d["significant"], d["dof"], d["verdict"],
+             tuple(d["look_alikes"]))
         assert close(c.explained, d["explained"]) and close(c.log10_p, d["log10_p"])
         assert list(c.params) == [p["name"] for p in d["params"]]
         assert all(close(c.params[p["name"]], p["value"]) for p in d["params"])
         assert (c.cv_rms_mm is None) == ("cv_rms_mm" not in d)
         if c.cv_rms_mm is not None:
             assert close(c.cv_rms_mm, d["cv_rms_mm"])
-    assert result.named.explained > 0.8
+    assert result.named.explained > 0.8 and result.named.cv_rms_mm < 0.2
     assert "joint_compliance:2" in result.summary()
 
 

@@ -111,6 +111,61 @@ def deploy_ur5(c, dhcal, d, calibrated, scratch):
             f'{mean_shift:.3f} mm mean')
 
 
+def verdicts(c, dhcal, rd):
+    """Issue #26: what dhcal says about the physics, on every real set as shipped
+    (orientation and temperature columns included). diagnose's named effect is refine's
+    first step (one ranking); every step of refine cross-validates on the same rows; the
+    UR5 gives at most 10 significant candidates; on the WAM nothing is named or added with
+    an unphysical value and there is no compliance about the vertical joint 1."""
+    start = 'base_frame,tool_offset'
+    for name in sorted(os.listdir(rd)):
+        d = os.path.join(rd, name)
+        data = os.path.join(d, 'data.csv')
+        if not (os.path.isfile(data) and os.path.isfile(os.path.join(d, 'model.json'))):
+            continue
+        model = os.path.join(d, 'model.json')
+        rd_, diag = fit_json(dhcal, model, data, start, command='diagnose')
+        rr, ref = fit_json(dhcal, model, data, start, command='refine')
+        c.check(f'{name}: diagnose and refine exit 0', rd_.returncode == 0 and
+                rr.returncode == 0, f'{rd_.stderr.strip()} {rr.stderr.strip()}')
+        if not (diag and ref):
+            continue
+        steps = ref['steps']
+        first = steps[1]['added'] if len(steps) > 1 else None
+        c.check(f'{name}: diagnose names what refine adds first', diag['named'] == first,
+                f'diagnose {diag["named"]}, refine {first}')
+        rows = {s['cv_rows'] for s in steps}
+        c.check(f'{name}: every step cross-validates on the same rows', len(rows) == 1,
+                str(sorted(rows)))
+        significant = [k for k in diag['candidates'] if k['significant']]
+        print(f'      {name}: named {diag["named"]}; {len(significant)} significant; refine '
+              f'{" -> ".join(s["added"] or "start" for s in steps)}; best rejected '
+              f'{(ref.get("best_rejected") or {}).get("effect")}: '
+              f'{(ref.get("best_rejected") or {}).get("why", "")[:90]}')
+        c.check(f'{name}: refine names the closest candidate that fell short',
+                ref.get('best_rejected') is None or
+                (ref['best_rejected']['effect'] and ref['best_rejected']['why']),
+                str(ref.get('best_rejected')))
+        for k in diag['candidates']:
+            if k['verdict'] in ('named', 'runner_up', 'look_alike') and 'magnitude' in k:
+                c.check(f'{name}: {k["effect"]}:{k["joint"]} passes only within its physical '
+                        'range', k['magnitude'] <= k['plausible_max'],
+                        f'{k["magnitude"]:.4g} of {k["plausible_max"]:.4g}')
+        if name == 'ur5-jacobi':
+            c.check('ur5: at most 10 candidates significant', len(significant) <= 10,
+                    str(len(significant)))
+        if name == 'wam-jacobi':
+            added = [s['added'] for s in steps[1:]]
+            c.check('wam: no compliance about the vertical joint 1, named or added',
+                    diag['named'] != 'joint_compliance:1' and
+                    'joint_compliance:1' not in added, f'{diag["named"]}, {added}')
+            j1 = [k for k in diag['candidates'] if k['effect'] == 'joint_compliance' and
+                  k['joint'] == 1]
+            c.check('wam: compliance about joint 1 is not offered (its axis is vertical)',
+                    bool(j1) and j1[0]['verdict'] == 'not_excited',
+                    j1[0]['why'] if j1 else 'absent')
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument('--dhcal', required=True)
@@ -227,6 +282,7 @@ def main():
         c.check('ur10 B -> C: the positioning uncertainty there is predicted',
                 0.0 < out['predicted_std_mm'] < 5.0, f'{out["predicted_std_mm"]:.4f} mm')
 
+    verdicts(c, a.dhcal, rd)
     print(f'{c.passed} passed, {c.failed} failed')
     return 0 if c.failed == 0 else 1
 

@@ -91,6 +91,22 @@ int dhcal_parse_noise(const char *text, dhc_noise_model *out, dhcal_error *err)
 
 /* t0 of the session's drift: the mean time of the rows fitted (docs/effects.md, 1), unless the
  * model already carries a drift with its own t0. */
+int dhcal_parse_repeatability(const char *text, double *out_mm, dhcal_error *err)
+{
+    char *end = NULL;
+    errno = 0;
+    const double v = strtod(text, &end);
+    if (end == text || *end != '\0' || errno != 0 || !(v >= DHCAL_REPEATABILITY_MIN_MM) ||
+        !(v <= DHCAL_REPEATABILITY_MAX_MM)) {
+        snprintf(err->msg, sizeof err->msg,
+                 "--repeatability: '%.60s' is not a distance in mm within [%g, %g]", text,
+                 DHCAL_REPEATABILITY_MIN_MM, DHCAL_REPEATABILITY_MAX_MM);
+        return DHCAL_IO_BAD_INPUT;
+    }
+    *out_mm = v;
+    return DHCAL_IO_OK;
+}
+
 static void set_drift_reference(dhc_model *model, const dhcal_samples *s)
 {
     const double *v = model->drift_mm_per_s;
@@ -232,9 +248,11 @@ int dhcal_fit_errors(const dhc_model *model, const dhcal_samples *s, double *res
     return fit_errors(model, s, NULL, resid, err_mm, stats);
 }
 
-int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhc_noise_model *noise,
-                   dhcal_samples *s, const dhcal_samples *held, dhcal_fit *out,
-                   dhcal_error *err)
+/* dhcal_fit_from (rejudge 1) and dhcal_fit_kept (rejudge 0: the rows stay as they are). */
+static int fit_rows_from(const dhc_model *start, const dhc_param_set *set,
+                         const dhc_noise_model *noise, dhcal_samples *s,
+                         const dhcal_samples *held, int rejudge, dhcal_fit *out,
+                         dhcal_error *err)
 {
     const dhcal_geometry geometry = out->geometry;
     memset(out, 0, sizeof *out);
@@ -246,7 +264,7 @@ int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhc_n
     }
     /* outliers judged afresh by this model: an earlier fit's marks would leave out rows a
      * better model explains, and the fit would depend on the path that led to it */
-    for (size_t i = 0U; i < s->n; ++i) {
+    for (size_t i = 0U; rejudge && i < s->n; ++i) {
         if (dhc_sample_is_outlier(s->flags[i])) {
             s->flags[i] = (uint8_t)DHC_SAMPLE_USED;
         }
@@ -254,6 +272,13 @@ int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhc_n
     set_drift_reference(&out->model, s);
     dhc_calib_options opt;
     dhcal_calib_options_for(start, &out->noise, &opt);
+    if (!rejudge) {
+        opt.outlier_threshold = 0.0;
+        opt.reach_margin = 0.0;
+        opt.joint_margin_rad = HUGE_VAL;
+        opt.robust_start = 0;
+        opt.max_outlier_rounds = 0U;
+    }
     opt.joint_sincos = dhcal_samples_sincos(s, start->arm.n_joints);
     /* optional: without it the outlier screens evaluate the model again */
     opt.sample_error2 = malloc((s->n + 1U) * sizeof *opt.sample_error2);
@@ -297,6 +322,32 @@ int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhc_n
         return DHCAL_IO_FAILED;
     }
     return DHCAL_IO_OK;
+}
+
+int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhc_noise_model *noise,
+                   dhcal_samples *s, const dhcal_samples *held, dhcal_fit *out,
+                   dhcal_error *err)
+{
+    return fit_rows_from(start, set, noise, s, held, 1, out, err);
+}
+
+int dhcal_fit_kept(const dhc_model *start, const dhc_param_set *set, const dhc_noise_model *noise,
+                   dhcal_samples *s, const dhcal_samples *held, dhcal_fit *out,
+                   dhcal_error *err)
+{
+    return fit_rows_from(start, set, noise, s, held, 0, out, err);
+}
+
+void dhcal_set_without_held(const dhcal_fit *fit, dhc_param_set *out)
+{
+    *out = fit->set;
+    size_t kept = 0U;
+    for (size_t k = 0U; k < fit->set.count; ++k) {
+        if (!fit->rep.unsupported[k]) {
+            out->id[kept++] = fit->set.id[k];
+        }
+    }
+    out->count = kept;
 }
 
 int dhcal_run_fit(const dhc_model *nominal, const char *effects, dhcal_geometry geometry,
@@ -510,7 +561,7 @@ double dhcal_param_fitted(const dhcal_fit *fit, const dhc_model *input, size_t k
     return w_rad[axis] * 180.0 / DHC_PI;
 }
 
-int dhcal_implausible(const dhc_model *nominal, const dhcal_fit *fit, char *why, size_t cap)
+size_t dhcal_implausible_param(const dhc_model *nominal, const dhcal_fit *fit, double *moved)
 {
     const double max_len = DHCAL_PLAUSIBLE_LENGTH_SHARE * dhc_arm_reach(&nominal->arm);
     const double max_ang = DHCAL_PLAUSIBLE_ANGLE_DEG * DHC_PI / 180.0;
@@ -519,19 +570,36 @@ int dhcal_implausible(const dhc_model *nominal, const dhcal_fit *fit, char *why,
         if (kind > (uint8_t)DHC_P_BETA || !fit->rep.identifiable[k]) {
             continue;
         }
-        const double moved = fit->rep.value[k] - dhc_params_value(&fit->set, nominal, k);
+        const double shift = fit->rep.value[k] - dhc_params_value(&fit->set, nominal, k);
         const int angle = kind == (uint8_t)DHC_P_THETA || kind == (uint8_t)DHC_P_ALPHA ||
                           kind == (uint8_t)DHC_P_BETA;
-        if (fabs(moved) > (angle ? max_ang : max_len)) {
-            char name[48];
-            (void)dhc_params_name(&fit->set, k, name, sizeof name);
-            snprintf(why, cap, "%s moved %.4g %s from its nominal value (physical bound %.4g)",
-                     name, angle ? moved * 180.0 / DHC_PI : moved, angle ? "deg" : "mm",
-                     angle ? DHCAL_PLAUSIBLE_ANGLE_DEG : max_len);
-            return 1;
+        if (fabs(shift) > (angle ? max_ang : max_len)) {
+            if (moved != NULL) {
+                *moved = angle ? shift * 180.0 / DHC_PI : shift;
+            }
+            return k;
         }
     }
-    return 0;
+    return fit->set.count;
+}
+
+int dhcal_implausible(const dhc_model *nominal, const dhcal_fit *fit, char *why, size_t cap)
+{
+    double moved = 0.0;
+    const size_t k = dhcal_implausible_param(nominal, fit, &moved);
+    if (k >= fit->set.count) {
+        return 0;
+    }
+    const uint8_t kind = fit->set.id[k].kind;
+    const int angle = kind == (uint8_t)DHC_P_THETA || kind == (uint8_t)DHC_P_ALPHA ||
+                      kind == (uint8_t)DHC_P_BETA;
+    char name[48];
+    (void)dhc_params_name(&fit->set, k, name, sizeof name);
+    snprintf(why, cap, "%s moved %.4g %s from its nominal value (physical bound %.4g)", name,
+             moved, angle ? "deg" : "mm",
+             angle ? DHCAL_PLAUSIBLE_ANGLE_DEG
+                   : DHCAL_PLAUSIBLE_LENGTH_SHARE * dhc_arm_reach(&nominal->arm));
+    return 1;
 }
 
 /* Joint angles, lexicographically, equal within DHCAL_REPEAT_TOL_RAD: the order that groups

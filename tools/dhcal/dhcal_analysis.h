@@ -20,6 +20,11 @@ static inline int dhcal_noise_on(const dhc_noise_model *noise)
  * measurement's sd in mm (greater than 0, up to 100). DHCAL_IO_BAD_INPUT with the reason. */
 int dhcal_parse_noise(const char *text, dhc_noise_model *out, dhcal_error *err);
 
+/* The arm's repeatability (--repeatability MM, ISO 9283 RP): a number within
+ * [DHCAL_REPEATABILITY_MIN_MM, DHCAL_REPEATABILITY_MAX_MM]. DHCAL_IO_BAD_INPUT with the
+ * reason. */
+int dhcal_parse_repeatability(const char *text, double *out_mm, dhcal_error *err);
+
 /* How much geometry a fit adjusts (--geometry): joint offsets; offsets plus a and d (beta
  * where Hayati's convention replaces d); every geometric parameter (the default). */
 typedef enum { DHCAL_GEOMETRY_OFFSETS, DHCAL_GEOMETRY_LENGTHS, DHCAL_GEOMETRY_FULL } dhcal_geometry;
@@ -31,15 +36,15 @@ const char *dhcal_geometry_name(dhcal_geometry g);
 int dhcal_geometry_set(const dhc_model *model, dhcal_geometry g, dhc_param_set *set);
 
 typedef struct {
-    dhc_model model;      /* calibrated (nominal when the fit failed) */
-    dhcal_geometry geometry;
+    dhcal_error_stats train;   /* over the rows fitted (filled by the caller's evaluation) */
+    dhcal_error_stats heldout; /* the model without the session's drift */
     dhc_noise_model noise;    /* what the fit weighted with (the diagnosis uses the same) */
     dhc_param_set set;    /* base model + effects */
+    dhc_model model;      /* calibrated (nominal when the fit failed) */
     dhc_calib_report rep;
+    dhcal_geometry geometry;
     dhc_status status;
-    dhcal_error_stats train;   /* over the rows fitted (filled by the caller's evaluation) */
     int have_heldout;
-    dhcal_error_stats heldout; /* the model without the session's drift */
 } dhcal_fit;
 
 /* The model without the calibration session's drift (drift_scale, drift_offset): what
@@ -77,6 +82,18 @@ void dhcal_fit_errors_forget(void);
 int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhc_noise_model *noise,
                    dhcal_samples *s, const dhcal_samples *held, dhcal_fit *out,
                    dhcal_error *err);
+
+/* dhcal_fit_from on the rows as they are: no row is screened or let back in (the screens
+ * are off), so that fits compared with each other (the candidates of a diagnosis, the
+ * steps of refine, the folds of a cross-validation) are made on one fixed set of rows. */
+int dhcal_fit_kept(const dhc_model *start, const dhc_param_set *set, const dhc_noise_model *noise,
+                   dhcal_samples *s, const dhcal_samples *held, dhcal_fit *out,
+                   dhcal_error *err);
+
+/* fit's parameter set less the link parameters its fit held at their input values for want
+ * of support (dhc_calib_report.unsupported): what a fit that builds on this one (a
+ * candidate added, a fold left out) fits, so that it does not free them again. */
+void dhcal_set_without_held(const dhcal_fit *fit, dhc_param_set *out);
 
 /* Fits the geometry level plus effects to s from nominal (dhcal_fit_from);
  * DHCAL_IO_BAD_INPUT for a bad effects list. */
@@ -132,6 +149,9 @@ double dhcal_param_fitted(const dhcal_fit *fit, const dhc_model *input, size_t k
 #define DHCAL_PLAUSIBLE_ANGLE_DEG 30.0
 #define DHCAL_PLAUSIBLE_LENGTH_SHARE 0.5
 int dhcal_implausible(const dhc_model *nominal, const dhcal_fit *fit, char *why, size_t cap);
+/* The index in fit->set of the first such parameter (fit->set.count: none) and how far it
+ * moved (deg or mm; moved may be NULL). */
+size_t dhcal_implausible_param(const dhc_model *nominal, const dhcal_fit *fit, double *moved);
 
 /* How well the fitted model explains the data, against a noise reference: the noise model
  * given (--noise; the whitened SSR is chi-square), or repeated poses in the data (rows with

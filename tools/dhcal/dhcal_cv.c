@@ -528,11 +528,17 @@ static int estimate_folds(fold_pass *fp, const dhc_normal_eq *ne, const dhc_nois
         double lambda_all = 0.0;
         fold_step(fp, ne, fac_all.identifiable, SIZE_MAX, out, &lambda_all, &no_step,
                   estimate);
-        *have_estimate = !no_step;
+        if (have_estimate != NULL) {
+            *have_estimate = !no_step;
+        }
     }
     free(flags);
     return rc;
 }
+
+static int cv_run(const dhc_model *start, const dhc_param_set *set,
+                  const dhc_noise_model *noise, const dhcal_samples *s, dhcal_cv *out,
+                  dhc_model *estimate, int *have_estimate, dhcal_error *err);
 
 int dhcal_cross_validate(const dhc_model *start, const dhc_param_set *set,
                          const dhc_noise_model *noise, const dhcal_samples *s, dhcal_cv *out,
@@ -547,6 +553,14 @@ int dhcal_cross_validate_step(const dhc_model *start, const dhc_param_set *set,
                               dhcal_error *err)
 {
     memset(out, 0, sizeof *out);
+    return cv_run(start, set, noise, s, out, estimate, have_estimate, err);
+}
+
+/* The accumulation, the folds' estimates and (estimate not NULL) the all-rows step. */
+static int cv_run(const dhc_model *start, const dhc_param_set *set,
+                  const dhc_noise_model *noise, const dhcal_samples *s, dhcal_cv *out,
+                  dhc_model *estimate, int *have_estimate, dhcal_error *err)
+{
     if (have_estimate != NULL) {
         *have_estimate = 0;
     }

@@ -6,72 +6,21 @@
 #define DHCAL_REFINE_H
 
 #include "dhcal_analysis.h"
+#include "dhcal_cv.h"
+#include "dhcal_evidence.h"
 
-/* Cross-validation: leave-one-out below this many rows, else DHCAL_CV_FOLDS folds. */
-#define DHCAL_CV_LOO_BELOW 30U
-#define DHCAL_CV_FOLDS 5U
 #define DHCAL_REFINE_MAX_STEPS 10U
-/* refine adds a candidate only when it lowers the cross-validated RMS by this share */
-#define DHCAL_REFINE_MIN_GAIN 0.01
-/* candidates tried per step: the diagnosis' best significant ones */
-#define DHCAL_REFINE_CANDIDATES 6U
+/* link parameters the start may hold at nominal for leaving their physical range */
+#define DHCAL_REFINE_MAX_HOLDS 3U
 #define DHCAL_EFFECTS_CAP 600U
-#define DHCAL_WORKSPACE_POSES 256U
-/* a candidate is tried only when it raises the positioning uncertainty predicted over the
- * model's joint ranges by this factor at most */
-#define DHCAL_REFINE_MAX_UNCERTAINTY_GROWTH 1.25
-/* Levenberg-Marquardt iterations of a fold's fit (it starts at the fit on all rows) */
-#define DHCAL_CV_MAX_ITERATIONS 25U
-
-/* The positioning uncertainty the fit predicts over poses spread across the model's joint
- * ranges (RMS, mm; dhcal_extrapolate): how far the calibration can be trusted where it
- * will be used, not only where it was measured. */
-double dhcal_workspace_std_mm(const dhcal_fit *fit, const dhcal_samples *s);
-
-typedef struct {
-    double rms_mm; /* RMS over every used row of its error when its fold was left out */
-    size_t folds;
-    size_t rows;
-} dhcal_cv;
-
-/* Cross-validates the parameters of set on the rows of s whose flag is DHC_SAMPLE_USED
- * (rows left out as outliers stay out), every fold's fit starting from start (the fit on
- * all rows: only the fold's own rows move it). Folds interleave the rows in file order, so
- * each spans the session. DHCAL_IO_FAILED with the reason when a fold cannot be fitted
- * (fewer rows than parameters); s->flags is left as it was. */
-int dhcal_cross_validate(const dhc_model *start, const dhc_param_set *set,
-                         const dhc_noise_model *noise, const dhcal_samples *s, dhcal_cv *out,
-                         dhcal_error *err);
-
-/* A diagnosis candidate tried as refine tries it: added to the fit's set, refitted from the
- * fit's solution, and cross-validated unless the positioning uncertainty it predicts over
- * the joint ranges grows by more than DHCAL_REFINE_MAX_UNCERTAINTY_GROWTH. */
-typedef struct {
-    int tried;               /* refitted */
-    int unsupported;         /* not cross-validated: the uncertainty grew too much */
-    double workspace_std_mm; /* with the candidate (dhcal_workspace_std_mm) */
-    dhcal_cv cv;             /* when tried and supported */
-} dhcal_trial;
-
-typedef struct {
-    dhcal_trial trial[DHC_MAX_CANDIDATES]; /* per diagnosis candidate, in its order */
-    double workspace_std_mm;               /* of the fit without any */
-    size_t best;                           /* lowest CV RMS; DHC_MAX_CANDIDATES: none */
-} dhcal_trials;
-
-/* Tries the diagnosis' best significant candidates (DHCAL_REFINE_CANDIDATES at most).
- * best_fit and best_flags (s->n entries; both may be NULL) receive the refit of out->best
- * and its flags; s->flags end as they started. DHCAL_IO_FAILED when memory runs out. */
-int dhcal_try_candidates(const dhcal_fit *fit, const dhc_diagnosis *diag,
-                         const dhc_noise_model *noise, dhcal_samples *s, const dhcal_samples *held,
-                         dhcal_trials *out, dhcal_fit *best_fit, uint8_t *best_flags,
-                         dhcal_error *err);
 
 typedef struct {
     char added[64];                    /* the effect added; "" for the start */
     char effects[DHCAL_EFFECTS_CAP];   /* the effect list after the step */
     double rms_mm;                     /* training RMS */
     double cv_rms_mm;
+    size_t cv_rows;                    /* the rows its cross-validation used: the same at
+                                          every step (the rows are decided once) */
     int have_heldout;
     double heldout_rms_mm;
     double heldout_mean_mm;
@@ -86,9 +35,15 @@ typedef struct {
     int geometry_chosen;               /* 1: cross-validation chose the level (few rows) */
     double geometry_cv_mm[3];          /* per level when chosen; negative: not fittable */
     char geometry_why[720];
-    char stopped_why[240];
-    char skipped[1024];                /* candidates not tried: unsupported over the joint
-                                          ranges (workspace uncertainty before -> after) */
+    char held_why[480];                /* link parameters held at nominal because the start's
+                                          fit moved them beyond their physical range */
+    char stopped_why[720];
+    /* the last judgement: of the final model's candidates when the loop stopped because
+     * none was named (then trials.best_rejected is the closest one and why it fell short) */
+    dhc_diagnosis diag;
+    dhcal_covariates cov;
+    dhcal_trials trials;
+    int judged;                        /* diag and trials hold a judgement */
 } dhcal_refine_result;
 
 /* Rows are few for a parameter set when the equations number fewer than this many times
@@ -96,15 +51,17 @@ typedef struct {
 #define DHCAL_FEW_ROWS_PER_PARAM 10U
 
 /* dhcal refine: fits the geometry level (NULL: full, or chosen by cross-validation when the
- * rows are few) plus start_effects from nominal, then repeatedly adds, of the diagnosis'
- * best significant candidates, the one whose refit (from the current solution) lowers the
- * cross-validated RMS most, while that falls by DHCAL_REFINE_MIN_GAIN or more. held (may be
- * NULL) is evaluated at every step, never used to choose. s->flags end as the final fit's.
+ * rows are few) plus start_effects from nominal (the rows are screened there, once), then
+ * repeatedly diagnoses the current fit, judges the candidates (dhcal_judge_candidates, on
+ * the same rows and folds) and adds the one named, at most max_steps times. max_steps 0 is
+ * `diagnose`: the start and its judgement. repeatability_mm (<= 0: not known) is the
+ * arm's ISO 9283 repeatability, a noise reference when the data give none. held (may be
+ * NULL) is evaluated at every step, never used to choose. s->flags end as the start fit's.
  * DHCAL_IO_BAD_INPUT for a bad effects list; DHCAL_IO_FAILED with the reason when the
  * start cannot be fitted. */
 int dhcal_run_refine(const dhc_model *nominal, const char *start_effects,
                      const dhcal_geometry *geometry, const dhc_noise_model *noise,
-                     dhcal_samples *s, const dhcal_samples *held, dhcal_refine_result *out,
-                     dhcal_error *err);
+                     double repeatability_mm, size_t max_steps, dhcal_samples *s,
+                     const dhcal_samples *held, dhcal_refine_result *out, dhcal_error *err);
 
 #endif /* DHCAL_REFINE_H */

@@ -5,6 +5,7 @@
 
 #include "dhcal_report.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -135,12 +136,106 @@ static void candidate_params(const dhcal_fit *fit, const dhc_candidate_result *c
     }
 }
 
+static void add_label(cJSON *obj, const char *key, const dhc_candidate_result *c)
+{
+    char label[64];
+    (void)dhc_effect_label(c->effect, c->joint, label, sizeof label);
+    cJSON_AddStringToObject(obj, key, label);
+}
+
+/* A candidate's judgement (dhcal_evidence.h): the keys of docs/cli.md 1.4. */
+static void candidate_trial(cJSON *j, const dhc_diagnosis *diag, const dhcal_trials *t, size_t i)
+{
+    const dhcal_trial *tr = &t->trial[i];
+    char why[600];
+    dhcal_verdict_words(t, diag, i, why, sizeof why);
+    cJSON_AddStringToObject(j, "verdict", dhcal_verdict_key(tr->verdict));
+    cJSON_AddStringToObject(j, "why", why);
+    if (tr->tried && tr->cv.folds > 0U) {
+        cJSON_AddNumberToObject(j, "cv_rms_mm", tr->cv.rms_mm);
+        cJSON_AddNumberToObject(j, "cv_gain", tr->cv_gain);
+        cJSON_AddNumberToObject(j, "gain_t", dhc_is_finite(tr->gain_t) ? tr->gain_t : 1e300);
+        cJSON_AddNumberToObject(j, "gain_log10_p",
+                                dhc_is_finite(tr->gain_log10_p) ? tr->gain_log10_p : -300.0);
+    }
+    if (tr->tried && tr->verdict != DHCAL_VERDICT_FAILED) {
+        cJSON *tool = cJSON_AddObjectToObject(j, "tool_change");
+        cJSON_AddNumberToObject(tool, "rms_mm", tr->tool_rms_mm);
+        cJSON_AddNumberToObject(tool, "max_mm", tr->tool_max_mm);
+        cJSON_AddNumberToObject(tool, "range_rms_mm", tr->range_rms_mm);
+        cJSON_AddNumberToObject(tool, "range_max_mm", tr->range_max_mm);
+        if (tr->plausible_max > 0.0) {
+            cJSON_AddNumberToObject(j, "magnitude", tr->magnitude);
+            cJSON_AddNumberToObject(j, "plausible_max", tr->plausible_max);
+        }
+    }
+    if (diag->c[i].effect == DHC_EFFECT_JOINT_COMPLIANCE) {
+        cJSON_AddNumberToObject(j, "excitation", tr->excitation);
+    }
+    cJSON *alikes = cJSON_AddArrayToObject(j, "look_alikes");
+    cJSON *detail = cJSON_AddArrayToObject(j, "look_alike_detail");
+    for (size_t k = 0U; k < tr->n_look_alikes; ++k) {
+        char label[64];
+        const dhc_candidate_result *o = &diag->c[tr->look_alike[k]];
+        (void)dhc_effect_label(o->effect, o->joint, label, sizeof label);
+        cJSON_AddItemToArray(alikes, cJSON_CreateString(label));
+        cJSON *d = cJSON_CreateObject();
+        cJSON_AddStringToObject(d, "effect", label);
+        cJSON_AddNumberToObject(d, "correlation", tr->look_alike_r[k]);
+        if (t->trial[tr->look_alike[k]].cv.folds > 0U) {
+            cJSON_AddNumberToObject(d, "cv_rms_mm", t->trial[tr->look_alike[k]].cv.rms_mm);
+        }
+        cJSON_AddItemToArray(detail, d);
+    }
+}
+
+/* The closest candidate that fell short: {"effect", "cv_gain", "reason", "why"}. */
+static void add_best_rejected(cJSON *obj, const dhc_diagnosis *diag, const dhcal_trials *t)
+{
+    if (t->best_rejected >= diag->count) {
+        cJSON_AddNullToObject(obj, "best_rejected");
+        return;
+    }
+    const size_t b = t->best_rejected;
+    cJSON *r = cJSON_AddObjectToObject(obj, "best_rejected");
+    add_label(r, "effect", &diag->c[b]);
+    if (t->trial[b].tried && t->trial[b].cv.folds > 0U) {
+        cJSON_AddNumberToObject(r, "cv_gain", t->trial[b].cv_gain);
+    } else {
+        cJSON_AddNullToObject(r, "cv_gain");
+    }
+    cJSON_AddStringToObject(r, "reason", dhcal_verdict_key(t->trial[b].verdict));
+    char why[600];
+    dhcal_verdict_words(t, diag, b, why, sizeof why);
+    cJSON_AddStringToObject(r, "why", why);
+}
+
+static void add_reference(cJSON *obj, const dhcal_size_reference *ref)
+{
+    cJSON *r = cJSON_AddObjectToObject(obj, "noise_reference");
+    if (ref->source != NULL) {
+        cJSON_AddStringToObject(r, "source", ref->source);
+        cJSON_AddNumberToObject(r, "point_mm", ref->point_mm);
+    } else {
+        cJSON_AddNullToObject(r, "source");
+        cJSON_AddNullToObject(r, "point_mm");
+    }
+}
+
 void dhcal_json_diagnosis(cJSON *obj, const dhcal_fit *fit, const dhc_diagnosis *diag,
                           const dhcal_covariates *cov, const dhcal_trials *trials)
 {
     cJSON_AddNumberToObject(obj, "time_pose_r2", cov->time_r2);
+    if (trials->named < diag->count) {
+        add_label(obj, "named", &diag->c[trials->named]);
+    } else {
+        cJSON_AddNullToObject(obj, "named");
+    }
+    add_best_rejected(obj, diag, trials);
+    add_reference(obj, &trials->reference);
     cJSON *cands = cJSON_AddArrayToObject(obj, "candidates");
-    for (size_t i = 0U; i < diag->count; ++i) {
+    for (size_t k = 0U; k < diag->count; ++k) {
+        const size_t i = trials->order[k];
         const dhc_candidate_result *c = &diag->c[i];
         cJSON *j = cJSON_CreateObject();
         cJSON_AddStringToObject(j, "effect", dhc_effect_name(c->effect));
@@ -150,19 +245,16 @@ void dhcal_json_diagnosis(cJSON *obj, const dhcal_fit *fit, const dhc_diagnosis 
             cJSON_AddNullToObject(j, "joint");
         }
         cJSON_AddNumberToObject(j, "explained", c->explained);
-        cJSON_AddBoolToObject(j, "significant", c->significant);
+        const dhcal_verdict v = trials->trial[i].verdict;
+        cJSON_AddBoolToObject(j, "significant",
+                              v == DHCAL_VERDICT_NAMED || v == DHCAL_VERDICT_RUNNER_UP ||
+                                  v == DHCAL_VERDICT_LOOKALIKE || v == DHCAL_VERDICT_SIZE ||
+                                  v == DHCAL_VERDICT_UNPHYSICAL);
+        cJSON_AddBoolToObject(j, "screened", c->significant);
         cJSON_AddNumberToObject(j, "log10_p", c->rank > 0U ? c->log10_p : 0.0);
         cJSON_AddNumberToObject(j, "dof", (double)c->rank);
         candidate_params(fit, c, cJSON_AddArrayToObject(j, "params"));
-        if (trials != NULL && trials->trial[i].tried && !trials->trial[i].unsupported) {
-            cJSON_AddNumberToObject(j, "cv_rms_mm", trials->trial[i].cv.rms_mm);
-        }
-        if (c->lookalike < diag->count) {
-            char label[64];
-            (void)dhc_effect_label(diag->c[c->lookalike].effect, diag->c[c->lookalike].joint,
-                                   label, sizeof label);
-            cJSON_AddStringToObject(j, "lookalike", label);
-        }
+        candidate_trial(j, diag, trials, i);
         cJSON_AddItemToArray(cands, j);
     }
 }
@@ -193,6 +285,7 @@ void dhcal_json_refine(cJSON *obj, const dhcal_refine_result *res)
         add_effect_list(cJSON_AddArrayToObject(j, "effects"), st->effects);
         cJSON_AddNumberToObject(j, "rms_mm", st->rms_mm);
         cJSON_AddNumberToObject(j, "cv_rms_mm", st->cv_rms_mm);
+        cJSON_AddNumberToObject(j, "cv_rows", (double)st->cv_rows);
         if (st->have_heldout) {
             cJSON_AddNumberToObject(j, "heldout_rms_mm", st->heldout_rms_mm);
             cJSON_AddNumberToObject(j, "heldout_mean_mm", st->heldout_mean_mm);
@@ -202,5 +295,115 @@ void dhcal_json_refine(cJSON *obj, const dhcal_refine_result *res)
     if (res->geometry_chosen) {
         cJSON_AddStringToObject(obj, "geometry_why", res->geometry_why);
     }
+    if (res->held_why[0] != '\0') {
+        cJSON_AddStringToObject(obj, "held_why", res->held_why);
+    }
     cJSON_AddStringToObject(obj, "stopped", res->stopped_why);
+    if (res->judged) {
+        add_best_rejected(obj, &res->diag, &res->trials);
+        add_reference(obj, &res->trials.reference);
+    } else {
+        cJSON_AddNullToObject(obj, "best_rejected");
+    }
+}
+
+/* ---------------------------------------------------------------- the diagnosis in words */
+
+static void text_named(FILE *f, const dhc_diagnosis *d, const char *effects,
+                       const dhcal_trials *t)
+{
+    char label[64];
+    if (t->named >= d->count) {
+        if (t->best_rejected < d->count) {
+            char why[600];
+            (void)dhc_effect_label(d->c[t->best_rejected].effect, d->c[t->best_rejected].joint,
+                                   label, sizeof label);
+            dhcal_verdict_words(t, d, t->best_rejected, why, sizeof why);
+            fprintf(f, "no missing effect named: the closest candidate, %s: %s\n", label, why);
+        } else {
+            fprintf(f, "no missing effect named: no candidate of the catalogue explains a "
+                       "significant share of the residual\n");
+        }
+        fprintf(f, "(whether the model fits the noise: see adequacy)\n");
+        return;
+    }
+    const dhc_candidate_result *top = &d->c[t->named];
+    const dhcal_trial *tr = &t->trial[t->named];
+    (void)dhc_effect_label(top->effect, top->joint, label, sizeof label);
+    fprintf(f,
+            "found %s: add '%s' (cross-validated RMS %.4f -> %.4f mm, %.1f %% lower, t %.1f "
+            "over %zu folds; it changes the tool by %.4f mm RMS, %.4f mm at most, over these "
+            "poses; %.4f mm RMS over the joint ranges)\n",
+            dhc_effect_info_of(top->effect)->summary, label, t->cv.rms_mm, tr->cv.rms_mm,
+            100.0 * tr->cv_gain, tr->gain_t, tr->cv.folds, tr->tool_rms_mm, tr->tool_max_mm,
+            tr->range_rms_mm);
+    for (size_t k = 0U; k < tr->n_look_alikes; ++k) {
+        const dhc_candidate_result *o = &d->c[tr->look_alike[k]];
+        char other[64];
+        (void)dhc_effect_label(o->effect, o->joint, other, sizeof other);
+        const dhcal_trial *ot = &t->trial[tr->look_alike[k]];
+        fprintf(f, "look-alike: '%s' changes the tool in nearly the same way over these poses "
+                   "(correlation %.2f; CV RMS %.4f against %.4f mm): ", other,
+                tr->look_alike_r[k], ot->cv.rms_mm, tr->cv.rms_mm);
+        if (ot->cv.rms_mm > DHCAL_LOOKALIKE_CLEAR_MARGIN * tr->cv.rms_mm) {
+            fprintf(f, "the cross-validation prefers '%s' clearly; `dhcal plan --discriminate "
+                       "%s,%s` proposes poses that would confirm it\n", label, label, other);
+        } else {
+            fprintf(f, "these data cannot tell the two apart; `dhcal plan --discriminate "
+                       "%s,%s` proposes poses that would\n", label, other);
+        }
+    }
+    fprintf(f, "next: dhcal fit --effects %s%s%s ... and compare the held-out error (or dhcal "
+               "refine, which repeats this while the evidence holds)\n",
+            effects != NULL ? effects : "", effects != NULL ? "," : "", label);
+}
+
+void dhcal_text_diagnosis(FILE *f, const dhcal_fit *fit, const dhc_diagnosis *d,
+                          const char *effects, const dhcal_trials *t)
+{
+    char label[64];
+    fprintf(f, "\ndiagnosis: %zu candidate effects screened by the score test against the "
+               "remaining residual (%s %.4g), the best %u refitted on the same rows and "
+               "cross-validated on the same folds\n",
+            d->count, dhcal_noise_on(&fit->noise) ? "whitened residual sd" : "noise estimate mm",
+            sqrt(d->sigma2), DHCAL_EVIDENCE_TRIALS);
+    if (t->reference.source != NULL) {
+        fprintf(f, "noise reference: %.4f mm per point (%s)\n", t->reference.point_mm,
+                t->reference.source);
+    }
+    text_named(f, d, effects, t);
+    fprintf(f, "%-22s %6s %9s %8s %10s %8s %9s  %s\n", "candidate", "params", "log10(p)",
+            "CV gain", "CV RMS mm", "t", "tool mm", "verdict");
+    size_t unseen = 0U;
+    for (size_t k = 0U; k < d->count; ++k) {
+        const size_t i = t->order[k];
+        const dhc_candidate_result *c = &d->c[i];
+        const dhcal_trial *tr = &t->trial[i];
+        if (c->rank == 0U) {
+            unseen++;
+            continue;
+        }
+        (void)dhc_effect_label(c->effect, c->joint, label, sizeof label);
+        fprintf(f, "%-22s %6zu %9.1f ", label, c->rank, c->log10_p);
+        if (tr->tried && tr->cv.folds > 0U) {
+            fprintf(f, "%7.1f%% %10.4f %8.2f %9.4f", 100.0 * tr->cv_gain, tr->cv.rms_mm,
+                    tr->gain_t, tr->tool_rms_mm);
+        } else {
+            fprintf(f, "%8s %10s %8s %9s", "", "", "", "");
+        }
+        char why[600];
+        dhcal_verdict_words(t, d, i, why, sizeof why);
+        fprintf(f, "  %s\n", tr->verdict == DHCAL_VERDICT_NAMED ? "named" : why);
+    }
+    if (unseen > 0U) {
+        fprintf(f, "cannot be seen in these data (looks exactly like what the fit already "
+                   "adjusts):");
+        for (size_t i = 0U; i < d->count; ++i) {
+            if (d->c[i].rank == 0U) {
+                (void)dhc_effect_label(d->c[i].effect, d->c[i].joint, label, sizeof label);
+                fprintf(f, " %s", label);
+            }
+        }
+        fprintf(f, "\n");
+    }
 }

@@ -6,6 +6,7 @@
 
 #include <cjson/cJSON.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include "dhcal_analysis.h"
 #include "dhcal_refine.h"
@@ -36,10 +37,15 @@ void dhcal_json_fit(cJSON *obj, const dhcal_fit *f, const dhc_model *input,
 /* geometry, cv_rms_mm, heldout_outside_range, predicted_std_mm, adequacy. */
 void dhcal_json_extras(cJSON *obj, const dhcal_fit *f, const dhcal_fit_extras *x);
 
-/* diagnose's time_pose_r2 and candidates; trials (may be NULL) adds each tried candidate's
- * cv_rms_mm. */
+/* diagnose's time_pose_r2, named, best_rejected, noise_reference and candidates (in the
+ * judgement's order, each with its verdict). */
 void dhcal_json_diagnosis(cJSON *obj, const dhcal_fit *fit, const dhc_diagnosis *diag,
                           const dhcal_covariates *cov, const dhcal_trials *trials);
+
+/* The diagnosis for people: what is named and why, its look-alikes, and every candidate
+ * with its verdict. */
+void dhcal_text_diagnosis(FILE *f, const dhcal_fit *fit, const dhc_diagnosis *d,
+                          const char *effects, const dhcal_trials *t);
 
 /* refine's effects, steps, geometry_why, stopped. */
 void dhcal_json_refine(cJSON *obj, const dhcal_refine_result *res);

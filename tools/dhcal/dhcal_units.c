@@ -273,7 +273,7 @@ static int predict(units_work *w, const reading *r)
     const size_t nj = w->model->arm.n_joints;
     const dhc_meas_kind kind = w->wires ? DHC_MEAS_WIRES : DHC_MEAS_POSITION;
     for (size_t i = 0U; i < w->m; ++i) {
-        double q[DHC_MAX_JOINTS];
+        double q[DHC_MAX_JOINTS] = {0.0};
         for (size_t j = 0U; j < nj; ++j) {
             q[j] = w->data->rows[w->idx[i]].q_rad[j] * r->factor;
         }
@@ -341,6 +341,7 @@ static int wire_fit(const double *meas, const double *pred, size_t m, size_t swa
 static double score(units_work *w, const reading *r, dhcal_similarity *fit)
 {
     dhcal_similarity unused;
+    memset(&unused, 0, sizeof unused);
     dhcal_similarity *f = fit != NULL ? fit : &unused;
     if (predict(w, r) != DHCAL_IO_OK) {
         return (double)NAN;
@@ -414,6 +415,7 @@ static void check_radians(units_work *w, reading *taken, double *e, dhcal_units_
         return;
     }
     dhcal_similarity f;
+    memset(&f, 0, sizeof f);
     rep->e_rad = score(w, &rad, &f);
     if (!(*e > DHCAL_UNITS_BETTER_RATIO * rep->e_rad)) {
         return;
@@ -582,6 +584,7 @@ static void check_scale(units_work *w, const reading *taken, double e,
                         dhcal_units_report *rep, char *cause, size_t cap)
 {
     dhcal_similarity f;
+    memset(&f, 0, sizeof f);
     if (isnan(score(w, taken, &f))) {
         return;
     }
@@ -616,6 +619,7 @@ static void check_frame(units_work *w, const dhcal_units_ask *ask, dhcal_units_r
 {
     const reading as_read = {1.0, 0U, 0U, 0U, 0U};
     dhcal_similarity f;
+    memset(&f, 0, sizeof f);
     if (ask->frame_refuses < 0 || isnan(score(w, &as_read, &f))) {
         return;
     }
@@ -742,10 +746,13 @@ static void check_rows(units_work *w, const dhcal_units_ask *ask, dhcal_units_re
 }
 
 int dhcal_units_check(const dhc_model *model, const dhcal_dataset *data, const char *path,
-                      const dhcal_units_ask *ask, dhcal_units_report *rep_out, dhcal_error *err)
+                      const dhcal_units_ask *ask, dhcal_units_report *rep, dhcal_error *err)
 {
     dhcal_units_report local;
-    dhcal_units_report *rep = rep_out != NULL ? rep_out : &local;
+    memset(&local, 0, sizeof local);
+    if (rep == NULL) {
+        rep = &local;
+    }
     report_init(model, rep);
     int rc = dhcal_units_check_model(model, "the model", NULL, NULL);
     if (rc != DHCAL_IO_OK) {

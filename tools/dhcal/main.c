@@ -22,6 +22,7 @@
 #include "dhcal_plot.h"
 #include "dhcal_refine.h"
 #include "dhcal_report.h"
+#include "dhcal_units.h"
 #include "dhcal_urdf_cmd.h"
 
 #define EXIT_COMPUTE 1
@@ -38,6 +39,8 @@ typedef struct {
     const char *geometry;
     int json;
     int cv; /* fit: report the cross-validated RMS too */
+    int no_units_check;
+    const char *repeatability; /* the arm's ISO 9283 repeatability, mm */
 } options;
 
 static const char *const model_data_help =
@@ -57,7 +60,12 @@ static const char *const common_help =
     "                     as noisy as the measurement, e.g. encoder quantisation\n"
     "  --geometry LEVEL   how much geometry to fit: offsets (joint offsets), lengths\n"
     "                     (offsets, a and d), full (every parameter, the default)\n"
-    "  --json             one JSON object on stdout instead of text\n";
+    "  --repeatability MM the arm's repeatability (ISO 9283 RP, mm; default the model's\n"
+    "                     repeatability_mm): diagnose and refine name no effect that\n"
+    "                     changes the tool by less than the noise it implies\n"
+    "  --json             one JSON object on stdout instead of text\n"
+    "  --no-units-check   go on when the data look like metres, radians, swapped columns\n"
+    "                     or another frame than the model's (docs/cli.md, 1.11)\n";
 
 static const char *const usage_text =
     "usage: dhcal <command> --model M.json --data D.csv [options]\n"
@@ -170,7 +178,7 @@ static int parse_args(int argc, char **argv, options *o)
         return -1;
     }
     enum { OPT_JSON = 1, OPT_CV, OPT_HELP, OPT_MODEL, OPT_DATA, OPT_HELDOUT, OPT_OUT,
-           OPT_EFFECTS, OPT_NOISE, OPT_GEOMETRY };
+           OPT_EFFECTS, OPT_NOISE, OPT_GEOMETRY, OPT_NO_UNITS, OPT_REPEATABILITY };
     static const struct option long_options[] = {
         {"json", no_argument, NULL, OPT_JSON},
         {"cv", no_argument, NULL, OPT_CV},
@@ -182,6 +190,8 @@ static int parse_args(int argc, char **argv, options *o)
         {"effects", required_argument, NULL, OPT_EFFECTS},
         {"noise", required_argument, NULL, OPT_NOISE},
         {"geometry", required_argument, NULL, OPT_GEOMETRY},
+        {"no-units-check", no_argument, NULL, OPT_NO_UNITS},
+        {"repeatability", required_argument, NULL, OPT_REPEATABILITY},
         {NULL, 0, NULL, 0}};
     dhcal_options opts;
     dhcal_options_begin(&opts, argc, argv);
@@ -195,6 +205,7 @@ static int parse_args(int argc, char **argv, options *o)
         switch (c) {
         case OPT_JSON: o->json = 1; continue;
         case OPT_CV: o->cv = 1; continue;
+        case OPT_NO_UNITS: o->no_units_check = 1; continue;
         case 'h':
         case OPT_HELP: print_command_help(o->command); return -1;
         case OPT_MODEL: slot = &o->model; break;
@@ -204,6 +215,7 @@ static int parse_args(int argc, char **argv, options *o)
         case OPT_EFFECTS: slot = &o->effects; break;
         case OPT_NOISE: slot = &o->noise; break;
         case OPT_GEOMETRY: slot = &o->geometry; break;
+        case OPT_REPEATABILITY: slot = &o->repeatability; break;
         default: continue; /* not reached: dhcal_options_error took every other value */
         }
         if (*slot != NULL) {
@@ -254,6 +266,7 @@ typedef struct {
     dhcal_dataset held_data;
     dhcal_samples held;
     int have_held;
+    double repeatability_mm; /* 0: not known */
 } session;
 
 static int load_session(const options *o, session *s)
@@ -262,6 +275,9 @@ static int load_session(const options *o, session *s)
     memset(&err, 0, sizeof err);
     memset(s, 0, sizeof *s);
     int rc = dhcal_parse_noise(o->noise, &s->noise, &err);
+    if (rc == DHCAL_IO_OK && o->repeatability != NULL) {
+        rc = dhcal_parse_repeatability(o->repeatability, &s->repeatability_mm, &err);
+    }
     if (rc == DHCAL_IO_OK) {
         rc = dhcal_parse_geometry(o->geometry, &s->geometry, &err);
     }
@@ -270,6 +286,9 @@ static int load_session(const options *o, session *s)
     }
     if (rc == DHCAL_IO_OK) {
         rc = dhcal_model_to_lib(&s->file_model, o->model, &s->model, &err);
+    }
+    if (rc == DHCAL_IO_OK && o->repeatability == NULL) {
+        s->repeatability_mm = s->file_model.repeatability_mm;
     }
     if (rc == DHCAL_IO_OK) {
         rc = dhcal_csv_load(o->data, s->model.arm.n_joints, &s->data, &err);
@@ -286,6 +305,14 @@ static int load_session(const options *o, session *s)
         if (rc == DHCAL_IO_OK) {
             rc = dhcal_samples_check_held(&s->samples, &s->held, o->heldout, &err);
         }
+    }
+    if (rc == DHCAL_IO_OK && !o->no_units_check) { /* before any fit (dhcal_units.h) */
+        const dhcal_units_ask ask = {o->effects, strcmp(o->command, "compare") != 0,
+                                     "use --no-units-check if they are right",
+                                     "--effects base_frame,..."};
+        rc = dhcal_units_check_files(&s->model, o->model, &s->data, o->data,
+                                     s->have_held ? &s->held_data : NULL, o->heldout, &ask,
+                                     stderr, &err);
     }
     if (rc != DHCAL_IO_OK) {
         fprintf(stderr, "dhcal: %s\n", err.msg);
@@ -688,126 +715,56 @@ static void text_covariates(const dhcal_covariates *cov)
     }
 }
 
-/* diagnose --cv: the fit's own cross-validation and each candidate's, as refine tries them */
-static int cross_validate_candidates(const dhcal_fit *fit, const dhc_diagnosis *diag,
-                                     session *s, dhcal_fit_extras *extras, dhcal_trials *trials)
-{
-    dhcal_error err;
-    memset(&err, 0, sizeof err);
-    extras->have_cv = dhcal_cross_validate(&fit->model, &fit->set, &s->noise, &s->samples,
-                                           &extras->cv, &err) == DHCAL_IO_OK;
-    if (!extras->have_cv ||
-        dhcal_try_candidates(fit, diag, &s->noise, &s->samples, s->have_held ? &s->held : NULL,
-                             trials, NULL, NULL, &err) != DHCAL_IO_OK) {
-        fprintf(stderr, "dhcal: %s\n", err.msg);
-        return EXIT_COMPUTE;
-    }
-    return 0;
-}
-
-static void text_diagnosis(const dhcal_fit *fit, const dhc_diagnosis *d, const char *effects,
-                           const dhcal_trials *trials)
-{
-    char label[64];
-    if (dhcal_noise_on(&fit->noise)) {
-        printf("\ndiagnosis: %zu candidate effects scored against the remaining residual "
-               "(rows weighted by the noise model: joint angles %.2g deg, measurements %.2g "
-               "mm; whitened residual sd %.3f, 1 when the model fits to that noise)\n",
-               d->count, fit->noise.joint_rad[0] * 180.0 / DHC_PI, fit->noise.meas_mm, sqrt(d->sigma2));
-    } else {
-        printf("\ndiagnosis: %zu candidate effects scored against the remaining residual "
-               "(noise estimate %.4f mm per coordinate)\n",
-               d->count, sqrt(d->sigma2));
-    }
-    const dhc_candidate_result *top = d->count > 0U ? &d->c[0] : NULL;
-    if (top == NULL || !top->significant) {
-        printf("no missing effect found: no effect of the catalogue explains a significant "
-               "share of the residual (whether the model fits the noise: see adequacy)\n");
-    } else {
-        (void)dhc_effect_label(top->effect, top->joint, label, sizeof label);
-        printf("found %s: add '%s' (explains %.0f%% of the residual, significant)\n",
-               dhc_effect_info_of(top->effect)->summary, label, 100.0 * top->explained);
-        if (top->lookalike < d->count) {
-            char other[64];
-            const dhc_candidate_result *l = &d->c[top->lookalike];
-            (void)dhc_effect_label(l->effect, l->joint, other, sizeof other);
-            printf("caution: '%s' explains the residual about as well (%.0f%%); these data "
-                   "cannot tell the two apart\n",
-                   other, 100.0 * l->explained);
-        }
-        printf("next: dhcal fit --effects %s%s%s ... and compare the held-out error (or dhcal "
-               "refine, which repeats this while cross-validation improves)\n",
-               effects != NULL ? effects : "", effects != NULL ? "," : "", label);
-    }
-    printf("%-22s %6s %10s %12s %-12s%s\n", "candidate", "params", "explained", "log10(p)", "",
-           trials != NULL ? "CV RMS mm" : "");
-    size_t unseen = 0U;
-    for (size_t i = 0U; i < d->count; ++i) {
-        const dhc_candidate_result *c = &d->c[i];
-        if (c->rank == 0U) {
-            unseen++;
-            continue;
-        }
-        (void)dhc_effect_label(c->effect, c->joint, label, sizeof label);
-        char cv[48] = "";
-        if (trials != NULL && trials->trial[i].tried) {
-            if (trials->trial[i].unsupported) {
-                snprintf(cv, sizeof cv, "(unsupported over the joint ranges)");
-            } else {
-                snprintf(cv, sizeof cv, "%.4f", trials->trial[i].cv.rms_mm);
-            }
-        }
-        printf("%-22s %6zu %9.1f%% %12.1f %-12s%s\n", label, c->rank, 100.0 * c->explained,
-               c->log10_p, c->significant ? "significant" : "", cv);
-    }
-    if (unseen > 0U) {
-        printf("cannot be seen in these data (looks exactly like what the fit already adjusts):");
-        for (size_t i = 0U; i < d->count; ++i) {
-            if (d->c[i].rank == 0U) {
-                (void)dhc_effect_label(d->c[i].effect, d->c[i].joint, label, sizeof label);
-                printf(" %s", label);
-            }
-        }
-        printf("\n");
-    }
-    (void)fit;
-}
-
 static int cmd_diagnose(const options *o, session *s)
 {
-    static dhcal_fit fit;
-    static dhc_diagnosis diag;
+    static dhcal_refine_result res;
     static dhcal_fit_extras extras;
-    dhcal_covariates cov;
-    double *row_err = NULL;
-    int rc = do_fit(o, s, &fit, &row_err);
     dhcal_error err;
     memset(&err, 0, sizeof err);
-    if (rc == 0 && dhcal_run_diagnose(&fit, &s->samples, &diag, &cov, &err) != DHCAL_IO_OK) {
+    /* refine's start and its first judgement: one ranking for both commands */
+    int rc = dhcal_run_refine(&s->model, o->effects, o->geometry != NULL ? &s->geometry : NULL,
+                              &s->noise, s->repeatability_mm, 0U, &s->samples,
+                              s->have_held ? &s->held : NULL, &res, &err);
+    if (rc != DHCAL_IO_OK) {
         fprintf(stderr, "dhcal: %s\n", err.msg);
-        rc = EXIT_COMPUTE;
+        return rc == DHCAL_IO_BAD_INPUT ? EXIT_USAGE : EXIT_COMPUTE;
     }
-    static dhcal_trials trials;
-    memset(&trials, 0, sizeof trials);
-    if (rc == 0) {
-        dhcal_fit_extras_compute(&fit, &s->samples, s->have_held ? &s->held : NULL, &extras);
-        if (o->cv) {
-            rc = cross_validate_candidates(&fit, &diag, s, &extras, &trials);
-        }
+    const dhcal_fit *fit = &res.fit;
+    if (refuse_implausible(s, fit, NULL) != 0) {
+        return EXIT_COMPUTE;
     }
-    if (rc == 0) {
-        if (o->json) {
-            cJSON *obj = cJSON_CreateObject();
-            dhcal_json_fit(obj, &fit, &s->model, &s->samples, row_err);
-            dhcal_json_extras(obj, &fit, &extras);
-            dhcal_json_diagnosis(obj, &fit, &diag, &cov, o->cv ? &trials : NULL);
-            rc = print_json(obj);
-        } else {
-            text_fit(&fit, s, o, row_err);
-            text_diagnosis(&fit, &diag, o->effects, o->cv ? &trials : NULL);
-            text_covariates(&cov);
-            text_extras(&fit, s, &extras, diag.count == 0U || !diag.c[0].significant);
+    if (!res.judged) {
+        fprintf(stderr, "dhcal: %s\n", res.stopped_why);
+        return EXIT_COMPUTE;
+    }
+    double *row_err = calloc(s->samples.n + 1U, sizeof *row_err);
+    dhcal_error_stats es;
+    if (row_err == NULL ||
+        dhcal_samples_errors(&fit->model, &s->samples, NULL, row_err, &es) != DHCAL_IO_OK) {
+        free(row_err);
+        fprintf(stderr, "dhcal: evaluation failed\n");
+        return EXIT_COMPUTE;
+    }
+    dhcal_fit_extras_compute(fit, &s->samples, s->have_held ? &s->held : NULL, &extras);
+    extras.have_cv = 1;
+    extras.cv = res.cv;
+    if (o->json) {
+        cJSON *obj = cJSON_CreateObject();
+        dhcal_json_fit(obj, fit, &s->model, &s->samples, row_err);
+        dhcal_json_extras(obj, fit, &extras);
+        dhcal_json_diagnosis(obj, fit, &res.diag, &res.cov, &res.trials);
+        rc = print_json(obj);
+    } else {
+        if (res.geometry_chosen) {
+            printf("%s\n", res.geometry_why);
         }
+        if (res.held_why[0] != '\0') {
+            printf("%s\n", res.held_why);
+        }
+        text_fit(fit, s, o, row_err);
+        dhcal_text_diagnosis(stdout, fit, &res.diag, o->effects, &res.trials);
+        text_covariates(&res.cov);
+        text_extras(fit, s, &extras, res.trials.named >= res.diag.count);
     }
     free(row_err);
     return rc;
@@ -822,8 +779,8 @@ static int cmd_refine(const options *o, session *s)
     dhcal_error err;
     memset(&err, 0, sizeof err);
     int rc = dhcal_run_refine(&s->model, o->effects, o->geometry != NULL ? &s->geometry : NULL,
-                              &s->noise, &s->samples, s->have_held ? &s->held : NULL, &res,
-                              &err);
+                              &s->noise, s->repeatability_mm, DHCAL_REFINE_MAX_STEPS,
+                              &s->samples, s->have_held ? &s->held : NULL, &res, &err);
     if (rc != DHCAL_IO_OK) {
         fprintf(stderr, "dhcal: %s\n", err.msg);
         return rc == DHCAL_IO_BAD_INPUT ? EXIT_USAGE : EXIT_COMPUTE;
@@ -864,12 +821,16 @@ static int cmd_refine(const options *o, session *s)
         if (res.geometry_chosen) {
             printf("%s\n", res.geometry_why);
         }
-        printf("%-5s %-24s %10s %12s %s\n", "step", "added", "RMS mm", "CV RMS mm",
-               s->have_held ? "held-out RMS / mean mm" : "");
+        if (res.held_why[0] != '\0') {
+            printf("%s\n", res.held_why);
+        }
+        printf("%-5s %-24s %10s %12s %8s %s\n", "step", "added", "RMS mm", "CV RMS mm",
+               "CV rows", s->have_held ? "held-out RMS / mean mm" : "");
         for (size_t k = 0U; k < res.n_steps; ++k) {
             const dhcal_refine_step *st = &res.step[k];
-            printf("%-5zu %-24s %10.4f %12.4f", k, st->added[0] != '\0' ? st->added : "(start)",
-                   st->rms_mm, st->cv_rms_mm);
+            printf("%-5zu %-24s %10.4f %12.4f %8zu", k,
+                   st->added[0] != '\0' ? st->added : "(start)", st->rms_mm, st->cv_rms_mm,
+                   st->cv_rows);
             if (st->have_heldout) {
                 printf("   %.4f / %.4f", st->heldout_rms_mm, st->heldout_mean_mm);
             }

@@ -279,7 +279,10 @@ class Candidate:
     dof: int
     params: Dict[str, float]
     cv_rms_mm: Optional[float] = None
-    lookalike: Optional[str] = None
+    verdict: str = ""
+    why: str = ""
+    look_alikes: Tuple[str, ...] = ()
+    screened: bool = False
 
     @property
     def label(self) -> str:
@@ -363,20 +366,29 @@ class Diagnosis(FitResult):
         self.candidates = [
             Candidate(c["effect"], c["joint"], c["explained"], bool(c["significant"]),
                       c["log10_p"], int(c["dof"]), {p["name"]: p["value"] for p in c["params"]},
-                      c.get("cv_rms_mm"), c.get("lookalike"))
+                      c.get("cv_rms_mm"), c["verdict"], c["why"], tuple(c["look_alikes"]),
+                      bool(c["screened"]))
             for c in r["candidates"]]
+        self.best_rejected = r.get("best_rejected")
 
     @property
     def named(self) -> Optional[Candidate]:
-        """The effect to add next: the best candidate when it is significant, else None."""
-        if self.candidates and self.candidates[0].significant:
-            return self.candidates[0]
-        return None
+        """The effect to add next (``named`` of the report: what ``refine`` adds first), or
+        None."""
+        label = self.report.get("named")
+        return next((c for c in self.candidates if c.label == label), None)
 
     def summary(self) -> str:
         best = self.named
-        head = (f"found: add '{best.label}' (explains {100 * best.explained:.0f}% of the "
-                "residual)" if best is not None else "no missing effect found")
+        if best is not None:
+            head = (f"found: add '{best.label}' (cross-validated RMS {best.cv_rms_mm:.4f} mm)")
+            if best.look_alikes:
+                head += "; these data cannot tell it from " + ", ".join(best.look_alikes)
+        elif self.best_rejected:
+            head = (f"no missing effect named: the closest, {self.best_rejected['effect']}: "
+                    f"{self.best_rejected['why']}")
+        else:
+            head = "no missing effect named"
         return super().summary() + "\n" + head
 
 
@@ -411,12 +423,22 @@ Effects = Union[str, Iterable[str]]
 
 def _run(command: str, model: Model, data: Measurements, effects: Effects,
          heldout: Optional[Measurements], noise: Optional[Tuple[float, float]],
-         geometry: Optional[str], cv: bool) -> Tuple[int, Dict[str, Any], Optional[Model], Any]:
+         geometry: Optional[str], cv: bool,
+         check_units: bool) -> Tuple[int, Dict[str, Any], Optional[Model], Any]:
     if not isinstance(model, Model):
         raise TypeError("dhcal: model must be a dhcal.Model (dhcal.load_model)")
     train = _Rows("training data", model, data)
     held = _Rows("held-out data", model, heldout) if heldout is not None else None
     effect_list = effects if isinstance(effects, str) else ",".join(effects)
+    if check_units:
+        # the program's check before any fit: metres, radians, swapped columns, a frame
+        err = _native.err_buffer()
+        held_c = ctypes.byref(held.c) if held is not None else None
+        code = _native.LIB.dhcal_py_units_check(model._ptr(), ctypes.byref(train.c), held_c,
+                                                _native.encode(effect_list), err,
+                                                _native.ERR_CAP)
+        if code != _native.OK:
+            _raise(code, err)
     noise_text = None
     if noise is not None:
         joint_deg, meas_mm = (float(v) for v in noise)
@@ -447,7 +469,8 @@ def _finish(cls: type, code: int, report: Dict[str, Any], model: Optional[Model]
 def fit(model: Model, q_deg: Any, xyz_mm: Any = None, effects: Effects = (),
         heldout: Any = None, *, directions: Any = None, temp_c: Any = None, t_s: Any = None,
         wires_mm: Any = None, noise: Optional[Tuple[float, float]] = None,
-        geometry: Optional[str] = None, cv: bool = False) -> FitResult:
+        geometry: Optional[str] = None, cv: bool = False,
+        check_units: bool = True) -> FitResult:
     """Least-squares calibration of ``model`` to the measured tool points, as ``dhcal fit``.
 
     q_deg: joint angles, N x joints, degrees (or a :class:`Measurements`, then no xyz_mm).
@@ -457,40 +480,45 @@ def fit(model: Model, q_deg: Any, xyz_mm: Any = None, effects: Effects = (),
     :class:`Measurements` or ``(q_deg, xyz_mm)`` evaluated with the fitted model, never
     fitted. directions, temp_c, t_s: the optional columns. noise: ``(joint_deg, meas_mm)``
     weights every row by its covariance (``--noise``). geometry: ``"offsets"``,
-    ``"lengths"`` or ``"full"``. cv: also cross-validate (``cv_rms_mm``).
+    ``"lengths"`` or ``"full"``. cv: also cross-validate (``cv_rms_mm``). check_units:
+    before any fit, compare the data with the nominal model (docs/python.md, 3.1) and refuse
+    positions or wire lengths that look like metres, angles that look like radians, two
+    swapped columns, and points in another frame than the model's base unless effects has
+    ``base_frame``; False goes on regardless.
 
     Raises ValueError for arrays of the wrong shape or with NaN or infinite values,
-    :class:`DhcalInputError` for values the measurement rules refuse or a bad effect name,
-    and :class:`DhcalError` when the fit fails, does not converge or is no plausible
-    calibration (``error.result`` holds the report then)."""
+    :class:`DhcalInputError` (also a ValueError) for values the measurement rules refuse, a
+    bad effect name or data the units check refuses (the message names the cause), and
+    :class:`DhcalError` when the fit fails, does not converge or is no plausible calibration
+    (``error.result`` holds the report then)."""
     data = _measurements(q_deg, xyz_mm, directions, temp_c, t_s, wires_mm)
     return _finish(FitResult, *_run("fit", model, data, effects, _heldout(heldout), noise,
-                                    geometry, cv))
+                                    geometry, cv, check_units))
 
 
 def diagnose(model: Model, q_deg: Any, xyz_mm: Any = None, effects: Effects = (),
              heldout: Any = None, *, directions: Any = None, temp_c: Any = None,
              t_s: Any = None, wires_mm: Any = None,
              noise: Optional[Tuple[float, float]] = None, geometry: Optional[str] = None,
-             cv: bool = False) -> Diagnosis:
+             cv: bool = False, check_units: bool = True) -> Diagnosis:
     """``dhcal diagnose``: the fit, then every effect of the catalogue the model does not have
     scored against the remaining residual (score test, Holm-corrected at 0.1 %).
     ``result.named`` is the effect to add next, or None. Arguments as :func:`fit`; cv also
     refits the best significant candidates and cross-validates each."""
     data = _measurements(q_deg, xyz_mm, directions, temp_c, t_s, wires_mm)
     return _finish(Diagnosis, *_run("diagnose", model, data, effects, _heldout(heldout),
-                                    noise, geometry, cv))
+                                    noise, geometry, cv, check_units))
 
 
 def refine(model: Model, q_deg: Any, xyz_mm: Any = None, effects: Effects = (),
            heldout: Any = None, *, directions: Any = None, temp_c: Any = None,
            t_s: Any = None, wires_mm: Any = None,
            noise: Optional[Tuple[float, float]] = None,
-           geometry: Optional[str] = None) -> RefineResult:
+           geometry: Optional[str] = None, check_units: bool = True) -> RefineResult:
     """``dhcal refine``: from the base model plus ``effects`` (the start set), adds the
     diagnosed effect that lowers the cross-validated RMS most, while that falls by 1 % or
     more; held-out rows are evaluated at every step, never used to choose. Arguments as
     :func:`fit`; ``result.model`` is the final calibrated model."""
     data = _measurements(q_deg, xyz_mm, directions, temp_c, t_s, wires_mm)
     return _finish(RefineResult, *_run("refine", model, data, effects, _heldout(heldout),
-                                       noise, geometry, False))
+                                       noise, geometry, False, check_units))

@@ -68,6 +68,9 @@ def _load() -> ctypes.PyDLL:
                                  c_char_p, c_char_p, c_char_p, c_int,
                                  ctypes.POINTER(c_void_p), ctypes.POINTER(c_void_p),
                                  c_char_p, c_size_t]
+    lib.dhcal_py_units_check.restype = c_int
+    lib.dhcal_py_units_check.argtypes = [c_void_p, ctypes.POINTER(Rows), ctypes.POINTER(Rows),
+                                         c_char_p, c_char_p, c_size_t]
     lib.dhcal_py_free.restype = None
     lib.dhcal_py_free.argtypes = [c_void_p]
     return lib
