@@ -906,8 +906,8 @@ static dhc_status free_identifiable(const fit_context *fc, dhc_calib_report *rep
 
 /* A step that turns a link angle (theta, alpha, beta) by more than this corrects no drawing
  * (the plausible bound is 30 deg): along a direction the data barely see (theta of the last
- * joint beside an unknown tool) the Gauss-Newton step runs off by 1e14 deg and lands where
- * the angle is noise. Such a step is damped as a rejected one is. */
+ * joint beside an unknown tool) the Gauss-Newton step is unbounded and lands where the
+ * angle is noise. Such a step is damped as a rejected one is. */
 #define MAX_LINK_ANGLE_STEP_RAD 1.0
 
 #if DHC_WITH_ROBUST_START

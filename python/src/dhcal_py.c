@@ -307,6 +307,7 @@ static int run_refine(const dhcal_py_model *m, py_session *s, const char *effect
     dhcal_json_extras(obj, &res.fit, &extras);
     if (max_steps == 0U) {
         dhcal_json_diagnosis(obj, &res.fit, &res.diag, &res.cov, &res.trials);
+        dhcal_json_start(obj, &res);
     } else {
         dhcal_json_refine(obj, &res);
     }
@@ -349,9 +350,11 @@ int dhcal_py_run(const char *command, const dhcal_py_model *m, const dhcal_py_ro
         }
     }
     /* As the program: fit and refine fail (after their report) on a fit that did not
-     * converge or is no plausible calibration; diagnose reports whatever the fit gave. */
-    if (rc == DHCAL_IO_OK && !is_diagnose && fit != NULL &&
-        (implausible(m, fit, &e) || not_converged(fit, is_refine ? "final fit" : "fit", &e))) {
+     * converge or is no plausible calibration; diagnose on a start that is no plausible
+     * calibration (it judges whatever else the start gave). */
+    if (rc == DHCAL_IO_OK && fit != NULL &&
+        (implausible(m, fit, &e) ||
+         (!is_diagnose && not_converged(fit, is_refine ? "final fit" : "fit", &e)))) {
         rc = DHCAL_IO_FAILED;
     }
     if (*report != NULL && !is_diagnose && fit != NULL) {

@@ -396,12 +396,15 @@ static void try_one(const judge_ctx *j, const dhc_candidate_result *cand, size_t
                      : DHCAL_VERDICT_UNSUPPORTED;
 }
 
-/* The rules, in the order a person asks: does it help, is that more than chance, is it big
- * enough to matter, is it the physics it is named after. */
+/* The rules, in the order a person asks: does it help, is it the physics it would be named
+ * after, is that more than chance, is it big enough to matter. */
 static dhcal_verdict judge_verdict(const dhcal_trial *t, const dhcal_size_reference *ref)
 {
     if (!(t->cv_gain >= DHCAL_EVIDENCE_MIN_GAIN)) {
         return DHCAL_VERDICT_CV;
+    }
+    if (t->plausible_max > 0.0 && !(t->magnitude <= t->plausible_max)) {
+        return DHCAL_VERDICT_UNPHYSICAL; /* the physics first: its size says what it is not */
     }
     if (!(t->gain_log10_p <= log10(DHCAL_EVIDENCE_ALPHA))) {
         return DHCAL_VERDICT_EVIDENCE;
@@ -409,10 +412,13 @@ static dhcal_verdict judge_verdict(const dhcal_trial *t, const dhcal_size_refere
     if (ref->source != NULL && !(t->tool_rms_mm >= ref->point_mm)) {
         return DHCAL_VERDICT_SIZE;
     }
-    if (t->plausible_max > 0.0 && !(t->magnitude <= t->plausible_max)) {
-        return DHCAL_VERDICT_UNPHYSICAL;
-    }
     return DHCAL_VERDICT_RUNNER_UP;
+}
+
+int dhcal_trial_significant(const dhcal_trial *t)
+{
+    return t->tried && t->cv.folds > 0U && t->cv_gain >= DHCAL_EVIDENCE_MIN_GAIN &&
+           t->gain_log10_p <= log10(DHCAL_EVIDENCE_ALPHA);
 }
 
 /* Tried candidates by CV RMS (those without one after them), then the others in the
@@ -611,8 +617,8 @@ void dhcal_verdict_words(const dhcal_trials *t, const dhc_diagnosis *diag, size_
     switch (tr->verdict) {
     case DHCAL_VERDICT_NAMED: snprintf(buf, cap, "named"); break;
     case DHCAL_VERDICT_RUNNER_UP:
-        snprintf(buf, cap, "passes every rule; another candidate lowered the cross-validated "
-                 "RMS more");
+        snprintf(buf, cap, "passes every rule; another candidate's gain was surer over the "
+                 "folds (t %.2f here)", tr->gain_t);
         break;
     case DHCAL_VERDICT_LOOKALIKE:
         (void)dhc_effect_label(diag->c[t->named].effect, diag->c[t->named].joint, label,

@@ -29,8 +29,8 @@
  * gains: their mean against their standard error). */
 #define DHCAL_EVIDENCE_ALPHA 0.05
 /* A candidate that raises the positioning uncertainty predicted over the model's joint
- * ranges by more than this factor is not cross-validated: fitted on a slice of its joint's
- * turn it can fit the rows and extrapolate by millimetres. */
+ * ranges by more than this factor is not named: fitted on a slice of its joint's turn it
+ * can fit the rows and extrapolate by millimetres. */
 #define DHCAL_EVIDENCE_MAX_UNCERTAINTY_GROWTH 1.25
 /* Two candidates whose fitted tool-error fields correlate above this are look-alikes. */
 #define DHCAL_LOOKALIKE_CORRELATION 0.9
@@ -72,7 +72,8 @@ typedef enum {
 } dhcal_verdict;
 
 /* "named", "runner_up", "look_alike", "screen", "not_tried", "not_excited", "failed",
- * "unsupported", "cv", "evidence", "size", "unphysical" (JSON `verdict`, docs/cli.md). */
+ * "geometry", "unsupported", "cv", "evidence", "size", "unphysical" (JSON `verdict`,
+ * docs/cli.md). */
 const char *dhcal_verdict_key(dhcal_verdict v);
 
 /* The noise an effect must stand out of: the RMS 3-D error of one measured point that the
@@ -166,6 +167,10 @@ const dhcal_samples *dhcal_workspace_poses(const dhc_model *model);
 /* The positioning uncertainty the fit predicts over those poses (RMS, mm;
  * dhcal_extrapolate): how far the calibration can be trusted where it will be used. */
 double dhcal_workspace_std_mm(const dhcal_fit *fit, const dhcal_samples *s);
+
+/* The evidence rule alone (JSON `significant`): refitted, cross-validated, its gain at
+ * least DHCAL_EVIDENCE_MIN_GAIN and positive over the folds at DHCAL_EVIDENCE_ALPHA. */
+int dhcal_trial_significant(const dhcal_trial *t);
 
 /* The reason a candidate fell short, in words for people ("lowers the cross-validated RMS
  * by 0.4 % only"), into buf. */

@@ -68,8 +68,18 @@ static int hold_implausible(const dhc_model *nominal, const dhc_noise_model *noi
         refit.geometry = out->fit.geometry;
         dhcal_error e2;
         memset(&e2, 0, sizeof e2);
-        if (dhcal_fit_from(nominal, &set, noise, s, held, &refit, &e2) != DHCAL_IO_OK) {
+        uint8_t *flags = malloc(s->n + 1U);
+        if (flags == NULL) {
             return DHCAL_IO_OK; /* the caller refuses the implausible fit with its reason */
+        }
+        memcpy(flags, s->flags, s->n);
+        const int rc = dhcal_fit_from(nominal, &set, noise, s, held, &refit, &e2);
+        if (rc != DHCAL_IO_OK) {
+            memcpy(s->flags, flags, s->n); /* the rows stay those of the fit kept */
+        }
+        free(flags);
+        if (rc != DHCAL_IO_OK) {
+            return DHCAL_IO_OK;
         }
         out->fit = refit;
         const size_t len = strlen(out->held_why);
@@ -275,6 +285,9 @@ int dhcal_run_refine(const dhc_model *nominal, const char *start_effects,
         (void)dhc_effect_label(out->diag.c[named].effect, out->diag.c[named].joint, label,
                                sizeof label);
         out->fit = best;
+        /* the next judgement's baseline is the named candidate's own cross-validation (from
+         * the previous fit; cross-validating the refit again moves it by a few tenths of a
+         * per cent: docs/effects.md 6) */
         out->cv = out->trials.trial[named].cv;
         list_append(out->effects, sizeof out->effects, label);
         record_step(out, label, out->effects, &out->fit, &out->cv);

@@ -158,7 +158,8 @@ static void candidate_trial(cJSON *j, const dhc_diagnosis *diag, const dhcal_tri
         cJSON_AddNumberToObject(j, "gain_log10_p",
                                 dhc_is_finite(tr->gain_log10_p) ? tr->gain_log10_p : -300.0);
     }
-    if (tr->tried && tr->verdict != DHCAL_VERDICT_FAILED) {
+    if (tr->tried && tr->verdict != DHCAL_VERDICT_FAILED &&
+        tr->verdict != DHCAL_VERDICT_GEOMETRY) {
         cJSON *tool = cJSON_AddObjectToObject(j, "tool_change");
         cJSON_AddNumberToObject(tool, "rms_mm", tr->tool_rms_mm);
         cJSON_AddNumberToObject(tool, "max_mm", tr->tool_max_mm);
@@ -245,11 +246,7 @@ void dhcal_json_diagnosis(cJSON *obj, const dhcal_fit *fit, const dhc_diagnosis 
             cJSON_AddNullToObject(j, "joint");
         }
         cJSON_AddNumberToObject(j, "explained", c->explained);
-        const dhcal_verdict v = trials->trial[i].verdict;
-        cJSON_AddBoolToObject(j, "significant",
-                              v == DHCAL_VERDICT_NAMED || v == DHCAL_VERDICT_RUNNER_UP ||
-                                  v == DHCAL_VERDICT_LOOKALIKE || v == DHCAL_VERDICT_SIZE ||
-                                  v == DHCAL_VERDICT_UNPHYSICAL);
+        cJSON_AddBoolToObject(j, "significant", dhcal_trial_significant(&trials->trial[i]));
         cJSON_AddBoolToObject(j, "screened", c->significant);
         cJSON_AddNumberToObject(j, "log10_p", c->rank > 0U ? c->log10_p : 0.0);
         cJSON_AddNumberToObject(j, "dof", (double)c->rank);
@@ -267,6 +264,16 @@ static void add_effect_list(cJSON *arr, const char *list)
     for (char *save = NULL, *tok = strtok_r(copy, ",", &save); tok != NULL;
          tok = strtok_r(NULL, ",", &save)) {
         cJSON_AddItemToArray(arr, cJSON_CreateString(tok));
+    }
+}
+
+void dhcal_json_start(cJSON *obj, const dhcal_refine_result *res)
+{
+    if (res->geometry_chosen) {
+        cJSON_AddStringToObject(obj, "geometry_why", res->geometry_why);
+    }
+    if (res->held_why[0] != '\0') {
+        cJSON_AddStringToObject(obj, "held_why", res->held_why);
     }
 }
 
@@ -292,18 +299,18 @@ void dhcal_json_refine(cJSON *obj, const dhcal_refine_result *res)
         }
         cJSON_AddItemToArray(steps, j);
     }
-    if (res->geometry_chosen) {
-        cJSON_AddStringToObject(obj, "geometry_why", res->geometry_why);
-    }
-    if (res->held_why[0] != '\0') {
-        cJSON_AddStringToObject(obj, "held_why", res->held_why);
-    }
+    dhcal_json_start(obj, res);
     cJSON_AddStringToObject(obj, "stopped", res->stopped_why);
-    if (res->judged) {
+    if (res->judged && res->trials.named >= res->diag.count) {
         add_best_rejected(obj, &res->diag, &res->trials);
+    } else { /* the step limit, with a candidate still named; or no judgement */
+        cJSON_AddNullToObject(obj, "best_rejected");
+    }
+    if (res->judged) {
         add_reference(obj, &res->trials.reference);
     } else {
-        cJSON_AddNullToObject(obj, "best_rejected");
+        const dhcal_size_reference none = {NULL, 0.0};
+        add_reference(obj, &none);
     }
 }
 

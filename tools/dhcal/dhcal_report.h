@@ -47,7 +47,10 @@ void dhcal_json_diagnosis(cJSON *obj, const dhcal_fit *fit, const dhc_diagnosis 
 void dhcal_text_diagnosis(FILE *f, const dhcal_fit *fit, const dhc_diagnosis *d,
                           const char *effects, const dhcal_trials *t);
 
-/* refine's effects, steps, geometry_why, stopped. */
+/* What the start chose or held: geometry_why, held_why (diagnose and refine). */
+void dhcal_json_start(cJSON *obj, const dhcal_refine_result *res);
+
+/* refine's effects, steps, geometry_why, held_why, stopped, best_rejected, noise_reference. */
 void dhcal_json_refine(cJSON *obj, const dhcal_refine_result *res);
 
 #endif /* DHCAL_REPORT_H */

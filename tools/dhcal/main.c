@@ -123,21 +123,24 @@ static void print_command_help(const char *command)
                "again as --model) only when the fit succeeds and is physically plausible.\n");
     } else if (strcmp(command, "diagnose") == 0) {
         printf("usage: dhcal diagnose --model M.json --data D.csv [--effects LIST] [--cv] [--json]\n"
-               "Fits, then scores every effect the model does not have yet against the\n"
-               "remaining residual (score test, Holm-corrected at 0.1 %%): the share of the\n"
-               "residual each would explain, whether that is significant, and look-alikes.\n"
+               "Fits as refine starts, screens every effect the model does not have yet with\n"
+               "the score test, refits the six best on the same rows and cross-validates them\n"
+               "on the same folds, and names the one whose gain holds over the folds, moves\n"
+               "the tool by more than the noise reference (--noise, repeats, --repeatability)\n"
+               "and has a physical size; reports look-alikes, and for every other candidate\n"
+               "why it fell short (docs/effects.md 6). refine's first step is the one named.\n"
                "Drift (thermal) candidates are scored only when the time (temperature) varies\n"
-               "apart from the pose. --cv refits the best significant candidates as refine\n"
-               "does and adds each one's cross-validated RMS.\n");
+               "apart from the pose. --cv is accepted (it always cross-validates).\n");
     } else if (strcmp(command, "refine") == 0) {
         printf("usage: dhcal refine --model M.json --data D.csv [--effects START] [--heldout H.csv]\n"
                "                    [--noise J,M] [--geometry LEVEL] [--out C.json] [--json]\n"
-               "From the base model plus START (e.g. base_frame,tool_offset), adds the candidate\n"
-               "effect of the diagnosis that lowers the cross-validated RMS most (leave-one-out\n"
-               "below 30 rows, else 5 folds), refits from the previous solution, and repeats\n"
-               "while that RMS falls by 1 %% or more. With few rows and no --geometry, cross-\n"
-               "validation also picks how much geometry to fit. --heldout rows are evaluated\n"
-               "at every step, never used to choose. --out writes the final model.\n");
+               "From the base model plus START (e.g. base_frame,tool_offset), adds the effect\n"
+               "the judgement names (as diagnose: evidence over the folds, size against the\n"
+               "noise reference, physical plausibility; the rows and folds fixed by the start)\n"
+               "and judges again until none passes, then names the closest and why. With few\n"
+               "rows and no --geometry, cross-validation also picks how much geometry to fit.\n"
+               "--heldout rows are evaluated at every step, never used to choose. --out writes\n"
+               "the final model.\n");
     } else if (strcmp(command, "plot") == 0) {
         printf("usage: dhcal plot --model M.json --data D.csv --out DIR [--effects LIST]\n"
                "Writes SVG files into DIR: residual components against each joint angle\n"
@@ -715,19 +718,61 @@ static void text_covariates(const dhcal_covariates *cov)
     }
 }
 
+/* refine's loop (max_steps 0: diagnose, its start and first judgement), the error on
+ * standard error: 0, EXIT_USAGE or EXIT_COMPUTE. */
+static int run_refine(const options *o, session *s, size_t max_steps, dhcal_refine_result *res)
+{
+    dhcal_error err;
+    memset(&err, 0, sizeof err);
+    const int rc = dhcal_run_refine(&s->model, o->effects,
+                                    o->geometry != NULL ? &s->geometry : NULL, &s->noise,
+                                    s->repeatability_mm, max_steps, &s->samples,
+                                    s->have_held ? &s->held : NULL, res, &err);
+    if (rc != DHCAL_IO_OK) {
+        fprintf(stderr, "dhcal: %s\n", err.msg);
+        return rc == DHCAL_IO_BAD_INPUT ? EXIT_USAGE : EXIT_COMPUTE;
+    }
+    return 0;
+}
+
+/* Every row's error at the result's model (caller frees; NULL on failure, said on standard
+ * error) and the report's extras, its cross-validation the loop's. */
+static double *refine_rows(const session *s, const dhcal_refine_result *res,
+                           dhcal_fit_extras *extras)
+{
+    double *row_err = calloc(s->samples.n + 1U, sizeof *row_err);
+    dhcal_error_stats es;
+    if (row_err == NULL ||
+        dhcal_samples_errors(&res->fit.model, &s->samples, NULL, row_err, &es) != DHCAL_IO_OK) {
+        free(row_err);
+        fprintf(stderr, "dhcal: evaluation failed\n");
+        return NULL;
+    }
+    dhcal_fit_extras_compute(&res->fit, &s->samples, s->have_held ? &s->held : NULL, extras);
+    extras->have_cv = 1;
+    extras->cv = res->cv;
+    return row_err;
+}
+
+/* What the start chose or held, for people. */
+static void text_start(const dhcal_refine_result *res)
+{
+    if (res->geometry_chosen) {
+        printf("%s\n", res->geometry_why);
+    }
+    if (res->held_why[0] != '\0') {
+        printf("%s\n", res->held_why);
+    }
+}
+
 static int cmd_diagnose(const options *o, session *s)
 {
     static dhcal_refine_result res;
     static dhcal_fit_extras extras;
-    dhcal_error err;
-    memset(&err, 0, sizeof err);
     /* refine's start and its first judgement: one ranking for both commands */
-    int rc = dhcal_run_refine(&s->model, o->effects, o->geometry != NULL ? &s->geometry : NULL,
-                              &s->noise, s->repeatability_mm, 0U, &s->samples,
-                              s->have_held ? &s->held : NULL, &res, &err);
-    if (rc != DHCAL_IO_OK) {
-        fprintf(stderr, "dhcal: %s\n", err.msg);
-        return rc == DHCAL_IO_BAD_INPUT ? EXIT_USAGE : EXIT_COMPUTE;
+    int rc = run_refine(o, s, 0U, &res);
+    if (rc != 0) {
+        return rc;
     }
     const dhcal_fit *fit = &res.fit;
     if (refuse_implausible(s, fit, NULL) != 0) {
@@ -737,30 +782,19 @@ static int cmd_diagnose(const options *o, session *s)
         fprintf(stderr, "dhcal: %s\n", res.stopped_why);
         return EXIT_COMPUTE;
     }
-    double *row_err = calloc(s->samples.n + 1U, sizeof *row_err);
-    dhcal_error_stats es;
-    if (row_err == NULL ||
-        dhcal_samples_errors(&fit->model, &s->samples, NULL, row_err, &es) != DHCAL_IO_OK) {
-        free(row_err);
-        fprintf(stderr, "dhcal: evaluation failed\n");
+    double *row_err = refine_rows(s, &res, &extras);
+    if (row_err == NULL) {
         return EXIT_COMPUTE;
     }
-    dhcal_fit_extras_compute(fit, &s->samples, s->have_held ? &s->held : NULL, &extras);
-    extras.have_cv = 1;
-    extras.cv = res.cv;
     if (o->json) {
         cJSON *obj = cJSON_CreateObject();
         dhcal_json_fit(obj, fit, &s->model, &s->samples, row_err);
         dhcal_json_extras(obj, fit, &extras);
         dhcal_json_diagnosis(obj, fit, &res.diag, &res.cov, &res.trials);
+        dhcal_json_start(obj, &res);
         rc = print_json(obj);
     } else {
-        if (res.geometry_chosen) {
-            printf("%s\n", res.geometry_why);
-        }
-        if (res.held_why[0] != '\0') {
-            printf("%s\n", res.held_why);
-        }
+        text_start(&res);
         text_fit(fit, s, o, row_err);
         dhcal_text_diagnosis(stdout, fit, &res.diag, o->effects, &res.trials);
         text_covariates(&res.cov);
@@ -776,29 +810,18 @@ static int cmd_refine(const options *o, session *s)
 {
     static dhcal_refine_result res;
     static dhcal_fit_extras extras;
-    dhcal_error err;
-    memset(&err, 0, sizeof err);
-    int rc = dhcal_run_refine(&s->model, o->effects, o->geometry != NULL ? &s->geometry : NULL,
-                              &s->noise, s->repeatability_mm, DHCAL_REFINE_MAX_STEPS,
-                              &s->samples, s->have_held ? &s->held : NULL, &res, &err);
-    if (rc != DHCAL_IO_OK) {
-        fprintf(stderr, "dhcal: %s\n", err.msg);
-        return rc == DHCAL_IO_BAD_INPUT ? EXIT_USAGE : EXIT_COMPUTE;
+    int rc = run_refine(o, s, DHCAL_REFINE_MAX_STEPS, &res);
+    if (rc != 0) {
+        return rc;
     }
     const dhcal_fit *fit = &res.fit;
     const int implausible = refuse_implausible(s, fit, o->out);
-    double *row_err = calloc(s->samples.n + 1U, sizeof *row_err);
-    dhcal_error_stats es;
-    if (row_err == NULL ||
-        dhcal_samples_errors(&fit->model, &s->samples, NULL, row_err, &es) != DHCAL_IO_OK) {
-        free(row_err);
-        fprintf(stderr, "dhcal: evaluation failed\n");
+    double *row_err = refine_rows(s, &res, &extras);
+    if (row_err == NULL) {
         return EXIT_COMPUTE;
     }
-    dhcal_fit_extras_compute(fit, &s->samples, s->have_held ? &s->held : NULL, &extras);
-    extras.have_cv = 1;
-    extras.cv = res.cv;
-    rc = 0;
+    dhcal_error err;
+    memset(&err, 0, sizeof err);
     if (o->out != NULL && fit->status == DHC_OK && implausible == 0) {
         static dhcal_model out;
         dhcal_model_from_lib(&fit->model, &s->file_model, &out);
@@ -818,12 +841,7 @@ static int cmd_refine(const options *o, session *s)
         printf("refine of '%s' to %s: base model (%s geometry)%s%s\n", s->file_model.name,
                o->data, dhcal_geometry_name(fit->geometry), o->effects != NULL ? " + " : "",
                o->effects != NULL ? o->effects : "");
-        if (res.geometry_chosen) {
-            printf("%s\n", res.geometry_why);
-        }
-        if (res.held_why[0] != '\0') {
-            printf("%s\n", res.held_why);
-        }
+        text_start(&res);
         printf("%-5s %-24s %10s %12s %8s %s\n", "step", "added", "RMS mm", "CV RMS mm",
                "CV rows", s->have_held ? "held-out RMS / mean mm" : "");
         for (size_t k = 0U; k < res.n_steps; ++k) {
@@ -857,21 +875,21 @@ static int cmd_refine(const options *o, session *s)
 
 static int cmd_plot(const options *o, session *s)
 {
-    static dhcal_fit before;
+    static dhcal_refine_result judged; /* diagnose's: the start and its judgement */
     static dhcal_fit after;
-    static dhc_diagnosis diag;
-    double *row_err = NULL;
-    int rc = do_fit(o, s, &before, &row_err);
-    free(row_err);
+    int rc = run_refine(o, s, 0U, &judged);
     if (rc != 0) {
         return rc;
     }
-    dhcal_error err;
-    memset(&err, 0, sizeof err);
-    if (dhcal_run_diagnose(&before, &s->samples, &diag, NULL, &err) != DHCAL_IO_OK) {
-        fprintf(stderr, "dhcal: %s\n", err.msg);
+    if (!judged.judged) {
+        fprintf(stderr, "dhcal: %s\n", judged.stopped_why);
         return EXIT_COMPUTE;
     }
+    const dhcal_fit *const before_fit = &judged.fit;
+    const dhc_diagnosis *const diag = &judged.diag;
+    const dhcal_trials *const trials = &judged.trials;
+    dhcal_error err;
+    memset(&err, 0, sizeof err);
     const size_t n = s->samples.n;
     const size_t nj = s->model.arm.n_joints;
     double *q_deg = calloc(n * nj + 1U, sizeof *q_deg);
@@ -889,12 +907,13 @@ static int cmd_plot(const options *o, session *s)
     dhcal_error_stats es_a = {0.0, 0.0, 0.0, 0U};
     char label[64] = "";
     if (rc == 0) {
-        rc = dhcal_samples_errors(&before.model, &s->samples, res_before, err_before, &es_b);
+        rc = dhcal_samples_errors(&before_fit->model, &s->samples, res_before, err_before, &es_b);
     }
 
     /* "after": the effect the diagnosis names, added to whatever --effects gave */
-    if (rc == 0 && diag.count > 0U && diag.c[0].significant) {
-        (void)dhc_effect_label(diag.c[0].effect, diag.c[0].joint, label, sizeof label);
+    if (rc == 0 && trials->named < diag->count) {
+        (void)dhc_effect_label(diag->c[trials->named].effect, diag->c[trials->named].joint,
+                               label, sizeof label);
         char list[600];
         snprintf(list, sizeof list, "%s%s%s", o->effects != NULL ? o->effects : "",
                  o->effects != NULL ? "," : "", label);
@@ -907,7 +926,7 @@ static int cmd_plot(const options *o, session *s)
                  ? 0
                  : EXIT_COMPUTE;
     } else if (rc == 0) {
-        after = before;
+        after = *before_fit;
     }
     if (rc == 0) {
         rc = dhcal_samples_errors(&after.model, &s->samples, res_after, err_after, &es_a);
@@ -925,13 +944,15 @@ static int cmd_plot(const options *o, session *s)
     }
     dhcal_plot_candidate cands[DHC_MAX_CANDIDATES];
     size_t nc = 0U;
-    for (size_t i = 0U; i < diag.count; ++i) {
-        if (diag.c[i].rank == 0U) {
+    for (size_t k = 0U; k < diag->count; ++k) {
+        const size_t i = trials->order[k]; /* the judgement's order: the one named first */
+        if (diag->c[i].rank == 0U) {
             continue;
         }
-        (void)dhc_effect_label(diag.c[i].effect, diag.c[i].joint, cands[nc].label, sizeof cands[nc].label);
-        cands[nc].explained = diag.c[i].explained;
-        cands[nc].significant = diag.c[i].significant;
+        (void)dhc_effect_label(diag->c[i].effect, diag->c[i].joint, cands[nc].label,
+                               sizeof cands[nc].label);
+        cands[nc].explained = diag->c[i].explained;
+        cands[nc].significant = dhcal_trial_significant(&trials->trial[i]);
         nc++;
     }
     if (rc == 0) {

@@ -501,10 +501,14 @@ def diagnose(model: Model, q_deg: Any, xyz_mm: Any = None, effects: Effects = ()
              t_s: Any = None, wires_mm: Any = None,
              noise: Optional[Tuple[float, float]] = None, geometry: Optional[str] = None,
              cv: bool = False, check_units: bool = True) -> Diagnosis:
-    """``dhcal diagnose``: the fit, then every effect of the catalogue the model does not have
-    scored against the remaining residual (score test, Holm-corrected at 0.1 %).
-    ``result.named`` is the effect to add next, or None. Arguments as :func:`fit`; cv also
-    refits the best significant candidates and cross-validates each."""
+    """``dhcal diagnose``: ``refine``'s start and its first judgement: every effect of the
+    catalogue the model does not have is screened by the score test, the six best are
+    refitted on the same rows and cross-validated on the same folds, and the one whose gain
+    holds over the folds, with a size above the noise reference and physical, is named
+    (docs/effects.md 6). ``result.named`` is the effect to add next (``refine``'s first
+    step), or None; ``result.best_rejected`` the closest that fell short. Arguments as
+    :func:`fit`; cv is accepted and changes nothing (the judgement always
+    cross-validates)."""
     data = _measurements(q_deg, xyz_mm, directions, temp_c, t_s, wires_mm)
     return _finish(Diagnosis, *_run("diagnose", model, data, effects, _heldout(heldout),
                                     noise, geometry, cv, check_units))
@@ -516,8 +520,8 @@ def refine(model: Model, q_deg: Any, xyz_mm: Any = None, effects: Effects = (),
            noise: Optional[Tuple[float, float]] = None,
            geometry: Optional[str] = None, check_units: bool = True) -> RefineResult:
     """``dhcal refine``: from the base model plus ``effects`` (the start set), adds the
-    diagnosed effect that lowers the cross-validated RMS most, while that falls by 1 % or
-    more; held-out rows are evaluated at every step, never used to choose. Arguments as
+    effect the judgement names (as :func:`diagnose`) and judges again until none passes;
+    held-out rows are evaluated at every step, never used to choose. Arguments as
     :func:`fit`; ``result.model`` is the final calibrated model."""
     data = _measurements(q_deg, xyz_mm, directions, temp_c, t_s, wires_mm)
     return _finish(RefineResult, *_run("refine", model, data, effects, _heldout(heldout),
