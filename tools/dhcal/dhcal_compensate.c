@@ -382,6 +382,7 @@ int dhcal_compensate_main(int argc, char **argv)
                                      &err);
     }
     if (rc != DHCAL_IO_OK) {
+        dhcal_dataset_free(&t); /* a refusal after the targets were read */
         fprintf(stderr, "dhcal: %s\n", err.msg);
         return rc == DHCAL_IO_BAD_INPUT ? EXIT_USAGE : EXIT_COMPUTE;
     }
