@@ -50,8 +50,11 @@ turn for the shape to be told from a joint offset (scale on a joint spanning 80-
 order-1 harmonics on joints spanning 240 deg or more, order 2 on joints spanning about 150 deg
 or more, so 2q spans most of a turn), compliance about a pitch joint that carries the arm's
 weight. The last joint, whose rotation barely moves the tool point, is not used. On UR10 D the
-ISO-cube poses keep the tool's orientation, so q5 = +-q1 on most rows: a harmonic of joint 5
-looks like one of joint 1 there, and only dhcal's look-alikes can make that case pass.
+ISO-cube poses keep the tool's orientation, so q5 = +-q1 on most rows: joint 5's effects look
+like joint 1's there and theta5, d5 are not identified, which lets the geometric start absorb
+an injected wrist or elbow effect into a wrist that turns by tens of degrees; the UR10's
+order-1 harmonic and compliance cases use series B (even rows fitted, odd rows held out),
+whose poses turn the wrist independently.
 
 Positions only: the test writes its copies (q1..qN, x, y, z) to --scratch (the build tree),
 never to the repository. Skips with the reason, exit 77, when the data folder is absent.
