@@ -5,8 +5,8 @@
  *   cv_speed --model M.json --data D.csv [--effects LIST] [--noise J,M] [--repeat N]
  *
  * Fits the base model plus LIST as `dhcal fit` does (dhcal_run_fit), cross-validates the
- * parameters the fit identified (dhcal_cv_set) by each method, N times each (default 3;
- * fewer once a method has taken a second), and prints one JSON object: rows, folds,
+ * parameters refine cross-validates (dhcal_set_without_held) by each method, N times each
+ * (default 3; fewer once a method has taken a second), and prints one JSON object: rows, folds,
  * parameters, both CV RMS and their relative difference, the largest relative difference of
  * a fold's sum of squares, the folds the fast method refitted, the best time of each and
  * their ratio. Exit 1 when a step fails, 2 for usage. bench/refine-speed runs it over the
@@ -118,7 +118,7 @@ int main(int argc, char **argv)
     double t_fast = -1.0;
     double t_refit = -1.0;
     if (rc == DHCAL_IO_OK) {
-        dhcal_cv_set(&fit, &set);
+        dhcal_set_without_held(&fit, &set);
         t_fast = best_time(dhcal_cross_validate, &fit, &set, &s, repeat, &fast, &err);
     }
     if (t_fast >= 0.0) {

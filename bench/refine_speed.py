@@ -31,27 +31,12 @@ import sys
 import tempfile
 import time
 
+# the real-data test's copy of a set with positions only (one definition for both)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'tests',
+                                'realdata'))
+from test_realdata import positions_only  # noqa: E402
+
 START = 'base_frame,tool_offset'
-
-
-def positions_only(src, dst, parity=None):
-    """The CSV with only q1..qN and x,y,z (comment lines kept); with parity 0 or 1 only the
-    even or odd data rows (0-based): as tests/realdata/test_realdata.py writes them."""
-    with open(src) as f:
-        lines = f.read().splitlines()
-    head_i = next(i for i, l in enumerate(lines) if l and not l.startswith('#'))
-    header = lines[head_i].split(',')
-    keep = [i for i, c in enumerate(header)
-            if (c.startswith('q') and c[1:].isdigit()) or c in ('x', 'y', 'z')]
-    with open(dst, 'w') as f:
-        for l in lines[:head_i + 1]:
-            f.write((l if l.startswith('#') else ','.join(header[i] for i in keep)) + '\n')
-        rows = [l for l in lines[head_i + 1:] if l and not l.startswith('#')]
-        for k, l in enumerate(rows):
-            if parity is not None and k % 2 != parity:
-                continue
-            cells = l.split(',')
-            f.write(','.join(cells[i] for i in keep) + '\n')
 
 
 def cases(rd, scratch):

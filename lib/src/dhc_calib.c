@@ -871,26 +871,6 @@ static int little_left_to_gain(const fit_context *fc, const pass_totals *tot, do
     return q * gain / (1.0 - q) <= tol * sigma2;
 }
 
-/* The SSR decrease the linear model predicts for the step delta: 2 delta^T g - delta^T N
- * delta (g = J^T W r, N = J^T W J of the accumulation at the current estimate). */
-static double predicted_decrease(const dhc_normal_eq *ne, const double *delta)
-{
-    const size_t n = ne->n;
-    double lin = 0.0;
-    double quad = 0.0;
-    for (size_t i = 0U; i < n; ++i) {
-        if (!(fabs(delta[i]) > 0.0)) {
-            continue;
-        }
-        lin += delta[i] * ne->jtr[i];
-        double row = 0.0;
-        for (size_t j = 0U; j < n; ++j) {
-            row += ne->jtj[i * n + j] * delta[j];
-        }
-        quad += delta[i] * row;
-    }
-    return 2.0 * lin - quad;
-}
 
 /* The identifiability checks of one fit_to_convergence: how many at a converged estimate
  * freed parameters, and whether LM may still free them between its steps (when any check
@@ -976,7 +956,7 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
         ws->trial = ws->current;
         st = dhc_params_apply(fc->set, &ws->trial, ws->delta, p);
         /* from the accumulation at the current estimate, before a trial overwrites it */
-        const double predicted = predicted_decrease(&ws->ne, ws->delta);
+        const double predicted = dhc_lsq_predicted_decrease(&ws->ne, ws->delta);
         /* Most steps are accepted: the trial's pass accumulates its normal equations too,
          * and an accepted step needs no pass of its own (a rejected one pays a pass to
          * accumulate the current estimate again). Not with the noise model on: a trial is

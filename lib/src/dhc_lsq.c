@@ -367,6 +367,25 @@ dhc_status dhc_lsq_analyse(const dhc_normal_eq *ne, double rel_tol, dhc_lsq_fact
     return DHC_OK;
 }
 
+double dhc_lsq_predicted_decrease(const dhc_normal_eq *ne, const double *delta)
+{
+    const size_t n = ne->n;
+    double lin = 0.0;
+    double quad = 0.0;
+    for (size_t i = 0U; i < n; ++i) {
+        if (!(fabs(delta[i]) > 0.0)) {
+            continue;
+        }
+        lin += delta[i] * ne->jtr[i];
+        double row = 0.0;
+        for (size_t j = 0U; j < n; ++j) {
+            row += ne->jtj[i * n + j] * delta[j];
+        }
+        quad += delta[i] * row;
+    }
+    return 2.0 * lin - quad;
+}
+
 dhc_status dhc_lsq_step(const dhc_normal_eq *ne, dhc_lsq_factor *fac, double lambda,
                         double *delta, size_t len)
 {

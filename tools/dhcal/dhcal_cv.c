@@ -355,26 +355,6 @@ static dhc_status hold_unsupported(dhc_normal_eq *ne, const dhc_param_set *set,
     return st;
 }
 
-/* The decrease of the equations' sum of squares the linear model promises for the step
- * delta: 2 delta^T g - delta^T A delta (columns left out have a zero step). */
-static double predicted_decrease(const dhc_normal_eq *ne, const double *delta)
-{
-    const size_t n = ne->n;
-    double lin = 0.0;
-    double quad = 0.0;
-    for (size_t i = 0U; i < n; ++i) {
-        if (!(fabs(delta[i]) > 0.0)) {
-            continue;
-        }
-        double row = 0.0;
-        for (size_t j = 0U; j < n; ++j) {
-            row += ne->jtj[i * n + j] * delta[j];
-        }
-        lin += delta[i] * ne->jtr[i];
-        quad += delta[i] * row;
-    }
-    return 2.0 * lin - quad;
-}
 
 /* At a fold's trial estimate, in one pass over the used rows: the sum of squares of the
  * equations of the rows outside fold f (whitened with the covariance at the start, as the fit
@@ -468,7 +448,7 @@ static void fold_step(fold_pass *fp, const dhc_normal_eq *ne, const uint8_t *ide
         }
         double ssr = HUGE_VAL;
         const dhc_status ev = st == DHC_OK ? evaluate_trial(fp, &model, f, &ssr, out) : st;
-        const double promised = predicted_decrease(&sys, delta);
+        const double promised = dhc_lsq_predicted_decrease(&sys, delta);
         if (ev == DHC_OK &&
             (!(promised > 0.0) || sys.ssr - ssr >= CV_MIN_GAIN_RATIO * promised)) {
             /* the folds share the curvature of the fit on all rows: the next fold starts a
@@ -605,16 +585,4 @@ static int cv_run(const dhc_model *start, const dhc_param_set *set,
         finish(out, cf.folds);
     }
     return rc;
-}
-
-void dhcal_cv_set(const dhcal_fit *fit, dhc_param_set *out)
-{
-    *out = fit->set;
-    size_t kept = 0U;
-    for (size_t k = 0U; k < fit->set.count; ++k) {
-        if (fit->rep.identifiable[k] && !fit->rep.unsupported[k]) {
-            out->id[kept++] = fit->set.id[k];
-        }
-    }
-    out->count = kept;
 }

@@ -71,12 +71,4 @@ int dhcal_cross_validate_refit(const dhc_model *start, const dhc_param_set *set,
                                const dhc_noise_model *noise, const dhcal_samples *s,
                                dhcal_cv *out, dhcal_error *err);
 
-/* The parameters a cross-validation of fit re-estimates in each fold (its set for
- * dhcal_cross_validate with start = fit->model): those the fit identified, without the ones
- * it kept at their input values (unidentifiable, or held for want of support). A fold's rows
- * pin those no better than all rows do: a fold that moved them would wander along what the
- * fit could not see (a refit creeps there until its iterations run out, and its estimate
- * depends on where it stops). */
-void dhcal_cv_set(const dhcal_fit *fit, dhc_param_set *out);
-
 #endif /* DHCAL_CV_H */

@@ -42,11 +42,17 @@ const dhcal_samples *dhcal_workspace_poses(const dhc_model *model)
     return &workspace;
 }
 
-double dhcal_workspace_std_mm(const dhcal_fit *fit, const dhcal_samples *s)
+/* dhcal_workspace_std_mm over poses w built already (the judgement builds them once). */
+static double workspace_std_on(const dhcal_fit *fit, const dhcal_samples *s,
+                               const dhcal_samples *w)
 {
-    const dhcal_samples *w = dhcal_workspace_poses(&fit->model);
     dhcal_extrapolation x;
     return dhcal_extrapolate(fit, s, w, &x) == DHCAL_IO_OK ? x.predicted_std_mm : HUGE_VAL;
+}
+
+double dhcal_workspace_std_mm(const dhcal_fit *fit, const dhcal_samples *s)
+{
+    return workspace_std_on(fit, s, dhcal_workspace_poses(&fit->model));
 }
 
 /* ---------------------------------------------------------------- words */
@@ -132,9 +138,9 @@ static double effect_term_rad(const dhc_model *m, dhc_effect e, size_t j, const 
 
 /* The fitted effect's magnitude (dhcal_trial.magnitude): the largest |term| over the data's
  * used poses and the poses across the joint ranges, in degrees (a scale: |s|). */
-static double magnitude_of(const dhc_model *m, dhc_effect e, size_t j, const dhcal_samples *s)
+static double magnitude_of(const dhc_model *m, dhc_effect e, size_t j, const dhcal_samples *s,
+                           const dhcal_samples *w)
 {
-    const dhcal_samples *w = dhcal_workspace_poses(m);
     double worst = 0.0;
     for (size_t pass = 0U; pass < 2U; ++pass) {
         const dhcal_samples *set = pass == 0U ? s : w;
@@ -145,19 +151,6 @@ static double magnitude_of(const dhc_model *m, dhc_effect e, size_t j, const dhc
         }
     }
     return e == DHC_EFFECT_JOINT_SCALE ? worst : worst * 180.0 / DHC_PI;
-}
-
-/* Gravity's moment about joint j's axis for a unit weight at the tool, RMS over the used
- * rows, as a share of the arm's reach (0 without gravity or reach). */
-double dhcal_compliance_excitation(const dhc_model *m, const dhcal_samples *s, size_t j)
-{
-    double share[DHC_MAX_JOINTS];
-    dhcal_compliance_columns(m, s, j, share);
-    double best = 0.0;
-    for (size_t k = j; k < m->arm.n_joints; ++k) {
-        best = fmax(best, share[k]);
-    }
-    return best;
 }
 
 void dhcal_compliance_columns(const dhc_model *m, const dhcal_samples *s, size_t j,
@@ -186,11 +179,9 @@ void dhcal_compliance_columns(const dhc_model *m, const dhcal_samples *s, size_t
 
 /* A compliance candidate's columns (joint j, weight at frame k) that gravity barely loads
  * in these poses leave the set: their coefficient would be fitted to a tiny regressor. */
-static void drop_unexcited_columns(const dhc_model *m, const dhcal_samples *s, size_t j,
+static void drop_unexcited_columns(const double share[DHC_MAX_JOINTS], size_t j,
                                    dhc_param_set *set)
 {
-    double share[DHC_MAX_JOINTS];
-    dhcal_compliance_columns(m, s, j, share);
     size_t kept = 0U;
     for (size_t k = 0U; k < set->count; ++k) {
         const dhc_param_id *id = &set->id[k];
@@ -324,6 +315,7 @@ typedef struct {
     const dhcal_fit *fit;
     const double *base;    /* residuals of the fit's model, data */
     const double *base_ws; /* ... and over the joint ranges */
+    const dhcal_samples *ws; /* the poses across the joint ranges, built once */
     dhcal_trials *out;
 } judge_ctx;
 
@@ -332,7 +324,7 @@ static dhcal_fit trial_fit[DHCAL_EVIDENCE_TRIALS];
 /* Refits candidate c, measures it, cross-validates it; field (3 per sample) receives the
  * change of the residual adding it makes. The verdict is left to judge_verdict. */
 static void try_one(const judge_ctx *j, const dhc_candidate_result *cand, size_t c,
-                    dhcal_fit *trial, double *field)
+                    const double share[DHC_MAX_JOINTS], dhcal_fit *trial, double *field)
 {
     dhcal_trial *t = &j->out->trial[c];
     const dhcal_fit *fit = j->fit;
@@ -344,7 +336,7 @@ static void try_one(const judge_ctx *j, const dhc_candidate_result *cand, size_t
         return;
     }
     if (cand->effect == DHC_EFFECT_JOINT_COMPLIANCE) {
-        drop_unexcited_columns(&fit->model, j->s, cand->joint, &set);
+        drop_unexcited_columns(share, cand->joint, &set);
     }
     dhcal_error e2;
     memset(&e2, 0, sizeof e2);
@@ -371,19 +363,19 @@ static void try_one(const judge_ctx *j, const dhc_candidate_result *cand, size_t
         t->verdict = DHCAL_VERDICT_GEOMETRY;
         return;
     }
-    t->workspace_std_mm = dhcal_workspace_std_mm(trial, j->s);
-    t->magnitude = magnitude_of(&trial->model, cand->effect, cand->joint, j->s);
+    t->workspace_std_mm = workspace_std_on(trial, j->s, j->ws);
+    t->magnitude = magnitude_of(&trial->model, cand->effect, cand->joint, j->s, j->ws);
     t->plausible_max = dhcal_plausible_magnitude(cand->effect);
     double *r = residuals_at(&trial->model, j->s);
     const dhc_model steady = dhcal_model_without_drift(&trial->model);
-    double *rw = residuals_at(&steady, dhcal_workspace_poses(&fit->model));
+    double *rw = residuals_at(&steady, j->ws);
     if (r == NULL || rw == NULL) {
         free(r);
         free(rw);
         return;
     }
     change_of(j->base, r, j->s, &t->tool_rms_mm, &t->tool_max_mm);
-    change_of(j->base_ws, rw, dhcal_workspace_poses(&fit->model), &t->range_rms_mm,
+    change_of(j->base_ws, rw, j->ws, &t->range_rms_mm,
               &t->range_max_mm);
     for (size_t k = 0U; k < 3U * j->s->n; ++k) {
         field[k] = j->base[k] - r[k];
@@ -536,10 +528,11 @@ int dhcal_judge_candidates(const dhc_model *nominal, const dhcal_fit *fit, const
     out->reference = *reference;
     out->named = DHC_MAX_CANDIDATES;
     out->best_rejected = DHC_MAX_CANDIDATES;
-    out->workspace_std_mm = dhcal_workspace_std_mm(fit, s);
+    const dhcal_samples *const ws = dhcal_workspace_poses(&fit->model); /* the ranges' */
+    out->workspace_std_mm = workspace_std_on(fit, s, ws);
     const dhc_model steady = dhcal_model_without_drift(&fit->model);
     double *base = residuals_at(&fit->model, s);
-    double *base_ws = residuals_at(&steady, dhcal_workspace_poses(&fit->model));
+    double *base_ws = residuals_at(&steady, ws);
     double *fields = calloc((size_t)DHCAL_EVIDENCE_TRIALS * 3U * s->n + 1U, sizeof *fields);
     uint8_t *flags0 = malloc(s->n + 1U);
     int rc = base != NULL && base_ws != NULL && fields != NULL && flags0 != NULL
@@ -550,13 +543,17 @@ int dhcal_judge_candidates(const dhc_model *nominal, const dhcal_fit *fit, const
         double *field[DHCAL_EVIDENCE_TRIALS];
         size_t tried = 0U;
         memcpy(flags0, s->flags, s->n);
-        const judge_ctx j = {nominal, s, held, fit, base, base_ws, out};
+        const judge_ctx j = {nominal, s, held, fit, base, base_ws, ws, out};
         for (size_t c = 0U; c < diag->count; ++c) {
             const dhc_candidate_result *cand = &diag->c[c];
             dhcal_trial *t = &out->trial[c];
             t->verdict = cand->significant ? DHCAL_VERDICT_NOT_TRIED : DHCAL_VERDICT_SCREEN;
+            double share[DHC_MAX_JOINTS] = {0.0}; /* compliance: each column's load */
             if (cand->effect == DHC_EFFECT_JOINT_COMPLIANCE) {
-                t->excitation = dhcal_compliance_excitation(&fit->model, s, cand->joint);
+                dhcal_compliance_columns(&fit->model, s, cand->joint, share);
+                for (size_t k = 0U; k < DHC_MAX_JOINTS; ++k) {
+                    t->excitation = fmax(t->excitation, share[k]);
+                }
                 if (cand->significant && t->excitation < DHCAL_COMPLIANCE_MIN_EXCITATION) {
                     t->verdict = DHCAL_VERDICT_NOT_EXCITED;
                     continue;
@@ -566,7 +563,7 @@ int dhcal_judge_candidates(const dhc_model *nominal, const dhcal_fit *fit, const
                 continue;
             }
             field[tried] = fields + tried * 3U * s->n;
-            try_one(&j, cand, c, &trial_fit[tried], field[tried]);
+            try_one(&j, cand, c, share, &trial_fit[tried], field[tried]);
             memcpy(s->flags, flags0, s->n);
             tried_idx[tried++] = c;
         }

@@ -151,12 +151,10 @@ int dhcal_judge_candidates(const dhc_model *nominal, const dhcal_fit *fit, const
 double dhcal_plausible_magnitude(dhc_effect e);
 
 /* Gravity's moment about joint j's axis for a unit weight at frame k, RMS over the used
- * rows, as a share of the arm's reach, the largest over k >= j: how much the data load
- * the axis. */
-double dhcal_compliance_excitation(const dhc_model *m, const dhcal_samples *s, size_t j);
-/* ... per column: share[k] for a unit weight at frame k (k >= j; 0 elsewhere). A column
- * below DHCAL_COMPLIANCE_MIN_EXCITATION is not fitted (its weight sits on or near the axis
- * in every pose: a coefficient fitted to it is no stiffness). */
+ * rows, as a share of the arm's reach: share[k] (k >= j; 0 elsewhere), how much the data
+ * load the axis through each column. The candidate is offered when its best column reaches
+ * DHCAL_COMPLIANCE_MIN_EXCITATION, and a column below it is not fitted (its weight sits on
+ * or near the axis in every pose: a coefficient fitted to it is no stiffness). */
 void dhcal_compliance_columns(const dhc_model *m, const dhcal_samples *s, size_t j,
                               double share[DHC_MAX_JOINTS]);
 

@@ -79,6 +79,12 @@ dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double
  * left empty, n = 0, and every later call on it returns DHC_ERR_ARGUMENT). */
 dhc_status dhc_lsq_analyse(const dhc_normal_eq *ne, double rel_tol, dhc_lsq_factor *fac);
 
+/* The decrease of the accumulated sum of squares the linear model promises for the step
+ * delta (ne->n entries; zero entries skipped): 2 delta^T g - delta^T N delta, g and N the
+ * accumulation's J^T r and J^T J. What a trust region compares the actual decrease with.
+ * O(n^2) over the nonzero entries. */
+double dhc_lsq_predicted_decrease(const dhc_normal_eq *ne, const double *delta);
+
 /* Levenberg-Marquardt step on the identifiable parameters:
  *   (S N11 S + lambda I) (S^-1 delta1) = S g1,   delta of unidentifiable parameters = 0,
  * where S is the column scaling. lambda >= 0 (0 = Gauss-Newton). delta has len >= n entries;
