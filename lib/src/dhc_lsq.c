@@ -94,11 +94,11 @@ DHC_AVX2 static double square_sum_avx2(const dhc_mat *jac, const double *r, size
     return ((four[0] + four[1]) + (four[2] + four[3])) + rest;
 }
 
-/* J^T J and J^T r of the k equations added; the whole matrix in blocks of 4 x 8 entries
- * held in registers over all k equations: each entry is loaded and stored once per batch
- * and each equation's entries feed 32 products. Entries (i, j) and (j, i) are the same
- * products summed in the same (the equations') order: the matrix stays exactly symmetric
- * without a transposed copy. */
+/* J^T J and J^T r of the k equations added; the lower triangle (j <= i) in blocks of 4 x 8
+ * entries held in registers over all k equations: each entry is loaded and stored once per
+ * batch and each equation's entries feed 32 products. The upper triangle is the caller's
+ * transposed copy: the blocks across the diagonal hold a few upper entries too, the same
+ * products in the same order, so the copy leaves them as they are. */
 DHC_AVX2 static void add_unweighted_avx2(dhc_normal_eq *ne, const dhc_mat *jac,
                                          const double *r, size_t k)
 {
@@ -114,7 +114,7 @@ DHC_AVX2 static void add_unweighted_avx2(dhc_normal_eq *ne, const dhc_mat *jac,
     const size_t whole_j = n - n % 8U;
     for (size_t i0 = 0U; i0 < whole_i; i0 += 4U) {
         double *const out = jtj + i0 * n;
-        for (size_t j0 = 0U; j0 < whole_j; j0 += 8U) {
+        for (size_t j0 = 0U; j0 < whole_j && j0 <= i0 + 3U; j0 += 8U) {
             __m256d c00 = _mm256_loadu_pd(out + j0);
             __m256d c01 = _mm256_loadu_pd(out + j0 + 4U);
             __m256d c10 = _mm256_loadu_pd(out + n + j0);
@@ -150,9 +150,9 @@ DHC_AVX2 static void add_unweighted_avx2(dhc_normal_eq *ne, const dhc_mat *jac,
             _mm256_storeu_pd(out + 3U * n + j0 + 4U, c31);
         }
     }
-    /* the entries outside the whole blocks: the last rows, and the last columns */
+    /* the lower entries outside the whole blocks: the last rows, and the last columns */
     for (size_t i = 0U; i < n; ++i) {
-        for (size_t j = i < whole_i ? whole_j : 0U; j < n; ++j) {
+        for (size_t j = i < whole_i ? whole_j : 0U; j <= i; ++j) {
             double sum = jtj[i * n + j];
             for (size_t e = 0U; e < k; ++e) {
                 sum += DHC_MAT_AT(jac, e, i) * DHC_MAT_AT(jac, e, j);
@@ -297,7 +297,7 @@ dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double
         }
     }
 #endif
-    for (size_t i = 0U; i < n && mirror_by_copy && !fast; ++i) {
+    for (size_t i = 0U; i < n && mirror_by_copy; ++i) {
         for (size_t j = 0U; j < i; ++j) {
             ne->jtj[j * n + i] = ne->jtj[i * n + j];
         }
