@@ -21,6 +21,7 @@ typedef struct {
     size_t refit_folds; /* folds whose estimate was refitted: every fold for
                            dhcal_cross_validate_refit; for dhcal_cross_validate those its step
                            could not serve (see there) */
+    size_t iterated_folds; /* folds whose estimate took iterated steps (see there) */
 } dhcal_cv;
 
 /* Cross-validates the parameters of set on the rows of s whose flag is DHC_SAMPLE_USED
@@ -42,14 +43,18 @@ typedef struct {
  * of squares at the estimate does not fall as the linear model promised (a model that curves
  * along a direction the rows barely determine), the step is damped as Levenberg-Marquardt
  * damps a rejected one until it does.
+ * A fold whose step no such damping confirms, or whose confirmed step missed its promise by
+ * more than 1 % of the other rows' sum of squares at the step (a candidate large enough to
+ * bend the model, cross-validated from the fit without it), iterates Gauss-Newton on its
+ * other rows (each step relinearised where the last ended; a step that lowers their sum of
+ * squares is taken while the linear model is poor) until a step promises, or a confirmed one
+ * misses, under a hundredth of one residual variance, at most 6 steps (iterated_folds).
  * A parameter the fold's other rows cannot identify (rank lower than all rows give) gets no
  * step: it keeps its start value, as the refit keeps at its input a parameter its start
  * cannot identify (the pivoted Cholesky's basic solution, not a refit). A fold is refitted
  * as dhcal_cross_validate_refit refits it (counted in refit_folds) only when its other rows
- * leave no redundancy, or when no damping up to 1e-5 (on the scaled matrix) gives a step
- * their sum of squares confirms: the model curves along directions the rows determine well
- * (a fitted compliance large enough that its moments' dependence on the geometry, left out
- * of the Jacobian, matters), and a step damped more would stop short of the fold's minimum.
+ * leave no redundancy, or when neither the damped step nor the iterated steps converge (a
+ * flat valley the steps creep along: two nearly equal compliance columns).
  * Cost: one pass over the rows to accumulate, one residual pass per fold, folds x O(P^3);
  * the refit costs up to DHCAL_CV_MAX_ITERATIONS passes per fold. Measured against the refit
  * in bench/refine-speed and docs/cli.md 1.5.
