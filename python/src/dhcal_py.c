@@ -201,8 +201,6 @@ static int open_session(const dhcal_py_model *m, const dhcal_py_rows *train,
 
 static void close_session(py_session *s)
 {
-    /* the analysis knows the rows it evaluated last by the samples' address */
-    dhcal_fit_errors_forget();
     dhcal_samples_free(&s->samples);
     dhcal_samples_free(&s->held);
     dhcal_dataset_free(&s->data);
@@ -258,7 +256,7 @@ static int run_fit(const dhcal_py_model *m, py_session *s, const char *effects, 
     double *row_err = calloc(s->samples.n > 0U ? s->samples.n : 1U, sizeof *row_err);
     dhcal_error_stats unused;
     if (row_err == NULL ||
-        dhcal_fit_errors(&fit.model, &s->samples, NULL, row_err, &unused) != DHCAL_IO_OK) {
+        dhcal_samples_errors(&fit.model, &s->samples, NULL, row_err, &unused) != DHCAL_IO_OK) {
         free(row_err);
         return dhcal_error_set(e, DHCAL_IO_FAILED, "evaluation failed");
     }

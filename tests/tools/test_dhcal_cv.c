@@ -25,14 +25,12 @@ static dhcal_fit g_fit;
 
 void setUp(void)
 {
-    dhcal_fit_errors_forget(); /* the fit's row cache is keyed by the samples' address */
     memset(&g_s, 0, sizeof g_s);
     memset(&g_fit, 0, sizeof g_fit);
 }
 
 void tearDown(void)
 {
-    dhcal_fit_errors_forget();
 }
 
 /* n measurements of truth at random poses over its joint ranges: the tool point (or the
@@ -123,7 +121,6 @@ static void test_known_effect_with_noise(void)
     TEST_ASSERT_TRUE(cv > g_fit.rep.rms_mm);
     TEST_ASSERT_FLOAT_WITHIN(0.15 * sqrt(3.0) * 0.05, sqrt(3.0) * 0.05, cv);
     /* without the effect the folds see the unmodelled compliance */
-    dhcal_fit_errors_forget();
     const double cv_geometry = fit_and_compare(&nominal, NULL, NULL, DHCAL_CV_FOLDS);
     TEST_ASSERT_TRUE(cv_geometry > 1.5 * cv);
 }

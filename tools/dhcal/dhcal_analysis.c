@@ -11,8 +11,11 @@
 
 
 /* Big library workspaces: static, this is a single-threaded command-line program. */
-static dhc_calib_workspace calib_ws;
-static dhc_diagnose_workspace diag_ws;
+/* One least-squares system and its analysis: a call's scratch (about 66 KiB), on the heap. */
+typedef struct {
+    dhc_normal_eq ne;
+    dhc_lsq_factor fac;
+} lsq_scratch;
 
 int dhcal_parse_effects(const char *list, const dhc_model *model, dhc_param_set *set,
                         dhcal_error *err)
@@ -192,62 +195,6 @@ void dhcal_calib_options_for(const dhc_model *model, const dhc_noise_model *nois
     }
 }
 
-/* The rows of the last model dhcal_fit_errors evaluated: the fit, its row report and its
- * adequacy test read the same errors of the same model (three passes, now one). One block:
- * 3 n residuals, then n errors. */
-static struct {
-    dhc_model model;
-    const dhc_sample *samples;
-    size_t n;
-    double *rows;
-} fit_rows;
-
-/* dhcal_fit_errors with the residuals of the used samples known (NULL: not known). */
-static int fit_errors(const dhc_model *model, const dhcal_samples *s, const double *known,
-                      double *resid, double *err_mm, dhcal_error_stats *stats)
-{
-    /* Bytes, not values: a model that differs only in padding or in the sign of a zero is
-     * evaluated again, which costs a pass and changes nothing. */
-    // NOLINTNEXTLINE(bugprone-suspicious-memory-comparison,cert-exp42-c,cert-flp37-c)
-    const int same_model = memcmp(&fit_rows.model, model, sizeof *model) == 0;
-    double *rows = fit_rows.rows;
-    if (rows == NULL || fit_rows.samples != s->samples || fit_rows.n != s->n || !same_model) {
-        fit_rows.rows = NULL;
-        fit_rows.samples = NULL;
-        free(rows);
-        rows = malloc((4U * s->n + 1U) * sizeof *rows);
-        dhcal_error_stats unused;
-        if (rows == NULL ||
-            dhcal_samples_errors_known(model, s, known, rows, rows + 3U * s->n, &unused) !=
-                DHCAL_IO_OK) {
-            free(rows);
-            return DHCAL_IO_FAILED;
-        }
-        fit_rows.rows = rows;
-        fit_rows.model = *model;
-        fit_rows.samples = s->samples;
-        fit_rows.n = s->n;
-    }
-    if (resid != NULL) {
-        memcpy(resid, rows, 3U * s->n * sizeof *resid);
-    }
-    memcpy(err_mm, rows + 3U * s->n, s->n * sizeof *err_mm);
-    dhcal_error_stats_of(s, err_mm, stats); /* the flags may have changed */
-    return DHCAL_IO_OK;
-}
-
-void dhcal_fit_errors_forget(void)
-{
-    free(fit_rows.rows);
-    memset(&fit_rows, 0, sizeof fit_rows);
-}
-
-int dhcal_fit_errors(const dhc_model *model, const dhcal_samples *s, double *resid,
-                     double *err_mm, dhcal_error_stats *stats)
-{
-    return fit_errors(model, s, NULL, resid, err_mm, stats);
-}
-
 /* dhcal_fit_from (rejudge 1) and dhcal_fit_kept (rejudge 0: the rows stay as they are). */
 static int fit_rows_from(const dhc_model *start, const dhc_param_set *set,
                          const dhc_noise_model *noise, dhcal_samples *s,
@@ -284,8 +231,11 @@ static int fit_rows_from(const dhc_model *start, const dhc_param_set *set,
     opt.sample_error2 = malloc((s->n + 1U) * sizeof *opt.sample_error2);
     /* optional: the fit's residuals spare the row report a pass */
     opt.sample_residual = malloc((3U * s->n + 1U) * sizeof *opt.sample_residual);
-    out->status = dhc_calib_fit(&out->model, &out->set, dhcal_samples_read, s, s->n, s->flags,
-                                &opt, &calib_ws, &out->rep);
+    dhc_calib_workspace *ws = malloc(sizeof *ws);
+    out->status = ws != NULL ? dhc_calib_fit(&out->model, &out->set, dhcal_samples_read, s, s->n,
+                                             s->flags, &opt, ws, &out->rep)
+                             : DHC_ERR_ARGUMENT;
+    free(ws);
     free(opt.sample_error2);
     if (out->status == DHC_ERR_UNDERDETERMINED) {
         free(opt.sample_residual);
@@ -303,7 +253,7 @@ static int fit_rows_from(const dhc_model *start, const dhc_param_set *set,
     }
     double *e = calloc(s->n > 0U ? s->n : 1U, sizeof *e);
     const double *known = out->rep.residuals_kept ? opt.sample_residual : NULL;
-    int rc = e != NULL ? fit_errors(&out->model, s, known, NULL, e, &out->train)
+    int rc = e != NULL ? dhcal_samples_errors_known(&out->model, s, known, NULL, e, &out->train)
                        : DHCAL_IO_FAILED;
     free(e);
     free(opt.sample_residual);
@@ -354,7 +304,7 @@ int dhcal_run_fit(const dhc_model *nominal, const char *effects, dhcal_geometry 
                   const dhc_noise_model *noise, dhcal_samples *s, const dhcal_samples *held,
                   dhcal_fit *out, dhcal_error *err)
 {
-    static dhc_param_set set;
+    dhc_param_set set;
     if (dhcal_geometry_set(nominal, geometry, &set) != DHCAL_IO_OK) {
         snprintf(err->msg, sizeof err->msg, "too many joints for the parameter limit");
         return DHCAL_IO_BAD_INPUT;
@@ -370,8 +320,6 @@ int dhcal_run_fit(const dhc_model *nominal, const char *effects, dhcal_geometry 
 int dhcal_session_covariates(const dhcal_fit *fit, const dhcal_samples *s,
                              dhcal_covariates *cov, dhcal_error *err)
 {
-    static dhc_normal_eq ne;
-    static dhc_lsq_factor fac;
     memset(cov, 0, sizeof *cov);
     double tmin = 0.0;
     double tmax = 0.0;
@@ -390,12 +338,16 @@ int dhcal_session_covariates(const dhcal_fit *fit, const dhcal_samples *s,
     /* NOLINTNEXTLINE(performance-no-int-to-ptr): a round trip of a valid pointer. */
     void *const ctx = (void *)(uintptr_t)s;
     const size_t nj = fit->model.arm.n_joints;
-    dhc_status st = dhc_covariate_pose_r2(nj, DHC_COVARIATE_TIME, dhcal_samples_read, ctx, s->n,
-                                          s->flags, &ne, &fac, &cov->time_r2);
+    lsq_scratch *w = malloc(sizeof *w);
+    dhc_status st = w != NULL ? dhc_covariate_pose_r2(nj, DHC_COVARIATE_TIME, dhcal_samples_read,
+                                                      ctx, s->n, s->flags, &w->ne, &w->fac,
+                                                      &cov->time_r2)
+                              : DHC_ERR_ARGUMENT;
     if (st == DHC_OK && cov->temperature_varies) {
         st = dhc_covariate_pose_r2(nj, DHC_COVARIATE_TEMPERATURE, dhcal_samples_read, ctx, s->n,
-                                   s->flags, &ne, &fac, &cov->temperature_r2);
+                                   s->flags, &w->ne, &w->fac, &cov->temperature_r2);
     }
+    free(w);
     if (st != DHC_OK) {
         snprintf(err->msg, sizeof err->msg, "diagnosis failed: %s", dhc_status_str(st));
         return DHCAL_IO_FAILED;
@@ -433,9 +385,15 @@ int dhcal_run_diagnose(const dhcal_fit *fit, const dhcal_samples *s, dhc_diagnos
     /* The reader context is void * for generality; dhcal_samples_read only reads through it.
      * NOLINTNEXTLINE(performance-no-int-to-ptr): a round trip of a valid pointer. */
     void *const ctx = (void *)(uintptr_t)s;
+    dhc_diagnose_workspace *ws = malloc(sizeof *ws);
+    if (ws == NULL) {
+        snprintf(err->msg, sizeof err->msg, "out of memory");
+        return DHCAL_IO_FAILED;
+    }
     const dhc_status st =
         dhc_diagnose(&fit->model, &fit->set, fit->rep.identifiable, sigma2, cands, nc,
-                     dhcal_samples_read, ctx, s->n, s->flags, &opt, &diag_ws, out);
+                     dhcal_samples_read, ctx, s->n, s->flags, &opt, ws, out);
+    free(ws);
     if (st == DHC_ERR_CAPACITY) {
         snprintf(err->msg, sizeof err->msg,
                  "the model's %zu parameters leave no room for another effect (%u at most)",
@@ -452,11 +410,10 @@ int dhcal_run_diagnose(const dhcal_fit *fit, const dhcal_samples *s, dhc_diagnos
 /* The joint error dq that best explains one sample's residual r (3 rows: tool point or
  * wires): least squares on the joint columns, least-norm where they lack rank. */
 static dhc_status joint_error_of_sample(const dhc_model *model, const dhc_param_set *offsets,
-                                        const dhc_sample *smp, double *dq,
+                                        const dhc_sample *smp, lsq_scratch *w, double *dq,
                                         dhc_prediction *pred)
 {
-    static dhc_normal_eq ne;
-    static dhc_lsq_factor fac;
+    dhc_normal_eq *const ne = &w->ne;
     const size_t nj = model->arm.n_joints;
     double r[DHC_MAX_ROWS_PER_SAMPLE];
     /* jac below points into this buffer until the end of the function, which cppcheck's
@@ -476,16 +433,16 @@ static dhc_status joint_error_of_sample(const dhc_model *model, const dhc_param_
     }
     if (st == DHC_OK) {
         jac.rows = 3U;
-        st = dhc_normal_eq_init(&ne, nj);
+        st = dhc_normal_eq_init(ne, nj);
     }
     if (st == DHC_OK) {
-        st = dhc_normal_eq_add(&ne, &jac, r, NULL, 3U);
+        st = dhc_normal_eq_add(ne, &jac, r, NULL, 3U);
     }
     if (st == DHC_OK) {
-        st = dhc_lsq_analyse(&ne, 1e-10, &fac);
+        st = dhc_lsq_analyse(ne, 1e-10, &w->fac);
     }
     if (st == DHC_OK) {
-        st = dhc_lsq_step(&ne, &fac, 0.0, dq, nj);
+        st = dhc_lsq_step(ne, &w->fac, 0.0, dq, nj);
     }
     return st;
 }
@@ -501,17 +458,22 @@ int dhcal_apparent_joint_errors(const dhc_model *model, const dhcal_samples *s, 
             return DHCAL_IO_FAILED;
         }
     }
+    lsq_scratch *w = malloc(sizeof *w);
+    if (w == NULL) {
+        return DHCAL_IO_FAILED;
+    }
     for (size_t i = 0U; i < s->n; ++i) {
         const dhc_sample *smp = &s->samples[i];
         double dq[DHC_MAX_JOINTS];
         double tau[DHC_MAX_JOINTS][DHC_MAX_JOINTS];
         dhc_prediction pred;
-        dhc_status st = joint_error_of_sample(model, &offsets, smp, dq, &pred);
+        dhc_status st = joint_error_of_sample(model, &offsets, smp, w, dq, &pred);
         if (st == DHC_OK) {
             st = dhc_model_gravity_moments(model, dhc_model_length_scale(model, smp->temp_c),
                                            smp->q_rad, tau);
         }
         if (st != DHC_OK) {
+            free(w);
             return DHCAL_IO_FAILED;
         }
         for (size_t j = 0U; j < nj; ++j) {
@@ -524,6 +486,7 @@ int dhcal_apparent_joint_errors(const dhc_model *model, const dhcal_samples *s, 
             moment_mm[i * nj + j] = m;
         }
     }
+    free(w);
     return DHCAL_IO_OK;
 }
 
@@ -715,7 +678,7 @@ int dhcal_assess(const dhcal_fit *fit, const dhcal_samples *s, dhcal_adequacy *o
     double *err = calloc(s->n > 0U ? s->n : 1U, sizeof *err);
     dhcal_error_stats es;
     if (resid == NULL || err == NULL ||
-        dhcal_fit_errors(&fit->model, s, resid, err, &es) != DHCAL_IO_OK || es.used == 0U) {
+        dhcal_samples_errors(&fit->model, s, resid, err, &es) != DHCAL_IO_OK || es.used == 0U) {
         free(resid);
         free(err);
         return DHCAL_IO_FAILED;
@@ -773,13 +736,10 @@ int dhcal_assess(const dhcal_fit *fit, const dhcal_samples *s, dhcal_adequacy *o
     return DHCAL_IO_OK;
 }
 
-static dhc_normal_eq extrapolation_ne;
-static dhc_lsq_factor extrapolation_fac;
-
-int dhcal_extrapolate(const dhcal_fit *fit, const dhcal_samples *s, const dhcal_samples *held,
-                      dhcal_extrapolation *out)
+/* dhcal_extrapolate in the caller's normal equations */
+static int extrapolate_in(const dhcal_fit *fit, const dhcal_samples *s, const dhcal_samples *held,
+                          lsq_scratch *w, dhcal_extrapolation *out)
 {
-    memset(out, 0, sizeof *out);
     const size_t n = fit->model.arm.n_joints;
     double lo[DHC_MAX_JOINTS];
     double hi[DHC_MAX_JOINTS];
@@ -807,21 +767,21 @@ int dhcal_extrapolate(const dhcal_fit *fit, const dhcal_samples *s, const dhcal_
         out->outside_range += outside ? 1U : 0U;
     }
     /* the identifiable parameters' normal equations over the training rows, at the fit */
-    static dhc_param_set id_set;
+    dhc_param_set id_set;
     dhc_params_clear(&id_set);
     for (size_t k = 0U; k < fit->set.count; ++k) {
         if (fit->rep.identifiable[k]) {
             id_set.id[id_set.count++] = fit->set.id[k];
         }
     }
-    if (id_set.count == 0U || dhc_normal_eq_init(&extrapolation_ne, id_set.count) != DHC_OK) {
+    if (id_set.count == 0U || dhc_normal_eq_init(&w->ne, id_set.count) != DHC_OK) {
         return DHCAL_IO_FAILED;
     }
     dhc_calib_options opt;
     dhcal_calib_options_for(&fit->model, &fit->noise, &opt);
-    static double buf[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS];
-    static dhc_arm_trig trig;
-    static dhc_model_eval ev;
+    double buf[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS];
+    dhc_arm_trig trig;
+    dhc_model_eval ev;
     dhc_arm_prepare(&fit->model.arm, &trig);
     for (size_t i = 0U; i < s->n; ++i) {
         if (s->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
@@ -842,11 +802,11 @@ int dhcal_extrapolate(const dhcal_fit *fit, const dhcal_samples *s, const dhcal_
                               opt.orientation_weight_mm_per_rad, r, r, &jac) != DHC_OK) {
             return DHCAL_IO_FAILED;
         }
-        if (dhc_normal_eq_add(&extrapolation_ne, &jac, r, NULL, rows) != DHC_OK) {
+        if (dhc_normal_eq_add(&w->ne, &jac, r, NULL, rows) != DHC_OK) {
             return DHCAL_IO_FAILED;
         }
     }
-    if (dhc_lsq_analyse(&extrapolation_ne, opt.rank_rel_tol, &extrapolation_fac) != DHC_OK) {
+    if (dhc_lsq_analyse(&w->ne, opt.rank_rel_tol, &w->fac) != DHC_OK) {
         return DHCAL_IO_FAILED;
     }
     const double sigma2 = fit->rep.sigma * fit->rep.sigma;
@@ -863,7 +823,7 @@ int dhcal_extrapolate(const dhcal_fit *fit, const dhcal_samples *s, const dhcal_
         }
         for (size_t r = 0U; r < 3U; ++r) {
             double v;
-            if (dhc_lsq_prediction_variance(&extrapolation_fac, sigma2, &DHC_MAT_AT(&jac, r, 0U),
+            if (dhc_lsq_prediction_variance(&w->fac, sigma2, &DHC_MAT_AT(&jac, r, 0U),
                                             id_set.count, &v) != DHC_OK) {
                 return DHCAL_IO_FAILED;
             }
@@ -872,4 +832,14 @@ int dhcal_extrapolate(const dhcal_fit *fit, const dhcal_samples *s, const dhcal_
     }
     out->predicted_std_mm = held->n > 0U ? sqrt(sum / (double)held->n) : 0.0;
     return DHCAL_IO_OK;
+}
+
+int dhcal_extrapolate(const dhcal_fit *fit, const dhcal_samples *s, const dhcal_samples *held,
+                      dhcal_extrapolation *out)
+{
+    memset(out, 0, sizeof *out);
+    lsq_scratch *w = malloc(sizeof *w);
+    const int rc = w != NULL ? extrapolate_in(fit, s, held, w, out) : DHCAL_IO_FAILED;
+    free(w);
+    return rc;
 }

@@ -62,16 +62,6 @@ int dhcal_parse_effects(const char *list, const dhc_model *model, dhc_param_set 
 void dhcal_calib_options_for(const dhc_model *model, const dhc_noise_model *noise,
                              dhc_calib_options *opt);
 
-/* dhcal_samples_errors for the session's samples (which do not change once built): the
- * rows of the last model asked for are kept, so that the fit, its row report and its
- * adequacy test evaluate the fitted model once between them. */
-int dhcal_fit_errors(const dhc_model *model, const dhcal_samples *s, double *resid,
-                     double *err_mm, dhcal_error_stats *stats);
-/* Drops the rows dhcal_fit_errors keeps. The rows are known by the samples' address: a
- * program that frees samples and builds others (the Python package, call after call) calls
- * this first, or new samples at the old address could be answered with the old rows. */
-void dhcal_fit_errors_forget(void);
-
 /* Fits the parameters of set, starting from start (a previous solution: the fit can only
  * lower its SSR), to s (flags updated with outliers, judged afresh: an earlier fit's outlier
  * marks are cleared first, rows the caller excluded stay out); evaluates the fitted rows into

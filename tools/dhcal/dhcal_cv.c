@@ -14,8 +14,24 @@ _Static_assert(DHCAL_CV_LOO_BELOW <= DHCAL_CV_MAX_FOLDS + 1U &&
                    DHCAL_CV_FOLDS <= DHCAL_CV_MAX_FOLDS,
                "every fold needs its entry in dhcal_cv");
 
-/* Each fold's refit has its own workspace: the caller's fit may sit in the analysis one. */
-static dhc_calib_workspace fold_ws;
+/* What one cross-validation works in, allocated per call (about 400 KiB): no state outlives
+ * a call, and calls in different threads share nothing. */
+typedef struct {
+    dhc_calib_workspace fold_ws; /* a fold's refit */
+    dhc_calib_report rep;
+    dhc_model refit_model;       /* ... its estimate */
+    dhc_arm_trig trig;           /* of a model evaluated apart from the accumulation */
+    dhc_normal_eq sys;           /* a fold's step: the other folds' equations */
+    dhc_lsq_factor fac;
+    double delta[DHC_MAX_PARAMS];
+    double std[DHC_MAX_PARAMS];
+    dhc_model trial;
+    dhc_model current;           /* a fold's iterated steps */
+    dhc_model next;
+    dhc_normal_eq all;           /* every row's equations */
+    dhc_lsq_factor fac_all;
+    dhc_model step;
+} cv_scratch;
 
 /* The folds of the used rows: row i's rank among them modulo the folds (SIZE_MAX: not
  * used). */
@@ -67,7 +83,8 @@ static void refit_options(const dhc_model *start, const dhc_noise_model *noise,
 /* Refits the rows outside fold f from start into *model; flags (s->n bytes) is scratch. */
 static int refit_fold(const dhc_model *start, const dhc_param_set *set,
                       const dhc_calib_options *opt, const dhcal_samples *s, const cv_folds *cf,
-                      size_t f, uint8_t *flags, dhc_model *model, dhcal_error *err)
+                      size_t f, uint8_t *flags, cv_scratch *w, dhc_model *model,
+                      dhcal_error *err)
 {
     for (size_t i = 0U; i < s->n; ++i) {
         flags[i] = cf->fold_of[i] == f ? (uint8_t)DHC_SAMPLE_EXCLUDED : s->flags[i];
@@ -75,9 +92,8 @@ static int refit_fold(const dhc_model *start, const dhc_param_set *set,
     dhcal_samples fold_samples = *s;
     fold_samples.flags = flags;
     *model = *start;
-    static dhc_calib_report rep;
     const dhc_status st = dhc_calib_fit(model, set, dhcal_samples_read, &fold_samples, s->n,
-                                        flags, opt, &fold_ws, &rep);
+                                        flags, opt, &w->fold_ws, &w->rep);
     if (st != DHC_OK && st != DHC_ERR_NOT_CONVERGED) {
         snprintf(err->msg, sizeof err->msg,
                  "cross-validation: the rows without fold %zu of %zu cannot be fitted (%s)",
@@ -90,10 +106,9 @@ static int refit_fold(const dhc_model *start, const dhc_param_set *set,
 /* The squared position errors of fold f's rows at model, into out->fold_ss[f] and
  * out->fold_rows[f]. */
 static int fold_errors(const dhc_model *model, const dhcal_samples *s, const cv_folds *cf,
-                       size_t f, dhcal_cv *out, dhcal_error *err)
+                       size_t f, dhc_arm_trig *trig, dhcal_cv *out, dhcal_error *err)
 {
-    static dhc_arm_trig trig;
-    dhc_arm_prepare(&model->arm, &trig);
+    dhc_arm_prepare(&model->arm, trig);
     const size_t nj = model->arm.n_joints;
     const double *const sincos = dhcal_samples_sincos(s, nj);
     for (size_t i = 0U; i < s->n; ++i) {
@@ -102,7 +117,7 @@ static int fold_errors(const dhc_model *model, const dhcal_samples *s, const cv_
         }
         double r[DHC_MAX_ROWS_PER_SAMPLE];
         size_t rows;
-        if (dhc_model_residual_prepared(model, &trig, &s->samples[i],
+        if (dhc_model_residual_prepared(model, trig, &s->samples[i],
                                         sincos != NULL ? sincos + 2U * nj * i : NULL,
                                         DHC_ORIENTATION_WEIGHT_MM_PER_RAD, r, &rows) != DHC_OK) {
             snprintf(err->msg, sizeof err->msg, "cross-validation: row %zu cannot be predicted",
@@ -141,20 +156,21 @@ int dhcal_cross_validate_refit(const dhc_model *start, const dhc_param_set *set,
     refit_options(start, noise, s, &opt);
     opt.sample_error2 = malloc((s->n + 1U) * sizeof *opt.sample_error2); /* optional */
     uint8_t *flags = malloc(s->n + 1U);
-    int rc = flags != NULL ? DHCAL_IO_OK : DHCAL_IO_FAILED;
-    if (flags == NULL) {
+    cv_scratch *w = malloc(sizeof *w);
+    int rc = flags != NULL && w != NULL ? DHCAL_IO_OK : DHCAL_IO_FAILED;
+    if (rc != DHCAL_IO_OK) {
         snprintf(err->msg, sizeof err->msg, "out of memory");
     }
-    static dhc_model model;
     for (size_t f = 0U; f < cf.folds && rc == DHCAL_IO_OK; ++f) {
-        rc = refit_fold(start, set, &opt, s, &cf, f, flags, &model, err);
+        rc = refit_fold(start, set, &opt, s, &cf, f, flags, w, &w->refit_model, err);
         if (rc == DHCAL_IO_OK) {
-            rc = fold_errors(&model, s, &cf, f, out, err);
+            rc = fold_errors(&w->refit_model, s, &cf, f, &w->trig, out, err);
         }
     }
     free(cf.fold_of);
     free(opt.sample_error2);
     free(flags);
+    free(w);
     if (rc == DHCAL_IO_OK) {
         finish(out, cf.folds);
         out->refit_folds = cf.folds;
@@ -195,6 +211,7 @@ typedef struct {
     size_t batch[DHCAL_CV_MAX_FOLDS];
     dhc_arm_trig trig; /* of model */
     dhc_model_eval ev;
+    cv_scratch *w;
 } fold_pass;
 
 static dhc_status flush(fold_pass *fp, size_t f, dhc_normal_eq *ne)
@@ -323,9 +340,9 @@ static double support_bound(const dhc_calib_options *opt, uint8_t kind)
  * first, at most CV_MAX_HOLDS): hidden from ne's analysis, so its step is 0 and it stays at
  * its start value. */
 static dhc_status hold_unsupported(dhc_normal_eq *ne, const dhc_param_set *set,
-                                   const dhc_calib_options *opt, dhc_lsq_factor *fac)
+                                   const dhc_calib_options *opt, dhc_lsq_factor *fac,
+                                   double *std)
 {
-    static double std[DHC_MAX_PARAMS];
     uint8_t keep[DHC_MAX_PARAMS];
     for (size_t k = 0U; k < set->count; ++k) {
         keep[k] = fac->identifiable[k];
@@ -363,12 +380,12 @@ static dhc_status hold_unsupported(dhc_normal_eq *ne, const dhc_param_set *set,
 static dhc_status evaluate_trial(fold_pass *fp, const dhc_model *model, size_t f, double *ssr,
                                  dhcal_cv *out)
 {
-    static dhc_arm_trig trig;
+    dhc_arm_trig *const trig = &fp->w->trig;
     const dhcal_samples *const s = fp->s;
     const size_t nj = model->arm.n_joints;
     const double *const sincos = dhcal_samples_sincos(s, nj);
     const double w = fp->opt->orientation_weight_mm_per_rad;
-    dhc_arm_prepare(&model->arm, &trig);
+    dhc_arm_prepare(&model->arm, trig);
     *ssr = 0.0;
     const int own = f < DHCAL_CV_MAX_FOLDS; /* SIZE_MAX: every row is an "other" row */
     if (own) {
@@ -384,7 +401,7 @@ static dhc_status evaluate_trial(fold_pass *fp, const dhc_model *model, size_t f
         const double *const sc = sincos != NULL ? sincos + 2U * nj * i : NULL;
         double r[DHC_MAX_ROWS_PER_SAMPLE];
         size_t rows;
-        st = dhc_model_residual_prepared(model, &trig, smp, sc, w, r, &rows);
+        st = dhc_model_residual_prepared(model, trig, smp, sc, w, r, &rows);
         if (st == DHC_OK && own && fp->cf->fold_of[i] == f) {
             out->fold_ss[f] += r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
             out->fold_rows[f]++;
@@ -450,40 +467,40 @@ static void fold_step_ratio(fold_pass *fp, const dhc_normal_eq *ne, const uint8_
                             size_t f, dhcal_cv *out, double *lambda0, int *refit,
                             dhc_model *estimate, double min_ratio, step_fit *fit)
 {
-    static dhc_normal_eq sys;
-    static dhc_lsq_factor fac;
-    static double delta[DHC_MAX_PARAMS];
-    static dhc_model model;
+    dhc_normal_eq *const sys = &fp->w->sys;
+    dhc_lsq_factor *const fac = &fp->w->fac;
+    double *const delta = fp->w->delta;
+    dhc_model *const model = &fp->w->trial;
     const size_t p = fp->set->count;
     *refit = 1;
     step_fit none = {HUGE_VAL, HUGE_VAL, HUGE_VAL};
     step_fit *const sf = fit != NULL ? fit : &none;
     *sf = none;
-    sum_folds(ne, fp->cf->folds, f, p, &sys);
-    dhc_status st = analyse_keeping(&sys, ident_all, fp->opt->rank_rel_tol, &fac);
-    if (st != DHC_OK || sys.rows <= fac.rank) {
+    sum_folds(ne, fp->cf->folds, f, p, sys);
+    dhc_status st = analyse_keeping(sys, ident_all, fp->opt->rank_rel_tol, fac);
+    if (st != DHC_OK || sys->rows <= fac->rank) {
         return;
     }
-    st = hold_unsupported(&sys, fp->set, fp->opt, &fac);
+    st = hold_unsupported(sys, fp->set, fp->opt, fac, fp->w->std);
     double lambda = *lambda0;
     for (size_t trial = 0U; st == DHC_OK && lambda <= CV_LAMBDA_LAST && trial < CV_TRIALS;
          ++trial) {
-        model = *fp->model;
-        st = dhc_lsq_step(&sys, &fac, lambda, delta, p);
+        *model = *fp->model;
+        st = dhc_lsq_step(sys, fac, lambda, delta, p);
         if (st == DHC_OK) {
-            st = dhc_params_apply(fp->set, &model, delta, p);
+            st = dhc_params_apply(fp->set, model, delta, p);
         }
         double ssr = HUGE_VAL;
-        const dhc_status ev = st == DHC_OK ? evaluate_trial(fp, &model, f, &ssr, out) : st;
-        const double promised = dhc_lsq_predicted_decrease(&sys, delta);
-        const double dof = (double)sys.rows - (double)fac.rank;
-        const double per_variance = dof > 0.0 && sys.ssr > 0.0 ? dof / sys.ssr : 0.0;
+        const dhc_status ev = st == DHC_OK ? evaluate_trial(fp, model, f, &ssr, out) : st;
+        const double promised = dhc_lsq_predicted_decrease(sys, delta);
+        const double dof = (double)sys->rows - (double)fac->rank;
+        const double per_variance = dof > 0.0 && sys->ssr > 0.0 ? dof / sys->ssr : 0.0;
         if (trial == 0U) {
             sf->left = fmax(promised, 0.0) * per_variance;
         }
         if (ev == DHC_OK && (!(promised > 0.0) ||
-                             (sys.ssr - ssr >= min_ratio * promised && ssr < sys.ssr))) {
-            const double miss = fabs(fmax(promised, 0.0) - (sys.ssr - ssr));
+                             (sys->ssr - ssr >= min_ratio * promised && ssr < sys->ssr))) {
+            const double miss = fabs(fmax(promised, 0.0) - (sys->ssr - ssr));
             sf->missed = miss * per_variance;
             sf->miss_share = ssr > 0.0 ? miss / ssr : (miss > 0.0 ? HUGE_VAL : 0.0);
             /* the folds share the curvature of the fit on all rows: the next fold starts a
@@ -491,7 +508,7 @@ static void fold_step_ratio(fold_pass *fp, const dhc_normal_eq *ne, const uint8_
             *lambda0 = lambda >= 10.0 * CV_LAMBDA_FIRST ? 0.1 * lambda : 0.0;
             *refit = 0;
             if (estimate != NULL) {
-                *estimate = model;
+                *estimate = *model;
             }
             return;
         }
@@ -527,39 +544,39 @@ static int iterate_fold(const fold_pass *fp, const dhc_normal_eq *ne, const uint
                         size_t f, const dhc_model *start, dhcal_cv *out, dhc_normal_eq *ne_k,
                         int *done, dhcal_error *err)
 {
-    static dhc_model current;
-    static dhc_model next;
+    dhc_model *const current = &fp->w->current;
+    dhc_model *const next = &fp->w->next;
     *done = 0;
     double lambda = 0.0;
     step_fit sf;
     int refit = 0;
     fold_pass at = *fp;
     if (start != NULL) {
-        current = *start;
+        *current = *start;
     } else {
-        fold_step_ratio(&at, ne, ident_all, f, out, &lambda, &refit, &current, 0.0, NULL);
+        fold_step_ratio(&at, ne, ident_all, f, out, &lambda, &refit, current, 0.0, NULL);
     }
     for (size_t it = 0U; !refit && it < CV_GN_ITERATIONS; ++it) {
-        at.model = &current;
+        at.model = current;
         if (accumulate_folds(&at, ne_k, err) != DHCAL_IO_OK) {
             return DHCAL_IO_FAILED;
         }
         lambda = 0.0;
-        fold_step_ratio(&at, ne_k, ident_all, f, out, &lambda, &refit, &next,
+        fold_step_ratio(&at, ne_k, ident_all, f, out, &lambda, &refit, next,
                         CV_MIN_GAIN_RATIO, &sf);
         if (sf.left <= CV_GN_LEFT || sf.missed <= CV_GN_LEFT) {
             double ssr = 0.0;
             /* at the confirmed step, or where it started when the step is within what the
              * evaluation resolves: the fold's rows evaluated there */
-            const dhc_status st = refit ? evaluate_trial(&at, &current, f, &ssr, out) : DHC_OK;
+            const dhc_status st = refit ? evaluate_trial(&at, current, f, &ssr, out) : DHC_OK;
             *done = st == DHC_OK;
             return DHCAL_IO_OK;
         }
         if (refit) {
             lambda = 0.0;
-            fold_step_ratio(&at, ne_k, ident_all, f, out, &lambda, &refit, &next, 0.0, NULL);
+            fold_step_ratio(&at, ne_k, ident_all, f, out, &lambda, &refit, next, 0.0, NULL);
         }
-        current = next;
+        *current = *next;
     }
     return DHCAL_IO_OK;
 }
@@ -570,12 +587,12 @@ static int estimate_folds(fold_pass *fp, const dhc_normal_eq *ne, const dhc_nois
                           dhcal_cv *out, dhc_model *estimate, int *have_estimate,
                           dhcal_error *err)
 {
-    static dhc_normal_eq all;
-    static dhc_lsq_factor fac_all;
-    static dhc_model model;
-    static dhc_model step;
-    sum_folds(ne, fp->cf->folds, SIZE_MAX, fp->set->count, &all);
-    if (dhc_lsq_analyse(&all, fp->opt->rank_rel_tol, &fac_all) != DHC_OK) {
+    dhc_normal_eq *const all = &fp->w->all;
+    dhc_lsq_factor *const fac_all = &fp->w->fac_all;
+    dhc_model *const model = &fp->w->refit_model;
+    dhc_model *const step = &fp->w->step;
+    sum_folds(ne, fp->cf->folds, SIZE_MAX, fp->set->count, all);
+    if (dhc_lsq_analyse(all, fp->opt->rank_rel_tol, fac_all) != DHC_OK) {
         snprintf(err->msg, sizeof err->msg, "cross-validation: the rows cannot be analysed");
         return DHCAL_IO_FAILED;
     }
@@ -587,7 +604,7 @@ static int estimate_folds(fold_pass *fp, const dhc_normal_eq *ne, const dhc_nois
     for (size_t f = 0U; f < fp->cf->folds && rc == DHCAL_IO_OK; ++f) {
         int refit = 0;
         step_fit sf;
-        fold_step_ratio(fp, ne, fac_all.identifiable, f, out, &lambda0, &refit, &step,
+        fold_step_ratio(fp, ne, fac_all->identifiable, f, out, &lambda0, &refit, step,
                         CV_MIN_GAIN_RATIO, &sf);
         if (!refit && sf.miss_share <= CV_MAX_MISS_SHARE) {
             continue;
@@ -596,9 +613,13 @@ static int estimate_folds(fold_pass *fp, const dhc_normal_eq *ne, const dhc_nois
             ne_k = calloc(fp->cf->folds, sizeof *ne_k);
         }
         int done = 0;
-        rc = ne_k != NULL ? iterate_fold(fp, ne, fac_all.identifiable, f, refit ? NULL : &step,
-                                         out, ne_k, &done, err)
-                          : DHCAL_IO_FAILED;
+        if (ne_k == NULL) {
+            snprintf(err->msg, sizeof err->msg, "out of memory");
+            rc = DHCAL_IO_FAILED;
+            break;
+        }
+        rc = iterate_fold(fp, ne, fac_all->identifiable, f, refit ? NULL : step, out, ne_k,
+                          &done, err);
         if (rc != DHCAL_IO_OK || done) {
             out->iterated_folds += done ? 1U : 0U;
             continue;
@@ -608,12 +629,12 @@ static int estimate_folds(fold_pass *fp, const dhc_normal_eq *ne, const dhc_nois
             flags = malloc(fp->s->n + 1U);
         }
         rc = flags != NULL ? refit_fold(fp->model, fp->set, &ropt, fp->s, fp->cf, f, flags,
-                                        &model, err)
+                                        fp->w, model, err)
                            : DHCAL_IO_FAILED;
         out->fold_ss[f] = 0.0;
         out->fold_rows[f] = 0U;
         if (rc == DHCAL_IO_OK) {
-            rc = fold_errors(&model, fp->s, fp->cf, f, out, err);
+            rc = fold_errors(model, fp->s, fp->cf, f, &fp->w->trig, out, err);
         }
         out->refit_folds++;
     }
@@ -621,7 +642,7 @@ static int estimate_folds(fold_pass *fp, const dhc_normal_eq *ne, const dhc_nois
         /* every row's step: the same step the folds take, on all of them */
         int no_step = 1;
         double lambda_all = 0.0;
-        fold_step(fp, ne, fac_all.identifiable, SIZE_MAX, out, &lambda_all, &no_step,
+        fold_step(fp, ne, fac_all->identifiable, SIZE_MAX, out, &lambda_all, &no_step,
                   estimate);
         if (have_estimate != NULL) {
             *have_estimate = !no_step;
@@ -678,8 +699,9 @@ static int cv_run(const dhc_model *start, const dhc_param_set *set,
     dhc_normal_eq *ne = calloc(cf.folds, sizeof *ne);
     fp.jac = malloc((cf.folds * CV_BATCH_ROWS * p + 1U) * sizeof *fp.jac);
     fp.r = malloc((cf.folds * CV_BATCH_ROWS + 1U) * sizeof *fp.r);
+    fp.w = malloc(sizeof *fp.w);
     int rc = DHCAL_IO_OK;
-    if (ne == NULL || fp.jac == NULL || fp.r == NULL) {
+    if (ne == NULL || fp.jac == NULL || fp.r == NULL || fp.w == NULL) {
         snprintf(err->msg, sizeof err->msg, "out of memory");
         rc = DHCAL_IO_FAILED;
     } else if (p == 0U || p > DHC_MAX_PARAMS ||
@@ -696,6 +718,7 @@ static int cv_run(const dhc_model *start, const dhc_param_set *set,
     free(ne);
     free(fp.jac);
     free(fp.r);
+    free(fp.w);
     free(cf.fold_of);
     if (rc == DHCAL_IO_OK) {
         finish(out, cf.folds);

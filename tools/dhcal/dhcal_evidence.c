@@ -1,10 +1,15 @@
 /* dhcal_evidence.c - the judgement of a diagnosis' candidates (dhcal_evidence.h). */
+#ifndef _POSIX_C_SOURCE
+#define _POSIX_C_SOURCE 200809L /* sysconf */
+#endif
 #include "dhcal_evidence.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "dhcal/dhc_effects.h"
 
@@ -12,15 +17,11 @@
 
 /* Poses spread over the model's joint ranges (deterministic): where a calibration will be
  * used, not only where it was measured. */
-static dhcal_samples workspace;
-static dhc_sample workspace_samples[DHCAL_WORKSPACE_POSES];
-static uint8_t workspace_flags[DHCAL_WORKSPACE_POSES];
-
-const dhcal_samples *dhcal_workspace_poses(const dhc_model *model)
+const dhcal_samples *dhcal_workspace_poses(const dhc_model *model, dhcal_range_poses *out)
 {
     uint32_t state = 0x9E3779B9U;
     for (size_t k = 0U; k < DHCAL_WORKSPACE_POSES; ++k) {
-        dhc_sample *s = &workspace_samples[k];
+        dhc_sample *s = &out->samples[k];
         memset(s, 0, sizeof *s);
         for (size_t j = 0U; j < model->arm.n_joints; ++j) {
             state ^= state << 13;
@@ -33,26 +34,24 @@ const dhcal_samples *dhcal_workspace_poses(const dhc_model *model)
         s->temp_c = model->thermal_ref_c;
         s->t_s = model->drift_ref_s;
         s->kind = (uint8_t)DHC_MEAS_POSITION;
-        workspace_flags[k] = (uint8_t)DHC_SAMPLE_USED;
+        out->flags[k] = (uint8_t)DHC_SAMPLE_USED;
     }
-    workspace.n = DHCAL_WORKSPACE_POSES;
-    workspace.samples = workspace_samples;
-    workspace.flags = workspace_flags;
-    workspace.path = "workspace";
-    return &workspace;
+    memset(&out->set, 0, sizeof out->set);
+    out->set.n = DHCAL_WORKSPACE_POSES;
+    out->set.samples = out->samples;
+    out->set.flags = out->flags;
+    out->set.path = "workspace";
+    return &out->set;
 }
 
-/* dhcal_workspace_std_mm over poses w built already (the judgement builds them once). */
+/* The positioning uncertainty the fit predicts over the poses w across the joint ranges
+ * (RMS, mm; dhcal_extrapolate): how far the calibration can be trusted where it will be
+ * used. */
 static double workspace_std_on(const dhcal_fit *fit, const dhcal_samples *s,
                                const dhcal_samples *w)
 {
     dhcal_extrapolation x;
     return dhcal_extrapolate(fit, s, w, &x) == DHCAL_IO_OK ? x.predicted_std_mm : HUGE_VAL;
-}
-
-double dhcal_workspace_std_mm(const dhcal_fit *fit, const dhcal_samples *s)
-{
-    return workspace_std_on(fit, s, dhcal_workspace_poses(&fit->model));
 }
 
 /* ---------------------------------------------------------------- words */
@@ -319,8 +318,6 @@ typedef struct {
     dhcal_trials *out;
 } judge_ctx;
 
-static dhcal_fit trial_fit[DHCAL_EVIDENCE_TRIALS];
-
 /* Refits candidate c, measures it, cross-validates it; field (3 per sample) receives the
  * change of the residual adding it makes. The verdict is left to judge_verdict. */
 static void try_one(const judge_ctx *j, const dhc_candidate_result *cand, size_t c,
@@ -330,7 +327,7 @@ static void try_one(const judge_ctx *j, const dhc_candidate_result *cand, size_t
     const dhcal_fit *fit = j->fit;
     t->tried = 1;
     t->verdict = DHCAL_VERDICT_FAILED;
-    static dhc_param_set set;
+    dhc_param_set set;
     dhcal_set_without_held(fit, &set);
     if (dhc_params_add_effect(&set, &fit->model, cand->effect, cand->joint) != DHC_OK) {
         return;
@@ -343,7 +340,7 @@ static void try_one(const judge_ctx *j, const dhc_candidate_result *cand, size_t
     /* cross-validated from the fit itself, as the model without the candidate is: both on
      * the same start, rows and folds; the same step on every row starts the refit near its
      * end (from the fit itself a refit creeps for tens of iterations) */
-    static dhc_model estimate;
+    dhc_model estimate;
     int have_estimate = 0;
     if (dhcal_cross_validate_step(&fit->model, &set, &fit->noise, j->s, &t->cv, &estimate,
                                   &have_estimate, &e2) != DHCAL_IO_OK) {
@@ -517,6 +514,78 @@ static void settle(const dhc_diagnosis *diag, dhcal_trials *out)
     }
 }
 
+/* One candidate's trial: try_one on the judged rows, with flags of its own (a refit may mark
+ * rows; the rows judged are the same for every candidate). */
+typedef struct {
+    const judge_ctx *j;
+    const dhc_candidate_result *cand;
+    size_t c;
+    double share[DHC_MAX_JOINTS];
+    dhcal_fit trial;
+    double *field;
+    dhcal_samples rows;
+} judge_job;
+
+static void run_job(judge_job *job)
+{
+    judge_ctx j = *job->j;
+    j.s = &job->rows;
+    try_one(&j, job->cand, job->c, job->share, &job->trial, job->field);
+}
+
+typedef struct {
+    judge_job *jobs;
+    size_t count;
+    size_t next;
+    pthread_mutex_t lock;
+} job_queue;
+
+static void *work(void *arg)
+{
+    job_queue *q = arg;
+    for (;;) {
+        pthread_mutex_lock(&q->lock);
+        const size_t k = q->next < q->count ? q->next++ : q->count;
+        pthread_mutex_unlock(&q->lock);
+        if (k == q->count) {
+            return NULL;
+        }
+        run_job(&q->jobs[k]);
+    }
+}
+
+/* How many threads judge the candidates: DHCAL_THREADS when set (1: one after another), else
+ * the processors online; at most one per job. */
+static size_t judge_threads(size_t jobs)
+{
+    const char *env = getenv("DHCAL_THREADS");
+    long n = env != NULL ? strtol(env, NULL, 10) : sysconf(_SC_NPROCESSORS_ONLN);
+    if (n < 1) {
+        n = 1;
+    }
+    return (size_t)n < jobs ? (size_t)n : jobs;
+}
+
+/* The trials side by side: each writes only its own job and its candidate's entry, so the
+ * result is the same bits whatever the number of threads. */
+static void run_jobs(judge_job *jobs, size_t count)
+{
+    job_queue q = {jobs, count, 0U, PTHREAD_MUTEX_INITIALIZER};
+    pthread_t helper[DHCAL_EVIDENCE_TRIALS];
+    size_t helpers = 0U;
+    const size_t threads = judge_threads(count);
+    for (size_t t = 1U; t < threads; ++t) {
+        if (pthread_create(&helper[helpers], NULL, work, &q) == 0) {
+            helpers++;
+        }
+    }
+    (void)work(&q); /* this thread too; alone when no helper could start */
+    for (size_t t = 0U; t < helpers; ++t) {
+        pthread_join(helper[t], NULL);
+    }
+    pthread_mutex_destroy(&q.lock);
+}
+
 int dhcal_judge_candidates(const dhc_model *nominal, const dhcal_fit *fit, const dhcal_cv *cv,
                            const dhc_diagnosis *diag,
                            const dhcal_size_reference *reference, dhcal_samples *s,
@@ -528,21 +597,23 @@ int dhcal_judge_candidates(const dhc_model *nominal, const dhcal_fit *fit, const
     out->reference = *reference;
     out->named = DHC_MAX_CANDIDATES;
     out->best_rejected = DHC_MAX_CANDIDATES;
-    const dhcal_samples *const ws = dhcal_workspace_poses(&fit->model); /* the ranges' */
-    out->workspace_std_mm = workspace_std_on(fit, s, ws);
+    dhcal_range_poses *poses = malloc(sizeof *poses);
+    judge_job *jobs = calloc(DHCAL_EVIDENCE_TRIALS, sizeof *jobs);
+    uint8_t *flags = malloc((size_t)DHCAL_EVIDENCE_TRIALS * s->n + 1U);
+    double *fields = calloc((size_t)DHCAL_EVIDENCE_TRIALS * 3U * s->n + 1U, sizeof *fields);
+    const dhcal_samples *const ws =
+        poses != NULL ? dhcal_workspace_poses(&fit->model, poses) : NULL; /* the ranges' */
+    out->workspace_std_mm = ws != NULL ? workspace_std_on(fit, s, ws) : HUGE_VAL;
     const dhc_model steady = dhcal_model_without_drift(&fit->model);
     double *base = residuals_at(&fit->model, s);
-    double *base_ws = residuals_at(&steady, ws);
-    double *fields = calloc((size_t)DHCAL_EVIDENCE_TRIALS * 3U * s->n + 1U, sizeof *fields);
-    uint8_t *flags0 = malloc(s->n + 1U);
-    int rc = base != NULL && base_ws != NULL && fields != NULL && flags0 != NULL
+    double *base_ws = ws != NULL ? residuals_at(&steady, ws) : NULL;
+    int rc = base != NULL && base_ws != NULL && fields != NULL && jobs != NULL && flags != NULL
                  ? DHCAL_IO_OK
                  : DHCAL_IO_FAILED;
     if (rc == DHCAL_IO_OK) {
         size_t tried_idx[DHCAL_EVIDENCE_TRIALS];
         double *field[DHCAL_EVIDENCE_TRIALS];
         size_t tried = 0U;
-        memcpy(flags0, s->flags, s->n);
         const judge_ctx j = {nominal, s, held, fit, base, base_ws, ws, out};
         for (size_t c = 0U; c < diag->count; ++c) {
             const dhc_candidate_result *cand = &diag->c[c];
@@ -563,16 +634,24 @@ int dhcal_judge_candidates(const dhc_model *nominal, const dhcal_fit *fit, const
                 continue;
             }
             field[tried] = fields + tried * 3U * s->n;
-            try_one(&j, cand, c, share, &trial_fit[tried], field[tried]);
-            memcpy(s->flags, flags0, s->n);
+            judge_job *job = &jobs[tried];
+            job->j = &j;
+            job->cand = cand;
+            job->c = c;
+            memcpy(job->share, share, sizeof share);
+            job->field = field[tried];
+            job->rows = *s;
+            job->rows.flags = flags + tried * s->n;
+            memcpy(job->rows.flags, s->flags, s->n);
             tried_idx[tried++] = c;
         }
+        run_jobs(jobs, tried);
         order_candidates(diag, out);
         find_look_alikes(s, tried_idx, tried, field, out);
         settle(diag, out);
         for (size_t k = 0U; best_fit != NULL && k < tried; ++k) {
             if (tried_idx[k] == out->named) {
-                *best_fit = trial_fit[k];
+                *best_fit = jobs[k].trial;
             }
         }
     } else {
@@ -581,7 +660,9 @@ int dhcal_judge_candidates(const dhc_model *nominal, const dhcal_fit *fit, const
     free(base);
     free(base_ws);
     free(fields);
-    free(flags0);
+    free(flags);
+    free(jobs);
+    free(poses);
     return rc;
 }
 

@@ -158,13 +158,16 @@ double dhcal_plausible_magnitude(dhc_effect e);
 void dhcal_compliance_columns(const dhc_model *m, const dhcal_samples *s, size_t j,
                               double share[DHC_MAX_JOINTS]);
 
-/* The poses across the model's joint ranges (DHCAL_WORKSPACE_POSES, deterministic; the
- * storage is static: valid until the next call). */
-const dhcal_samples *dhcal_workspace_poses(const dhc_model *model);
+/* Poses across a model's joint ranges, in the caller's storage (about 52 KiB). */
+typedef struct {
+    dhcal_samples set;
+    dhc_sample samples[DHCAL_WORKSPACE_POSES];
+    uint8_t flags[DHCAL_WORKSPACE_POSES];
+} dhcal_range_poses;
 
-/* The positioning uncertainty the fit predicts over those poses (RMS, mm;
- * dhcal_extrapolate): how far the calibration can be trusted where it will be used. */
-double dhcal_workspace_std_mm(const dhcal_fit *fit, const dhcal_samples *s);
+/* The poses across the model's joint ranges (DHCAL_WORKSPACE_POSES, deterministic), built in
+ * *out: &out->set. */
+const dhcal_samples *dhcal_workspace_poses(const dhc_model *model, dhcal_range_poses *out);
 
 /* The evidence rule alone (JSON `significant`): refitted, cross-validated, its gain at
  * least DHCAL_EVIDENCE_MIN_GAIN and positive over the folds at DHCAL_EVIDENCE_ALPHA. */

@@ -47,8 +47,9 @@ static int hold_implausible(const dhc_model *nominal, const dhc_noise_model *noi
                             dhcal_samples *s, const dhcal_samples *held,
                             dhcal_refine_result *out, dhcal_error *err)
 {
-    static dhc_param_set set;
-    static dhcal_fit refit;
+    dhc_param_set set;
+    dhcal_fit refit;
+    memset(&refit, 0, sizeof refit);
     for (size_t round = 0U; round < DHCAL_REFINE_MAX_HOLDS; ++round) {
         double moved = 0.0;
         const size_t k = dhcal_implausible_param(nominal, &out->fit, &moved);
@@ -102,7 +103,7 @@ static int fit_start(const dhc_model *nominal, const char *effects,
                      dhcal_samples *s, const dhcal_samples *held, dhcal_refine_result *out,
                      dhcal_error *err)
 {
-    static dhc_param_set set;
+    dhc_param_set set;
     int rc = dhcal_geometry_set(nominal, DHCAL_GEOMETRY_FULL, &set);
     if (rc == DHCAL_IO_OK) {
         rc = dhcal_parse_effects(effects, nominal, &set, err);
@@ -120,7 +121,8 @@ static int fit_start(const dhc_model *nominal, const char *effects,
     uint8_t *const flags_full = flags + s->n + 1U;
     uint8_t *const flags_best = flags + 2U * (s->n + 1U);
     memcpy(flags0, s->flags, s->n);
-    static dhcal_fit full;
+    dhcal_fit full;
+    memset(&full, 0, sizeof full);
     dhcal_error e_full;
     memset(&e_full, 0, sizeof e_full);
     full.geometry = DHCAL_GEOMETRY_FULL;
@@ -146,14 +148,15 @@ static int fit_start(const dhc_model *nominal, const char *effects,
             rc = hold_implausible(nominal, noise, s, held, out, err);
         }
         if (rc == DHCAL_IO_OK) {
-            static dhc_param_set cv_set;
+            dhc_param_set cv_set;
             dhcal_set_without_held(&out->fit, &cv_set);
             rc = dhcal_cross_validate(&out->fit.model, &cv_set, noise, s, &out->cv, err);
         }
         return rc;
     }
     /* few rows: the best plausible cross-validation wins */
-    static dhcal_fit trial;
+    dhcal_fit trial;
+    memset(&trial, 0, sizeof trial);
     int best = -1;
     dhcal_cv best_cv;
     memset(&best_cv, 0, sizeof best_cv);
@@ -181,7 +184,7 @@ static int fit_start(const dhc_model *nominal, const char *effects,
             continue;
         }
         dhcal_cv cv;
-        static dhc_param_set cv_set;
+        dhc_param_set cv_set;
         dhcal_set_without_held(&trial, &cv_set);
         if (dhcal_cross_validate(&trial.model, &cv_set, noise, s, &cv, &e2) != DHCAL_IO_OK) {
             snprintf(reasons[g], sizeof reasons[g], "cannot be cross-validated");
@@ -254,7 +257,8 @@ int dhcal_run_refine(const dhc_model *nominal, const char *start_effects,
         return rc;
     }
     record_step(out, "", out->effects, &out->fit, &out->cv);
-    static dhcal_fit best;
+    dhcal_fit best;
+    memset(&best, 0, sizeof best);
     max_steps = max_steps < DHCAL_REFINE_MAX_STEPS ? max_steps : DHCAL_REFINE_MAX_STEPS;
     snprintf(out->stopped_why, sizeof out->stopped_why, "the step limit (%zu) was reached",
              max_steps);

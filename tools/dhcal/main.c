@@ -592,7 +592,7 @@ static int do_fit(const options *o, session *s, dhcal_fit *fit, double **row_err
     *row_err = calloc(s->samples.n > 0U ? s->samples.n : 1U, sizeof **row_err);
     dhcal_error_stats unused;
     if (*row_err == NULL ||
-        dhcal_fit_errors(&fit->model, &s->samples, NULL, *row_err, &unused) != DHCAL_IO_OK) {
+        dhcal_samples_errors(&fit->model, &s->samples, NULL, *row_err, &unused) != DHCAL_IO_OK) {
         fprintf(stderr, "dhcal: evaluation failed\n");
         return EXIT_COMPUTE;
     }
