@@ -23,7 +23,7 @@ static dhc_sample samples[MAX_POSES];
 static dhc_calib_workspace ws;
 static dhc_calib_report rep;
 
-static dhc_status read_sample(void *ctx, size_t index, dhc_sample *out)
+static dhc_status read_sample(const void *ctx, size_t index, dhc_sample *out)
 {
     (void)ctx;
     *out = samples[index];

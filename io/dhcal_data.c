@@ -102,7 +102,7 @@ const double *dhcal_samples_sincos(const dhcal_samples *s, size_t n_joints)
     return s->joint_sincos != NULL && s->sincos_joints == n_joints ? s->joint_sincos : NULL;
 }
 
-dhc_status dhcal_samples_read(void *ctx, size_t index, dhc_sample *out)
+dhc_status dhcal_samples_read(const void *ctx, size_t index, dhc_sample *out)
 {
     const dhcal_samples *s = ctx;
     if (index >= s->n) {

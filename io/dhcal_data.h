@@ -41,7 +41,7 @@ int dhcal_samples_check_held(const dhcal_samples *train, const dhcal_samples *he
                              const char *held_path, dhcal_error *err);
 
 /* dhc_sample_reader over dhcal_samples. */
-dhc_status dhcal_samples_read(void *ctx, size_t index, dhc_sample *out);
+dhc_status dhcal_samples_read(const void *ctx, size_t index, dhc_sample *out);
 
 /* RMS, mean and largest error norm over the samples counted (flag DHC_SAMPLE_USED). */
 typedef struct {

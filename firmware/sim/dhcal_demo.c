@@ -112,7 +112,7 @@ static int run_targets(const dhc_model *model, size_t n, uint32_t seed, phase_re
 
 /* ---------------------------------------------------------------- noise floor */
 
-static dhc_status read_job_sample(void *ctx, size_t index, dhc_sample *out)
+static dhc_status read_job_sample(const void *ctx, size_t index, dhc_sample *out)
 {
     const fw_job *j = ctx;
     if (index >= j->n_samples) {

@@ -13,7 +13,7 @@ typedef struct {
     size_t n;
 } sample_buf;
 
-static dhc_status read_sample(void *ctx, size_t index, dhc_sample *out)
+static dhc_status read_sample(const void *ctx, size_t index, dhc_sample *out)
 {
     const sample_buf *b = ctx;
     if (index >= b->n) {

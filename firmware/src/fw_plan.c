@@ -80,7 +80,7 @@ typedef struct {
     const fw_pose *poses;
 } pose_list;
 
-static dhc_status read_pose(void *ctx, size_t index, dhc_sample *out)
+static dhc_status read_pose(const void *ctx, size_t index, dhc_sample *out)
 {
     const pose_list *l = ctx;
     pose_sample(l->model, &l->poses[index], out);

@@ -164,7 +164,7 @@ static double covariate_of(const dhc_sample *smp, dhc_covariate which)
 }
 
 dhc_status dhc_covariate_pose_r2(size_t n_joints, dhc_covariate which, dhc_sample_reader read,
-                                 void *ctx, size_t n, const uint8_t *flags, dhc_normal_eq *ne,
+                                 const void *ctx, size_t n, const uint8_t *flags, dhc_normal_eq *ne,
                                  dhc_lsq_factor *fac, double *r2)
 {
     if (read == NULL || flags == NULL || ne == NULL || fac == NULL || r2 == NULL ||
@@ -238,7 +238,7 @@ dhc_status dhc_covariate_pose_r2(size_t n_joints, dhc_covariate which, dhc_sampl
 }
 #else
 dhc_status dhc_covariate_pose_r2(size_t n_joints, dhc_covariate which, dhc_sample_reader read,
-                                 void *ctx, size_t n, const uint8_t *flags, dhc_normal_eq *ne,
+                                 const void *ctx, size_t n, const uint8_t *flags, dhc_normal_eq *ne,
                                  dhc_lsq_factor *fac, double *r2)
 {
     (void)n_joints; (void)which; (void)read; (void)ctx; (void)n; (void)flags; (void)ne;
@@ -436,7 +436,7 @@ static dhc_status score_columns(const batch_state *b, const size_t *cols, size_t
 }
 
 /* One pass over the used samples into ws->ne for the columns of ws->set. */
-static dhc_status accumulate(const dhc_model *model, dhc_sample_reader read, void *ctx,
+static dhc_status accumulate(const dhc_model *model, dhc_sample_reader read, const void *ctx,
                              size_t n, const uint8_t *flags, const dhc_diagnose_options *opt,
                              dhc_diagnose_workspace *ws, double *ssr, size_t *rows)
 {
@@ -541,7 +541,7 @@ static dhc_status add_candidate(dhc_diagnose_workspace *ws, const dhc_model *mod
  * nothing to it when both are in. One more data pass with the best and its rivals. */
 static dhc_status find_lookalikes(const dhc_model *model, const dhc_param_set *base,
                                   const uint8_t *identifiable, dhc_sample_reader read,
-                                  void *ctx, size_t n, const uint8_t *flags,
+                                  const void *ctx, size_t n, const uint8_t *flags,
                                   const dhc_diagnose_options *opt, dhc_diagnose_workspace *ws,
                                   dhc_diagnosis *out)
 {
@@ -611,7 +611,7 @@ static dhc_status find_lookalikes(const dhc_model *model, const dhc_param_set *b
 dhc_status dhc_diagnose(const dhc_model *model, const dhc_param_set *base,
                         const uint8_t *identifiable, double sigma2,
                         const dhc_candidate *candidates, size_t n_candidates,
-                        dhc_sample_reader read, void *ctx, size_t n, const uint8_t *flags,
+                        dhc_sample_reader read, const void *ctx, size_t n, const uint8_t *flags,
                         const dhc_diagnose_options *opt, dhc_diagnose_workspace *ws,
                         dhc_diagnosis *out)
 {
@@ -692,7 +692,7 @@ dhc_status dhc_diagnose(const dhc_model *model, const dhc_param_set *base,
 dhc_status dhc_diagnose(const dhc_model *model, const dhc_param_set *base,
                         const uint8_t *identifiable, double sigma2,
                         const dhc_candidate *candidates, size_t n_candidates,
-                        dhc_sample_reader read, void *ctx, size_t n, const uint8_t *flags,
+                        dhc_sample_reader read, const void *ctx, size_t n, const uint8_t *flags,
                         const dhc_diagnose_options *opt, dhc_diagnose_workspace *ws,
                         dhc_diagnosis *out)
 {

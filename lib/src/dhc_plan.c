@@ -22,7 +22,7 @@ static double sq(double x)
 
 /* The candidate's Jacobian rows (R x set->count) into ws->jac, or from the store. */
 static dhc_status candidate_jacobian(const dhc_model *model, const dhc_param_set *set,
-                                     dhc_sample_reader read, void *ctx, size_t c,
+                                     dhc_sample_reader read, const void *ctx, size_t c,
                                      const double *store, dhc_plan_workspace *ws)
 {
     const size_t p = set->count;
@@ -595,7 +595,7 @@ dhc_status dhc_plan_select(const dhc_model *model, const dhc_param_set *set,
 #endif /* DHC_WITH_PLAN */
 
 dhc_status dhc_plan_observability(const dhc_model *model, const dhc_param_set *set,
-                                  dhc_sample_reader read, void *ctx, const size_t *index,
+                                  dhc_sample_reader read, const void *ctx, const size_t *index,
                                   size_t n, dhc_plan_workspace *ws, double *o1, size_t *rank)
 {
     if (model == NULL || set == NULL || read == NULL || ws == NULL || o1 == NULL || n == 0U) {

@@ -13,7 +13,7 @@ static const dhc_noise_model no_noise = {{0.0}, 0.0};
 
 dhc_status dhc_uncertainty_from_samples(dhc_uncertainty *u, const dhc_model *model,
                                         const dhc_param_set *set, const uint8_t *use,
-                                        dhc_sample_reader read, void *ctx, size_t n,
+                                        dhc_sample_reader read, const void *ctx, size_t n,
                                         const dhc_noise_model *noise, double weight_mm_per_rad,
                                         double sigma)
 {
@@ -143,7 +143,7 @@ dhc_status dhc_uncertainty_tool_point(dhc_uncertainty *u, const dhc_model *model
 /* Left out of this build (DHC_WITH_UNCERTAINTY 0): every call is refused. */
 dhc_status dhc_uncertainty_from_samples(dhc_uncertainty *u, const dhc_model *model,
                                         const dhc_param_set *set, const uint8_t *use,
-                                        dhc_sample_reader read, void *ctx, size_t n,
+                                        dhc_sample_reader read, const void *ctx, size_t n,
                                         const dhc_noise_model *noise, double weight_mm_per_rad,
                                         double sigma)
 {

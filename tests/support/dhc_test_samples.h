@@ -18,7 +18,7 @@ typedef struct {
     uint8_t flags[TEST_MAX_SAMPLES];
 } test_dataset;
 
-static inline dhc_status test_read_sample(void *ctx, size_t index, dhc_sample *out)
+static inline dhc_status test_read_sample(const void *ctx, size_t index, dhc_sample *out)
 {
     const test_dataset *d = (const test_dataset *)ctx;
     if (index >= d->n) {

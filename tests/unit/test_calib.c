@@ -340,7 +340,7 @@ static void test_iteration_limit_reports_not_converged_with_the_best_iterate(voi
     TEST_ASSERT_TRUE(err_after < err_before);
 }
 
-static dhc_status failing_reader(void *ctx, size_t index, dhc_sample *out)
+static dhc_status failing_reader(const void *ctx, size_t index, dhc_sample *out)
 {
     (void)ctx;
     (void)out;

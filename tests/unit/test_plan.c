@@ -20,7 +20,7 @@ static dhc_plan_workspace ws;
 #define STORE_PARAMS 16U /* the sets here have fewer: a store the M4's RAM holds */
 static double store[POOL * 3U * STORE_PARAMS];
 
-static dhc_status read_pool(void *ctx, size_t index, dhc_sample *out)
+static dhc_status read_pool(const void *ctx, size_t index, dhc_sample *out)
 {
     (void)ctx;
     if (index >= POOL) {

@@ -19,7 +19,7 @@ static test_rng rng = {0x5DEECE66DULL};
 static dhc_sample samples[N_SAMPLES];
 static dhc_uncertainty unc;
 
-static dhc_status read_sample(void *ctx, size_t index, dhc_sample *out)
+static dhc_status read_sample(const void *ctx, size_t index, dhc_sample *out)
 {
     (void)ctx;
     *out = samples[index];

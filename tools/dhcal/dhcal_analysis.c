@@ -335,8 +335,7 @@ int dhcal_session_covariates(const dhcal_fit *fit, const dhcal_samples *s,
     }
     cov->temperature_varies = tmax > tmin;
     cov->time_from_rows = s->source == NULL || !s->source->has_time;
-    /* NOLINTNEXTLINE(performance-no-int-to-ptr): a round trip of a valid pointer. */
-    void *const ctx = (void *)(uintptr_t)s;
+    const void *const ctx = s;
     const size_t nj = fit->model.arm.n_joints;
     lsq_scratch *w = malloc(sizeof *w);
     dhc_status st = w != NULL ? dhc_covariate_pose_r2(nj, DHC_COVARIATE_TIME, dhcal_samples_read,
@@ -382,9 +381,7 @@ int dhcal_run_diagnose(const dhcal_fit *fit, const dhcal_samples *s, dhc_diagnos
                  "diagnose");
         return DHCAL_IO_FAILED;
     }
-    /* The reader context is void * for generality; dhcal_samples_read only reads through it.
-     * NOLINTNEXTLINE(performance-no-int-to-ptr): a round trip of a valid pointer. */
-    void *const ctx = (void *)(uintptr_t)s;
+    const void *const ctx = s;
     dhc_diagnose_workspace *ws = malloc(sizeof *ws);
     if (ws == NULL) {
         snprintf(err->msg, sizeof err->msg, "out of memory");

@@ -100,7 +100,7 @@ typedef struct {
     dhc_meas_kind kind;
 } candidates;
 
-static dhc_status read_candidate(void *ctx, size_t index, dhc_sample *out)
+static dhc_status read_candidate(const void *ctx, size_t index, dhc_sample *out)
 {
     const candidates *c = ctx;
     dhc_model_sample_at(c->model, c->q_rad + index * c->model->arm.n_joints, NULL, c->kind, out);

@@ -132,7 +132,7 @@ typedef enum {
  * n_joints 0 or above DHC_MAX_JOINTS), DHC_ERR_NONFINITE (a non-finite covariate or angle),
  * errors of read. Two passes, O(n n_joints^2). */
 dhc_status dhc_covariate_pose_r2(size_t n_joints, dhc_covariate which, dhc_sample_reader read,
-                                 void *ctx, size_t n, const uint8_t *flags, dhc_normal_eq *ne,
+                                 const void *ctx, size_t n, const uint8_t *flags, dhc_normal_eq *ne,
                                  dhc_lsq_factor *fac, double *r2);
 
 /* Every candidate the model can express that is not already in base: per-joint effects on
@@ -156,7 +156,7 @@ size_t dhc_diagnose_candidates(const dhc_model *model, const dhc_param_set *base
 dhc_status dhc_diagnose(const dhc_model *model, const dhc_param_set *base,
                         const uint8_t *identifiable, double sigma2,
                         const dhc_candidate *candidates, size_t n_candidates,
-                        dhc_sample_reader read, void *ctx, size_t n, const uint8_t *flags,
+                        dhc_sample_reader read, const void *ctx, size_t n, const uint8_t *flags,
                         const dhc_diagnose_options *opt, dhc_diagnose_workspace *ws,
                         dhc_diagnosis *out);
 

@@ -112,7 +112,7 @@ typedef struct {
  * there, and a line is fixed best by its ends). workspace 0 or above count: all of them. */
 typedef struct {
     dhc_sample_reader read;
-    void *ctx;
+    const void *ctx;
     size_t count;
     size_t workspace;
 } dhc_plan_candidates;
@@ -155,7 +155,7 @@ dhc_status dhc_plan_weighting(const dhc_model *model, const dhc_param_set *set,
  * set, and in *rank (may be NULL) the parameters it identifies. Errors of the reader and of
  * dhc_model_jacobian_prepared; DHC_ERR_ARGUMENT for NULL or n = 0. */
 dhc_status dhc_plan_observability(const dhc_model *model, const dhc_param_set *set,
-                                  dhc_sample_reader read, void *ctx, const size_t *index,
+                                  dhc_sample_reader read, const void *ctx, const size_t *index,
                                   size_t n, dhc_plan_workspace *ws, double *o1, size_t *rank);
 
 #ifdef __cplusplus

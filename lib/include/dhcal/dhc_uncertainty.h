@@ -57,7 +57,7 @@ typedef struct {
  * dhc_lsq_analyse. O(n P^2 + P^3). */
 dhc_status dhc_uncertainty_from_samples(dhc_uncertainty *u, const dhc_model *model,
                                         const dhc_param_set *set, const uint8_t *use,
-                                        dhc_sample_reader read, void *ctx, size_t n,
+                                        dhc_sample_reader read, const void *ctx, size_t n,
                                         const dhc_noise_model *noise, double weight_mm_per_rad,
                                         double sigma);
 

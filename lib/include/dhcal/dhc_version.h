@@ -5,10 +5,10 @@
 #define DHC_VERSION_H
 
 #define DHCAL_VERSION_MAJOR 0
-#define DHCAL_VERSION_MINOR 3
+#define DHCAL_VERSION_MINOR 4
 #define DHCAL_VERSION_PATCH 0
 
-#define DHCAL_VERSION_STRING "0.3.0"
+#define DHCAL_VERSION_STRING "0.4.0"
 
 /* One number for preprocessor comparisons: 10000 * major + 100 * minor + patch. */
 #define DHCAL_VERSION                                                                        \

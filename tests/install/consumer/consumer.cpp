@@ -49,7 +49,7 @@ dhc_sample samples[kSamples];
 dhc_calib_workspace workspace;
 dhc_calib_report report;
 
-dhc_status read_sample(void *, size_t index, dhc_sample *out)
+dhc_status read_sample(const void *, size_t index, dhc_sample *out)
 {
     *out = samples[index];
     return DHC_OK;

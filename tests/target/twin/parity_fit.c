@@ -16,7 +16,7 @@ static uint8_t flags[TWIN_MAX_SAMPLES];
 static dhc_calib_workspace ws;
 static dhc_calib_report rep;
 
-static dhc_status read_sample(void *ctx, size_t index, dhc_sample *out)
+static dhc_status read_sample(const void *ctx, size_t index, dhc_sample *out)
 {
     (void)ctx;
     if (index >= TWIN_MAX_SAMPLES) {
