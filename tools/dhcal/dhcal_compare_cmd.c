@@ -1,0 +1,53 @@
+/* dhcal_compare_cmd.c - `dhcal compare`: the model against the measurements, without fitting
+ * (docs/cli.md 1.1). */
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dhcal_cli.h"
+
+static int run_compare(const dhcal_cli_options *o, dhcal_cli_session *s)
+{
+    const size_t n = s->samples.n;
+    double *err_mm = calloc(n > 0U ? n : 1U, sizeof *err_mm);
+    dhcal_error_stats es = {0.0, 0.0, 0.0, 0U};
+    if (err_mm == NULL ||
+        dhcal_samples_errors(&s->model, &s->samples, NULL, err_mm, &es) != DHCAL_IO_OK) {
+        free(err_mm);
+        fprintf(stderr, "dhcal: compare failed\n");
+        return EXIT_COMPUTE;
+    }
+    if (o->json) {
+        cJSON *obj = cJSON_CreateObject();
+        cJSON_AddNumberToObject(obj, "rms_mm", es.rms_mm);
+        cJSON_AddNumberToObject(obj, "mean_mm", es.mean_mm);
+        cJSON_AddNumberToObject(obj, "max_mm", es.max_mm);
+        cJSON *rows = cJSON_AddArrayToObject(obj, "rows");
+        for (size_t i = 0U; i < n; ++i) {
+            cJSON *r = cJSON_CreateObject();
+            cJSON_AddNumberToObject(r, "row", (double)(i + 1U));
+            cJSON_AddNumberToObject(r, "error_mm", err_mm[i]);
+            cJSON_AddItemToArray(rows, r);
+        }
+        free(err_mm);
+        return dhcal_cli_print_json(obj);
+    }
+    printf("model '%s' against %s: %zu rows (%s)\n", s->file_model.name, o->data, n,
+           s->samples.wires ? "wire lengths" : "tool points");
+    printf("%6s %8s %12s\n", "row", "line", "error_mm");
+    for (size_t i = 0U; i < n; ++i) {
+        printf("%6zu %8zu %12.4f\n", i + 1U, s->data.rows[i].line, err_mm[i]);
+    }
+    printf("RMS %.4f mm, mean %.4f mm, max %.4f mm\n", es.rms_mm, es.mean_mm, es.max_mm);
+    free(err_mm);
+    return 0;
+}
+
+const dhcal_measured_command dhcal_compare_command = {
+    "compare", run_compare,
+    "usage: dhcal compare --model M.json --data D.csv [--json]\n"
+    "The model's prediction for every row against its measurement, without\n"
+    "fitting: per-row error, RMS and maximum (mm; wire-length space for L1..L3).\n",
+    DHCAL_OUT_NONE, 0};
