@@ -21,8 +21,8 @@
 #include <string.h>
 #include <time.h>
 
-#include "dhcal_analysis.h"
-#include "dhcal_cv.h"
+#include "dhcal_desk/dhcal_analysis.h"
+#include "dhcal_desk/dhcal_cv.h"
 #include "dhcal_io.h"
 #include "dhcal_model_map.h"
 

@@ -9,13 +9,13 @@
 #include <string.h>
 
 #include "dhcal/dhc_version.h"
-#include "dhcal_analysis.h"
+#include "dhcal_desk/dhcal_analysis.h"
 #include "dhcal_data.h"
 #include "dhcal_io.h"
 #include "dhcal_model_map.h"
-#include "dhcal_refine.h"
-#include "dhcal_report.h"
-#include "dhcal_units.h"
+#include "dhcal_desk/dhcal_refine.h"
+#include "dhcal_desk/dhcal_report.h"
+#include "dhcal_desk/dhcal_units.h"
 
 struct dhcal_py_model {
     char path[1024]; /* stands for the file in messages */

@@ -9,7 +9,7 @@
 #include <string.h>
 
 #include "dhc_test_arms.h"
-#include "dhcal_cv.h"
+#include "dhcal_desk/dhcal_cv.h"
 #include "unity.h"
 
 #define MAX_ROWS 400U

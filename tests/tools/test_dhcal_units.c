@@ -12,7 +12,7 @@
 
 #include "dhcal/dhc_geometry.h"
 #include "dhcal/dhc_model.h"
-#include "dhcal_units.h"
+#include "dhcal_desk/dhcal_units.h"
 #include "unity.h"
 
 void setUp(void) {}

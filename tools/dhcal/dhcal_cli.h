@@ -8,11 +8,11 @@
 #include <cjson/cJSON.h>
 #include <stddef.h>
 
-#include "dhcal_analysis.h"
+#include "dhcal_desk/dhcal_analysis.h"
 #include "dhcal_data.h"
 #include "dhcal_io.h"
-#include "dhcal_refine.h"
-#include "dhcal_report.h"
+#include "dhcal_desk/dhcal_refine.h"
+#include "dhcal_desk/dhcal_report.h"
 
 #define EXIT_COMPUTE 1
 #define EXIT_USAGE 2

@@ -25,7 +25,7 @@
 #include "dhcal_io.h"
 #include "dhcal_options.h"
 #include "dhcal_text.h"
-#include "dhcal_units.h"
+#include "dhcal_desk/dhcal_units.h"
 
 #define EXIT_COMPUTE 1
 #define EXIT_USAGE 2

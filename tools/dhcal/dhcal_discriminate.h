@@ -37,7 +37,7 @@
 #include <stdint.h>
 
 #include "dhcal/dhc_params.h"
-#include "dhcal_analysis.h"
+#include "dhcal_desk/dhcal_analysis.h"
 
 /* The two effects of --discriminate A,B. */
 typedef struct {

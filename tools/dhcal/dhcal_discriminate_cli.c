@@ -10,7 +10,7 @@
 #include <string.h>
 
 #include "dhcal_model_file.h"
-#include "dhcal_units.h"
+#include "dhcal_desk/dhcal_units.h"
 
 /* ---------------------------------------------------------------- the labels */
 

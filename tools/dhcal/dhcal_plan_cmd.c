@@ -19,14 +19,14 @@
 #include <string.h>
 
 #include "dhcal/dhc_plan.h"
-#include "dhcal_analysis.h"
+#include "dhcal_desk/dhcal_analysis.h"
 #include "dhcal_csv.h"
 #include "dhcal_discriminate.h"
 #include "dhcal_file.h"
 #include "dhcal_model_file.h"
 #include "dhcal_model_map.h"
 #include "dhcal_options.h"
-#include "dhcal_units.h"
+#include "dhcal_desk/dhcal_units.h"
 
 #define PLAN_MAX_CANDIDATES 100000UL
 /* the candidates' Jacobians are kept when they take at most this much memory */

@@ -19,7 +19,7 @@
 #include "dhcal_model_map.h"
 #include "dhcal_options.h"
 #include "dhcal_plan_cmd.h"
-#include "dhcal_units.h"
+#include "dhcal_desk/dhcal_units.h"
 #include "dhcal_urdf_cmd.h"
 
 /* A command: the measurement commands share this file's options and session (measured);

@@ -3,7 +3,7 @@
 #define _POSIX_C_SOURCE 200809L /* strtok_r */
 #endif
 
-#include "dhcal_report.h"
+#include "dhcal_desk/dhcal_report.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -16,8 +16,8 @@
 #ifndef DHCAL_EVIDENCE_H
 #define DHCAL_EVIDENCE_H
 
-#include "dhcal_analysis.h"
-#include "dhcal_cv.h"
+#include "dhcal_desk/dhcal_analysis.h"
+#include "dhcal_desk/dhcal_cv.h"
 
 /* Poses spread across the joint ranges (dhcal_workspace_poses). */
 #define DHCAL_WORKSPACE_POSES 256U

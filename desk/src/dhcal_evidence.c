@@ -2,7 +2,7 @@
 #ifndef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 200809L /* sysconf */
 #endif
-#include "dhcal_evidence.h"
+#include "dhcal_desk/dhcal_evidence.h"
 
 #include <math.h>
 #include <pthread.h>

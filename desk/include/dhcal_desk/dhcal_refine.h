@@ -5,9 +5,9 @@
 #ifndef DHCAL_REFINE_H
 #define DHCAL_REFINE_H
 
-#include "dhcal_analysis.h"
-#include "dhcal_cv.h"
-#include "dhcal_evidence.h"
+#include "dhcal_desk/dhcal_analysis.h"
+#include "dhcal_desk/dhcal_cv.h"
+#include "dhcal_desk/dhcal_evidence.h"
 
 #define DHCAL_REFINE_MAX_STEPS 10U
 /* link parameters the start may hold at nominal for leaving their physical range */

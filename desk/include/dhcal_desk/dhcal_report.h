@@ -8,8 +8,8 @@
 #include <stdint.h>
 #include <stdio.h>
 
-#include "dhcal_analysis.h"
-#include "dhcal_refine.h"
+#include "dhcal_desk/dhcal_analysis.h"
+#include "dhcal_desk/dhcal_refine.h"
 
 /* The contract's name of an outlier's reason: joint_range, beyond_reach, robust, residual. */
 const char *dhcal_outlier_reason(uint8_t flag);

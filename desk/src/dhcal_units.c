@@ -8,7 +8,7 @@
  * unit and of the frame, so that one mistake does not hide another, and a model error,
  * which is the same under every reading, cancels from their ratio.
  */
-#include "dhcal_units.h"
+#include "dhcal_desk/dhcal_units.h"
 
 #include <math.h>
 #include <stdarg.h>

@@ -1,6 +1,6 @@
 /* dhcal_cv.c - k-fold cross-validation (dhcal_cv.h): the folds' estimates from the normal
  * equations of all rows with each fold's own taken out, and the refitting reference. */
-#include "dhcal_cv.h"
+#include "dhcal_desk/dhcal_cv.h"
 
 #include "dhcal/dhc_jacobian.h"
 

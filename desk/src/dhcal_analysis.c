@@ -1,5 +1,5 @@
 /* dhcal_analysis.c - fit and diagnose over loaded samples. */
-#include "dhcal_analysis.h"
+#include "dhcal_desk/dhcal_analysis.h"
 
 #include "dhcal/dhc_jacobian.h"
 

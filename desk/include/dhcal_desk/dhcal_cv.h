@@ -3,7 +3,7 @@
 #ifndef DHCAL_CV_H
 #define DHCAL_CV_H
 
-#include "dhcal_analysis.h"
+#include "dhcal_desk/dhcal_analysis.h"
 
 /* Cross-validation: leave-one-out below this many rows, else DHCAL_CV_FOLDS folds. */
 #define DHCAL_CV_LOO_BELOW 30U

@@ -1,5 +1,5 @@
 /* dhcal_refine.c - the refine loop (dhcal_refine.h); the cross-validation is dhcal_cv.c. */
-#include "dhcal_refine.h"
+#include "dhcal_desk/dhcal_refine.h"
 
 #include <math.h>
 #include <stdio.h>
