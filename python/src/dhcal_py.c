@@ -15,6 +15,7 @@
 #include "dhcal_model_map.h"
 #include "dhcal_desk/dhcal_refine.h"
 #include "dhcal_desk/dhcal_report.h"
+#include "dhcal_desk/dhcal_session.h"
 #include "dhcal_desk/dhcal_units.h"
 
 struct dhcal_py_model {
@@ -154,57 +155,32 @@ void dhcal_py_rows_free(void *rows)
 
 /* ---------------------------------------------------------------- commands */
 
-/* What one command works on: main.c's session, built from arrays instead of files. */
-typedef struct {
-    dhc_noise_model noise;
-    dhcal_geometry geometry;
-    dhcal_dataset data;
-    dhcal_samples samples;
-    dhcal_dataset held_data;
-    dhcal_samples held;
-    int have_held;
-} py_session;
-
-static int rows_to_samples(const dhcal_py_model *m, const dhcal_py_rows *r, const char *name,
-                           dhcal_dataset *data, dhcal_samples *samples, dhcal_error *e)
+/* The rows of r as a data set (name: in messages). */
+static int rows_to_dataset(const dhcal_py_model *m, const dhcal_py_rows *r, const char *name,
+                           dhcal_dataset *data, dhcal_error *e)
 {
     const dhcal_arrays a = {name,   r->n_rows,  m->lib.arm.n_joints, r->q_deg, r->xyz_mm,
                             r->dir, r->temp_c, r->t_s,              r->wires_mm};
-    int rc = dhcal_dataset_from_arrays(&a, data, e);
-    if (rc == DHCAL_IO_OK) {
-        rc = dhcal_samples_build(&m->lib, data, name, samples, e);
-    }
-    return rc;
+    return dhcal_dataset_from_arrays(&a, data, e);
 }
 
+/* What one command works on: the program's session, built from arrays instead of files. */
 static int open_session(const dhcal_py_model *m, const dhcal_py_rows *train,
                         const dhcal_py_rows *held, const char *noise, const char *geometry,
-                        py_session *s, dhcal_error *e)
+                        dhcal_session *s, dhcal_error *e)
 {
-    memset(s, 0, sizeof *s);
-    int rc = dhcal_parse_noise(noise, &s->noise, e);
+    int rc = dhcal_session_begin(s, &m->file, m->path, noise, geometry, NULL, e);
     if (rc == DHCAL_IO_OK) {
-        rc = dhcal_parse_geometry(geometry, &s->geometry, e);
-    }
-    if (rc == DHCAL_IO_OK) {
-        rc = rows_to_samples(m, train, "training data", &s->data, &s->samples, e);
+        rc = rows_to_dataset(m, train, "training data", &s->data, e);
     }
     if (rc == DHCAL_IO_OK && held != NULL) {
-        rc = rows_to_samples(m, held, "held-out data", &s->held_data, &s->held, e);
+        rc = rows_to_dataset(m, held, "held-out data", &s->held_data, e);
         s->have_held = rc == DHCAL_IO_OK;
-        if (rc == DHCAL_IO_OK) {
-            rc = dhcal_samples_check_held(&s->samples, &s->held, "held-out data", e);
-        }
+    }
+    if (rc == DHCAL_IO_OK) {
+        rc = dhcal_session_build_rows(s, "training data", "held-out data", e);
     }
     return rc;
-}
-
-static void close_session(py_session *s)
-{
-    dhcal_samples_free(&s->samples);
-    dhcal_samples_free(&s->held);
-    dhcal_dataset_free(&s->data);
-    dhcal_dataset_free(&s->held_data);
 }
 
 /* The calibrated model as `--out` writes it, and as loading that file gives it back. */
@@ -243,7 +219,7 @@ static int not_converged(const dhcal_fit *fit, const char *what, dhcal_error *e)
 }
 
 /* fit: main.c's do_fit, then its report (cmd_fit). */
-static int run_fit(const dhcal_py_model *m, py_session *s, const char *effects, int cv,
+static int run_fit(const dhcal_py_model *m, dhcal_session *s, const char *effects, int cv,
                    cJSON *obj, dhcal_fit **fit_out, dhcal_error *e)
 {
     static dhcal_fit fit;
@@ -276,14 +252,14 @@ static int run_fit(const dhcal_py_model *m, py_session *s, const char *effects, 
 }
 
 /* refine and diagnose (its first judgement): main.c's cmd_refine and cmd_diagnose. */
-static int run_refine(const dhcal_py_model *m, py_session *s, const char *effects,
+static int run_refine(const dhcal_py_model *m, dhcal_session *s, const char *effects,
                       const char *geometry, size_t max_steps, cJSON *obj, dhcal_fit **fit_out,
                       dhcal_error *e)
 {
     static dhcal_refine_result res;
     static dhcal_fit_extras extras;
     int rc = dhcal_run_refine(&m->lib, effects, geometry != NULL ? &s->geometry : NULL,
-                              &s->noise, m->file.repeatability_mm, max_steps, &s->samples,
+                              &s->noise, s->repeatability_mm, max_steps, &s->samples,
                               s->have_held ? &s->held : NULL, &res, e);
     if (rc != DHCAL_IO_OK) {
         return rc;
@@ -327,7 +303,7 @@ int dhcal_py_run(const char *command, const dhcal_py_model *m, const dhcal_py_ro
     if (!is_fit && !is_diagnose && !is_refine) {
         return fail(err, err_cap, DHCAL_IO_BAD_INPUT, "unknown command");
     }
-    static py_session s;
+    static dhcal_session s;
     dhcal_error e;
     memset(&e, 0, sizeof e);
     int rc = open_session(m, train, held, noise, geometry, &s, &e);
@@ -360,7 +336,7 @@ int dhcal_py_run(const char *command, const dhcal_py_model *m, const dhcal_py_ro
         *fitted = fitted_model(m, fit, &unused);
     }
     cJSON_Delete(obj);
-    close_session(&s);
+    dhcal_session_free(&s);
     return rc == DHCAL_IO_OK ? rc : fail(err, err_cap, rc, e.msg);
 }
 

@@ -13,6 +13,7 @@
 #include "dhcal_io.h"
 #include "dhcal_desk/dhcal_refine.h"
 #include "dhcal_desk/dhcal_report.h"
+#include "dhcal_desk/dhcal_session.h"
 
 #define EXIT_COMPUTE 1
 #define EXIT_USAGE 2
@@ -33,19 +34,6 @@ typedef struct {
     const char *repeatability; /* the arm's ISO 9283 repeatability, mm */
 } dhcal_cli_options;
 
-/* Everything a command works on, loaded and checked. */
-typedef struct {
-    dhcal_model file_model;
-    dhc_model model;
-    dhc_noise_model noise;
-    dhcal_geometry geometry;
-    dhcal_dataset data;
-    dhcal_samples samples;
-    dhcal_dataset held_data;
-    dhcal_samples held;
-    int have_held;
-    double repeatability_mm; /* 0: not known */
-} dhcal_cli_session;
 
 /* What --out names for a command. */
 typedef enum {
@@ -59,7 +47,7 @@ typedef enum {
  * common ones. */
 typedef struct {
     const char *name;
-    int (*run)(const dhcal_cli_options *o, dhcal_cli_session *s);
+    int (*run)(const dhcal_cli_options *o, dhcal_session *s);
     const char *help;
     dhcal_out_use out;
     int takes_cv;
@@ -75,17 +63,17 @@ extern const dhcal_measured_command dhcal_plot_command;
 int dhcal_cli_print_json(cJSON *obj);
 
 /* fit's printers and check, which refine's report shares (dhcal_fit_cmd.c). */
-void dhcal_cli_text_fit(const dhcal_fit *f, const dhcal_cli_session *s,
+void dhcal_cli_text_fit(const dhcal_fit *f, const dhcal_session *s,
                         const dhcal_cli_options *o, const double *row_err);
-void dhcal_cli_text_extras(const dhcal_fit *f, const dhcal_cli_session *s,
+void dhcal_cli_text_extras(const dhcal_fit *f, const dhcal_session *s,
                            const dhcal_fit_extras *x, int diagnosed_nothing);
-int dhcal_cli_refuse_implausible(const dhcal_cli_session *s, const dhcal_fit *fit,
+int dhcal_cli_refuse_implausible(const dhcal_session *s, const dhcal_fit *fit,
                                  const char *out);
 
 /* refine's loop on the session (max_steps 0: diagnose, its start and first judgement), the
  * error on standard error: 0, EXIT_USAGE or EXIT_COMPUTE (dhcal_refine_cmd.c; plot draws
  * what it names). */
-int dhcal_cli_run_refine(const dhcal_cli_options *o, dhcal_cli_session *s, size_t max_steps,
+int dhcal_cli_run_refine(const dhcal_cli_options *o, dhcal_session *s, size_t max_steps,
                          dhcal_refine_result *res);
 
 #endif /* DHCAL_CLI_H */

@@ -8,7 +8,7 @@
 
 #include "dhcal_cli.h"
 
-static int run_compare(const dhcal_cli_options *o, dhcal_cli_session *s)
+static int run_compare(const dhcal_cli_options *o, dhcal_session *s)
 {
     const size_t n = s->samples.n;
     double *err_mm = calloc(n > 0U ? n : 1U, sizeof *err_mm);
@@ -34,7 +34,7 @@ static int run_compare(const dhcal_cli_options *o, dhcal_cli_session *s)
         free(err_mm);
         return dhcal_cli_print_json(obj);
     }
-    printf("model '%s' against %s: %zu rows (%s)\n", s->file_model.name, o->data, n,
+    printf("model '%s' against %s: %zu rows (%s)\n", s->file.name, o->data, n,
            s->samples.wires ? "wire lengths" : "tool points");
     printf("%6s %8s %12s\n", "row", "line", "error_mm");
     for (size_t i = 0U; i < n; ++i) {

@@ -20,7 +20,7 @@ static const char *outlier_words(uint8_t flag)
 
 /* Where a systematic error shows: the apparent joint error's RMS per joint (deg) and the
  * residual's linear trend over the session (mm from first to last row). */
-static void text_where(const dhcal_fit *f, const dhcal_cli_session *s)
+static void text_where(const dhcal_fit *f, const dhcal_session *s)
 {
     const size_t n = s->samples.n;
     const size_t nj = f->model.arm.n_joints;
@@ -88,7 +88,7 @@ static void text_where(const dhcal_fit *f, const dhcal_cli_session *s)
     free(err);
 }
 
-void dhcal_cli_text_extras(const dhcal_fit *f, const dhcal_cli_session *s,
+void dhcal_cli_text_extras(const dhcal_fit *f, const dhcal_session *s,
                            const dhcal_fit_extras *x, int diagnosed_nothing)
 {
     if (x->have_cv) {
@@ -133,11 +133,11 @@ void dhcal_cli_text_extras(const dhcal_fit *f, const dhcal_cli_session *s,
     text_where(f, s);
 }
 
-void dhcal_cli_text_fit(const dhcal_fit *f, const dhcal_cli_session *s,
+void dhcal_cli_text_fit(const dhcal_fit *f, const dhcal_session *s,
                         const dhcal_cli_options *o, const double *row_err)
 {
     const dhc_calib_report *rep = &f->rep;
-    printf("fit of '%s' to %s: %zu rows used, %zu outliers left out\n", s->file_model.name,
+    printf("fit of '%s' to %s: %zu rows used, %zu outliers left out\n", s->file.name,
            o->data, rep->samples_used, rep->outliers);
     printf("%s after %zu iterations: RMS %.4f mm, max %.4f mm%s",
            rep->converged ? "converged" : "NOT converged", rep->iterations, rep->rms_mm,
@@ -206,7 +206,7 @@ void dhcal_cli_text_fit(const dhcal_fit *f, const dhcal_cli_session *s,
 }
 
 /* Runs the fit; on success fills row_err (caller frees). */
-static int do_fit(const dhcal_cli_options *o, dhcal_cli_session *s, dhcal_fit *fit,
+static int do_fit(const dhcal_cli_options *o, dhcal_session *s, dhcal_fit *fit,
                   double **row_err)
 {
     dhcal_error err;
@@ -228,7 +228,7 @@ static int do_fit(const dhcal_cli_options *o, dhcal_cli_session *s, dhcal_fit *f
 }
 
 /* A fitted model outside its physical range is refused as a calibration (exit 1). */
-int dhcal_cli_refuse_implausible(const dhcal_cli_session *s, const dhcal_fit *fit,
+int dhcal_cli_refuse_implausible(const dhcal_session *s, const dhcal_fit *fit,
                                  const char *out)
 {
     char why[200];
@@ -272,7 +272,7 @@ static void text_covariates_fitted(const dhcal_fit *fit, const dhcal_samples *sa
     }
 }
 
-static int run_fit(const dhcal_cli_options *o, dhcal_cli_session *s)
+static int run_fit(const dhcal_cli_options *o, dhcal_session *s)
 {
     static dhcal_fit fit;
     static dhcal_fit_extras extras;
@@ -296,7 +296,7 @@ static int run_fit(const dhcal_cli_options *o, dhcal_cli_session *s)
     }
     if (rc == 0 && o->out != NULL && fit.status == DHC_OK && implausible == 0) {
         static dhcal_model out;
-        dhcal_model_from_lib(&fit.model, &s->file_model, &out);
+        dhcal_model_from_lib(&fit.model, &s->file, &out);
         dhcal_error err;
         memset(&err, 0, sizeof err);
         if (dhcal_model_save(o->out, &out, &err) != DHCAL_IO_OK) {

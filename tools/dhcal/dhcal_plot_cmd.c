@@ -9,7 +9,7 @@
 #include "dhcal_cli.h"
 #include "dhcal_plot.h"
 
-static int run_plot(const dhcal_cli_options *o, dhcal_cli_session *s)
+static int run_plot(const dhcal_cli_options *o, dhcal_session *s)
 {
     static dhcal_refine_result judged; /* diagnose's: the start and its judgement */
     static dhcal_fit after;
@@ -92,7 +92,7 @@ static int run_plot(const dhcal_cli_options *o, dhcal_cli_session *s)
         nc++;
     }
     if (rc == 0) {
-        const dhcal_plot_data d = {s->file_model.name, n, nj, q_deg, res_before, res_after,
+        const dhcal_plot_data d = {s->file.name, n, nj, q_deg, res_before, res_after,
                                    err_before, err_after, es_b.rms_mm, es_a.rms_mm,
                                    s->samples.wires, label, cands, nc, joint_err, moment, dir};
         rc = dhcal_plot_write(o->out, &d, &err) == DHCAL_IO_OK ? 0 : EXIT_COMPUTE;

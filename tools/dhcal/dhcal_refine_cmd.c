@@ -27,7 +27,7 @@ static void text_covariates(const dhcal_covariates *cov)
 
 /* refine's loop (max_steps 0: diagnose, its start and first judgement), the error on
  * standard error: 0, EXIT_USAGE or EXIT_COMPUTE. */
-int dhcal_cli_run_refine(const dhcal_cli_options *o, dhcal_cli_session *s, size_t max_steps,
+int dhcal_cli_run_refine(const dhcal_cli_options *o, dhcal_session *s, size_t max_steps,
                          dhcal_refine_result *res)
 {
     dhcal_error err;
@@ -45,7 +45,7 @@ int dhcal_cli_run_refine(const dhcal_cli_options *o, dhcal_cli_session *s, size_
 
 /* Every row's error at the result's model (caller frees; NULL on failure, said on standard
  * error) and the report's extras, its cross-validation the loop's. */
-static double *refine_rows(const dhcal_cli_session *s, const dhcal_refine_result *res,
+static double *refine_rows(const dhcal_session *s, const dhcal_refine_result *res,
                            dhcal_fit_extras *extras)
 {
     double *row_err = calloc(s->samples.n + 1U, sizeof *row_err);
@@ -73,7 +73,7 @@ static void text_start(const dhcal_refine_result *res)
     }
 }
 
-static int run_diagnose(const dhcal_cli_options *o, dhcal_cli_session *s)
+static int run_diagnose(const dhcal_cli_options *o, dhcal_session *s)
 {
     static dhcal_refine_result res;
     static dhcal_fit_extras extras;
@@ -114,7 +114,7 @@ static int run_diagnose(const dhcal_cli_options *o, dhcal_cli_session *s)
 
 /* ---------------------------------------------------------------- refine */
 
-static int run_refine(const dhcal_cli_options *o, dhcal_cli_session *s)
+static int run_refine(const dhcal_cli_options *o, dhcal_session *s)
 {
     static dhcal_refine_result res;
     static dhcal_fit_extras extras;
@@ -132,7 +132,7 @@ static int run_refine(const dhcal_cli_options *o, dhcal_cli_session *s)
     memset(&err, 0, sizeof err);
     if (o->out != NULL && fit->status == DHC_OK && implausible == 0) {
         static dhcal_model out;
-        dhcal_model_from_lib(&fit->model, &s->file_model, &out);
+        dhcal_model_from_lib(&fit->model, &s->file, &out);
         if (dhcal_model_save(o->out, &out, &err) != DHCAL_IO_OK) {
             fprintf(stderr, "dhcal: %s\n", err.msg);
             rc = EXIT_COMPUTE;
@@ -146,7 +146,7 @@ static int run_refine(const dhcal_cli_options *o, dhcal_cli_session *s)
         const int prc = dhcal_cli_print_json(obj);
         rc = rc != 0 ? rc : prc;
     } else {
-        printf("refine of '%s' to %s: base model (%s geometry)%s%s\n", s->file_model.name,
+        printf("refine of '%s' to %s: base model (%s geometry)%s%s\n", s->file.name,
                o->data, dhcal_geometry_name(fit->geometry), o->effects != NULL ? " + " : "",
                o->effects != NULL ? o->effects : "");
         text_start(&res);

@@ -208,42 +208,26 @@ static int parse_args(int argc, char **argv, const dhcal_measured_command *cmd,
     return 0;
 }
 
-static int load_session(const dhcal_cli_options *o, dhcal_cli_session *s)
+static int load_session(const dhcal_cli_options *o, dhcal_session *s)
 {
     dhcal_error err;
     memset(&err, 0, sizeof err);
     memset(s, 0, sizeof *s);
-    int rc = dhcal_parse_noise(o->noise, &s->noise, &err);
-    if (rc == DHCAL_IO_OK && o->repeatability != NULL) {
-        rc = dhcal_parse_repeatability(o->repeatability, &s->repeatability_mm, &err);
-    }
+    static dhcal_model file;
+    int rc = dhcal_model_load(o->model, &file, &err);
     if (rc == DHCAL_IO_OK) {
-        rc = dhcal_parse_geometry(o->geometry, &s->geometry, &err);
-    }
-    if (rc == DHCAL_IO_OK) {
-        rc = dhcal_model_load(o->model, &s->file_model, &err);
-    }
-    if (rc == DHCAL_IO_OK) {
-        rc = dhcal_model_to_lib(&s->file_model, o->model, &s->model, &err);
-    }
-    if (rc == DHCAL_IO_OK && o->repeatability == NULL) {
-        s->repeatability_mm = s->file_model.repeatability_mm;
+        rc = dhcal_session_begin(s, &file, o->model, o->noise, o->geometry, o->repeatability,
+                                 &err);
     }
     if (rc == DHCAL_IO_OK) {
         rc = dhcal_csv_load(o->data, s->model.arm.n_joints, &s->data, &err);
     }
-    if (rc == DHCAL_IO_OK) {
-        rc = dhcal_samples_build(&s->model, &s->data, o->data, &s->samples, &err);
-    }
     if (rc == DHCAL_IO_OK && o->heldout != NULL) {
         rc = dhcal_csv_load(o->heldout, s->model.arm.n_joints, &s->held_data, &err);
-        if (rc == DHCAL_IO_OK) {
-            rc = dhcal_samples_build(&s->model, &s->held_data, o->heldout, &s->held, &err);
-            s->have_held = rc == DHCAL_IO_OK;
-        }
-        if (rc == DHCAL_IO_OK) {
-            rc = dhcal_samples_check_held(&s->samples, &s->held, o->heldout, &err);
-        }
+        s->have_held = rc == DHCAL_IO_OK;
+    }
+    if (rc == DHCAL_IO_OK) {
+        rc = dhcal_session_build_rows(s, o->data, o->heldout, &err);
     }
     if (rc == DHCAL_IO_OK && !o->no_units_check) { /* before any fit (dhcal_units.h) */
         const dhcal_units_ask ask = {o->effects, strcmp(o->command, "compare") != 0,
@@ -258,14 +242,6 @@ static int load_session(const dhcal_cli_options *o, dhcal_cli_session *s)
         return rc == DHCAL_IO_BAD_INPUT ? EXIT_USAGE : EXIT_COMPUTE;
     }
     return 0;
-}
-
-static void free_session(dhcal_cli_session *s)
-{
-    dhcal_samples_free(&s->samples);
-    dhcal_samples_free(&s->held);
-    dhcal_dataset_free(&s->data);
-    dhcal_dataset_free(&s->held_data);
 }
 
 int dhcal_cli_print_json(cJSON *obj)
@@ -289,12 +265,12 @@ static int run_measured(int argc, char **argv, const dhcal_measured_command *cmd
     if (rc != 0) {
         return rc < 0 ? 0 : rc;
     }
-    static dhcal_cli_session s;
+    static dhcal_session s;
     rc = load_session(&o, &s);
     if (rc == 0) {
         rc = cmd->run(&o, &s);
     }
-    free_session(&s);
+    dhcal_session_free(&s);
     return rc;
 }
 
