@@ -4,6 +4,7 @@
 #define _POSIX_C_SOURCE 200809L
 #endif
 
+#include <cjson/cJSON.h>
 #include <errno.h>
 #include <getopt.h>
 #include <stdarg.h>
@@ -338,49 +339,146 @@ static int bus_number(const char *name, const char *v, unsigned long long max,
     return 0;
 }
 
-static int run_bus(int argc, char **argv)
-{
-    const char *scenario = NULL;
+/* bus's options (bus_help): the plant on the CAN bus, or the encoder lines played on gpio-sim. */
+typedef struct {
+    const char *scenario;
     dhs_bus_linux_options bo;
-    memset(&bo, 0, sizeof bo);
-    bo.run_seed = 7U;
-    bo.idle_exit_ms = 1500U;
-    bo.start_wait_ms = 20000U;
     dhs_gpio_play_options go;
-    memset(&go, 0, sizeof go);
-    go.start_delay_ms = 1500U;
-    go.steps = 16U;
-    go.step_us = 2000U;
-    int have_lines = 0;
-    enum { BUS_SCENARIO = 256, BUS_CAN, BUS_ID_OFFSET, BUS_GPIO_CHIP, BUS_SEED, BUS_DROP,
-           BUS_STOP_AT, BUS_IDLE_EXIT, BUS_START_WAIT, BUS_LINES, BUS_STEPS, BUS_BURST,
-           BUS_PAUSE, BUS_START_DELAY, BUS_STEP_US };
-    static const struct option longs[] = {
-        {"help", no_argument, NULL, 'h'},
-        {"scenario", required_argument, NULL, BUS_SCENARIO},
-        {"can", required_argument, NULL, BUS_CAN},
-        {"can-id-offset", required_argument, NULL, BUS_ID_OFFSET},
-        {"gpio-chip", required_argument, NULL, BUS_GPIO_CHIP},
-        {"seed", required_argument, NULL, BUS_SEED},
-        {"drop-frame", required_argument, NULL, BUS_DROP},
-        {"stop-at", required_argument, NULL, BUS_STOP_AT},
-        {"idle-exit-ms", required_argument, NULL, BUS_IDLE_EXIT},
-        {"start-wait-ms", required_argument, NULL, BUS_START_WAIT},
-        {"lines", required_argument, NULL, BUS_LINES},
-        {"gpio-steps", required_argument, NULL, BUS_STEPS},
-        {"gpio-burst", required_argument, NULL, BUS_BURST},
-        {"gpio-pause-ms", required_argument, NULL, BUS_PAUSE},
-        {"gpio-start-delay-ms", required_argument, NULL, BUS_START_DELAY},
-        {"gpio-step-us", required_argument, NULL, BUS_STEP_US},
-        {NULL, 0, NULL, 0}};
+    int have_lines;
+} bus_config;
+
+enum { BUS_SCENARIO = 256, BUS_CAN, BUS_ID_OFFSET, BUS_GPIO_CHIP, BUS_SEED, BUS_DROP,
+       BUS_STOP_AT, BUS_IDLE_EXIT, BUS_START_WAIT, BUS_LINES, BUS_STEPS, BUS_BURST,
+       BUS_PAUSE, BUS_START_DELAY, BUS_STEP_US };
+static const struct option bus_longs[] = {
+    {"help", no_argument, NULL, 'h'},
+    {"scenario", required_argument, NULL, BUS_SCENARIO},
+    {"can", required_argument, NULL, BUS_CAN},
+    {"can-id-offset", required_argument, NULL, BUS_ID_OFFSET},
+    {"gpio-chip", required_argument, NULL, BUS_GPIO_CHIP},
+    {"seed", required_argument, NULL, BUS_SEED},
+    {"drop-frame", required_argument, NULL, BUS_DROP},
+    {"stop-at", required_argument, NULL, BUS_STOP_AT},
+    {"idle-exit-ms", required_argument, NULL, BUS_IDLE_EXIT},
+    {"start-wait-ms", required_argument, NULL, BUS_START_WAIT},
+    {"lines", required_argument, NULL, BUS_LINES},
+    {"gpio-steps", required_argument, NULL, BUS_STEPS},
+    {"gpio-burst", required_argument, NULL, BUS_BURST},
+    {"gpio-pause-ms", required_argument, NULL, BUS_PAUSE},
+    {"gpio-start-delay-ms", required_argument, NULL, BUS_START_DELAY},
+    {"gpio-step-us", required_argument, NULL, BUS_STEP_US},
+    {NULL, 0, NULL, 0}};
+
+/* One option's value (a: its "--name" for messages): 0, or a usage error's exit code. */
+static int bus_option(int opt, const char *a, const char *v, const char *given, bus_config *b)
+{
+    unsigned long long n = 0U;
+    int rc = 0;
+    switch (opt) {
+    case BUS_SCENARIO: {
+        b->scenario = v;
+    } break;
+    case BUS_CAN: {
+        b->bo.can = v;
+    } break;
+    case BUS_ID_OFFSET: {
+        rc = bus_number(a, v, FW_CAN_OFFSET_MAX, &n);
+        b->bo.id_offset = (uint32_t)n;
+    } break;
+    case BUS_GPIO_CHIP: {
+        b->go.chip = v;
+    } break;
+    case BUS_SEED: {
+        rc = bus_number(a, v, 18446744073709551615ULL, &n);
+        b->bo.run_seed = n;
+    } break;
+    case BUS_DROP: {
+        char *end = NULL;
+        errno = 0;
+        const unsigned long id = strtoul(v, &end, 0);
+        if (errno != 0 || end == v || *end != '@' || id > 0x7FFUL ||
+            !parse_ulong(end + 1, 18446744073709551615ULL, &n)) {
+            return usage_error("--drop-frame: '%s' is not ID@TICK (e.g. 0x181@500)", v);
+        }
+        b->bo.drop = 1;
+        b->bo.drop_id = (uint32_t)id;
+        b->bo.drop_tick = n;
+    } break;
+    case BUS_STOP_AT: {
+        rc = bus_number(a, v, 18446744073709551615ULL, &n);
+        b->bo.stop = 1;
+        b->bo.stop_tick = n;
+    } break;
+    case BUS_IDLE_EXIT: {
+        rc = bus_number(a, v, 3600000U, &n);
+        b->bo.idle_exit_ms = (uint32_t)n;
+    } break;
+    case BUS_START_WAIT: {
+        rc = bus_number(a, v, 3600000U, &n);
+        b->bo.start_wait_ms = (uint32_t)n;
+    } break;
+    case BUS_LINES: {
+        unsigned long long la = 0U;
+        unsigned long long lb = 0U;
+        const char *comma = strchr(v, ',');
+        char first[24];
+        if (comma == NULL || (size_t)(comma - v) >= sizeof first) {
+            return usage_error("--lines: '%s' is not two different offsets A,B", v);
+        }
+        memcpy(first, v, (size_t)(comma - v));
+        first[comma - v] = '\0';
+        if (!parse_ulong(first, 65535U, &la) || !parse_ulong(comma + 1, 65535U, &lb) ||
+            la == lb) {
+            return usage_error("--lines: '%s' is not two different offsets A,B", v);
+        }
+        b->go.line[0] = (unsigned)la;
+        b->go.line[1] = (unsigned)lb;
+        b->have_lines = 1;
+    } break;
+    case BUS_STEPS: {
+        rc = bus_number(a, v, 1000000U, &n);
+        b->go.steps = (uint32_t)n;
+    } break;
+    case BUS_BURST: {
+        rc = bus_number(a, v, 1000000U, &n);
+        b->go.burst = (uint32_t)n;
+    } break;
+    case BUS_PAUSE: {
+        rc = bus_number(a, v, 3600000U, &n);
+        b->go.pause_ms = (uint32_t)n;
+    } break;
+    case BUS_START_DELAY: {
+        rc = bus_number(a, v, 3600000U, &n);
+        b->go.start_delay_ms = (uint32_t)n;
+    } break;
+    case BUS_STEP_US: {
+        rc = bus_number(a, v, 10000000U, &n);
+        b->go.step_us = (uint32_t)n;
+    } break;
+    default:
+        return usage_error("bus: unknown option '%s'", given);
+    }
+    return rc;
+}
+
+/* The options into *b: 0, -1 after --help, or a usage error's exit code. */
+static int parse_bus(int argc, char **argv, bus_config *b)
+{
+    memset(b, 0, sizeof *b);
+    b->bo.run_seed = 7U;
+    b->bo.idle_exit_ms = 1500U;
+    b->bo.start_wait_ms = 20000U;
+    b->go.start_delay_ms = 1500U;
+    b->go.steps = 16U;
+    b->go.step_us = 2000U;
     opterr = 0;
     optind = 1;
     const char *given = NULL;
     int opt;
-    while ((opt = next_option(argc, argv, longs, &given)) != -1) {
+    while ((opt = next_option(argc, argv, bus_longs, &given)) != -1) {
         if (opt == 'h') {
             fputs(bus_help, stdout);
-            return 0;
+            return -1;
         }
         if (opt == ':') {
             return usage_error("%s needs a value", given);
@@ -390,94 +488,8 @@ static int run_bus(int argc, char **argv)
         }
         /* "--name" for the messages, whichever way the option was written */
         char a[40];
-        (void)snprintf(a, sizeof a, "--%s", longs[opt - BUS_SCENARIO + 1].name);
-        const char *v = optarg;
-        unsigned long long n = 0U;
-        int rc = 0;
-        switch (opt) {
-        case BUS_SCENARIO: {
-            scenario = v;
-        } break;
-        case BUS_CAN: {
-            bo.can = v;
-        } break;
-        case BUS_ID_OFFSET: {
-            rc = bus_number(a, v, FW_CAN_OFFSET_MAX, &n);
-            bo.id_offset = (uint32_t)n;
-        } break;
-        case BUS_GPIO_CHIP: {
-            go.chip = v;
-        } break;
-        case BUS_SEED: {
-            rc = bus_number(a, v, 18446744073709551615ULL, &n);
-            bo.run_seed = n;
-        } break;
-        case BUS_DROP: {
-            char *end = NULL;
-            errno = 0;
-            const unsigned long id = strtoul(v, &end, 0);
-            if (errno != 0 || end == v || *end != '@' || id > 0x7FFUL ||
-                !parse_ulong(end + 1, 18446744073709551615ULL, &n)) {
-                return usage_error("--drop-frame: '%s' is not ID@TICK (e.g. 0x181@500)", v);
-            }
-            bo.drop = 1;
-            bo.drop_id = (uint32_t)id;
-            bo.drop_tick = n;
-        } break;
-        case BUS_STOP_AT: {
-            rc = bus_number(a, v, 18446744073709551615ULL, &n);
-            bo.stop = 1;
-            bo.stop_tick = n;
-        } break;
-        case BUS_IDLE_EXIT: {
-            rc = bus_number(a, v, 3600000U, &n);
-            bo.idle_exit_ms = (uint32_t)n;
-        } break;
-        case BUS_START_WAIT: {
-            rc = bus_number(a, v, 3600000U, &n);
-            bo.start_wait_ms = (uint32_t)n;
-        } break;
-        case BUS_LINES: {
-            unsigned long long la = 0U;
-            unsigned long long lb = 0U;
-            const char *comma = strchr(v, ',');
-            char first[24];
-            if (comma == NULL || (size_t)(comma - v) >= sizeof first) {
-                return usage_error("--lines: '%s' is not two different offsets A,B", v);
-            }
-            memcpy(first, v, (size_t)(comma - v));
-            first[comma - v] = '\0';
-            if (!parse_ulong(first, 65535U, &la) || !parse_ulong(comma + 1, 65535U, &lb) ||
-                la == lb) {
-                return usage_error("--lines: '%s' is not two different offsets A,B", v);
-            }
-            go.line[0] = (unsigned)la;
-            go.line[1] = (unsigned)lb;
-            have_lines = 1;
-        } break;
-        case BUS_STEPS: {
-            rc = bus_number(a, v, 1000000U, &n);
-            go.steps = (uint32_t)n;
-        } break;
-        case BUS_BURST: {
-            rc = bus_number(a, v, 1000000U, &n);
-            go.burst = (uint32_t)n;
-        } break;
-        case BUS_PAUSE: {
-            rc = bus_number(a, v, 3600000U, &n);
-            go.pause_ms = (uint32_t)n;
-        } break;
-        case BUS_START_DELAY: {
-            rc = bus_number(a, v, 3600000U, &n);
-            go.start_delay_ms = (uint32_t)n;
-        } break;
-        case BUS_STEP_US: {
-            rc = bus_number(a, v, 10000000U, &n);
-            go.step_us = (uint32_t)n;
-        } break;
-        default:
-            return usage_error("bus: unknown option '%s'", given);
-        }
+        (void)snprintf(a, sizeof a, "--%s", bus_longs[opt - BUS_SCENARIO + 1].name);
+        const int rc = bus_option(opt, a, optarg, given, b);
         if (rc != 0) {
             return rc;
         }
@@ -485,23 +497,43 @@ static int run_bus(int argc, char **argv)
     if (optind < argc - 1) {
         return usage_error("bus: unexpected argument '%s'", argv[optind + 1]);
     }
+    return 0;
+}
+
+static int print_json(cJSON *obj)
+{
+    char *text = obj != NULL ? cJSON_PrintUnformatted(obj) : NULL;
+    cJSON_Delete(obj);
+    if (text == NULL) {
+        fprintf(stderr, "dhcal-sim: out of memory\n");
+        return EXIT_COMPUTE;
+    }
+    puts(text);
+    free(text);
+    return 0;
+}
+
+/* The encoder lines played on gpio-sim. */
+static int run_gpio(bus_config *b)
+{
     char why[320];
-    if (go.chip != NULL || have_lines) {
-        if (go.chip == NULL || !have_lines || bo.can != NULL) {
-            return usage_error("bus: --gpio-chip goes with --lines, and not with --can");
-        }
-        const int rc = dhs_gpio_play(&go, why, sizeof why);
-        if (rc != 0) {
-            fprintf(stderr, "dhcal-sim: %s\n", why);
-            return rc == 2 ? EXIT_USAGE : EXIT_COMPUTE;
-        }
-        printf("{\"mode\": \"gpio\", \"chip\": \"%s\", \"lines\": [%u, %u], \"steps\": %u}\n",
-               go.chip, go.line[0], go.line[1], go.steps);
-        return 0;
+    const int rc = dhs_gpio_play(&b->go, why, sizeof why);
+    if (rc != 0) {
+        fprintf(stderr, "dhcal-sim: %s\n", why);
+        return rc == 2 ? EXIT_USAGE : EXIT_COMPUTE;
     }
-    if (scenario == NULL || bo.can == NULL) {
-        return usage_error("bus: needs --scenario and --can (or --gpio-chip and --lines)");
-    }
+    cJSON *obj = cJSON_CreateObject();
+    cJSON_AddStringToObject(obj, "mode", "gpio");
+    cJSON_AddStringToObject(obj, "chip", b->go.chip);
+    const int lines[2] = {(int)b->go.line[0], (int)b->go.line[1]};
+    cJSON_AddItemToObject(obj, "lines", cJSON_CreateIntArray(lines, 2));
+    cJSON_AddNumberToObject(obj, "steps", b->go.steps);
+    return print_json(obj);
+}
+
+/* The plant on the CAN bus, until the controller stops. */
+static int run_can(const char *scenario, bus_config *b)
+{
     static dhs_scenario_file sf;
     dhcal_error err;
     memset(&err, 0, sizeof err);
@@ -517,18 +549,47 @@ static int run_bus(int argc, char **argv)
         fprintf(stderr, "dhcal-sim: bus: %s: a 3-joint arm is needed\n", scenario);
         return EXIT_USAGE;
     }
+    char why[320];
     dhs_bus_linux_report rep;
-    const int rc = dhs_bus_linux_run(&sf.sc, q_start, &bo, &rep, why, sizeof why);
+    const int rc = dhs_bus_linux_run(&sf.sc, q_start, &b->bo, &rep, why, sizeof why);
     if (rc != 0) {
         fprintf(stderr, "dhcal-sim: %s\n", why);
     }
-    printf("{\"mode\": \"bus\", \"can\": \"%s\", \"syncs\": %llu, \"frames_sent\": %u, "
-           "\"dropped\": %u, \"overruns\": %u, \"commands_after_stop\": %u, "
-           "\"last_dac\": [%u, %u, %u], \"last_enable\": [%u, %u, %u], \"plant_failed\": %d}\n",
-           bo.can, (unsigned long long)rep.syncs, rep.frames_sent, rep.dropped, rep.overruns,
-           rep.commands_after_stop, rep.last_dac[0], rep.last_dac[1], rep.last_dac[2],
-           rep.last_enable[0], rep.last_enable[1], rep.last_enable[2], rep.plant_failed);
-    return rc == 2 ? EXIT_USAGE : rc;
+    cJSON *obj = cJSON_CreateObject();
+    cJSON_AddStringToObject(obj, "mode", "bus");
+    cJSON_AddStringToObject(obj, "can", b->bo.can);
+    cJSON_AddNumberToObject(obj, "syncs", (double)rep.syncs);
+    cJSON_AddNumberToObject(obj, "frames_sent", rep.frames_sent);
+    cJSON_AddNumberToObject(obj, "dropped", rep.dropped);
+    cJSON_AddNumberToObject(obj, "overruns", rep.overruns);
+    cJSON_AddNumberToObject(obj, "commands_after_stop", rep.commands_after_stop);
+    const int dac[3] = {(int)rep.last_dac[0], (int)rep.last_dac[1], (int)rep.last_dac[2]};
+    const int enable[3] = {(int)rep.last_enable[0], (int)rep.last_enable[1],
+                           (int)rep.last_enable[2]};
+    cJSON_AddItemToObject(obj, "last_dac", cJSON_CreateIntArray(dac, 3));
+    cJSON_AddItemToObject(obj, "last_enable", cJSON_CreateIntArray(enable, 3));
+    cJSON_AddNumberToObject(obj, "plant_failed", rep.plant_failed);
+    const int prc = print_json(obj);
+    return rc == 2 ? EXIT_USAGE : rc != 0 ? rc : prc;
+}
+
+static int run_bus(int argc, char **argv)
+{
+    static bus_config b;
+    const int rc = parse_bus(argc, argv, &b);
+    if (rc != 0) {
+        return rc < 0 ? 0 : rc;
+    }
+    if (b.go.chip != NULL || b.have_lines) {
+        if (b.go.chip == NULL || !b.have_lines || b.bo.can != NULL) {
+            return usage_error("bus: --gpio-chip goes with --lines, and not with --can");
+        }
+        return run_gpio(&b);
+    }
+    if (b.scenario == NULL || b.bo.can == NULL) {
+        return usage_error("bus: needs --scenario and --can (or --gpio-chip and --lines)");
+    }
+    return run_can(b.scenario, &b);
 }
 #endif
 

@@ -41,33 +41,16 @@ typedef struct {
     int damping;
 } joint_given;
 
-static int parse_joint(const dhcal_jctx *c, const cJSON *obj, const char *path, int is_default,
-                       dhs_joint_params *j, joint_given *given)
+static int parse_joint_motor(const dhcal_jctx *c, const cJSON *obj, const char *path,
+                             dhs_joint_params *j)
 {
-    static const char *const top[] = {"motor", "amplifier", "gear", "link", "encoder",
-                                      "tacho", "controller", "comment"};
     static const char *const motor[] = {"r_ohm", "l_h", "ke_v_s_per_rad", "kt_nm_per_a",
                                         "jm_kgm2", "bm_nms_per_rad", "coulomb_nm",
                                         "brake_nm"};
-    static const char *const amp[] = {"gain_v_per_v", "supply_v", "current_limit_a"};
-    static const char *const gear[] = {"ratio", "backlash_deg", "stiffness_nm_per_rad",
-                                       "damping_nms_per_rad", "transmission_error"};
-    static const char *const link_all[] = {"mass_kg", "com_mm", "inertia_kgm2", "coulomb_nm",
-                                           "viscous_nms_per_rad"};
-    static const char *const link_def[] = {"inertia_kgm2", "coulomb_nm", "viscous_nms_per_rad"};
-    static const char *const enc[] = {"lines"};
-    static const char *const tacho[] = {"v_s_per_rad", "ripple", "ripple_cycles", "noise_v"};
-    static const char *const ctl[] = {"gear_ratio", "encoder_lines"};
-    static const char *const te_keys[] = {"order", "sin_mrad", "cos_mrad"};
-
-    int rc = dhcal_jcheck_object(c, obj, path, DHCAL_JKEYS(top));
-    if (rc != DHCAL_IO_OK) {
-        return rc;
-    }
-    const cJSON *o = NULL;
     char p[DHCAL_JPATH_CAP];
-
     dhcal_jpath_key(p, path, "motor");
+    const cJSON *o = NULL;
+    int rc;
     if ((rc = dhcal_jobject(c, obj, path, "motor", 0, DHCAL_JKEYS(motor), &o)) != DHCAL_IO_OK) {
         return rc;
     }
@@ -84,8 +67,17 @@ static int parse_joint(const dhcal_jctx *c, const cJSON *obj, const char *path, 
          (rc = get_num(c, o, p, "brake_nm", 0, DHCAL_JNONNEG, &j->brake_nm)) != DHCAL_IO_OK)) {
         return rc;
     }
+    return DHCAL_IO_OK;
+}
 
+static int parse_joint_amplifier(const dhcal_jctx *c, const cJSON *obj, const char *path,
+                                 dhs_joint_params *j)
+{
+    static const char *const amp[] = {"gain_v_per_v", "supply_v", "current_limit_a"};
+    char p[DHCAL_JPATH_CAP];
     dhcal_jpath_key(p, path, "amplifier");
+    const cJSON *o = NULL;
+    int rc;
     if ((rc = dhcal_jobject(c, obj, path, "amplifier", 0, DHCAL_JKEYS(amp), &o)) != DHCAL_IO_OK) {
         return rc;
     }
@@ -97,8 +89,19 @@ static int parse_joint(const dhcal_jctx *c, const cJSON *obj, const char *path, 
                        &j->current_limit_a)) != DHCAL_IO_OK)) {
         return rc;
     }
+    return DHCAL_IO_OK;
+}
 
+static int parse_joint_gear(const dhcal_jctx *c, const cJSON *obj, const char *path,
+                            dhs_joint_params *j, joint_given *given)
+{
+    static const char *const gear[] = {"ratio", "backlash_deg", "stiffness_nm_per_rad",
+                                       "damping_nms_per_rad", "transmission_error"};
+    static const char *const te_keys[] = {"order", "sin_mrad", "cos_mrad"};
+    char p[DHCAL_JPATH_CAP];
     dhcal_jpath_key(p, path, "gear");
+    const cJSON *o = NULL;
+    int rc;
     if ((rc = dhcal_jobject(c, obj, path, "gear", 0, DHCAL_JKEYS(gear), &o)) != DHCAL_IO_OK) {
         return rc;
     }
@@ -168,8 +171,19 @@ static int parse_joint(const dhcal_jctx *c, const cJSON *obj, const char *path, 
             }
         }
     }
+    return DHCAL_IO_OK;
+}
 
+static int parse_joint_link(const dhcal_jctx *c, const cJSON *obj, const char *path,
+                            int is_default, dhs_joint_params *j)
+{
+    static const char *const link_all[] = {"mass_kg", "com_mm", "inertia_kgm2", "coulomb_nm",
+                                           "viscous_nms_per_rad"};
+    static const char *const link_def[] = {"inertia_kgm2", "coulomb_nm", "viscous_nms_per_rad"};
+    char p[DHCAL_JPATH_CAP];
     dhcal_jpath_key(p, path, "link");
+    const cJSON *o = NULL;
+    int rc;
     rc = is_default ? dhcal_jobject(c, obj, path, "link", 0, DHCAL_JKEYS(link_def), &o)
                     : dhcal_jobject(c, obj, path, "link", 1, DHCAL_JKEYS(link_all), &o);
     if (rc != DHCAL_IO_OK) {
@@ -190,9 +204,18 @@ static int parse_joint(const dhcal_jctx *c, const cJSON *obj, const char *path, 
         }
         dhc_vec3_scale(com_mm, 1e-3, j->com_m);
     }
+    return DHCAL_IO_OK;
+}
 
-    uint64_t u = 0U;
+static int parse_joint_encoder(const dhcal_jctx *c, const cJSON *obj, const char *path,
+                               dhs_joint_params *j)
+{
+    static const char *const enc[] = {"lines"};
+    char p[DHCAL_JPATH_CAP];
     dhcal_jpath_key(p, path, "encoder");
+    const cJSON *o = NULL;
+    int rc;
+    uint64_t u = 0U;
     if ((rc = dhcal_jobject(c, obj, path, "encoder", 0, DHCAL_JKEYS(enc), &o)) != DHCAL_IO_OK) {
         return rc;
     }
@@ -202,8 +225,18 @@ static int parse_joint(const dhcal_jctx *c, const cJSON *obj, const char *path, 
         }
         j->encoder_lines = (uint32_t)u;
     }
+    return DHCAL_IO_OK;
+}
 
+static int parse_joint_tacho(const dhcal_jctx *c, const cJSON *obj, const char *path,
+                             dhs_joint_params *j)
+{
+    static const char *const tacho[] = {"v_s_per_rad", "ripple", "ripple_cycles", "noise_v"};
+    char p[DHCAL_JPATH_CAP];
     dhcal_jpath_key(p, path, "tacho");
+    const cJSON *o = NULL;
+    int rc;
+    uint64_t u = 0U;
     if ((rc = dhcal_jobject(c, obj, path, "tacho", 0, DHCAL_JKEYS(tacho), &o)) != DHCAL_IO_OK) {
         return rc;
     }
@@ -228,8 +261,18 @@ static int parse_joint(const dhcal_jctx *c, const cJSON *obj, const char *path, 
             j->tacho_ripple_cycles = (unsigned)u;
         }
     }
+    return DHCAL_IO_OK;
+}
 
+static int parse_joint_controller(const dhcal_jctx *c, const cJSON *obj, const char *path,
+                                  dhs_joint_params *j, joint_given *given)
+{
+    static const char *const ctl[] = {"gear_ratio", "encoder_lines"};
+    char p[DHCAL_JPATH_CAP];
     dhcal_jpath_key(p, path, "controller");
+    const cJSON *o = NULL;
+    int rc;
+    uint64_t u = 0U;
     if ((rc = dhcal_jobject(c, obj, path, "controller", 0, DHCAL_JKEYS(ctl), &o)) != DHCAL_IO_OK) {
         return rc;
     }
@@ -248,6 +291,25 @@ static int parse_joint(const dhcal_jctx *c, const cJSON *obj, const char *path, 
             j->nominal_encoder_lines = (uint32_t)u;
             given->nominal_lines = 1;
         }
+    }
+    return DHCAL_IO_OK;
+}
+
+static int parse_joint(const dhcal_jctx *c, const cJSON *obj, const char *path, int is_default,
+                       dhs_joint_params *j, joint_given *given)
+{
+    static const char *const top[] = {"motor", "amplifier", "gear", "link", "encoder",
+                                      "tacho", "controller", "comment"};
+    int rc = dhcal_jcheck_object(c, obj, path, DHCAL_JKEYS(top));
+    if (rc != DHCAL_IO_OK ||
+        (rc = parse_joint_motor(c, obj, path, j)) != DHCAL_IO_OK ||
+        (rc = parse_joint_amplifier(c, obj, path, j)) != DHCAL_IO_OK ||
+        (rc = parse_joint_gear(c, obj, path, j, given)) != DHCAL_IO_OK ||
+        (rc = parse_joint_link(c, obj, path, is_default, j)) != DHCAL_IO_OK ||
+        (rc = parse_joint_encoder(c, obj, path, j)) != DHCAL_IO_OK ||
+        (rc = parse_joint_tacho(c, obj, path, j)) != DHCAL_IO_OK ||
+        (rc = parse_joint_controller(c, obj, path, j, given)) != DHCAL_IO_OK) {
+        return rc;
     }
     return DHCAL_IO_OK;
 }

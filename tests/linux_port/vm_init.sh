@@ -107,8 +107,8 @@ fault_case() { # name "dhcal-fw options" dhcal-sim-options...
     wait $SIM
     show "OUT fw-$name" fw-$name.json; show "OUT sim-$name" sim-$name.json
     F=$(field fw-$name.json fault)
-    DAC=$(sed -n 's/.*"last_dac": \[\([^]]*\)\].*/\1/p' sim-$name.json)
-    if [ "$RC" = 1 ] && [ "$F" = port_timeout ] && [ "$DAC" = "2048, 2048, 2048" ]; then
+    DAC=$(sed -n 's/.*"last_dac": *\[\([^]]*\)\].*/\1/p' sim-$name.json | tr -d ' ')
+    if [ "$RC" = 1 ] && [ "$F" = port_timeout ] && [ "$DAC" = "2048,2048,2048" ]; then
         result "$name" PASS "fault $F after $(field fw-$name.json ticks) ticks, drives commanded to 0 V (codes $DAC)"
     else
         result "$name" FAIL "exit $RC, fault '$F', last drive codes '$DAC'"
@@ -136,9 +136,9 @@ RC=$?
 wait $SIM
 show "OUT fw-stop" fw-stop.json; show "ERR fw-stop" fw-stop.err; show "OUT sim-stop" sim-stop.json
 F=$(field fw-stop.json fault)
-DAC=$(sed -n 's/.*"last_dac": \[\([^]]*\)\].*/\1/p' sim-stop.json)
-EN=$(sed -n 's/.*"last_enable": \[\([^]]*\)\].*/\1/p' sim-stop.json)
-if [ "$RC" = 1 ] && [ "$F" = stopped ] && [ "$DAC" = "2048, 2048, 2048" ] && [ "$EN" = "0, 0, 0" ]; then
+DAC=$(sed -n 's/.*"last_dac": *\[\([^]]*\)\].*/\1/p' sim-stop.json | tr -d ' ')
+EN=$(sed -n 's/.*"last_enable": *\[\([^]]*\)\].*/\1/p' sim-stop.json | tr -d ' ')
+if [ "$RC" = 1 ] && [ "$F" = stopped ] && [ "$DAC" = "2048,2048,2048" ] && [ "$EN" = "0,0,0" ]; then
     result sigterm PASS "fault $F after $(field fw-stop.json ticks) ticks, drives commanded to 0 V (codes $DAC) and disabled (enable $EN)"
 else
     result sigterm FAIL "exit $RC, fault '$F', last drive codes '$DAC', enable '$EN'"
