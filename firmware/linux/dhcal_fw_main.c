@@ -12,6 +12,7 @@
 #define _POSIX_C_SOURCE 200809L
 #endif
 
+#include <cjson/cJSON.h>
 #include <errno.h>
 #include <getopt.h>
 #include <math.h>
@@ -459,6 +460,19 @@ static fw_linux_gpio_status open_encoder_lines(const options *o, fw_linux_gpio_e
     return st;
 }
 
+/* obj on standard output as one line, deleted. */
+static void print_json(cJSON *obj)
+{
+    char *text = obj != NULL ? cJSON_PrintUnformatted(obj) : NULL;
+    cJSON_Delete(obj);
+    if (text == NULL) {
+        fprintf(stderr, "dhcal-fw: out of memory\n");
+        return;
+    }
+    puts(text);
+    free(text);
+}
+
 static int run_gpio_watch(const options *o)
 {
     static fw_linux_gpio_enc enc;
@@ -473,11 +487,17 @@ static int run_gpio_watch(const options *o)
     fw_linux_gpio_watch(&enc, (int64_t)o->gpio_watch, (uint32_t)o->gpio_timeout_ms,
                         (uint32_t)o->gpio_stall_ms, &r);
     fw_linux_gpio_close(&enc);
-    printf("{\"mode\": \"gpio-watch\", \"chip\": \"%s\", \"lines\": [%u, %u], \"edges\": %llu, "
-           "\"counts\": %lld, \"fault\": \"%s\", \"detail\": \"%s\"}\n",
-           o->gpio_chip, o->enc_line[0], o->enc_line[1], (unsigned long long)r.edges,
-           (long long)r.counts, r.fault ? fw_fault_name(FW_FAULT_ENCODER_JUMP) : "none",
-           r.detail);
+    cJSON *obj = cJSON_CreateObject();
+    cJSON_AddStringToObject(obj, "mode", "gpio-watch");
+    cJSON_AddStringToObject(obj, "chip", o->gpio_chip);
+    const int lines[2] = {(int)o->enc_line[0], (int)o->enc_line[1]};
+    cJSON_AddItemToObject(obj, "lines", cJSON_CreateIntArray(lines, 2));
+    cJSON_AddNumberToObject(obj, "edges", (double)r.edges);
+    cJSON_AddNumberToObject(obj, "counts", (double)r.counts);
+    cJSON_AddStringToObject(obj, "fault",
+                            r.fault ? fw_fault_name(FW_FAULT_ENCODER_JUMP) : "none");
+    cJSON_AddStringToObject(obj, "detail", r.detail);
+    print_json(obj);
     return r.fault ? EXIT_FAULT : 0;
 }
 
@@ -592,80 +612,104 @@ static int open_nv(const options *o)
     return 0;
 }
 
-static void print_counters(void)
+/* The bus's counters (the Linux port). */
+static void add_counters(cJSON *obj)
 {
     const fw_can_link_counters *k = &link_.counters;
-    printf(", \"bus\": {\"ticks\": %llu, \"complete\": %llu, \"timeouts\": %u, \"lost\": %u, "
-           "\"late\": %u, \"duplicate\": %u, \"malformed\": %u, \"overruns\": %u, "
-           "\"io_errors\": %u, \"rx_frames\": %llu, \"tx_frames\": %llu}",
-           (unsigned long long)k->ticks, (unsigned long long)k->complete, k->timeouts, k->lost,
-           k->late, k->duplicate, k->malformed, k->overruns, k->io_errors,
-           (unsigned long long)can_bus.rx_frames, (unsigned long long)can_bus.tx_frames);
+    cJSON *bus = cJSON_AddObjectToObject(obj, "bus");
+    cJSON_AddNumberToObject(bus, "ticks", (double)k->ticks);
+    cJSON_AddNumberToObject(bus, "complete", (double)k->complete);
+    cJSON_AddNumberToObject(bus, "timeouts", k->timeouts);
+    cJSON_AddNumberToObject(bus, "lost", k->lost);
+    cJSON_AddNumberToObject(bus, "late", k->late);
+    cJSON_AddNumberToObject(bus, "duplicate", k->duplicate);
+    cJSON_AddNumberToObject(bus, "malformed", k->malformed);
+    cJSON_AddNumberToObject(bus, "overruns", k->overruns);
+    cJSON_AddNumberToObject(bus, "io_errors", k->io_errors);
+    cJSON_AddNumberToObject(bus, "rx_frames", (double)can_bus.rx_frames);
+    cJSON_AddNumberToObject(bus, "tx_frames", (double)can_bus.tx_frames);
 }
 
-/* The JSON result. fault: the controller's (FW_FAULT_NONE when the run completed). */
-/* Returns 0 when --params-out (if asked for) could not be written, else 1. */
+/* The calibrated parameters into obj's "params", and (--params-out) the parameter file,
+ * replaced whole or left as it was: a reader never sees half a parameter file. Returns 0
+ * when that file could not be written, else 1. */
+static int add_params(const options *o, cJSON *obj)
+{
+    int written = 1;
+    cJSON *params_json = cJSON_AddObjectToObject(obj, "params");
+    dhc_param_set set;
+    (void)fw_job_param_set(&job, &set);
+    dhcal_text params = {0};
+    for (size_t k = 0U; k < set.count; ++k) {
+        char name[64];
+        (void)dhc_params_name(&set, k, name, sizeof name);
+        const double v = dhc_params_value(&set, &job.calibrated, k);
+        /* every digit (cJSON's own numbers stop at 15 where they compare equal within an
+         * epsilon): the parameter file and the JSON give the same doubles */
+        char digits[32];
+        (void)snprintf(digits, sizeof digits, "%.17g", v);
+        cJSON_AddRawToObject(params_json, name, digits);
+        dhcal_text_printf(&params, "%s %s\n", name, digits);
+    }
+    if (o->params_out != NULL) {
+        dhcal_error err = {0};
+        if (params.failed) {
+            (void)snprintf(err.msg, sizeof err.msg, "%s: out of memory", o->params_out);
+            written = 0;
+        } else if (dhcal_file_write_atomic(o->params_out, params.p, params.len, &err) !=
+                   DHCAL_IO_OK) {
+            written = 0;
+        }
+        if (!written) {
+            fprintf(stderr, "dhcal-fw: --params-out: %s\n", err.msg);
+        }
+    }
+    free(params.p);
+    return written;
+}
+
+/* The JSON result. fault: the controller's (FW_FAULT_NONE when the run completed).
+ * Returns 0 when --params-out (if asked for) could not be written, else 1. */
 static int print_result(const options *o, fw_fault fault, size_t n_done, int calibrated,
                         const struct timespec *t0)
 {
     int written = 1;
-    const int is_linux = strcmp(o->port, "linux") == 0;
-    printf("{\"mode\": \"calibrate\", \"port\": \"%s\", \"fault\": \"%s\", \"fault_index\": %zu, "
-           "\"ticks\": %llu, \"samples\": %zu",
-           o->port, fw_fault_name(fault), fault != FW_FAULT_NONE ? job.ctrl.fault_index : 0U,
-           (unsigned long long)job.ctrl.ticks, n_done);
+    const size_t nj = machine.n_joints;
+    cJSON *obj = cJSON_CreateObject();
+    cJSON_AddStringToObject(obj, "mode", "calibrate");
+    cJSON_AddStringToObject(obj, "port", o->port);
+    cJSON_AddStringToObject(obj, "fault", fw_fault_name(fault));
+    cJSON_AddNumberToObject(obj, "fault_index",
+                            fault != FW_FAULT_NONE ? (double)job.ctrl.fault_index : 0.0);
+    cJSON_AddNumberToObject(obj, "ticks", (double)job.ctrl.ticks);
+    cJSON_AddNumberToObject(obj, "samples", (double)n_done);
     if (fault != FW_FAULT_NONE) {
         /* What the controller last commanded: 0 V once the fault latched. */
-        printf(", \"drive_v_after_fault\": [");
-        for (size_t j = 0U; j < machine.n_joints; ++j) {
-            printf("%s%.6f", j > 0U ? ", " : "", job.ctrl.u_v[j]);
-        }
-        printf("]");
+        cJSON_AddItemToObject(obj, "drive_v_after_fault",
+                              cJSON_CreateDoubleArray(job.ctrl.u_v, (int)nj));
     }
     if (calibrated) {
         char effect[64];
         (void)fw_autocal_effect_label(&job.result, effect, sizeof effect);
-        printf(", \"effect\": \"%s\", \"geometric_rms_mm\": %.9f, \"wire_rms_mm\": %.9f, "
-               "\"saved\": %d, \"seq\": %u, \"params\": {",
-               effect, job.result.geo.rms_mm, job.result.new_rms_mm, job.result.saved, (unsigned)job.result.seq);
-        dhc_param_set set;
-        (void)fw_job_param_set(&job, &set);
-        dhcal_text params = {0};
-        for (size_t k = 0U; k < set.count; ++k) {
-            char name[64];
-            (void)dhc_params_name(&set, k, name, sizeof name);
-            const double v = dhc_params_value(&set, &job.calibrated, k);
-            printf("%s\"%s\": %.17g", k > 0U ? ", " : "", name, v);
-            dhcal_text_printf(&params, "%s %.17g\n", name, v);
-        }
-        printf("}");
-        /* Replaced whole or left as it was: a reader never sees half a parameter file. */
-        if (o->params_out != NULL) {
-            dhcal_error err = {0};
-            if (params.failed) {
-                (void)snprintf(err.msg, sizeof err.msg, "%s: out of memory", o->params_out);
-                written = 0;
-            } else if (dhcal_file_write_atomic(o->params_out, params.p, params.len, &err) !=
-                       DHCAL_IO_OK) {
-                written = 0;
-            }
-            if (!written) {
-                fprintf(stderr, "dhcal-fw: --params-out: %s\n", err.msg);
-            }
-        }
-        free(params.p);
+        cJSON_AddStringToObject(obj, "effect", effect);
+        cJSON_AddNumberToObject(obj, "geometric_rms_mm", job.result.geo.rms_mm);
+        cJSON_AddNumberToObject(obj, "wire_rms_mm", job.result.new_rms_mm);
+        cJSON_AddNumberToObject(obj, "saved", job.result.saved);
+        cJSON_AddNumberToObject(obj, "seq", (double)job.result.seq);
+        written = add_params(o, obj);
     }
-    if (is_linux) {
-        print_counters();
+    if (strcmp(o->port, "linux") == 0) {
+        add_counters(obj);
     } else {
         /* the simulated drives' last commands, as codes (2048: 0 V) */
-        printf(", \"plant_dac\": [");
-        for (size_t j = 0U; j < machine.n_joints; ++j) {
-            printf("%s%u", j > 0U ? ", " : "", (unsigned)sim.plant.dac[j]);
+        int dac[DHC_MAX_JOINTS];
+        for (size_t j = 0U; j < nj; ++j) {
+            dac[j] = (int)sim.plant.dac[j];
         }
-        printf("]");
+        cJSON_AddItemToObject(obj, "plant_dac", cJSON_CreateIntArray(dac, (int)nj));
     }
-    printf(", \"elapsed_s\": %.3f}\n", elapsed_s(t0));
+    cJSON_AddNumberToObject(obj, "elapsed_s", elapsed_s(t0));
+    print_json(obj);
     fflush(stdout);
     return written;
 }

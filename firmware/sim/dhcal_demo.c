@@ -18,6 +18,7 @@
 #define _POSIX_C_SOURCE 200809L
 #endif
 
+#include <cjson/cJSON.h>
 #include <getopt.h>
 #include <math.h>
 #include <stdio.h>
@@ -672,20 +673,34 @@ int main(int argc, char **argv)
         fprintf(log, "wrote %s/samples.csv and %s/positioning.csv\n", out_dir, out_dir);
     }
     if (json) {
-        printf("{\"before_rms_mm\": %.6f, \"geometric_rms_mm\": %.6f, \"after_rms_mm\": %.6f, "
-               "\"effect\": \"%s\", \"noise_floor_mm\": %.6f, \"before_max_mm\": %.6f, "
-               "\"geometric_max_mm\": %.6f, \"after_max_mm\": %.6f, \"samples\": %zu, "
-               "\"observability_o1\": %.6g, ",
-               ph[0].rms_mm, ph[1].rms_mm, ph[2].rms_mm, effect, floor_mm, ph[0].max_mm,
-               ph[1].max_mm, ph[2].max_mm, n_done, o1);
         /* the noise model the controller measured and fitted with: what `dhcal --noise`
          * takes at the desk (largest joint sd, in degrees) */
         double joint_sd_deg = 0.0;
         for (size_t j = 0U; j < nominal.arm.n_joints; ++j) {
             joint_sd_deg = fmax(joint_sd_deg, res->noise.joint_rad[j] * 180.0 / DHC_PI);
         }
-        printf("\"noise_model\": {\"joint_deg\": %.6g, \"meas_mm\": %.6g}}\n", joint_sd_deg,
-               res->noise.meas_mm);
+        cJSON *obj = cJSON_CreateObject();
+        cJSON_AddNumberToObject(obj, "before_rms_mm", ph[0].rms_mm);
+        cJSON_AddNumberToObject(obj, "geometric_rms_mm", ph[1].rms_mm);
+        cJSON_AddNumberToObject(obj, "after_rms_mm", ph[2].rms_mm);
+        cJSON_AddStringToObject(obj, "effect", effect);
+        cJSON_AddNumberToObject(obj, "noise_floor_mm", floor_mm);
+        cJSON_AddNumberToObject(obj, "before_max_mm", ph[0].max_mm);
+        cJSON_AddNumberToObject(obj, "geometric_max_mm", ph[1].max_mm);
+        cJSON_AddNumberToObject(obj, "after_max_mm", ph[2].max_mm);
+        cJSON_AddNumberToObject(obj, "samples", (double)n_done);
+        cJSON_AddNumberToObject(obj, "observability_o1", o1);
+        cJSON *noise = cJSON_AddObjectToObject(obj, "noise_model");
+        cJSON_AddNumberToObject(noise, "joint_deg", joint_sd_deg);
+        cJSON_AddNumberToObject(noise, "meas_mm", res->noise.meas_mm);
+        char *text = cJSON_PrintUnformatted(obj);
+        cJSON_Delete(obj);
+        if (text == NULL) {
+            fprintf(stderr, "dhcal-demo: out of memory\n");
+            return 1;
+        }
+        puts(text);
+        free(text);
     }
     return 0;
 }

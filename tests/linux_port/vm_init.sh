@@ -22,8 +22,8 @@ settle() { # let a background dhcal-sim open its socket
     usleep 300000
 }
 field() { # file key: the first value of key in a one-line JSON object
-    awk -v k="\"$2\": " 'NR == 1 { i = index($0, k); if (i == 0) exit;
-        s = substr($0, i + length(k)); sub(/^"/, "", s); sub(/["},].*/, "", s); print s }' "$1"
+    awk -v k="$2" 'NR == 1 { if (!match($0, "\"" k "\": *")) exit;
+        s = substr($0, RSTART + RLENGTH); sub(/^"/, "", s); sub(/["},].*/, "", s); print s }' "$1"
 }
 
 # ---------------------------------------------------------------- devices
