@@ -3,7 +3,7 @@
 
 #include <string.h>
 
-#include "dhcal/dhc_params.h"
+#include "dhcal/dhc_param_kind.h"
 
 #define KINDS(first, last) (uint8_t)(first), (uint8_t)((unsigned)(last) - (unsigned)(first) + 1U)
 

@@ -20,6 +20,7 @@
 #include "dhc_matrix.h"
 #include "dhc_model.h"
 #include "dhc_noise.h"
+#include "dhc_param_kind.h"
 #include "dhc_params.h"
 #include "dhc_plan.h"
 #include "dhc_status.h"

@@ -1,5 +1,6 @@
-/* test_eiv.c - errors in variables: the noise model of dhc_calib_options / dhc_diagnose_options
- * (joint-angle noise through the pose's Jacobian plus the measurement's own noise).
+/* test_noise.c - errors in variables: the noise model (dhc_noise.h) of dhc_calib_options and
+ * dhc_diagnose_options (joint-angle noise through the pose's Jacobian plus the measurement's
+ * own noise).
  *   (a) off (all 0): the fit and the diagnosis are bit for bit what they were before the
  *       noise model existed (values captured from that build), and a noise model of
  *       exactly 1 mm per row, which whitens by 1, changes no bit either;
