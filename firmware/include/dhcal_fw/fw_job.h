@@ -37,10 +37,7 @@ typedef struct {
                                configured effects best (fw_plan_select), and with the
                                diagnosis on the effects it may add as well: a plan for the
                                base model alone gathers its poses where look-alikes cannot
-                               be told apart (measured, dhcal-demo: with it, 50 planned
-                               poses took joint_compliance:2 for joint_scale:2; with the
-                               candidates, 40 planned poses find every hidden effect of
-                               host_sim/scenarios as 60 random ones do) */
+                               be told apart (measured: docs/numbers.md, 5) */
     const fw_pose *poses;  /* NULL: the job plans its poses (plan_candidates, plan_seed,
                               mixed_dirs); else the n_samples poses to measure, in this
                               order, as given: a plan made at the desk (`dhcal plan`, e.g.
