@@ -550,6 +550,42 @@ static int set_up(demo_options *o)
     return 0;
 }
 
+/* The --json summary: the phases' errors (ph), the effect, the noise floor and the noise
+ * model the controller measured and fitted with. 0, or 1 out of memory. */
+static int print_summary(const char *effect, double floor_mm, size_t n_done, double o1,
+                         const fw_autocal_result *res, size_t n_joints)
+{
+    /* the noise model the controller measured and fitted with: what `dhcal --noise`
+     * takes at the desk (largest joint sd, in degrees) */
+    double joint_sd_deg = 0.0;
+    for (size_t j = 0U; j < n_joints; ++j) {
+        joint_sd_deg = fmax(joint_sd_deg, res->noise.joint_rad[j] * 180.0 / DHC_PI);
+    }
+    cJSON *obj = cJSON_CreateObject();
+    cJSON_AddNumberToObject(obj, "before_rms_mm", ph[0].rms_mm);
+    cJSON_AddNumberToObject(obj, "geometric_rms_mm", ph[1].rms_mm);
+    cJSON_AddNumberToObject(obj, "after_rms_mm", ph[2].rms_mm);
+    cJSON_AddStringToObject(obj, "effect", effect);
+    cJSON_AddNumberToObject(obj, "noise_floor_mm", floor_mm);
+    cJSON_AddNumberToObject(obj, "before_max_mm", ph[0].max_mm);
+    cJSON_AddNumberToObject(obj, "geometric_max_mm", ph[1].max_mm);
+    cJSON_AddNumberToObject(obj, "after_max_mm", ph[2].max_mm);
+    cJSON_AddNumberToObject(obj, "samples", (double)n_done);
+    cJSON_AddNumberToObject(obj, "observability_o1", o1);
+    cJSON *noise = cJSON_AddObjectToObject(obj, "noise_model");
+    cJSON_AddNumberToObject(noise, "joint_deg", joint_sd_deg);
+    cJSON_AddNumberToObject(noise, "meas_mm", res->noise.meas_mm);
+    char *text = cJSON_PrintUnformatted(obj);
+    cJSON_Delete(obj);
+    if (text == NULL) {
+        fprintf(stderr, "dhcal-demo: out of memory\n");
+        return 1;
+    }
+    puts(text);
+    free(text);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     static demo_options o;
@@ -673,34 +709,7 @@ int main(int argc, char **argv)
         fprintf(log, "wrote %s/samples.csv and %s/positioning.csv\n", out_dir, out_dir);
     }
     if (json) {
-        /* the noise model the controller measured and fitted with: what `dhcal --noise`
-         * takes at the desk (largest joint sd, in degrees) */
-        double joint_sd_deg = 0.0;
-        for (size_t j = 0U; j < nominal.arm.n_joints; ++j) {
-            joint_sd_deg = fmax(joint_sd_deg, res->noise.joint_rad[j] * 180.0 / DHC_PI);
-        }
-        cJSON *obj = cJSON_CreateObject();
-        cJSON_AddNumberToObject(obj, "before_rms_mm", ph[0].rms_mm);
-        cJSON_AddNumberToObject(obj, "geometric_rms_mm", ph[1].rms_mm);
-        cJSON_AddNumberToObject(obj, "after_rms_mm", ph[2].rms_mm);
-        cJSON_AddStringToObject(obj, "effect", effect);
-        cJSON_AddNumberToObject(obj, "noise_floor_mm", floor_mm);
-        cJSON_AddNumberToObject(obj, "before_max_mm", ph[0].max_mm);
-        cJSON_AddNumberToObject(obj, "geometric_max_mm", ph[1].max_mm);
-        cJSON_AddNumberToObject(obj, "after_max_mm", ph[2].max_mm);
-        cJSON_AddNumberToObject(obj, "samples", (double)n_done);
-        cJSON_AddNumberToObject(obj, "observability_o1", o1);
-        cJSON *noise = cJSON_AddObjectToObject(obj, "noise_model");
-        cJSON_AddNumberToObject(noise, "joint_deg", joint_sd_deg);
-        cJSON_AddNumberToObject(noise, "meas_mm", res->noise.meas_mm);
-        char *text = cJSON_PrintUnformatted(obj);
-        cJSON_Delete(obj);
-        if (text == NULL) {
-            fprintf(stderr, "dhcal-demo: out of memory\n");
-            return 1;
-        }
-        puts(text);
-        free(text);
+        return print_summary(effect, floor_mm, n_done, o1, res, nominal.arm.n_joints);
     }
     return 0;
 }

@@ -18,7 +18,7 @@
 #include "dhcal_sim/dhs_dataset.h"
 #include "dhcal_sim/dhs_scenario_json.h"
 #if defined(DHCAL_SIM_BUS)
-#include "dhcal_fw/fw_can_offset.h"
+#include "dhcal_can/fw_can_offset.h"
 #include "dhs_bus_linux.h"
 #endif
 
@@ -314,7 +314,7 @@ static const char *const bus_help =
     "       dhcal-sim bus --gpio-chip NAME --lines A,B [--gpio-steps N] [--gpio-burst N\n"
     "                     --gpio-pause-ms MS] [--gpio-start-delay-ms MS] [--gpio-step-us US]\n"
     "The simulated arm's drives and draw-wire measurer on a SocketCAN interface, in lockstep\n"
-    "with the controller (firmware/can/dhcal.dbc): each SYNC advances the plant one 1 ms\n"
+    "with the controller (can/dhcal.dbc): each SYNC advances the plant one 1 ms\n"
     "tick and is answered with the drives' and the measurer's feedback. The plant starts\n"
     "at q = (0, 60, -60) deg with run seed K (default 7): dhcal-fw --port sim's run.\n"
     "  --can-id-offset N     the DBC's identifiers moved by N on the bus (0..1535; the\n"

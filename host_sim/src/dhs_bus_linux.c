@@ -1,5 +1,5 @@
 /* dhs_bus_linux.c - dhs_bus on SocketCAN, and quadrature edges on gpio-sim (dhs_bus_linux.h).
- * The socket is the firmware's own transport (dhcal_socketcan, firmware/can/linux): the two
+ * The socket is the firmware's own transport (dhcal_socketcan, can/linux): the two
  * ends of the test share its poll loop, filters and size checks. */
 #ifndef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 200809L
@@ -13,8 +13,8 @@
 #include <sys/stat.h>
 #include <time.h>
 
-#include "dhcal_fw/fw_can.h"
-#include "dhcal_fw/fw_can_offset.h"
+#include "dhcal_can/fw_can.h"
+#include "dhcal_can/fw_can_offset.h"
 #include "dhcal_sim/dhs_bus.h"
 #include "dhcal_sim/dhs_plant.h"
 #include "fw_linux_can.h"

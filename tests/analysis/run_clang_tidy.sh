@@ -2,12 +2,12 @@
 # run_clang_tidy.sh BUILD_DIR SOURCE_DIR [DIR...]
 #   clang-tidy (configuration: SOURCE_DIR/.clang-tidy, and any .clang-tidy below it) over
 #   every translation unit of BUILD_DIR/compile_commands.json under SOURCE_DIR/DIR (default
-#   lib io desk tools firmware host_sim), in parallel. Prints every finding; exit 1 if there is any, 0 otherwise.
+#   lib can io desk tools firmware host_sim), in parallel. Prints every finding; exit 1 if there is any, 0 otherwise.
 set -eu
 build=$1
 src=$2
 shift 2
-[ $# -gt 0 ] || set -- lib io desk tools firmware host_sim
+[ $# -gt 0 ] || set -- lib can io desk tools firmware host_sim
 db=$build/compile_commands.json
 [ -f "$db" ] || { echo "run_clang_tidy.sh: no $db (configure first)" >&2; exit 2; }
 out=$build/clang-tidy.log

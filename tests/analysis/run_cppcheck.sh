@@ -1,14 +1,14 @@
 #!/bin/sh
 # run_cppcheck.sh BUILD_DIR SOURCE_DIR [DIR...]
 #   cppcheck over the translation units of BUILD_DIR/compile_commands.json under
-#   SOURCE_DIR/DIR (default lib io desk tools firmware host_sim), with the suppressions of cppcheck-suppressions.txt
+#   SOURCE_DIR/DIR (default lib can io desk tools firmware host_sim), with the suppressions of cppcheck-suppressions.txt
 #   (each justified there). Checks: warning, style, performance, portability, inconclusive
 #   included. Exit 1 on any finding.
 set -eu
 build=$1
 src=$2
 shift 2
-[ $# -gt 0 ] || set -- lib io desk tools firmware host_sim
+[ $# -gt 0 ] || set -- lib can io desk tools firmware host_sim
 here=$(cd "$(dirname "$0")" && pwd)
 db=$build/compile_commands.json
 [ -f "$db" ] || { echo "run_cppcheck.sh: no $db (configure first)" >&2; exit 2; }

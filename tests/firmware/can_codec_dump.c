@@ -20,7 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "dhcal_fw/fw_can.h"
+#include "dhcal_can/fw_can.h"
 
 #define MAX_FIELDS 10
 

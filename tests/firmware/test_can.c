@@ -16,7 +16,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "dhcal_fw/fw_can.h"
+#include "dhcal_can/fw_can.h"
 #include "dhcal_fw/fw_can_link.h"
 #include "dhcal_fw/fw_quadrature.h"
 #include "unity.h"

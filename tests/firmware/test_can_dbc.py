@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """test_can_dbc.py --dump BIN --dbc FILE --pydeps DIR: the C CAN codec (fw_can.h) and the
-DBC file (firmware/can/dhcal.dbc) describe the same protocol.
+DBC file (can/dhcal.dbc) describe the same protocol.
 
 cantools (an independent DBC implementation) decodes every frame the C encoder makes to the
 same physical values the C side put in (codes to volts by the DBC's scale and offset), and

@@ -5,8 +5,8 @@
  * 0x180 + j, 0x200), not computed by the code under test. */
 #include <string.h>
 
-#include "dhcal_fw/fw_can.h"
-#include "dhcal_fw/fw_can_offset.h"
+#include "dhcal_can/fw_can.h"
+#include "dhcal_can/fw_can_offset.h"
 #include "unity.h"
 
 /* A bus that records what is sent and hands out a queue of frames. */

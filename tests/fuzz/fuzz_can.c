@@ -20,7 +20,7 @@
  */
 #include "fuzz_common.h" /* first: it sets the POSIX feature level */
 
-#include "dhcal_fw/fw_can.h"
+#include "dhcal_can/fw_can.h"
 #include "dhcal_fw/fw_can_link.h"
 #include "dhcal_fw/fw_quadrature.h"
 

@@ -1,5 +1,5 @@
 /* fw_can_link.h - fw_port over CAN: the controller's side of the lockstep protocol of
- * fw_can.h (firmware/can/dhcal.dbc), on any fw_can_transport.
+ * fw_can.h (can/dhcal.dbc), on any fw_can_transport.
  *
  * Usage:
  *     static fw_can_link link;
@@ -49,8 +49,8 @@
 #include <stdint.h>
 
 #include "dhcal/dhc_config.h"
-#include "dhcal_fw/fw_can.h"
-#include "dhcal_fw/fw_can_transport.h"
+#include "dhcal_can/fw_can.h"
+#include "dhcal_can/fw_can_transport.h"
 #include "dhcal_fw/fw_port.h"
 
 /* Optional time source. Both NULL: no pacing, recv timeouts only (simulation, tests). */

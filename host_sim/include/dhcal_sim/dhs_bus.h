@@ -1,5 +1,5 @@
 /* dhs_bus.h - the drives' and the draw-wire measurer's side of the CAN protocol
- * (firmware/include/dhcal_fw/fw_can.h, firmware/can/dhcal.dbc) around the simulated
+ * (can/include/dhcal_can/fw_can.h, can/dhcal.dbc) around the simulated
  * plant: what the controller's fw_can_link talks to in tests and in the simulator.
  *
  * Usage:
@@ -38,8 +38,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "dhcal_fw/fw_can.h"
-#include "dhcal_fw/fw_can_transport.h"
+#include "dhcal_can/fw_can.h"
+#include "dhcal_can/fw_can_transport.h"
 #include "dhs_plant.h"
 
 #define DHS_BUS_CMD_WATCHDOG_TICKS 10U

@@ -1,9 +1,9 @@
 /* fw_can_offset.c - see fw_can_offset.h. */
-#include "dhcal_fw/fw_can_offset.h"
+#include "dhcal_can/fw_can_offset.h"
 
 #include <stddef.h>
 
-#include "dhcal_fw/fw_can.h"
+#include "dhcal_can/fw_can.h"
 
 static fw_can_status offset_send(void *ctx, const fw_can_frame *frame)
 {

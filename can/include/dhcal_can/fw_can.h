@@ -1,4 +1,4 @@
-/* fw_can.h - the controller's CAN messages (firmware/can/dhcal.dbc) as C structs, and the
+/* fw_can.h - the controller's CAN messages (can/dhcal.dbc) as C structs, and the
  * codec between them and fw_can_frame.
  *
  * The protocol, lockstep at the control rate (1 kHz), 11-bit identifiers, little-endian
@@ -32,7 +32,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "dhcal_fw/fw_can_transport.h"
+#include "dhcal_can/fw_can_transport.h"
 
 #define FW_CAN_MAX_DRIVES 3U     /* the DBC defines three drives */
 #define FW_CAN_N_WIRES 3U

@@ -1,6 +1,6 @@
 /* fw_can.c - the CAN message codec (fw_can.h). Bit positions are those of
- * firmware/can/dhcal.dbc; tests/firmware/test_can_dbc.py checks them against it. */
-#include "dhcal_fw/fw_can.h"
+ * can/dhcal.dbc; tests/firmware/test_can_dbc.py checks them against it. */
+#include "dhcal_can/fw_can.h"
 
 #include <string.h>
 

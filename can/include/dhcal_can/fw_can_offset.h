@@ -1,6 +1,6 @@
 /* fw_can_offset.h - the protocol's identifiers moved by a fixed offset on the bus.
  *
- * firmware/can/dhcal.dbc fixes the identifiers of one arm (SYNC 0x080 ... MEAS_WIRES 0x200).
+ * can/dhcal.dbc fixes the identifiers of one arm (SYNC 0x080 ... MEAS_WIRES 0x200).
  * A bus shared with other devices, or with a second arm, needs them elsewhere: this
  * transport wraps another and adds the offset to every frame it sends and takes it off
  * every frame it receives, so the codec and the link keep the DBC's identifiers. A received
@@ -12,7 +12,7 @@
 
 #include <stdint.h>
 
-#include "dhcal_fw/fw_can_transport.h"
+#include "dhcal_can/fw_can_transport.h"
 
 /* Largest offset: the protocol's highest identifier (MEAS_WIRES) stays 11-bit. */
 #define FW_CAN_OFFSET_MAX (0x7FFU - 0x200U)

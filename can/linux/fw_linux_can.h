@@ -30,7 +30,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "dhcal_fw/fw_can_transport.h"
+#include "dhcal_can/fw_can_transport.h"
 
 #define FW_LINUX_CAN_MAX_FILTERS 32U
 #define FW_LINUX_CAN_TX_WAIT_MS 50

@@ -12,7 +12,7 @@
 
 #define FW_CAN_MAX_DLC 8U
 
-/* 11-bit identifiers only: the protocol (firmware/can/dhcal.dbc) uses no extended frames. */
+/* 11-bit identifiers only: the protocol (can/dhcal.dbc) uses no extended frames. */
 typedef struct {
     uint32_t id;
     uint8_t len;                  /* 0..8 */
