@@ -2,6 +2,7 @@
 #include "dhcal_desk/dhcal_analysis.h"
 
 #include "dhcal/dhc_jacobian.h"
+#include "dhcal_effect_list.h"
 
 #include <errno.h>
 #include <math.h>
@@ -9,8 +10,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-
-/* Big library workspaces: static, this is a single-threaded command-line program. */
 /* One least-squares system and its analysis: a call's scratch (about 66 KiB), on the heap. */
 typedef struct {
     dhc_normal_eq ne;
@@ -20,16 +19,15 @@ typedef struct {
 int dhcal_parse_effects(const char *list, const dhc_model *model, dhc_param_set *set,
                         dhcal_error *err)
 {
-    if (list == NULL) {
-        return DHCAL_IO_OK;
-    }
-    const char *p = list;
-    while (*p != '\0') {
-        const char *end = strchr(p, ',');
-        const size_t len = end != NULL ? (size_t)(end - p) : strlen(p);
-        dhc_effect effect;
-        size_t joint;
-        if (dhc_effect_parse(p, len, model->arm.n_joints, &effect, &joint) != DHC_OK) {
+    const char *cursor = list;
+    dhc_effect effect;
+    size_t joint;
+    const char *p;
+    size_t len;
+    int got;
+    while ((got = dhcal_effect_list_next(&cursor, model->arm.n_joints, &effect, &joint, &p,
+                                         &len)) != 0) {
+        if (got < 0) {
             char known[512];
             (void)dhcal_effect_catalogue(known, sizeof known);
             snprintf(err->msg, sizeof err->msg,
@@ -49,10 +47,6 @@ int dhcal_parse_effects(const char *list, const dhc_model *model, dhc_param_set 
                          ? " or the model has no 'measurer'"
                          : "");
             return DHCAL_IO_BAD_INPUT;
-        }
-        p += len;
-        if (*p == ',') {
-            ++p;
         }
     }
     return DHCAL_IO_OK;

@@ -27,6 +27,7 @@
 
 #include "dhcal/dhc_params.h"
 #include "dhcal/dhc_uncertainty.h"
+#include "dhcal_effect_list.h"
 #include "dhcal_fw/fw_calstore.h"
 #include "dhcal_fw/fw_controller.h"
 #include "dhcal_fw/fw_ik.h"
@@ -511,18 +512,21 @@ static int set_up(demo_options *o)
         n_candidates = 0U;
     }
     /* The configured effects, comma separated, by their names in docs/effects.md. */
-    for (const char *e = effects; e != NULL && *e != '\0';) {
-        const char *comma = strchr(e, ',');
-        const size_t len = comma != NULL ? (size_t)(comma - e) : strlen(e);
-        if (autocal.n_effects == FW_AUTOCAL_MAX_EFFECTS ||
-            dhc_effect_parse(e, len, nj, &autocal.effect[autocal.n_effects],
-                             &autocal.effect_joint[autocal.n_effects]) != DHC_OK) {
+    const char *cursor = effects;
+    dhc_effect effect;
+    size_t joint;
+    const char *item;
+    size_t len;
+    int got;
+    while ((got = dhcal_effect_list_next(&cursor, nj, &effect, &joint, &item, &len)) != 0) {
+        if (got < 0 || autocal.n_effects == FW_AUTOCAL_MAX_EFFECTS) {
             fprintf(stderr, "dhcal-demo: --effects: '%.*s' is not an effect of a %zu-joint arm "
-                            "(at most %u)\n", (int)len, e, nj, FW_AUTOCAL_MAX_EFFECTS);
+                            "(at most %u)\n", (int)len, item, nj, FW_AUTOCAL_MAX_EFFECTS);
             return 2;
         }
+        autocal.effect[autocal.n_effects] = effect;
+        autocal.effect_joint[autocal.n_effects] = joint;
         ++autocal.n_effects;
-        e = comma != NULL ? comma + 1 : e + len;
     }
 
     fw_sim_io_config(&sf.sc, &io);
