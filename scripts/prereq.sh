@@ -198,6 +198,19 @@ probe_asan() {
   ./a || prereq_fail "the ASan + UBSan program did not run"
 }
 
+# Line coverage (need coverage): gcc's --coverage compiles, links and runs, leaving its
+# counts (.gcda), and gcovr reads them.
+probe_coverage() {
+  probe_build_tools && probe_host_c && probe_cjson && probe_libxml2 || return 1
+  prereq_cmd gcovr || return 1
+  printf '%s\n' "$prereq_c_source" >c.c
+  gcc -std=c11 --coverage -fprofile-update=atomic -o a c.c -lm >log 2>&1 ||
+    prereq_fail "gcc cannot link with --coverage: $(tail -3 log)" || return 1
+  ./a || prereq_fail "the --coverage program did not run" || return 1
+  [ -f a-c.gcda ] || [ -f c.gcda ] || prereq_fail "the --coverage program left no counts" || return 1
+  gcovr -r . --print-summary >log 2>&1 || prereq_fail "gcovr cannot read the counts: $(tail -3 log)"
+}
+
 probe_fuzz() {
   probe_build_tools && probe_cjson && probe_libxml2 || return 1
   prereq_cmd clang || return 1

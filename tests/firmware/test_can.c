@@ -139,7 +139,14 @@ static void test_every_field_round_trips_at_its_boundaries(void)
                 fw_can_drive_fb b2;
                 TEST_ASSERT_EQUAL(FW_CAN_MSG_OK, fw_can_decode_drive_fb(&f, &jj, &b2));
                 TEST_ASSERT_EQUAL_size_t(j, jj);
-                TEST_ASSERT_EQUAL_MEMORY(&fb, &b2, sizeof fb);
+                /* field by field: the struct's padding byte is no field (a byte-wise
+                 * comparison read it, and failed at -O0) */
+                TEST_ASSERT_EQUAL_UINT16(fb.encoder_counts, b2.encoder_counts);
+                TEST_ASSERT_EQUAL_UINT16(fb.tacho_code, b2.tacho_code);
+                TEST_ASSERT_EQUAL_UINT8(fb.enabled, b2.enabled);
+                TEST_ASSERT_EQUAL_UINT8(fb.saturated, b2.saturated);
+                TEST_ASSERT_EQUAL_UINT8(fb.fault, b2.fault);
+                TEST_ASSERT_EQUAL_UINT16(fb.tick, b2.tick);
             }
         }
     }
