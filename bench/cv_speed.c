@@ -23,8 +23,8 @@
 
 #include "dhcal_desk/dhcal_analysis.h"
 #include "dhcal_desk/dhcal_cv.h"
-#include "dhcal_io.h"
-#include "dhcal_model_map.h"
+#include "dhcal_io/dhcal_io.h"
+#include "dhcal_io/dhcal_model_map.h"
 
 static double now_s(void)
 {

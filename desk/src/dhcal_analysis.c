@@ -2,7 +2,7 @@
 #include "dhcal_desk/dhcal_analysis.h"
 
 #include "dhcal/dhc_jacobian.h"
-#include "dhcal_effect_list.h"
+#include "dhcal_io/dhcal_effect_list.h"
 
 #include <errno.h>
 #include <math.h>

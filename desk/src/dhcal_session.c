@@ -3,7 +3,7 @@
 
 #include <string.h>
 
-#include "dhcal_model_map.h"
+#include "dhcal_io/dhcal_model_map.h"
 
 int dhcal_session_begin(dhcal_session *s, const dhcal_model *file, const char *path,
                         const char *noise, const char *geometry, const char *repeatability,

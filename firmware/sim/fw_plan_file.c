@@ -5,7 +5,7 @@
 #include <string.h>
 
 #include "dhcal/dhc_geometry.h"
-#include "dhcal_csv.h"
+#include "dhcal_io/dhcal_csv.h"
 
 /* The file's 9 decimals of a degree put an end of a range at most this far beyond it. */
 #define PLAN_FILE_END_TOL_RAD 1e-9

@@ -13,8 +13,8 @@
 #include <string.h>
 
 #include "dhcal/dhc_geometry.h"
-#include "dhcal_file.h"
-#include "dhcal_io.h"
+#include "dhcal_io/dhcal_file.h"
+#include "dhcal_io/dhcal_io.h"
 #include "dhcal_sim/dhs_dataset.h"
 #include "dhcal_sim/dhs_scenario_json.h"
 #if defined(DHCAL_SIM_BUS)

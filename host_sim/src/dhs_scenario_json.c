@@ -15,7 +15,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "dhcal_json.h"
+#include "dhcal_io/dhcal_json.h"
 
 /* obj[key] as a number obeying r into *out; absent: an error when required, *out untouched
  * otherwise. */

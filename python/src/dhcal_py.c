@@ -10,9 +10,9 @@
 
 #include "dhcal/dhc_version.h"
 #include "dhcal_desk/dhcal_analysis.h"
-#include "dhcal_data.h"
-#include "dhcal_io.h"
-#include "dhcal_model_map.h"
+#include "dhcal_io/dhcal_data.h"
+#include "dhcal_io/dhcal_io.h"
+#include "dhcal_io/dhcal_model_map.h"
 #include "dhcal_desk/dhcal_refine.h"
 #include "dhcal_desk/dhcal_report.h"
 #include "dhcal_desk/dhcal_session.h"

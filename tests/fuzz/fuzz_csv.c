@@ -15,8 +15,8 @@
  */
 #include "fuzz_common.h" /* first: it sets the POSIX feature level */
 
-#include "dhcal_data.h"
-#include "dhcal_io.h"
+#include "dhcal_io/dhcal_data.h"
+#include "dhcal_io/dhcal_io.h"
 
 #define DEG (3.14159265358979323846 / 180.0)
 

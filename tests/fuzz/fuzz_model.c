@@ -12,8 +12,8 @@
  */
 #include "fuzz_common.h" /* first: it sets the POSIX feature level */
 
-#include "dhcal_io.h"
-#include "dhcal_model_map.h"
+#include "dhcal_io/dhcal_io.h"
+#include "dhcal_io/dhcal_model_map.h"
 
 #define ANGLE_TOL_RAD 1e-12
 

@@ -11,8 +11,8 @@
  */
 #include "fuzz_common.h" /* first: it sets the POSIX feature level */
 
-#include "dhcal_io.h"
-#include "dhcal_urdf.h"
+#include "dhcal_io/dhcal_io.h"
+#include "dhcal_io/dhcal_urdf.h"
 
 static dhcal_model imported;
 static dhcal_model reloaded;

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # check_install.sh BUILD_DIR VERSION: installs the build into a fresh prefix, then builds and
 # runs tests/install/consumer against it twice: as a CMake project of its own
-# (find_package(dhcal CONFIG), dhcal::dhcal) and with pkg-config (dhcal.pc). Nothing of the
+# (find_package(dhcal CONFIG), dhcal::dhcal, and dhcal::io for fit_files.c, which loads the
+# example's model file and CSV and fits) and with pkg-config (dhcal.pc). Nothing of the
 # dhcal tree is on either include path: only the installed files.
 set -euo pipefail
 build=$1
@@ -40,6 +41,13 @@ cmake -S "$here/consumer" -B "$work/consumer" -G Ninja -DCMAKE_BUILD_TYPE=Releas
   || { cat "$work/configure.log"; exit 1; }
 cmake --build "$work/consumer" >"$work/build.log" || { cat "$work/build.log"; exit 1; }
 "$work/consumer/consumer"
+# dhcal::io: the model file and measurements of the example, loaded and fitted
+examples=$(cd "$here/../../examples/data/compliance" && pwd)
+"$work/consumer/fit_files" "$examples/model.json" "$examples/train.csv" |
+  tee "$work/fit_files.log"
+grep -qE 'RMS [0-9.]+ mm, ok' "$work/fit_files.log" ||
+  { echo "FAIL: fit_files did not fit the example"; exit 1; }
+[ -f "$prefix/include/dhcal_io/dhcal_io.h" ] || { echo "FAIL: dhcal_io headers not installed"; exit 1; }
 
 echo "--- pkg-config --cflags --libs dhcal"
 pcdir=$(dirname "$(find "$prefix" -name dhcal.pc | head -1)")

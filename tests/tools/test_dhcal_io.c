@@ -17,7 +17,7 @@
 #include <unistd.h>
 
 #include "dhc_test_arms.h"
-#include "dhcal_io.h"
+#include "dhcal_io/dhcal_io.h"
 #include "dhc_test_files.h"
 #include "unity.h"
 

@@ -13,8 +13,8 @@
 
 #include "dhc_test_arms.h"
 #include "dhcal/dhc_params.h"
-#include "dhcal_io.h"
-#include "dhcal_model_map.h"
+#include "dhcal_io/dhcal_io.h"
+#include "dhcal_io/dhcal_model_map.h"
 #include "dhc_test_files.h"
 #include "unity.h"
 

@@ -12,9 +12,9 @@
 #include <unistd.h>
 
 #include "dhc_test_arms.h"
-#include "dhcal_machine.h"
-#include "dhcal_model_file.h"
-#include "dhcal_model_map.h"
+#include "dhcal_io/dhcal_machine.h"
+#include "dhcal_io/dhcal_model_file.h"
+#include "dhcal_io/dhcal_model_map.h"
 #include "dhc_test_files.h"
 #include "unity.h"
 

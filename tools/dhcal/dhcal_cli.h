@@ -9,8 +9,8 @@
 #include <stddef.h>
 
 #include "dhcal_desk/dhcal_analysis.h"
-#include "dhcal_data.h"
-#include "dhcal_io.h"
+#include "dhcal_io/dhcal_data.h"
+#include "dhcal_io/dhcal_io.h"
 #include "dhcal_desk/dhcal_refine.h"
 #include "dhcal_desk/dhcal_report.h"
 #include "dhcal_desk/dhcal_session.h"

@@ -22,9 +22,9 @@
 
 #include "dhcal/dhc_geometry.h"
 #include "dhcal/dhc_inverse.h"
-#include "dhcal_io.h"
+#include "dhcal_io/dhcal_io.h"
 #include "dhcal_options.h"
-#include "dhcal_text.h"
+#include "dhcal_io/dhcal_text.h"
 #include "dhcal_desk/dhcal_units.h"
 
 #define EXIT_COMPUTE 1

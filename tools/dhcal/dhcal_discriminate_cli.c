@@ -9,7 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "dhcal_model_file.h"
+#include "dhcal_io/dhcal_model_file.h"
 #include "dhcal_desk/dhcal_units.h"
 
 /* ---------------------------------------------------------------- the labels */

@@ -20,11 +20,11 @@
 
 #include "dhcal/dhc_plan.h"
 #include "dhcal_desk/dhcal_analysis.h"
-#include "dhcal_csv.h"
+#include "dhcal_io/dhcal_csv.h"
 #include "dhcal_discriminate.h"
-#include "dhcal_file.h"
-#include "dhcal_model_file.h"
-#include "dhcal_model_map.h"
+#include "dhcal_io/dhcal_file.h"
+#include "dhcal_io/dhcal_model_file.h"
+#include "dhcal_io/dhcal_model_map.h"
 #include "dhcal_options.h"
 #include "dhcal_desk/dhcal_units.h"
 

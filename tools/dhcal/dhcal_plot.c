@@ -20,7 +20,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "dhcal_file.h"
+#include "dhcal_io/dhcal_file.h"
 #include "dhcal_svg.h"
 
 /* |value| beyond this (mm or degrees) is no measurement; refusing it also keeps every range,

@@ -4,7 +4,7 @@
 
 #include <stddef.h>
 
-#include "dhcal_io.h"
+#include "dhcal_io/dhcal_io.h"
 
 typedef struct {
     char label[64];   /* "joint_compliance:2" */

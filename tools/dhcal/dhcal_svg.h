@@ -22,7 +22,7 @@
 
 #include <stddef.h>
 
-#include "dhcal_text.h"
+#include "dhcal_io/dhcal_text.h"
 
 /* The palette: position components x, y, z; before and after an effect; significant and
  * other candidates; approach directions; the frame's furniture. */

@@ -15,9 +15,9 @@
 #include <string.h>
 
 #include "dhcal/dhc_model.h"
-#include "dhcal_io.h"
+#include "dhcal_io/dhcal_io.h"
 #include "dhcal_options.h"
-#include "dhcal_urdf.h"
+#include "dhcal_io/dhcal_urdf.h"
 
 #define EXIT_WRITE 1
 #define EXIT_USAGE 2

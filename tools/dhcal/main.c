@@ -16,7 +16,7 @@
 #include "dhcal/dhc_version.h"
 #include "dhcal_cli.h"
 #include "dhcal_compensate.h"
-#include "dhcal_model_map.h"
+#include "dhcal_io/dhcal_model_map.h"
 #include "dhcal_options.h"
 #include "dhcal_plan_cmd.h"
 #include "dhcal_desk/dhcal_units.h"

@@ -4,8 +4,8 @@
 #define DHCAL_ANALYSIS_H
 
 #include "dhcal/dhc_diagnose.h"
-#include "dhcal_data.h"
-#include "dhcal_io.h"
+#include "dhcal_io/dhcal_data.h"
+#include "dhcal_io/dhcal_io.h"
 
 /* 1 when the samples are weighted by a noise model (--noise given), by the library's rule. */
 static inline int dhcal_noise_on(const dhc_noise_model *noise)

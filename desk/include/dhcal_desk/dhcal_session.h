@@ -5,10 +5,10 @@
 #ifndef DHCAL_SESSION_H
 #define DHCAL_SESSION_H
 
-#include "dhcal_csv.h"
-#include "dhcal_data.h"
+#include "dhcal_io/dhcal_csv.h"
+#include "dhcal_io/dhcal_data.h"
 #include "dhcal_desk/dhcal_analysis.h"
-#include "dhcal_model_file.h"
+#include "dhcal_io/dhcal_model_file.h"
 
 typedef struct {
     dhcal_model file;        /* the model file's content (names, limits, repeatability) */

@@ -21,8 +21,8 @@
 #include <stdio.h>
 
 #include "dhcal/dhc_model.h"
-#include "dhcal_csv.h"
-#include "dhcal_error.h"
+#include "dhcal_io/dhcal_csv.h"
+#include "dhcal_io/dhcal_error.h"
 
 /* An arm whose links and tool sum to less than this (mm) is no arm: the numbers are metres
  * (an arm of 0.2 to 3 m reads 0.2 to 3), 20 mm lies a decade from both. */

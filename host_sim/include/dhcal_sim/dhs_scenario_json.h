@@ -53,7 +53,7 @@
 #ifndef DHS_SCENARIO_JSON_H
 #define DHS_SCENARIO_JSON_H
 
-#include "dhcal_io.h"
+#include "dhcal_io/dhcal_io.h"
 #include "dhcal_sim/dhs_scenario.h"
 
 #define DHS_SCENARIO_MAX_BYTES 1048576U

@@ -5,7 +5,7 @@
 #include <stddef.h>
 
 #include "dhcal/dhc_linalg.h"
-#include "dhcal_error.h"
+#include "dhcal_io/dhcal_error.h"
 
 /* Value ranges of the file formats (docs/formats.md), shared by the model file and the CSV. */
 #define LEN_MAX_MM 1e5

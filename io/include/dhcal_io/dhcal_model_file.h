@@ -13,7 +13,7 @@
 
 #include "dhcal/dhc_effects.h"
 #include "dhcal/dhc_kinematics.h"
-#include "dhcal_error.h"
+#include "dhcal_io/dhcal_error.h"
 
 /* Largest model file accepted (bytes). */
 #define DHCAL_MODEL_MAX_BYTES 1048576U

@@ -1,13 +1,14 @@
 /* dhcal_machine.c - the machine file (dhcal_machine.h). */
-#include "dhcal_machine.h"
+#include "dhcal_io/dhcal_machine.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "dhcal/dhc_geometry.h"
-#include "dhcal_json.h"
-#include "dhcal_model_map.h"
+#include "dhcal_io/dhcal_json.h"
+#include "dhcal_io_common.h"
+#include "dhcal_io/dhcal_model_map.h"
 
 
 static const char *const TOP_KEYS[] = {"comment", "name",     "model",   "n_joints",

@@ -4,7 +4,7 @@
  * message that names the file and the line. Lines grow a heap buffer up to
  * DHCAL_CSV_MAX_LINE; no fixed-size line buffer.
  */
-#include "dhcal_csv.h"
+#include "dhcal_io/dhcal_csv.h"
 
 #include <errno.h>
 #include <math.h>

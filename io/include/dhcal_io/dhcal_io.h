@@ -5,10 +5,10 @@
 #ifndef DHCAL_IO_H
 #define DHCAL_IO_H
 
-#include "dhcal_csv.h"
-#include "dhcal_error.h"
-#include "dhcal_file.h"
-#include "dhcal_model_file.h"
-#include "dhcal_model_map.h"
+#include "dhcal_io/dhcal_csv.h"
+#include "dhcal_io/dhcal_error.h"
+#include "dhcal_io/dhcal_file.h"
+#include "dhcal_io/dhcal_model_file.h"
+#include "dhcal_io/dhcal_model_map.h"
 
 #endif /* DHCAL_IO_H */

@@ -1,5 +1,5 @@
 /* dhcal_data.c - measurement rows to library samples. */
-#include "dhcal_data.h"
+#include "dhcal_io/dhcal_data.h"
 
 #include <math.h>
 #include <stdio.h>

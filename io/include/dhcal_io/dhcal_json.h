@@ -13,9 +13,8 @@
 #include <stdint.h>
 
 #include "dhcal/dhc_geometry.h"
-#include "dhcal_error.h"
-#include "dhcal_io_common.h"
-#include "dhcal_model_file.h"
+#include "dhcal_io/dhcal_error.h"
+#include "dhcal_io/dhcal_model_file.h"
 
 #define DHCAL_JPATH_CAP 160U
 

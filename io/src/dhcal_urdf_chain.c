@@ -1,5 +1,5 @@
 /* dhcal_urdf_chain.c - a URDF chain's axes as DH frames (the method: dhcal_urdf_chain.h). */
-#include "dhcal_urdf_chain.h"
+#include "dhcal_io/dhcal_urdf_chain.h"
 
 #include <math.h>
 

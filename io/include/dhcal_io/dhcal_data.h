@@ -6,7 +6,7 @@
 #include <stdint.h>
 
 #include "dhcal/dhc_calib.h"
-#include "dhcal_csv.h"
+#include "dhcal_io/dhcal_csv.h"
 
 /* Samples of a dataset, in file row order, ready for dhc_calib_fit (heap). */
 typedef struct {

@@ -1,5 +1,5 @@
 /* dhcal_text.c - the growing text buffer (dhcal_text.h). */
-#include "dhcal_text.h"
+#include "dhcal_io/dhcal_text.h"
 
 #include <stdarg.h>
 #include <stdint.h>

@@ -16,7 +16,7 @@
 
 #include "dhcal/dhc_config.h"
 #include "dhcal/dhc_model.h"
-#include "dhcal_error.h"
+#include "dhcal_io/dhcal_error.h"
 
 /* Largest machine file accepted (bytes). */
 #define DHCAL_MACHINE_MAX_BYTES 1048576U

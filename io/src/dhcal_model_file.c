@@ -4,7 +4,7 @@
  * message that names the file and the JSON path; the file is read whole up to
  * DHCAL_MODEL_MAX_BYTES. Saving goes through the atomic write of dhcal_file.h.
  */
-#include "dhcal_model_file.h"
+#include "dhcal_io/dhcal_model_file.h"
 
 #include <cjson/cJSON.h>
 #include <errno.h>
@@ -16,10 +16,10 @@
 #include <string.h>
 
 #include "dhcal/dhc_params.h"
-#include "dhcal_file.h"
+#include "dhcal_io/dhcal_file.h"
 #include "dhcal_io_common.h"
-#include "dhcal_json.h"
-#include "dhcal_text.h"
+#include "dhcal_io/dhcal_json.h"
+#include "dhcal_io/dhcal_text.h"
 
 /* Value ranges of the model file (docs/formats.md). */
 #define MODEL_ANGLE_MAX_DEG 360.0

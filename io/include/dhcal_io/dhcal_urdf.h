@@ -14,8 +14,8 @@
 #include <stddef.h>
 
 #include "dhcal/dhc_config.h"
-#include "dhcal_error.h"
-#include "dhcal_model_file.h"
+#include "dhcal_io/dhcal_error.h"
+#include "dhcal_io/dhcal_model_file.h"
 
 /* Largest URDF file read (bytes): robot descriptions with inline meshes stay far below. */
 #define DHCAL_URDF_MAX_BYTES 16777216U /* 16 MiB */

@@ -3,7 +3,7 @@
 #ifndef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 200809L
 #endif
-#include "dhcal_file.h"
+#include "dhcal_io/dhcal_file.h"
 
 #include <errno.h>
 #include <fcntl.h>

@@ -1,5 +1,5 @@
 /* dhcal_model_map.c - model file effects <-> dhc_model. */
-#include "dhcal_model_map.h"
+#include "dhcal_io/dhcal_model_map.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -1,6 +1,6 @@
 /* dhcal_json.c - strict JSON files through cJSON, shared by the file layer's loaders
  * (dhcal_json.h). */
-#include "dhcal_json.h"
+#include "dhcal_io/dhcal_json.h"
 
 #include <ctype.h>
 #include <errno.h>

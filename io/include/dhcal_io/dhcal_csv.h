@@ -12,8 +12,8 @@
 #include <stddef.h>
 
 #include "dhcal/dhc_config.h"
-#include "dhcal_error.h"
-#include "dhcal_text.h"
+#include "dhcal_io/dhcal_error.h"
+#include "dhcal_io/dhcal_text.h"
 
 /* Longest CSV line accepted (bytes, not counting the newline). */
 #define DHCAL_CSV_MAX_LINE 65536U

@@ -12,7 +12,7 @@
 #define DHCAL_MODEL_MAP_H
 
 #include "dhcal/dhc_model.h"
-#include "dhcal_model_file.h"
+#include "dhcal_io/dhcal_model_file.h"
 
 /* DHCAL_IO_BAD_INPUT with "<path>: effects.<name>: ..." for a wrong value count or an
  * entry that belongs elsewhere. */

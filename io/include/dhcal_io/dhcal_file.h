@@ -14,7 +14,7 @@
 
 #include <stddef.h>
 
-#include "dhcal_error.h"
+#include "dhcal_io/dhcal_error.h"
 
 /* path := data[0..len), atomically:
  *   1. creates "<path>.tmp.<pid>.<k>" (k = 0..99, the first free one) in path's directory

@@ -3,7 +3,7 @@
 #define _POSIX_C_SOURCE 200809L
 #endif
 
-#include "dhcal_urdf.h"
+#include "dhcal_io/dhcal_urdf.h"
 
 #include <errno.h>
 #include <libxml/parser.h>
@@ -13,10 +13,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "dhcal_file.h"
+#include "dhcal_io/dhcal_file.h"
 #include "dhcal_io_common.h"
-#include "dhcal_text.h"
-#include "dhcal_urdf_chain.h"
+#include "dhcal_io/dhcal_text.h"
+#include "dhcal_io/dhcal_urdf_chain.h"
 
 #define MM_PER_M 1000.0
 #define RANGE_MAX_DEG 720.0

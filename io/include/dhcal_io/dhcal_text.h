@@ -17,7 +17,7 @@
 
 #include <stddef.h>
 
-#include "dhcal_error.h"
+#include "dhcal_io/dhcal_error.h"
 
 typedef struct {
     char *p;

@@ -1,5 +1,5 @@
 /* dhcal_effect_list.c - a comma-separated list of effects (dhcal_effect_list.h). */
-#include "dhcal_effect_list.h"
+#include "dhcal_io/dhcal_effect_list.h"
 
 #include <string.h>
 
