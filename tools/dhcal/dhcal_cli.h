@@ -43,14 +43,15 @@ typedef enum {
 } dhcal_out_use;
 
 /* A command that reads measurements: its work on the loaded session (0, EXIT_USAGE or
- * EXIT_COMPUTE), its help (usage and what it does), and the options it takes beyond the
- * common ones. */
+ * EXIT_COMPUTE), its help (usage and what it does), and the options it takes beyond
+ * --model, --data, --json and --no-units-check. */
 typedef struct {
     const char *name;
     int (*run)(const dhcal_cli_options *o, dhcal_session *s);
     const char *help;
     dhcal_out_use out;
     int takes_cv;
+    int fits; /* takes the options that shape a fit (--effects, --heldout, --noise, ...) */
 } dhcal_measured_command;
 
 extern const dhcal_measured_command dhcal_compare_command;

@@ -343,4 +343,4 @@ const dhcal_measured_command dhcal_fit_command = {
     "ranges and the uncertainty the calibration predicts there. --cv adds the\n"
     "cross-validated RMS. --out writes the calibrated model (same schema; it loads\n"
     "again as --model) only when the fit succeeds and is physically plausible.\n",
-    DHCAL_OUT_MODEL, 1};
+    DHCAL_OUT_MODEL, 1, 1};

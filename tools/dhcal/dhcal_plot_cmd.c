@@ -137,4 +137,4 @@ const dhcal_measured_command dhcal_plot_command = {
     "Writes SVG files into DIR: residual components against each joint angle\n"
     "(where a missing effect shows its shape), per-row error before and after\n"
     "adding the effect the diagnosis names, and the candidate ranking.\n",
-    DHCAL_OUT_DIR, 0};
+    DHCAL_OUT_DIR, 0, 1};

@@ -192,7 +192,7 @@ const dhcal_measured_command dhcal_diagnose_command = {
     "why it fell short (docs/effects.md 6). refine's first step is the one named.\n"
     "Drift (thermal) candidates are scored only when the time (temperature) varies\n"
     "apart from the pose. --cv is accepted (it always cross-validates).\n",
-    DHCAL_OUT_NONE, 1};
+    DHCAL_OUT_NONE, 1, 1};
 
 const dhcal_measured_command dhcal_refine_command = {
     "refine", run_refine,
@@ -205,4 +205,4 @@ const dhcal_measured_command dhcal_refine_command = {
     "rows and no --geometry, cross-validation also picks how much geometry to fit.\n"
     "--heldout rows are evaluated at every step, never used to choose. --out writes\n"
     "the final model.\n",
-    DHCAL_OUT_MODEL, 0};
+    DHCAL_OUT_MODEL, 0, 1};

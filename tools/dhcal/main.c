@@ -75,12 +75,14 @@ static const char *const model_data_help =
     "  --model M.json     nominal model (docs/formats.md, section 2)\n"
     "  --data D.csv       measurements: q1..qN in deg; x,y,z in mm or raw wire lengths\n"
     "                     L1,L2,L3 (fitted in wire-length space when the model has a\n"
-    "                     measurer); optional dir1..dirN, temp_c, t_s, qw,qx,qy,qz\n"
+    "                     measurer); optional dir1..dirN, temp_c, t_s, qw,qx,qy,qz\n";
+
+static const char *const effects_help =
     "  --effects LIST     effects to fit besides joint offsets and link geometry, comma\n"
     "                     separated (i: a joint number; drift: time from t_s, else the\n"
     "                     row number):\n";
 
-static const char *const common_help =
+static const char *const fit_help =
     "  --heldout H.csv    rows not used in the fit; their RMS error is reported\n"
     "  --noise J,M        the samples' noise: each joint angle's sd J (deg) and each\n"
     "                     measured coordinate's sd M (mm); every row is then weighted by\n"
@@ -90,12 +92,14 @@ static const char *const common_help =
     "                     (offsets, a and d), full (every parameter, the default)\n"
     "  --repeatability MM the arm's repeatability (ISO 9283 RP, mm; default the model's\n"
     "                     repeatability_mm): diagnose and refine name no effect that\n"
-    "                     changes the tool by less than the noise it implies\n"
+    "                     changes the tool by less than the noise it implies\n";
+
+static const char *const output_help =
     "  --json             one JSON object on stdout instead of text\n"
     "  --no-units-check   go on when the data look like metres, radians, swapped columns\n"
     "                     or another frame than the model's (docs/cli.md, 1.11)\n";
 
-
+/* The catalogue's names, wrapped under the option's description. */
 static void print_effect_names(void)
 {
     enum { INDENT = 21, WIDTH = 88 };
@@ -116,13 +120,26 @@ static void print_effect_names(void)
     putchar('\n');
 }
 
+/* The command's help and the options it takes (docs/cli.md 1.2). */
 static void print_command_help(const dhcal_measured_command *cmd)
 {
     fputs(cmd->help, stdout);
     printf("options:\n%s", model_data_help);
-    print_effect_names();
-    fputs(common_help, stdout);
-    if (cmd->out == DHCAL_OUT_DIR) {
+    if (cmd->fits) {
+        fputs(effects_help, stdout);
+        print_effect_names();
+        fputs(fit_help, stdout);
+    }
+    if (cmd->takes_cv) {
+        printf("  --cv               the cross-validated RMS too (%s)\n",
+               cmd->out == DHCAL_OUT_MODEL ? "5 folds" : "accepted: it always cross-validates");
+    }
+    fputs(output_help, stdout);
+    if (cmd->out == DHCAL_OUT_MODEL) {
+        printf("  --out C.json       the calibrated model (the same schema; it loads again as\n"
+               "                     --model), written only when the fit succeeds and is\n"
+               "                     physically plausible\n");
+    } else if (cmd->out == DHCAL_OUT_DIR) {
         printf("  --out DIR          directory for the SVG files (created if missing)\n");
     }
 }
