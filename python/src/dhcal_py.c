@@ -24,9 +24,22 @@ struct dhcal_py_model {
     dhc_model lib;
 };
 
+/* msg into err. The desk library names a value by the program's option ("--effects: ..."):
+ * here it is an argument of the Python function ("effects: ..."). */
 static int fail(char *err, size_t cap, int code, const char *msg)
 {
-    if (err != NULL && cap > 0U) {
+    if (err == NULL || cap == 0U) {
+        return code;
+    }
+    size_t n = 0U;
+    if (msg[0] == '-' && msg[1] == '-') {
+        while (msg[2U + n] >= 'a' && msg[2U + n] <= 'z') {
+            ++n;
+        }
+    }
+    if (n > 0U && msg[2U + n] == ':') {
+        snprintf(err, cap, "%s", msg + 2);
+    } else {
         snprintf(err, cap, "%s", msg);
     }
     return code;

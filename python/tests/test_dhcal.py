@@ -399,3 +399,15 @@ def test_heldout_measured_otherwise_is_refused_as_the_program_does(model, train,
     with pytest.raises(dhcal.DhcalInputError, match="measured like the training rows"):
         dhcal.fit(model, train["q_deg"], wires_mm=wires, heldout=heldout,
                   directions=train["directions"])
+
+
+def test_errors_name_the_functions_arguments_not_the_programs_options(model, train) -> None:
+    """The desk library says '--effects: ...' to the program's user; a Python caller reads
+    the argument's name (issue 29)."""
+    with pytest.raises(ValueError) as e:
+        dhcal.fit(model, train["q_deg"], train["xyz_mm"], effects=("gremlins",))
+    assert str(e.value).startswith("effects: 'gremlins' is not an effect"), str(e.value)
+    assert "--" not in str(e.value)
+    with pytest.raises(ValueError) as e:
+        dhcal.fit(model, train["q_deg"], train["xyz_mm"], geometry="most")
+    assert "--geometry" not in str(e.value) and "geometry" in str(e.value), str(e.value)
