@@ -148,6 +148,13 @@ static double deg(double rad)
     return rad / DHC_DEG + 0.0;
 }
 
+/* A value for people: what the URDF's decimals and the conversion's rounding leave of a zero
+ * (alpha 2.8e-10 deg) is shown as 0; the model file keeps every digit. */
+static double shown(double v)
+{
+    return fabs(v) < 1e-7 ? 0.0 : v + 0.0;
+}
+
 static void print_import_report(const urdf_options *o, const dhcal_model *m,
                                 const dhcal_urdf_import_report *r)
 {
@@ -160,20 +167,22 @@ static void print_import_report(const urdf_options *o, const dhcal_model *m,
         printf("joint %zu  %-24s (line %ld) %-6s theta %.9g deg  d %.9g mm  a %.9g mm  "
                "alpha %.9g deg",
                i + 1U, r->joint_names[i], r->joint_lines[i], hayati ? "Hayati" : "DH",
-               deg(j->theta_offset_rad), j->d_mm, j->a_mm, deg(j->alpha_rad));
+               shown(deg(j->theta_offset_rad)), shown(j->d_mm), shown(j->a_mm),
+               shown(deg(j->alpha_rad)));
         if (hayati) {
-            printf("  beta %.9g deg", deg(j->beta_rad));
+            printf("  beta %.9g deg", shown(deg(j->beta_rad)));
         }
         printf("  range %.9g..%.9g deg%s\n", deg(j->min_rad), deg(j->max_rad),
                r->continuous[i] ? " (continuous)" : "");
     }
     double rpy[3];
     dhc_rot_to_rpy(&arm->base.rot, rpy);
-    printf("base (frame 0 in link '%s'): xyz_mm [%.9g, %.9g, %.9g], rpy_deg [%.9g, %.9g, %.9g]\n",
-           o->base, arm->base.pos[0] + 0.0, arm->base.pos[1] + 0.0, arm->base.pos[2] + 0.0, deg(rpy[0]),
-           deg(rpy[1]), deg(rpy[2]));
-    printf("tool_mm (in frame %zu): [%.9g, %.9g, %.9g]\n", arm->n_joints, arm->tool_mm[0] + 0.0,
-           arm->tool_mm[1] + 0.0, arm->tool_mm[2] + 0.0);
+    printf("base (frame 0 in link '%s'): xyz_mm [%.9g, %.9g, %.9g], rpy_deg [%.9g, %.9g, "
+           "%.9g]\n",
+           o->base, shown(arm->base.pos[0]), shown(arm->base.pos[1]), shown(arm->base.pos[2]),
+           shown(deg(rpy[0])), shown(deg(rpy[1])), shown(deg(rpy[2])));
+    printf("tool_mm (in frame %zu): [%.9g, %.9g, %.9g]\n", arm->n_joints,
+           shown(arm->tool_mm[0]), shown(arm->tool_mm[1]), shown(arm->tool_mm[2]));
     double w[3];
     dhc_rot_log(&r->tip_in_frame_n, w);
     const double angle = dhc_vec3_norm(w);
