@@ -152,8 +152,9 @@ void dhcal_cli_text_fit(const dhcal_fit *f, const dhcal_session *s,
                rep->rank, rep->structural_rank);
     }
     if (rep->freed > 0U) {
-        printf("%zu parameter%s that the input values could not identify, the estimate can: "
-               "fitted\n", rep->freed, rep->freed == 1U ? "" : "s");
+        printf("%zu parameter%s could not be identified at the nominal model but can be at the "
+               "fitted one (the fit moved a point off the axis it sat on): fitted too\n",
+               rep->freed, rep->freed == 1U ? "" : "s");
     }
     for (size_t i = 0U; i < f->model.arm.n_joints; ++i) {
         if (f->model.arm.joint[i].convention == DHC_CONV_HAYATI) {
