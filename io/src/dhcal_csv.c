@@ -357,6 +357,14 @@ static int parse_header(csv_ctx *c, dhcal_dataset *data)
         csv_col col = {COL_Q, 0U};
         size_t beyond = 0U;
         const int cls = classify(f.s, c->n_joints, &col, &beyond);
+        if (cls == 0 && memchr(f.s, ';', f.n) != NULL) {
+            /* "q1;q2;q3;x;y;z": a spreadsheet's export in a locale that writes a decimal comma */
+            return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
+                             "%s:%zu: unknown column '%s': the file looks separated by ';', "
+                             "dhcal reads ',' between values and '.' in numbers "
+                             "(docs/formats.md 3)",
+                             path, line, dhcal_quote(f.s, f.n, sb));
+        }
         if (cls < 0) {
             return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
                              "%s:%zu: column '%s' is beyond the model's %zu joints", path, line,

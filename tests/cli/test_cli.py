@@ -202,6 +202,15 @@ class Cli(unittest.TestCase):
         self.assertEqual(r.stdout.strip(),
                          'dhcal %s.%s.%s' % (parts['MAJOR'], parts['MINOR'], parts['PATCH']))
 
+    def test_a_semicolon_separated_file_is_named_as_such(self):
+        rows = [l for l in GOOD_CSV.splitlines() if not l.startswith('#')]
+        semi = '\n'.join(l.replace(',', ';') for l in rows[:5]) + '\n'
+        data = self.write('semicolons.csv', semi)
+        r = self.run_dhcal('compare', '--model', self.model, '--data', data)
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertIn("semicolons.csv:1: unknown column", r.stderr)
+        self.assertIn("separated by ';'", r.stderr)
+
     def test_bad_noise_models_exit_2_and_leave_out_untouched(self):
         for bad in ('0.001', 'x,0.01', '0.001,0', '0.001,-1', '-0.001,0.01', '2,0.01',
                     'nan,0.01', '0.001,inf', '0.001,0.01,3', '0.001,1e3'):
