@@ -8,6 +8,39 @@
 
 #include "dhcal_cli.h"
 
+/* Rows shown in the text report: every row of a short file, else the largest errors
+ * (`--json` lists every row). */
+#define COMPARE_ROWS_SHOWN 10U
+
+/* The rows with the largest errors, largest first (all of them when there are few), each
+ * with its file line. */
+static void print_worst_rows(const dhcal_session *s, const double *err_mm, size_t n)
+{
+    size_t pick[COMPARE_ROWS_SHOWN];
+    const size_t shown = n < COMPARE_ROWS_SHOWN ? n : COMPARE_ROWS_SHOWN;
+    for (size_t k = 0U; k < shown; ++k) { /* selection: a few passes over the rows */
+        size_t best = n;
+        for (size_t i = 0U; i < n; ++i) {
+            int taken = 0;
+            for (size_t m = 0U; m < k; ++m) {
+                taken |= pick[m] == i;
+            }
+            if (!taken && (best == n || err_mm[i] > err_mm[best])) {
+                best = i;
+            }
+        }
+        pick[k] = best;
+    }
+    if (n > shown) {
+        printf("the %zu largest errors of %zu rows (--json lists every row):\n", shown, n);
+    }
+    printf("%6s %8s %12s\n", "row", "line", "error_mm");
+    for (size_t k = 0U; k < shown; ++k) {
+        const size_t i = n > shown ? pick[k] : k;
+        printf("%6zu %8zu %12.4f\n", i + 1U, s->data.rows[i].line, err_mm[i]);
+    }
+}
+
 static int run_compare(const dhcal_cli_options *o, dhcal_session *s)
 {
     const size_t n = s->samples.n;
@@ -36,10 +69,7 @@ static int run_compare(const dhcal_cli_options *o, dhcal_session *s)
     }
     printf("model '%s' against %s: %zu rows (%s)\n", s->file.name, o->data, n,
            s->samples.wires ? "wire lengths" : "tool points");
-    printf("%6s %8s %12s\n", "row", "line", "error_mm");
-    for (size_t i = 0U; i < n; ++i) {
-        printf("%6zu %8zu %12.4f\n", i + 1U, s->data.rows[i].line, err_mm[i]);
-    }
+    print_worst_rows(s, err_mm, n);
     printf("RMS %.4f mm, mean %.4f mm, max %.4f mm\n", es.rms_mm, es.mean_mm, es.max_mm);
     free(err_mm);
     return 0;
