@@ -12,33 +12,50 @@
  * (`--json` lists every row). */
 #define COMPARE_ROWS_SHOWN 10U
 
-/* The rows with the largest errors, largest first (all of them when there are few), each
- * with its file line. */
+/* A row's error and its index, for ordering. */
+typedef struct {
+    double error_mm;
+    size_t row;
+} row_error;
+
+/* Largest error first; equal errors in file order. */
+static int by_error(const void *a, const void *b)
+{
+    const row_error *x = a;
+    const row_error *y = b;
+    if (x->error_mm < y->error_mm) {
+        return 1;
+    }
+    if (x->error_mm > y->error_mm) {
+        return -1;
+    }
+    return x->row < y->row ? -1 : (x->row > y->row ? 1 : 0);
+}
+
+/* The rows with the largest errors, largest first (every row, in file order, when there
+ * are few), each with its file line. */
 static void print_worst_rows(const dhcal_session *s, const double *err_mm, size_t n)
 {
-    size_t pick[COMPARE_ROWS_SHOWN];
-    const size_t shown = n < COMPARE_ROWS_SHOWN ? n : COMPARE_ROWS_SHOWN;
-    for (size_t k = 0U; k < shown; ++k) { /* selection: a few passes over the rows */
-        size_t best = n;
-        for (size_t i = 0U; i < n; ++i) {
-            int taken = 0;
-            for (size_t m = 0U; m < k; ++m) {
-                taken |= pick[m] == i;
-            }
-            if (!taken && (best == n || err_mm[i] > err_mm[best])) {
-                best = i;
-            }
-        }
-        pick[k] = best;
+    row_error *order = malloc((n + 1U) * sizeof *order);
+    if (order == NULL) {
+        return; /* the summary line still follows */
     }
-    if (n > shown) {
+    for (size_t i = 0U; i < n; ++i) {
+        order[i].error_mm = err_mm[i];
+        order[i].row = i;
+    }
+    size_t shown = n;
+    if (n > COMPARE_ROWS_SHOWN) {
+        qsort(order, n, sizeof *order, by_error);
+        shown = COMPARE_ROWS_SHOWN;
         printf("the %zu largest errors of %zu rows (--json lists every row):\n", shown, n);
     }
     printf("%6s %8s %12s\n", "row", "line", "error_mm");
     for (size_t k = 0U; k < shown; ++k) {
-        const size_t i = n > shown ? pick[k] : k;
+        const size_t i = order[k].row;
         printf("%6zu %8zu %12.4f\n", i + 1U, s->data.rows[i].line, err_mm[i]);
     }
+    free(order);
 }
 
 static int run_compare(const dhcal_cli_options *o, dhcal_session *s)
