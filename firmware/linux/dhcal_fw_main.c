@@ -29,6 +29,7 @@
 #include "dhcal_fw/fw_can_link.h"
 #include "dhcal_can/fw_can_offset.h"
 #include "dhcal_fw/fw_controller.h"
+#include "dhcal_io/dhcal_json.h"
 #include "dhcal_io/dhcal_file.h"
 #include "dhcal_io/dhcal_machine.h"
 #include "dhcal_io/dhcal_text.h"
@@ -460,19 +461,6 @@ static fw_linux_gpio_status open_encoder_lines(const options *o, fw_linux_gpio_e
     return st;
 }
 
-/* obj on standard output as one line, deleted. */
-static void print_json(cJSON *obj)
-{
-    char *text = obj != NULL ? cJSON_PrintUnformatted(obj) : NULL;
-    cJSON_Delete(obj);
-    if (text == NULL) {
-        fprintf(stderr, "dhcal-fw: out of memory\n");
-        return;
-    }
-    puts(text);
-    free(text);
-}
-
 static int run_gpio_watch(const options *o)
 {
     static fw_linux_gpio_enc enc;
@@ -497,7 +485,7 @@ static int run_gpio_watch(const options *o)
     cJSON_AddStringToObject(obj, "fault",
                             r.fault ? fw_fault_name(FW_FAULT_ENCODER_JUMP) : "none");
     cJSON_AddStringToObject(obj, "detail", r.detail);
-    print_json(obj);
+    (void)dhcal_json_print(obj, "dhcal-fw");
     return r.fault ? EXIT_FAULT : 0;
 }
 
@@ -709,7 +697,7 @@ static int print_result(const options *o, fw_fault fault, size_t n_done, int cal
         cJSON_AddItemToObject(obj, "plant_dac", cJSON_CreateIntArray(dac, (int)nj));
     }
     cJSON_AddNumberToObject(obj, "elapsed_s", elapsed_s(t0));
-    print_json(obj);
+    (void)dhcal_json_print(obj, "dhcal-fw");
     fflush(stdout);
     return written;
 }

@@ -27,6 +27,7 @@
 
 #include "dhcal/dhc_params.h"
 #include "dhcal/dhc_uncertainty.h"
+#include "dhcal_io/dhcal_json.h"
 #include "dhcal_io/dhcal_effect_list.h"
 #include "dhcal_fw/fw_calstore.h"
 #include "dhcal_fw/fw_controller.h"
@@ -579,15 +580,7 @@ static int print_summary(const char *effect, double floor_mm, size_t n_done, dou
     cJSON *noise = cJSON_AddObjectToObject(obj, "noise_model");
     cJSON_AddNumberToObject(noise, "joint_deg", joint_sd_deg);
     cJSON_AddNumberToObject(noise, "meas_mm", res->noise.meas_mm);
-    char *text = cJSON_PrintUnformatted(obj);
-    cJSON_Delete(obj);
-    if (text == NULL) {
-        fprintf(stderr, "dhcal-demo: out of memory\n");
-        return 1;
-    }
-    puts(text);
-    free(text);
-    return 0;
+    return dhcal_json_print(obj, "dhcal-demo") == 0 ? 0 : 1;
 }
 
 int main(int argc, char **argv)

@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "dhcal/dhc_geometry.h"
+#include "dhcal_io/dhcal_json.h"
 #include "dhcal_io/dhcal_file.h"
 #include "dhcal_io/dhcal_io.h"
 #include "dhcal_sim/dhs_dataset.h"
@@ -502,15 +503,7 @@ static int parse_bus(int argc, char **argv, bus_config *b)
 
 static int print_json(cJSON *obj)
 {
-    char *text = obj != NULL ? cJSON_PrintUnformatted(obj) : NULL;
-    cJSON_Delete(obj);
-    if (text == NULL) {
-        fprintf(stderr, "dhcal-sim: out of memory\n");
-        return EXIT_COMPUTE;
-    }
-    puts(text);
-    free(text);
-    return 0;
+    return dhcal_json_print(obj, "dhcal-sim") == 0 ? 0 : EXIT_COMPUTE;
 }
 
 /* The encoder lines played on gpio-sim. */

@@ -554,3 +554,16 @@ int dhcal_json_load(const char *path, size_t max_bytes, const char *what, cJSON 
     free(text);
     return rc;
 }
+
+int dhcal_json_print(cJSON *obj, const char *program)
+{
+    char *text = obj != NULL ? cJSON_PrintUnformatted(obj) : NULL;
+    cJSON_Delete(obj);
+    if (text == NULL) {
+        fprintf(stderr, "%s: out of memory\n", program);
+        return -1;
+    }
+    puts(text);
+    free(text);
+    return 0;
+}

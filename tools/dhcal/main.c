@@ -16,6 +16,7 @@
 #include "dhcal/dhc_version.h"
 #include "dhcal_cli.h"
 #include "dhcal_compensate.h"
+#include "dhcal_io/dhcal_json.h"
 #include "dhcal_io/dhcal_model_map.h"
 #include "dhcal_options.h"
 #include "dhcal_plan_cmd.h"
@@ -263,15 +264,7 @@ static int load_session(const dhcal_cli_options *o, dhcal_session *s)
 
 int dhcal_cli_print_json(cJSON *obj)
 {
-    char *text = cJSON_PrintUnformatted(obj);
-    cJSON_Delete(obj);
-    if (text == NULL) {
-        fprintf(stderr, "dhcal: out of memory\n");
-        return EXIT_COMPUTE;
-    }
-    puts(text);
-    free(text);
-    return 0;
+    return dhcal_json_print(obj, "dhcal") == 0 ? 0 : EXIT_COMPUTE;
 }
 
 /* A measurement command: its options, its session, its work. */

@@ -102,4 +102,9 @@ int dhcal_jfile_beside(const dhcal_jctx *c, const char *jpath, const char *rel, 
 int dhcal_model_from_json(const char *file, const char *jpath, const cJSON *obj,
                           dhcal_model *model, dhcal_error *err);
 
+/* A program's JSON result: obj printed on standard output as one line (cJSON's unformatted
+ * print) and deleted (obj may be NULL: out of memory). 0, or -1 with "PROGRAM: out of
+ * memory" on standard error. */
+int dhcal_json_print(cJSON *obj, const char *program);
+
 #endif /* DHCAL_JSON_H */
