@@ -43,19 +43,22 @@
 #define EXIT_FAULT 1
 #define EXIT_USAGE 2
 #define NV_SIZE 8192U
-#define MAX_CONFIG_BYTES 65536U
+
+_Static_assert(DHCAL_MACHINE_MAX_SAMPLES == FW_ACQ_MAX_SAMPLES &&
+                   DHCAL_MACHINE_MAX_CANDIDATES == FW_PLAN_MAX_CANDIDATES,
+               "the machine file's acquisition limits are the controller's");
 
 static const char *const help_text =
-    "usage: dhcal-fw --machine M.json [--config FILE] [options]\n"
+    "usage: dhcal-fw --machine M.json [options]\n"
     "       dhcal-fw --machine M.json --port sim --scenario S.json [options]\n"
     "       dhcal-fw --gpio-chip NAME --enc-lines A,B --gpio-watch N\n"
     "The controller's calibration run: plan the poses, move the arm through them and read\n"
     "the draw-wire measurer, calibrate (geometry, diagnosis, the named effect) and store the\n"
-    "result; prints one JSON object. Options (each also a 'key = value' line of --config,\n"
-    "without the dashes; the command line wins):\n"
-    "  --config FILE         key = value lines, '#' comments\n"
+    "result; prints one JSON object. The machine file configures the controller; an option\n"
+    "given here wins over its key (the defaults below apply when neither gives one):\n"
     "  --machine FILE        the machine file: nominal model, joints, encoder and gear\n"
-    "                        scaling, drive limits, CAN, GPIO, store (required for a run)\n"
+    "                        scaling, drive limits, CAN, GPIO, store, acquisition\n"
+    "                        (required for a run)\n"
     "  --port linux|sim      linux (default): drives and measurer over SocketCAN;\n"
     "                        sim: the simulated arm in-process (the reference run)\n"
     "  --scenario FILE       sim port: the host_sim scenario of the simulated arm\n"
@@ -113,13 +116,15 @@ typedef struct {
     unsigned long long gpio_stall_ms;
     unsigned enc_line[2];
     int have_lines;
+    /* which numbers the command line gave (the machine file gives the others) */
+    int have_reply_timeout;
     int have_can_id_offset;
+    int have_start_timeout;
     int have_samples;
+    int have_plan_seed;
     int have_candidates;
+    int have_hold_ticks;
 } options;
-
-/* Config file values live here: options point into it. */
-static char config_text[MAX_CONFIG_BYTES + 1U];
 
 static int usage(const char *fmt, const char *arg)
 {
@@ -144,50 +149,68 @@ static int parse_u(const char *s, unsigned long long max, unsigned long long *ou
     return 0;
 }
 
+static int set_enc_lines(options *o, const char *val)
+{
+    unsigned long long a = 0U;
+    unsigned long long b = 0U;
+    const char *comma = strchr(val, ',');
+    char first[24];
+    if (comma == NULL || (size_t)(comma - val) >= sizeof first) {
+        return usage("enc-lines: '%s' is not two different line offsets A,B", val);
+    }
+    memcpy(first, val, (size_t)(comma - val));
+    first[comma - val] = '\0';
+    if (parse_u(first, 65535U, &a) != 0 || parse_u(comma + 1, 65535U, &b) != 0 || a == b) {
+        return usage("enc-lines: '%s' is not two different line offsets A,B", val);
+    }
+    o->enc_line[0] = (unsigned)a;
+    o->enc_line[1] = (unsigned)b;
+    o->have_lines = 1;
+    return 0;
+}
+
 /* One option by its name (without dashes). Returns 0, or EXIT_USAGE after a message. */
 static int set_option(options *o, const char *key, const char *val)
 {
+    int ignored = 0;
     struct {
         const char *name;
         unsigned long long *dst;
         unsigned long long max;
+        int *given;
     } nums[] = {
-        {"reply-timeout-us", &o->reply_timeout_us, 10000000ULL},
-        {"can-id-offset", &o->can_id_offset, FW_CAN_OFFSET_MAX},
-        {"start-timeout-ms", &o->start_timeout_ms, 600000ULL},
-        {"samples", &o->samples, FW_ACQ_MAX_SAMPLES},
-        {"plan-seed", &o->plan_seed, 0xFFFFFFFFULL},
-        {"plan-candidates", &o->plan_candidates, FW_PLAN_MAX_CANDIDATES},
-        {"run-seed", &o->run_seed, 0xFFFFFFFFULL},
-        {"hold-ticks", &o->hold_ticks, 100000ULL},
-        {"gpio-watch", &o->gpio_watch, 1000000ULL},
-        {"gpio-timeout-ms", &o->gpio_timeout_ms, 600000ULL},
-        {"gpio-stall-ms", &o->gpio_stall_ms, 600000ULL},
+        {"reply-timeout-us", &o->reply_timeout_us, 10000000ULL, &o->have_reply_timeout},
+        {"can-id-offset", &o->can_id_offset, FW_CAN_OFFSET_MAX, &o->have_can_id_offset},
+        {"start-timeout-ms", &o->start_timeout_ms, 600000ULL, &o->have_start_timeout},
+        {"samples", &o->samples, FW_ACQ_MAX_SAMPLES, &o->have_samples},
+        {"plan-seed", &o->plan_seed, 0xFFFFFFFFULL, &o->have_plan_seed},
+        {"plan-candidates", &o->plan_candidates, FW_PLAN_MAX_CANDIDATES, &o->have_candidates},
+        {"run-seed", &o->run_seed, 0xFFFFFFFFULL, &ignored},
+        {"hold-ticks", &o->hold_ticks, 100000ULL, &o->have_hold_ticks},
+        {"gpio-watch", &o->gpio_watch, 1000000ULL, &ignored},
+        {"gpio-timeout-ms", &o->gpio_timeout_ms, 600000ULL, &ignored},
+        {"gpio-stall-ms", &o->gpio_stall_ms, 600000ULL, &ignored},
     };
     for (size_t i = 0U; i < sizeof nums / sizeof nums[0]; ++i) {
         if (strcmp(key, nums[i].name) == 0) {
             if (parse_u(val, nums[i].max, nums[i].dst) != 0) {
-                fprintf(stderr, "dhcal-fw: %s: '%s' is not a number in 0..%llu\n", key,
-                        val != NULL ? val : "", nums[i].max);
+                fprintf(stderr, "dhcal-fw: %s: '%s' is not a number in 0..%llu\n", key, val,
+                        nums[i].max);
                 return EXIT_USAGE;
             }
-            o->have_can_id_offset |= nums[i].dst == &o->can_id_offset;
-            o->have_samples |= nums[i].dst == &o->samples;
-            o->have_candidates |= nums[i].dst == &o->plan_candidates;
+            *nums[i].given = 1;
             return 0;
         }
     }
     struct {
         const char *name;
         const char **dst;
-    } strs[] = {{"port", &o->port},           {"machine", &o->machine},
-                {"scenario", &o->scenario},
-                {"can", &o->can},             {"nv", &o->nv},
-                {"params-out", &o->params_out}, {"gpio-chip", &o->gpio_chip},
-                {"plan", &o->plan}};
+    } strs[] = {{"port", &o->port},     {"machine", &o->machine},       {"scenario", &o->scenario},
+                {"can", &o->can},       {"nv", &o->nv},                 {"params-out", &o->params_out},
+                {"gpio-chip", &o->gpio_chip}, {"plan", &o->plan}};
     for (size_t i = 0U; i < sizeof strs / sizeof strs[0]; ++i) {
         if (strcmp(key, strs[i].name) == 0) {
-            if (val == NULL || val[0] == '\0') {
+            if (val[0] == '\0') {
                 return usage("%s needs a value", key);
             }
             *strs[i].dst = val;
@@ -195,90 +218,14 @@ static int set_option(options *o, const char *key, const char *val)
         }
     }
     if (strcmp(key, "enc-lines") == 0) {
-        unsigned long long a = 0U;
-        unsigned long long b = 0U;
-        const char *comma = val != NULL ? strchr(val, ',') : NULL;
-        char first[24];
-        if (comma == NULL || (size_t)(comma - val) >= sizeof first) {
-            return usage("enc-lines: '%s' is not two different line offsets A,B",
-                         val != NULL ? val : "");
-        }
-        memcpy(first, val, (size_t)(comma - val));
-        first[comma - val] = '\0';
-        if (parse_u(first, 65535U, &a) != 0 || parse_u(comma + 1, 65535U, &b) != 0 || a == b) {
-            return usage("enc-lines: '%s' is not two different line offsets A,B", val);
-        }
-        o->enc_line[0] = (unsigned)a;
-        o->enc_line[1] = (unsigned)b;
-        o->have_lines = 1;
-        return 0;
+        return set_enc_lines(o, val);
     }
     return usage("unknown option '%s'", key);
 }
 
-static char *trim(char *s)
-{
-    while (*s == ' ' || *s == '\t') {
-        ++s;
-    }
-    size_t n = strlen(s);
-    while (n > 0U && (s[n - 1U] == ' ' || s[n - 1U] == '\t' || s[n - 1U] == '\r')) {
-        s[--n] = '\0';
-    }
-    return s;
-}
-
-static int load_config(options *o, const char *path)
-{
-    FILE *f = fopen(path, "r");
-    if (f == NULL) {
-        fprintf(stderr, "dhcal-fw: config %s: %s\n", path, strerror(errno));
-        return EXIT_USAGE;
-    }
-    const size_t n = fread(config_text, 1U, MAX_CONFIG_BYTES + 1U, f);
-    const int bad = ferror(f);
-    (void)fclose(f);
-    if (bad || n > MAX_CONFIG_BYTES) {
-        fprintf(stderr, "dhcal-fw: config %s: unreadable or larger than %u bytes\n", path,
-                MAX_CONFIG_BYTES);
-        return EXIT_USAGE;
-    }
-    config_text[n] = '\0';
-    size_t line_no = 0U;
-    for (char *line = config_text; line != NULL && *line != '\0';) {
-        char *next = strchr(line, '\n');
-        if (next != NULL) {
-            *next++ = '\0';
-        }
-        ++line_no;
-        char *hash = strchr(line, '#');
-        if (hash != NULL) {
-            *hash = '\0';
-        }
-        char *s = trim(line);
-        if (*s != '\0') {
-            char *eq = strchr(s, '=');
-            if (eq == NULL) {
-                fprintf(stderr, "dhcal-fw: config %s:%zu: expected 'key = value'\n", path,
-                        line_no);
-                return EXIT_USAGE;
-            }
-            *eq = '\0';
-            const int rc = set_option(o, trim(s), trim(eq + 1));
-            if (rc != 0) {
-                fprintf(stderr, "  (in %s:%zu)\n", path, line_no);
-                return rc;
-            }
-        }
-        line = next;
-    }
-    return 0;
-}
-
-/* The long options, each with a value except --help; the same names are the keys of the
- * config file (set_option). */
+/* The long options, each with a value except --help (set_option's names). */
 static const struct option long_options[] = {
-    {"config", required_argument, NULL, 0},          {"machine", required_argument, NULL, 0},
+    {"machine", required_argument, NULL, 0},
     {"port", required_argument, NULL, 0},            {"scenario", required_argument, NULL, 0},
     {"can", required_argument, NULL, 0},             {"can-id-offset", required_argument, NULL, 0},
     {"reply-timeout-us", required_argument, NULL, 0},
@@ -292,23 +239,13 @@ static const struct option long_options[] = {
     {"gpio-stall-ms", required_argument, NULL, 0},   {"help", no_argument, NULL, 'h'},
     {NULL, 0, NULL, 0}};
 
+/* The checks of the command line alone; check_merged checks it with the machine's keys. */
 static int parse_args(int argc, char **argv, options *o)
 {
     memset(o, 0, sizeof *o);
     o->port = "linux";
-    o->reply_timeout_us = 20000U;
-    o->start_timeout_ms = 5000U;
-    o->samples = 30U;
-    o->plan_seed = 4242U;
     o->run_seed = 7U;
-    o->hold_ticks = 200U;
     o->gpio_timeout_ms = 3000U;
-    /* The options in their order; the config file is applied first, wherever it stands,
-     * so that the command line overrides it. */
-    const char *names[64];
-    const char *values[64];
-    size_t n = 0U;
-    const char *config = NULL;
     opterr = 0; /* our own messages, in our words */
     int index = -1;
     int c;
@@ -324,29 +261,13 @@ static int parse_args(int argc, char **argv, options *o)
             const char *const bad = argv[optind - 1];
             return usage("unknown option '%s'", bad + strspn(bad, "-"));
         }
-        if (strcmp(long_options[index].name, "config") == 0) {
-            config = optarg;
-        } else if (n < sizeof names / sizeof names[0]) {
-            names[n] = long_options[index].name;
-            values[n++] = optarg;
-        } else {
-            return usage("%s", "too many options");
+        const int rc = set_option(o, long_options[index].name, optarg);
+        if (rc != 0) {
+            return rc;
         }
     }
     if (optind < argc) {
         return usage("unexpected argument '%s'", argv[optind]);
-    }
-    if (config != NULL) {
-        const int rc = load_config(o, config);
-        if (rc != 0) {
-            return rc;
-        }
-    }
-    for (size_t k = 0U; k < n; ++k) {
-        const int rc = set_option(o, names[k], values[k]);
-        if (rc != 0) {
-            return rc;
-        }
     }
     if (strcmp(o->port, "linux") != 0 && strcmp(o->port, "sim") != 0) {
         return usage("--port: '%s' is neither linux nor sim", o->port);
@@ -361,14 +282,11 @@ static int parse_args(int argc, char **argv, options *o)
         return usage("%s", "--scenario is the simulated arm of --port sim; the controller "
                            "is configured by --machine");
     }
-    if (o->gpio_watch == 0U && o->samples < 10U) {
+    if (o->have_samples && o->samples < 10U) {
         return usage("%s", "--samples: 10..128");
     }
     if (o->plan != NULL && (o->have_samples || o->have_candidates)) {
         return usage("%s", "--plan gives the poses: not with --samples or --plan-candidates");
-    }
-    if (o->plan == NULL && o->plan_candidates != 0U && o->plan_candidates <= o->samples) {
-        return usage("%s", "--plan-candidates: more candidates than --samples, or 0");
     }
     if ((o->gpio_chip != NULL) != (o->have_lines != 0)) {
         return usage("%s", "--gpio-chip and --enc-lines go together");
@@ -376,21 +294,48 @@ static int parse_args(int argc, char **argv, options *o)
     if (o->gpio_watch > 0U && o->gpio_chip == NULL) {
         return usage("%s", "--gpio-watch needs --gpio-chip and --enc-lines");
     }
-    if (o->reply_timeout_us == 0U) {
+    if (o->have_reply_timeout && o->reply_timeout_us == 0U) {
         return usage("%s", "--reply-timeout-us must be > 0");
     }
     return 0;
 }
 
-/* What the command line and the config file leave open, the machine file gives: CAN
- * interface and identifier offset, encoder lines, the store; then the defaults. */
-static void apply_machine(options *o, const dhcal_machine *m)
+/* A number the command line left open: the machine's key when given, else the default. */
+static void take_number(unsigned long long *dst, int given, int machine_has, unsigned machine,
+                        unsigned long long fallback)
+{
+    if (!given) {
+        *dst = machine_has ? machine : fallback;
+    }
+}
+
+/* What the command line leaves open, the machine file gives; then the defaults. The command
+ * line's choice of poses (--plan, or --samples and --plan-candidates) replaces the machine's
+ * whole. Returns 0 or EXIT_USAGE after a message. */
+static int apply_machine(options *o, const dhcal_machine *m)
 {
     if (o->can == NULL) {
         o->can = m->can_interface[0] != '\0' ? m->can_interface : "vcan0";
     }
-    if (!o->have_can_id_offset && m->has_can_id_offset) {
-        o->can_id_offset = m->can_id_offset;
+    take_number(&o->can_id_offset, o->have_can_id_offset, m->has_can_id_offset,
+                m->can_id_offset, 0U);
+    take_number(&o->reply_timeout_us, o->have_reply_timeout, m->can_reply_timeout_us != 0U,
+                m->can_reply_timeout_us, 20000U);
+    take_number(&o->start_timeout_ms, o->have_start_timeout, m->has_can_start_timeout,
+                m->can_start_timeout_ms, 5000U);
+    take_number(&o->plan_seed, o->have_plan_seed, m->has_plan_seed, m->plan_seed, 4242U);
+    take_number(&o->hold_ticks, o->have_hold_ticks, m->hold_ticks != 0U, m->hold_ticks, 200U);
+    const int cli_chooses_poses = o->plan != NULL || o->have_samples || o->have_candidates;
+    if (!cli_chooses_poses && m->plan_path[0] != '\0') {
+        o->plan = m->plan_path;
+    }
+    const int machine_counts = !cli_chooses_poses;
+    take_number(&o->samples, o->have_samples, machine_counts && m->samples != 0U, m->samples,
+                DHCAL_MACHINE_DEFAULT_SAMPLES);
+    take_number(&o->plan_candidates, o->have_candidates,
+                machine_counts && m->has_plan_candidates, m->plan_candidates, 0U);
+    if (o->plan == NULL && o->plan_candidates != 0U && o->plan_candidates <= o->samples) {
+        return usage("%s", "--plan-candidates: more candidates than --samples, or 0");
     }
     if (o->gpio_chip == NULL && m->gpio_chip[0] != '\0') {
         o->gpio_chip = m->gpio_chip;
@@ -398,9 +343,13 @@ static void apply_machine(options *o, const dhcal_machine *m)
         o->enc_line[1] = m->gpio_lines[1];
         o->have_lines = 1;
     }
+    if (o->params_out == NULL && m->params_out_path[0] != '\0') {
+        o->params_out = m->params_out_path;
+    }
     if (o->nv == NULL && strcmp(o->port, "linux") == 0) {
         o->nv = m->store_path[0] != '\0' ? m->store_path : "dhcal-fw.nv";
     }
+    return 0;
 }
 
 /* The machine's raw-code conversions (fw_port.h): encoder counts per joint radian through
@@ -712,7 +661,9 @@ static int run_calibration(options *o)
         fprintf(stderr, "dhcal-fw: %s\n", err.msg);
         return EXIT_USAGE;
     }
-    apply_machine(o, &machine);
+    if (apply_machine(o, &machine) != 0) {
+        return EXIT_USAGE;
+    }
     machine_io_config(&machine, &io);
     size_t n_given = 0U;
     if (o->plan != NULL) { /* the desk's poses, checked against the machine's joint ranges */

@@ -13,14 +13,18 @@
 
 static const char *const TOP_KEYS[] = {"comment", "name",     "model",   "n_joints",
                                        "start_pose_deg", "joints", "drives", "measurer",
-                                       "can",     "gpio",     "store"};
+                                       "can",     "gpio",     "store", "params_out",
+                                       "acquisition"};
 static const char *const JOINT_KEYS[] = {"comment", "encoder_counts_per_rev", "gear_ratio",
                                          "tacho_v_s_per_rad"};
 static const char *const DRIVE_KEYS[] = {"comment", "dac_range_v", "adc_range_v",
                                          "max_speed_deg_s", "max_accel_deg_s2"};
 static const char *const MEASURER_KEYS[] = {"comment", "wheel_radius_mm", "counts_per_rev",
                                             "zero_length_mm"};
-static const char *const CAN_KEYS[] = {"comment", "interface", "id_offset"};
+static const char *const CAN_KEYS[] = {"comment", "interface", "id_offset", "reply_timeout_us",
+                                       "start_timeout_ms"};
+static const char *const ACQUISITION_KEYS[] = {"comment", "samples", "plan_seed",
+                                               "plan_candidates", "plan", "hold_ticks"};
 static const char *const GPIO_KEYS[] = {"comment", "chip", "encoder_lines"};
 
 /* Largest CAN identifier offset: the protocol's identifiers stay 11-bit (fw_can_offset.h). */
@@ -186,53 +190,150 @@ static int load_measurer(const dhcal_jctx *c, const cJSON *root, dhcal_machine *
     return rc;
 }
 
-static int load_bus_and_store(const dhcal_jctx *c, const cJSON *root, dhcal_machine *m)
+/* An optional whole number in [lo, hi] at parent.key; *has says whether it was given. */
+static int opt_whole(const dhcal_jctx *c, const cJSON *obj, const char *parent,
+                     const char *key, double lo, double hi, unsigned *out, int *has)
 {
-    int rc = DHCAL_IO_OK;
+    const cJSON *const item = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (item == NULL) {
+        return DHCAL_IO_OK;
+    }
+    char kp[DHCAL_JPATH_CAP];
+    dhcal_jpath_key(kp, parent, key);
+    const int rc = whole_number(c, item, kp, lo, hi, out);
+    if (has != NULL) {
+        *has = rc == DHCAL_IO_OK;
+    }
+    return rc;
+}
+
+/* An optional file path at parent.key, resolved beside the machine file ("" when absent). */
+static int opt_path(const dhcal_jctx *c, const cJSON *obj, const char *parent, const char *key,
+                    char *out, size_t cap)
+{
+    char given[DHCAL_MACHINE_PATH_CAP] = "";
+    int rc = opt_string(c, obj, parent, key, given, sizeof given);
+    if (rc == DHCAL_IO_OK && given[0] != '\0') {
+        char kp[DHCAL_JPATH_CAP];
+        dhcal_jpath_key(kp, parent, key);
+        rc = dhcal_jfile_beside(c, kp, given, out, cap);
+    }
+    return rc;
+}
+
+static int load_can(const dhcal_jctx *c, const cJSON *root, dhcal_machine *m)
+{
     const cJSON *const can = cJSON_GetObjectItemCaseSensitive(root, "can");
-    if (can != NULL) {
-        rc = dhcal_jcheck_object(c, can, "can", DHCAL_JKEYS(CAN_KEYS));
-        if (rc == DHCAL_IO_OK) {
-            rc = opt_string(c, can, "can", "interface", m->can_interface,
-                            sizeof m->can_interface);
-        }
-        const cJSON *const off = cJSON_GetObjectItemCaseSensitive(can, "id_offset");
-        if (rc == DHCAL_IO_OK && off != NULL) {
-            rc = whole_number(c, off, "can.id_offset", 0.0, CAN_ID_OFFSET_MAX, &m->can_id_offset);
-            m->has_can_id_offset = rc == DHCAL_IO_OK;
-        }
+    if (can == NULL) {
+        return DHCAL_IO_OK;
     }
-    const cJSON *const gpio = cJSON_GetObjectItemCaseSensitive(root, "gpio");
-    if (rc == DHCAL_IO_OK && gpio != NULL) {
-        rc = dhcal_jcheck_object(c, gpio, "gpio", DHCAL_JKEYS(GPIO_KEYS));
-        const cJSON *const lines = cJSON_GetObjectItemCaseSensitive(gpio, "encoder_lines");
-        if (rc == DHCAL_IO_OK && (cJSON_GetObjectItemCaseSensitive(gpio, "chip") == NULL ||
-                                  lines == NULL)) {
-            return dhcal_jfail(c, "gpio", "needs both 'chip' and 'encoder_lines'");
-        }
-        if (rc == DHCAL_IO_OK) {
-            rc = opt_string(c, gpio, "gpio", "chip", m->gpio_chip, sizeof m->gpio_chip);
-        }
-        if (rc == DHCAL_IO_OK && (!cJSON_IsArray(lines) || dhcal_jcount(lines) != 2U)) {
-            return dhcal_jfail(c, "gpio.encoder_lines", "expected two line offsets [A, B], got %s",
-                               dhcal_jtype(lines));
-        }
-        for (size_t k = 0U; k < 2U && rc == DHCAL_IO_OK; ++k) {
-            char ip[DHCAL_JPATH_CAP];
-            dhcal_jpath_index(ip, "gpio.encoder_lines", k);
-            rc = whole_number(c, cJSON_GetArrayItem(lines, (int)k), ip, 0.0, 65535.0,
-                              &m->gpio_lines[k]);
-        }
-        if (rc == DHCAL_IO_OK && m->gpio_lines[0] == m->gpio_lines[1]) {
-            return dhcal_jfail(c, "gpio.encoder_lines", "A and B are the same line");
-        }
-    }
-    char store[DHCAL_MACHINE_PATH_CAP] = "";
+    int rc = dhcal_jcheck_object(c, can, "can", DHCAL_JKEYS(CAN_KEYS));
     if (rc == DHCAL_IO_OK) {
-        rc = opt_string(c, root, "", "store", store, sizeof store);
+        rc = opt_string(c, can, "can", "interface", m->can_interface, sizeof m->can_interface);
     }
-    if (rc == DHCAL_IO_OK && store[0] != '\0') {
-        rc = dhcal_jfile_beside(c, "store", store, m->store_path, sizeof m->store_path);
+    if (rc == DHCAL_IO_OK) {
+        rc = opt_whole(c, can, "can", "id_offset", 0.0, CAN_ID_OFFSET_MAX, &m->can_id_offset,
+                       &m->has_can_id_offset);
+    }
+    if (rc == DHCAL_IO_OK) {
+        rc = opt_whole(c, can, "can", "reply_timeout_us", 1.0, 1e7, &m->can_reply_timeout_us,
+                       NULL);
+    }
+    if (rc == DHCAL_IO_OK) {
+        rc = opt_whole(c, can, "can", "start_timeout_ms", 0.0, 6e5, &m->can_start_timeout_ms,
+                       &m->has_can_start_timeout);
+    }
+    return rc;
+}
+
+static int load_gpio(const dhcal_jctx *c, const cJSON *root, dhcal_machine *m)
+{
+    const cJSON *const gpio = cJSON_GetObjectItemCaseSensitive(root, "gpio");
+    if (gpio == NULL) {
+        return DHCAL_IO_OK;
+    }
+    int rc = dhcal_jcheck_object(c, gpio, "gpio", DHCAL_JKEYS(GPIO_KEYS));
+    const cJSON *const lines = cJSON_GetObjectItemCaseSensitive(gpio, "encoder_lines");
+    if (rc == DHCAL_IO_OK &&
+        (cJSON_GetObjectItemCaseSensitive(gpio, "chip") == NULL || lines == NULL)) {
+        return dhcal_jfail(c, "gpio", "needs both 'chip' and 'encoder_lines'");
+    }
+    if (rc == DHCAL_IO_OK) {
+        rc = opt_string(c, gpio, "gpio", "chip", m->gpio_chip, sizeof m->gpio_chip);
+    }
+    if (rc == DHCAL_IO_OK && (!cJSON_IsArray(lines) || dhcal_jcount(lines) != 2U)) {
+        return dhcal_jfail(c, "gpio.encoder_lines", "expected two line offsets [A, B], got %s",
+                           dhcal_jtype(lines));
+    }
+    for (size_t k = 0U; k < 2U && rc == DHCAL_IO_OK; ++k) {
+        char ip[DHCAL_JPATH_CAP];
+        dhcal_jpath_index(ip, "gpio.encoder_lines", k);
+        rc = whole_number(c, cJSON_GetArrayItem(lines, (int)k), ip, 0.0, 65535.0,
+                          &m->gpio_lines[k]);
+    }
+    if (rc == DHCAL_IO_OK && m->gpio_lines[0] == m->gpio_lines[1]) {
+        return dhcal_jfail(c, "gpio.encoder_lines", "A and B are the same line");
+    }
+    return rc;
+}
+
+/* How the controller gathers its samples: so many planned poses, or a pose file. */
+static int load_acquisition(const dhcal_jctx *c, const cJSON *root, dhcal_machine *m)
+{
+    const cJSON *const a = cJSON_GetObjectItemCaseSensitive(root, "acquisition");
+    if (a == NULL) {
+        return DHCAL_IO_OK;
+    }
+    int rc = dhcal_jcheck_object(c, a, "acquisition", DHCAL_JKEYS(ACQUISITION_KEYS));
+    if (rc == DHCAL_IO_OK) {
+        rc = opt_whole(c, a, "acquisition", "samples", (double)DHCAL_MACHINE_MIN_SAMPLES,
+                       (double)DHCAL_MACHINE_MAX_SAMPLES, &m->samples, NULL);
+    }
+    if (rc == DHCAL_IO_OK) {
+        rc = opt_whole(c, a, "acquisition", "plan_seed", 0.0, 4294967295.0, &m->plan_seed,
+                       &m->has_plan_seed);
+    }
+    if (rc == DHCAL_IO_OK) {
+        rc = opt_whole(c, a, "acquisition", "plan_candidates", 0.0,
+                       (double)DHCAL_MACHINE_MAX_CANDIDATES, &m->plan_candidates,
+                       &m->has_plan_candidates);
+    }
+    if (rc == DHCAL_IO_OK) {
+        rc = opt_whole(c, a, "acquisition", "hold_ticks", 1.0, 1e5, &m->hold_ticks, NULL);
+    }
+    if (rc == DHCAL_IO_OK) {
+        rc = opt_path(c, a, "acquisition", "plan", m->plan_path, sizeof m->plan_path);
+    }
+    if (rc != DHCAL_IO_OK) {
+        return rc;
+    }
+    if (m->plan_path[0] != '\0' && (m->samples != 0U || m->has_plan_candidates)) {
+        return dhcal_jfail(c, "acquisition.plan", "the plan gives the poses: not with "
+                                                  "'samples' or 'plan_candidates'");
+    }
+    const unsigned samples = m->samples != 0U ? m->samples : DHCAL_MACHINE_DEFAULT_SAMPLES;
+    if (m->plan_candidates != 0U && m->plan_candidates <= samples) {
+        return dhcal_jfail(c, "acquisition.plan_candidates",
+                           "%u candidates for %u samples: more candidates than samples, or 0",
+                           m->plan_candidates, samples);
+    }
+    return DHCAL_IO_OK;
+}
+
+static int load_bus_and_files(const dhcal_jctx *c, const cJSON *root, dhcal_machine *m)
+{
+    int rc = load_can(c, root, m);
+    if (rc == DHCAL_IO_OK) {
+        rc = load_gpio(c, root, m);
+    }
+    if (rc == DHCAL_IO_OK) {
+        rc = opt_path(c, root, "", "store", m->store_path, sizeof m->store_path);
+    }
+    if (rc == DHCAL_IO_OK) {
+        rc = opt_path(c, root, "", "params_out", m->params_out_path, sizeof m->params_out_path);
+    }
+    if (rc == DHCAL_IO_OK) {
+        rc = load_acquisition(c, root, m);
     }
     return rc;
 }
@@ -286,7 +387,7 @@ static int load_root(dhcal_jctx *c, const cJSON *root, dhcal_machine *m)
         rc = load_measurer(c, root, m);
     }
     if (rc == DHCAL_IO_OK) {
-        rc = load_bus_and_store(c, root, m);
+        rc = load_bus_and_files(c, root, m);
     }
     return rc;
 }

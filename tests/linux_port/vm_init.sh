@@ -44,7 +44,6 @@ fi
 [ -n "$CHIP" ] || result setup-gpio-sim FAIL "cannot create a gpio-sim chip"
 echo "INFO vcan0 up, gpio-sim chip '$CHIP', up $(cut -d' ' -f1 /proc/uptime) s"
 cd /tmp
-CONF=/etc/dhcal-fw.conf
 
 # ---------------------------------------------------------------- the transport alone
 if [ -x /bin/linux_can_check ]; then
@@ -60,7 +59,7 @@ t0=$(cut -d' ' -f1 /proc/uptime)
 dhcal-sim bus --scenario "$SCENARIO" --can vcan0 >sim-a.json 2>sim-a.err &
 SIM=$!
 settle # (dhcal-fw repeats its first SYNC until the drives answer; this saves a timeout)
-dhcal-fw --config $CONF --machine "$MACHINE" --nv nv-a.bin --params-out params-a.txt \
+dhcal-fw --machine "$MACHINE" --nv nv-a.bin --params-out params-a.txt \
     >fw-a.json 2>fw-a.err
 RC=$?
 wait $SIM
@@ -101,7 +100,7 @@ fault_case() { # name "dhcal-fw options" dhcal-sim-options...
     SIM=$!
     settle
     # shellcheck disable=SC2086 # word splitting intended: an option list
-    dhcal-fw --config $CONF --machine "$MACHINE" --nv nv-$name.bin $fw_opts >fw-$name.json \
+    dhcal-fw --machine "$MACHINE" --nv nv-$name.bin $fw_opts >fw-$name.json \
         2>fw-$name.err
     RC=$?
     wait $SIM
@@ -127,7 +126,7 @@ dhcal-sim bus --scenario "$SCENARIO" --can vcan0 --idle-exit-ms 3000 >sim-stop.j
     2>sim-stop.err &
 SIM=$!
 settle
-dhcal-fw --config $CONF --machine "$MACHINE" --nv nv-stop.bin >fw-stop.json 2>fw-stop.err &
+dhcal-fw --machine "$MACHINE" --nv nv-stop.bin >fw-stop.json 2>fw-stop.err &
 FW=$!
 sleep 3
 kill -TERM $FW
@@ -181,7 +180,7 @@ fi
 # ---------------------------------------------------------------- configuration errors
 err_case() { # name expected-text dhcal-fw-options...
     name=$1; want=$2; shift 2
-    dhcal-fw --config $CONF --machine "$MACHINE" "$@" >/dev/null 2>err-$name.txt
+    dhcal-fw --machine "$MACHINE" "$@" >/dev/null 2>err-$name.txt
     RC=$?
     if [ "$RC" = 2 ] && grep -q "$want" err-$name.txt; then
         result "$name" PASS "exit 2: $(head -n1 err-$name.txt)"

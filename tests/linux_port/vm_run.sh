@@ -80,16 +80,17 @@ cp "$CACHE"/modules/*.ko "$R/lib/modules/"
 # The scenario names its model file relative to itself: copy its whole directory.
 cp "$(dirname "$SCENARIO")"/*.json "$R/scenarios/"
 VM_SCENARIO=/scenarios/$(basename "$SCENARIO")
-cp "$MACHINE" "$R/etc/machine.json"
-cat >"$R/etc/dhcal-fw.conf" <<EOF
-# dhcal-fw in the test VM (the same settings as the sim-port reference run)
-port = linux
-can = vcan0
-samples = $SAMPLES
-# TCG emulates one CPU for both processes, on a host that may be busy with other tests:
-# give the drives a second to be scheduled (a lost frame still ends the run at once).
-reply-timeout-us = 1000000
-EOF
+# dhcal-fw in the test VM is configured by its machine file alone: the example's, with the
+# acquisition of the sim-port reference run and a longer reply timeout (TCG emulates one CPU
+# for both processes, on a host that may be busy with other tests: the drives get a second to
+# be scheduled; a lost frame still ends the run at once).
+python3 - "$MACHINE" "$R/etc/machine.json" "$SAMPLES" <<'PY'
+import json, sys
+machine = json.load(open(sys.argv[1]))
+machine["can"] = dict(machine.get("can", {}), interface="vcan0", reply_timeout_us=1000000)
+machine["acquisition"] = {"samples": int(sys.argv[3])}
+json.dump(machine, open(sys.argv[2], "w"), indent=1)
+PY
 cat >"$R/etc/dhcal-vm.env" <<EOF
 MACHINE=/etc/machine.json
 SCENARIO=$VM_SCENARIO

@@ -136,6 +136,47 @@ static void test_the_example_machine_is_the_simulated_paper_arm(void)
     TEST_ASSERT_EQUAL_DOUBLE(4.0, g_machine.max_accel_rad_s2);
 }
 
+/* The controller's whole configuration: timeouts, acquisition, the output file. */
+static void test_the_acquisition_and_timeouts_are_keys(void)
+{
+    const char *const path = machine_with(
+        "\"store\": \"cal/dhcal-fw.nv\"",
+        "\"store\": \"cal/dhcal-fw.nv\", \"params_out\": \"out/params.txt\",\n"
+        "  \"acquisition\": {\"samples\": 40, \"plan_seed\": 0, \"plan_candidates\": 200,"
+        " \"hold_ticks\": 150}");
+    TEST_ASSERT_EQUAL(DHCAL_IO_OK, dhcal_machine_load(path, &g_machine, &g_err));
+    TEST_ASSERT_EQUAL_UINT(40U, g_machine.samples);
+    TEST_ASSERT_TRUE(g_machine.has_plan_seed);
+    TEST_ASSERT_EQUAL_UINT(0U, g_machine.plan_seed);
+    TEST_ASSERT_TRUE(g_machine.has_plan_candidates);
+    TEST_ASSERT_EQUAL_UINT(200U, g_machine.plan_candidates);
+    TEST_ASSERT_EQUAL_UINT(150U, g_machine.hold_ticks);
+    TEST_ASSERT_EQUAL_STRING("", g_machine.plan_path);
+    TEST_ASSERT_EQUAL_UINT(0U, g_machine.can_reply_timeout_us); /* not given */
+    TEST_ASSERT_FALSE(g_machine.has_can_start_timeout);
+    char out[600];
+    (void)snprintf(out, sizeof out, "%s/out/params.txt", g_dir);
+    TEST_ASSERT_EQUAL_STRING(out, g_machine.params_out_path);
+
+    TEST_ASSERT_EQUAL(DHCAL_IO_OK,
+                      dhcal_machine_load(machine_with("\"id_offset\": 32",
+                                                      "\"id_offset\": 32, \"reply_timeout_us\":"
+                                                      " 1000000, \"start_timeout_ms\": 0"),
+                                         &g_machine, &g_err));
+    TEST_ASSERT_EQUAL_UINT(1000000U, g_machine.can_reply_timeout_us);
+    TEST_ASSERT_TRUE(g_machine.has_can_start_timeout);
+    TEST_ASSERT_EQUAL_UINT(0U, g_machine.can_start_timeout_ms);
+    TEST_ASSERT_EQUAL_UINT(0U, g_machine.samples);
+
+    TEST_ASSERT_EQUAL(DHCAL_IO_OK,
+                      dhcal_machine_load(machine_with("\"store\": \"cal/dhcal-fw.nv\"",
+                                                      "\"acquisition\": {\"plan\": \"p.csv\"}"),
+                                         &g_machine, &g_err));
+    char plan[600];
+    (void)snprintf(plan, sizeof plan, "%s/p.csv", g_dir);
+    TEST_ASSERT_EQUAL_STRING(plan, g_machine.plan_path);
+}
+
 static void expect_bad(const char *from, const char *to, const char *want)
 {
     const char *const path = machine_with(from, to);
@@ -167,6 +208,18 @@ static void test_bad_input_names_file_and_place(void)
     expect_bad("\"dac_range_v\": 10, ", "", "drives.dac_range_v: required key missing");
     expect_bad("\"store\": \"cal/dhcal-fw.nv\"", "\"store\": \"\"", "store: expected 1..");
     expect_bad("\"n_joints\": 2,", "\"n_joints\": 2,,", "machine.json:3:");
+    expect_bad("\"id_offset\": 32", "\"id_offset\": 32, \"reply_timeout_us\": 0",
+               "can.reply_timeout_us: 0 is outside");
+    const char *const store = "\"store\": \"cal/dhcal-fw.nv\"";
+    expect_bad(store, "\"acquisition\": {\"samples\": 9}", "acquisition.samples: 9 is outside");
+    expect_bad(store, "\"acquisition\": {\"samples\": 129}", "acquisition.samples: 129 is");
+    expect_bad(store, "\"acquisition\": {\"sample\": 20}", "acquisition.sample: unknown key");
+    expect_bad(store, "\"acquisition\": {\"plan_candidates\": 30}",
+               "acquisition.plan_candidates: 30 candidates for 30 samples");
+    expect_bad(store, "\"acquisition\": {\"plan\": \"p.csv\", \"plan_candidates\": 0}",
+               "acquisition.plan: the plan gives the poses");
+    expect_bad(store, "\"acquisition\": {\"hold_ticks\": 0}", "acquisition.hold_ticks: 0 is");
+    expect_bad(store, "\"params_out\": 3", "params_out: expected a string");
     /* a model without a measurer: nothing to calibrate against */
     (void)write_text("m.json", "{\"joints\": [{\"alpha_deg\": 90, \"a_mm\": 0, \"d_mm\": 400},"
                                " {\"alpha_deg\": 0, \"a_mm\": 500, \"d_mm\": 0}]}");
@@ -178,6 +231,7 @@ int main(void)
     UNITY_BEGIN();
     RUN_TEST(test_a_machine_with_its_model_beside_it);
     RUN_TEST(test_the_example_machine_is_the_simulated_paper_arm);
+    RUN_TEST(test_the_acquisition_and_timeouts_are_keys);
     RUN_TEST(test_bad_input_names_file_and_place);
     return UNITY_END();
 }

@@ -2,7 +2,9 @@
  * know about the arm it runs: its nominal model (a model file's path, or the model inline),
  * the joint count, each joint's encoder counts per motor turn, gear ratio and tacho
  * constant, the converters' ranges and the drives' limits, the measurer's wheel, the CAN
- * interface and identifier offset, the GPIO lines of an encoder, and the calibration store.
+ * interface, identifier offset and timeouts, the GPIO lines of an encoder, the calibration
+ * store, how the controller acquires its samples (the pose plan) and where it writes the
+ * calibrated parameters: everything dhcal-fw is configured by.
  *
  * Strict JSON (cJSON): unknown or repeated keys, a wrong type, a number that is not finite
  * or out of its range are refused with one message naming the file and the JSON path
@@ -21,6 +23,12 @@
 /* Largest machine file accepted (bytes). */
 #define DHCAL_MACHINE_MAX_BYTES 1048576U
 #define DHCAL_MACHINE_PATH_CAP 4096U
+/* The acquisition's limits: the controller's (fw_acquire.h, fw_plan.h; dhcal-fw checks that
+ * they agree). */
+#define DHCAL_MACHINE_MIN_SAMPLES 10U
+#define DHCAL_MACHINE_MAX_SAMPLES 128U
+#define DHCAL_MACHINE_MAX_CANDIDATES 512U
+#define DHCAL_MACHINE_DEFAULT_SAMPLES 30U
 
 typedef struct {
     char name[64];
@@ -43,12 +51,25 @@ typedef struct {
     char can_interface[32];              /* "" when not given */
     int has_can_id_offset;
     unsigned can_id_offset;
+    unsigned can_reply_timeout_us;       /* 0 when not given */
+    int has_can_start_timeout;
+    unsigned can_start_timeout_ms;
     char gpio_chip[64];                  /* "" when not given */
     unsigned gpio_lines[2];
     char store_path[DHCAL_MACHINE_PATH_CAP]; /* resolved; "" when not given */
+    char params_out_path[DHCAL_MACHINE_PATH_CAP]; /* resolved; "" when not given */
+    /* acquisition: at most one of samples/plan_candidates and plan_path is given */
+    unsigned samples;                    /* 0 when not given */
+    int has_plan_seed;
+    unsigned plan_seed;
+    int has_plan_candidates;
+    unsigned plan_candidates;
+    char plan_path[DHCAL_MACHINE_PATH_CAP]; /* resolved; "" when not given */
+    unsigned hold_ticks;                 /* 0 when not given */
 } dhcal_machine;
 
-/* Loads and checks a machine file. Relative paths in it ("model", "store") are taken from
+/* Loads and checks a machine file. Relative paths in it ("model", "store", "params_out",
+ * "acquisition.plan") are taken from
  * the machine file's directory. The model must have a measurer and as many joints as
  * "n_joints" and "joints". DHCAL_IO_BAD_INPUT with the message in err (file, JSON path or
  * line); DHCAL_IO_FAILED when out of memory. On error *m is zeroed. */
