@@ -41,7 +41,8 @@
 #include <string>
 #include <vector>
 
-namespace {
+namespace
+{
 
 using Clock = std::chrono::steady_clock;
 constexpr double kDeg = M_PI / 180.0;
@@ -161,9 +162,15 @@ Model load_model(const char *path)
         const double cr = std::cos(rpy[0] * kDeg), sr = std::sin(rpy[0] * kDeg);
         const double cp = std::cos(rpy[1] * kDeg), sp = std::sin(rpy[1] * kDeg);
         const double cy = std::cos(rpy[2] * kDeg), sy = std::sin(rpy[2] * kDeg);
-        const double r[9] = {cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr,
-                             sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr,
-                             -sp,     cp * sr,                cp * cr};
+        const double r[9] = {cy * cp,
+                             cy * sp * sr - sy * cr,
+                             cy * sp * cr + sy * sr,
+                             sy * cp,
+                             sy * sp * sr + cy * cr,
+                             sy * sp * cr - cy * sr,
+                             -sp,
+                             cp * sr,
+                             cp * cr};
         std::memcpy(m.base_r, r, sizeof r);
     }
     cJSON_Delete(root);
@@ -307,8 +314,7 @@ inline void cross(const double u[3], const double v[3], double out[3])
 // axis x1 (a), turns it about x1 (alpha) and then about the new y axis y2 (beta), both
 // through the new origin o_i. Each derivative is that motion applied to the tool point.
 void point_and_jacobian(const Model &nominal, const Joint *arm, const std::vector<Param> &ps,
-                        const double *q, double p[3], double *jac, int row_stride,
-                        int col_stride)
+                        const double *q, double p[3], double *jac, int row_stride, int col_stride)
 {
     const int n = static_cast<int>(nominal.joints.size());
     double X[3], Y[3], Z[3], o[3];
@@ -391,8 +397,9 @@ struct Problem {
 };
 
 // One row for ceres::Solve: three residuals, one parameter block of all parameters.
-class RowCost final : public ceres::CostFunction {
-public:
+class RowCost final : public ceres::CostFunction
+{
+  public:
     RowCost(const Problem &pb, int row) : pb_(pb), row_(row)
     {
         set_num_residuals(3);
@@ -413,14 +420,15 @@ public:
         return true;
     }
 
-private:
+  private:
     const Problem &pb_;
     int row_;
 };
 
 // All rows in one residual block (--one-block): fewer, larger blocks for ceres::Solve.
-class AllRowsCost final : public ceres::CostFunction {
-public:
+class AllRowsCost final : public ceres::CostFunction
+{
+  public:
     explicit AllRowsCost(const Problem &pb) : pb_(pb)
     {
         set_num_residuals(3 * pb.data.rows);
@@ -444,7 +452,7 @@ public:
         return true;
     }
 
-private:
+  private:
     const Problem &pb_;
 };
 
@@ -454,8 +462,14 @@ struct TinyFunctor {
     enum { NUM_RESIDUALS = Eigen::Dynamic, NUM_PARAMETERS = Eigen::Dynamic };
     const Problem &pb;
 
-    int NumResiduals() const { return 3 * pb.data.rows; }
-    int NumParameters() const { return static_cast<int>(pb.params.size()); }
+    int NumResiduals() const
+    {
+        return 3 * pb.data.rows;
+    }
+    int NumParameters() const
+    {
+        return static_cast<int>(pb.params.size());
+    }
 
     bool operator()(const double *x, double *residuals, double *jacobian) const
     {
@@ -529,7 +543,7 @@ int main(int argc, char **argv)
     if (model_path == nullptr || data_path == nullptr ||
         (solver != "solve" && solver != "solve-qr" && solver != "tiny"))
         die("usage: ceres_fit --model M.json --data D.csv [--solver solve|solve-qr|tiny] "
-                "[--one-block]");
+            "[--one-block]");
 
     Problem pb;
     pb.model = load_model(model_path);

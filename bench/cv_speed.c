@@ -108,8 +108,8 @@ int main(int argc, char **argv)
     memset(&err, 0, sizeof err);
     int rc = dhcal_parse_noise(arg_of(argc, argv, "--noise"), &noise, &err);
     if (rc == DHCAL_IO_OK) {
-        rc = load_and_fit(model_path, data_path, arg_of(argc, argv, "--effects"), &noise, &data,
-                          &s, &fit, &err);
+        rc = load_and_fit(model_path, data_path, arg_of(argc, argv, "--effects"), &noise, &data, &s,
+                          &fit, &err);
     }
     dhcal_cv fast;
     dhcal_cv refit;
@@ -140,8 +140,8 @@ int main(int argc, char **argv)
            "\"cv_rel_diff\": %.3e, \"fold_ss_max_rel_diff\": %.3e, \"fast_refit_folds\": %zu, "
            "\"fast_s\": %.6f, \"refit_s\": %.6f, \"speedup\": %.1f}\n",
            fast.rows, fast.folds, fit.set.count, set.count, fit.rep.rms_mm, fast.rms_mm,
-           refit.rms_mm, (fast.rms_mm - refit.rms_mm) / refit.rms_mm, fold_diff,
-           fast.refit_folds, t_fast, t_refit, t_refit / t_fast);
+           refit.rms_mm, (fast.rms_mm - refit.rms_mm) / refit.rms_mm, fold_diff, fast.refit_folds,
+           t_fast, t_refit, t_refit / t_fast);
     dhcal_samples_free(&s);
     dhcal_dataset_free(&data);
     return 0;

@@ -46,8 +46,7 @@ fw_can_kind fw_can_classify(uint32_t id, size_t *drive)
     if (id >= FW_CAN_ID_DRIVE_CMD_BASE && id < FW_CAN_ID_DRIVE_CMD_BASE + FW_CAN_MAX_DRIVES) {
         kind = FW_CAN_KIND_DRIVE_CMD;
         base = FW_CAN_ID_DRIVE_CMD_BASE;
-    } else if (id >= FW_CAN_ID_DRIVE_FB_BASE &&
-               id < FW_CAN_ID_DRIVE_FB_BASE + FW_CAN_MAX_DRIVES) {
+    } else if (id >= FW_CAN_ID_DRIVE_FB_BASE && id < FW_CAN_ID_DRIVE_FB_BASE + FW_CAN_MAX_DRIVES) {
         kind = FW_CAN_KIND_DRIVE_FB;
         base = FW_CAN_ID_DRIVE_FB_BASE;
     } else {
@@ -162,8 +161,7 @@ fw_can_msg_status fw_can_decode_drive_fb(const fw_can_frame *frame, size_t *driv
         return FW_CAN_MSG_ERR_ARGUMENT;
     }
     size_t j = 0U;
-    const fw_can_msg_status st =
-        check_frame(frame, FW_CAN_KIND_DRIVE_FB, FW_CAN_DLC_DRIVE_FB, &j);
+    const fw_can_msg_status st = check_frame(frame, FW_CAN_KIND_DRIVE_FB, FW_CAN_DLC_DRIVE_FB, &j);
     if (st != FW_CAN_MSG_OK) {
         return st;
     }
@@ -213,18 +211,12 @@ fw_can_msg_status fw_can_decode_wires(const fw_can_frame *frame, fw_can_wires *m
 const char *fw_can_msg_status_name(fw_can_msg_status st)
 {
     switch (st) {
-    case FW_CAN_MSG_OK:
-        return "ok";
-    case FW_CAN_MSG_ERR_ARGUMENT:
-        return "argument";
-    case FW_CAN_MSG_ERR_ID:
-        return "id";
-    case FW_CAN_MSG_ERR_DLC:
-        return "dlc";
-    case FW_CAN_MSG_ERR_RESERVED:
-        return "reserved";
-    case FW_CAN_MSG_ERR_RANGE:
-        return "range";
+    case FW_CAN_MSG_OK: return "ok";
+    case FW_CAN_MSG_ERR_ARGUMENT: return "argument";
+    case FW_CAN_MSG_ERR_ID: return "id";
+    case FW_CAN_MSG_ERR_DLC: return "dlc";
+    case FW_CAN_MSG_ERR_RESERVED: return "reserved";
+    case FW_CAN_MSG_ERR_RANGE: return "range";
     }
     return "unknown";
 }

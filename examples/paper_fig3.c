@@ -12,12 +12,10 @@
 
 #define MAX_POSES 10U
 
-static const double table1[6][3] = {{91.2, 101.0, 201.0}, {1.0, 104.0, 2.0},
-                                    {1.8, 102.0, 100.1},  {-92.1, -1.0, 12.0},
-                                    {-0.8, 14.0, 110.0},  {91.1, 3.0, 2.1}};
-static const double table2[6][3] = {{90.0, 100.0, 200.0}, {0.0, 100.0, 0.0},
-                                    {0.0, 100.0, 100.0},  {-90.0, 0.0, 10.0},
-                                    {0.0, 10.0, 100.0},   {90.0, 0.0, 0.0}};
+static const double table1[6][3] = {{91.2, 101.0, 201.0}, {1.0, 104.0, 2.0},   {1.8, 102.0, 100.1},
+                                    {-92.1, -1.0, 12.0},  {-0.8, 14.0, 110.0}, {91.1, 3.0, 2.1}};
+static const double table2[6][3] = {{90.0, 100.0, 200.0}, {0.0, 100.0, 0.0},  {0.0, 100.0, 100.0},
+                                    {-90.0, 0.0, 10.0},   {0.0, 10.0, 100.0}, {90.0, 0.0, 0.0}};
 
 static dhc_sample samples[MAX_POSES];
 static dhc_calib_workspace ws;
@@ -87,8 +85,8 @@ static int calibrate(size_t poses, dhc_arm *out)
         printf("%zu poses: calibration failed: %s\n", poses, dhc_status_str(st));
         return 0;
     }
-    printf("%zu poses: converged in %zu iterations, rank %zu of %zu, residual RMS %.3g mm\n",
-           poses, rep.iterations, rep.rank, rep.n_params, rep.rms_mm);
+    printf("%zu poses: converged in %zu iterations, rank %zu of %zu, residual RMS %.3g mm\n", poses,
+           rep.iterations, rep.rank, rep.n_params, rep.rms_mm);
     for (size_t i = 0U; i < 6U; ++i) {
         if (out->joint[i].convention == DHC_CONV_HAYATI) {
             printf("  joint %zu: axes %zu-%zu nominally parallel: fitted with Hayati beta "

@@ -154,9 +154,8 @@ static fw_can_status can_recv(void *ctx, fw_can_frame *frame, uint32_t timeout_u
     }
 }
 
-fw_linux_can_status fw_linux_can_open(fw_linux_can *bus, const char *ifname,
-                                      const uint32_t *rx_ids, size_t n_ids,
-                                      fw_can_transport *t, char *why, size_t why_cap)
+fw_linux_can_status fw_linux_can_open(fw_linux_can *bus, const char *ifname, const uint32_t *rx_ids,
+                                      size_t n_ids, fw_can_transport *t, char *why, size_t why_cap)
 {
     memset(bus, 0, sizeof *bus);
     bus->fd = -1;

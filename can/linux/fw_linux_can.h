@@ -37,25 +37,24 @@
 
 typedef enum {
     FW_LINUX_CAN_OK = 0,
-    FW_LINUX_CAN_NO_PF_CAN,  /* this kernel has no SocketCAN (socket(PF_CAN) unsupported) */
-    FW_LINUX_CAN_NO_IFACE,   /* no such interface */
-    FW_LINUX_CAN_ERR         /* bad argument, or the socket setup failed */
+    FW_LINUX_CAN_NO_PF_CAN, /* this kernel has no SocketCAN (socket(PF_CAN) unsupported) */
+    FW_LINUX_CAN_NO_IFACE,  /* no such interface */
+    FW_LINUX_CAN_ERR        /* bad argument, or the socket setup failed */
 } fw_linux_can_status;
 
 typedef struct {
     int fd;
-    uint32_t drops_seen;   /* last SO_RXQ_OVFL value */
+    uint32_t drops_seen; /* last SO_RXQ_OVFL value */
     uint64_t rx_frames;
     uint64_t tx_frames;
-    uint64_t overruns;     /* recv calls that returned FW_CAN_OVERRUN */
+    uint64_t overruns; /* recv calls that returned FW_CAN_OVERRUN */
 } fw_linux_can;
 
 /* Opens a raw CAN socket bound to ifname, receiving only the n_ids 11-bit IDs in rx_ids
  * (n_ids 0: none at all; at most FW_LINUX_CAN_MAX_FILTERS). Fills t. On failure closes
  * what it opened and writes a one-line reason into why (why_cap bytes, may be 0). */
-fw_linux_can_status fw_linux_can_open(fw_linux_can *bus, const char *ifname,
-                                      const uint32_t *rx_ids, size_t n_ids,
-                                      fw_can_transport *t, char *why, size_t why_cap);
+fw_linux_can_status fw_linux_can_open(fw_linux_can *bus, const char *ifname, const uint32_t *rx_ids,
+                                      size_t n_ids, fw_can_transport *t, char *why, size_t why_cap);
 
 /* Closes the socket (idempotent). */
 void fw_linux_can_close(fw_linux_can *bus);

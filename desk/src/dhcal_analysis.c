@@ -150,7 +150,9 @@ int dhcal_parse_geometry(const char *text, dhcal_geometry *out, dhcal_error *err
 
 const char *dhcal_geometry_name(dhcal_geometry g)
 {
-    return g == DHCAL_GEOMETRY_OFFSETS ? "offsets" : g == DHCAL_GEOMETRY_LENGTHS ? "lengths" : "full";
+    return g == DHCAL_GEOMETRY_OFFSETS   ? "offsets"
+           : g == DHCAL_GEOMETRY_LENGTHS ? "lengths"
+                                         : "full";
 }
 
 int dhcal_geometry_set(const dhc_model *model, dhcal_geometry g, dhc_param_set *set)
@@ -165,10 +167,10 @@ int dhcal_geometry_set(const dhc_model *model, dhcal_geometry g, dhc_param_set *
     size_t kept = 0U;
     for (size_t k = 0U; k < set->count; ++k) {
         const uint8_t kind = set->id[k].kind;
-        const int keep = kind == (uint8_t)DHC_P_THETA ||
-                         (g == DHCAL_GEOMETRY_LENGTHS &&
-                          (kind == (uint8_t)DHC_P_A || kind == (uint8_t)DHC_P_D ||
-                           kind == (uint8_t)DHC_P_BETA));
+        const int keep =
+            kind == (uint8_t)DHC_P_THETA ||
+            (g == DHCAL_GEOMETRY_LENGTHS &&
+             (kind == (uint8_t)DHC_P_A || kind == (uint8_t)DHC_P_D || kind == (uint8_t)DHC_P_BETA));
         if (keep) {
             set->id[kept++] = set->id[k];
         }
@@ -191,9 +193,8 @@ void dhcal_calib_options_for(const dhc_model *model, const dhc_noise_model *nois
 
 /* dhcal_fit_from (rejudge 1) and dhcal_fit_kept (rejudge 0: the rows stay as they are). */
 static int fit_rows_from(const dhc_model *start, const dhc_param_set *set,
-                         const dhc_noise_model *noise, dhcal_samples *s,
-                         const dhcal_samples *held, int rejudge, dhcal_fit *out,
-                         dhcal_error *err)
+                         const dhc_noise_model *noise, dhcal_samples *s, const dhcal_samples *held,
+                         int rejudge, dhcal_fit *out, dhcal_error *err)
 {
     const dhcal_geometry geometry = out->geometry;
     memset(out, 0, sizeof *out);
@@ -269,15 +270,13 @@ static int fit_rows_from(const dhc_model *start, const dhc_param_set *set,
 }
 
 int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhc_noise_model *noise,
-                   dhcal_samples *s, const dhcal_samples *held, dhcal_fit *out,
-                   dhcal_error *err)
+                   dhcal_samples *s, const dhcal_samples *held, dhcal_fit *out, dhcal_error *err)
 {
     return fit_rows_from(start, set, noise, s, held, 1, out, err);
 }
 
 int dhcal_fit_kept(const dhc_model *start, const dhc_param_set *set, const dhc_noise_model *noise,
-                   dhcal_samples *s, const dhcal_samples *held, dhcal_fit *out,
-                   dhcal_error *err)
+                   dhcal_samples *s, const dhcal_samples *held, dhcal_fit *out, dhcal_error *err)
 {
     return fit_rows_from(start, set, noise, s, held, 0, out, err);
 }
@@ -311,8 +310,8 @@ int dhcal_run_fit(const dhc_model *nominal, const char *effects, dhcal_geometry 
     return dhcal_fit_from(nominal, &set, noise, s, held, out, err);
 }
 
-int dhcal_session_covariates(const dhcal_fit *fit, const dhcal_samples *s,
-                             dhcal_covariates *cov, dhcal_error *err)
+int dhcal_session_covariates(const dhcal_fit *fit, const dhcal_samples *s, dhcal_covariates *cov,
+                             dhcal_error *err)
 {
     memset(cov, 0, sizeof *cov);
     double tmin = 0.0;
@@ -332,10 +331,10 @@ int dhcal_session_covariates(const dhcal_fit *fit, const dhcal_samples *s,
     const void *const ctx = s;
     const size_t nj = fit->model.arm.n_joints;
     lsq_scratch *w = malloc(sizeof *w);
-    dhc_status st = w != NULL ? dhc_covariate_pose_r2(nj, DHC_COVARIATE_TIME, dhcal_samples_read,
-                                                      ctx, s->n, s->flags, &w->ne, &w->fac,
-                                                      &cov->time_r2)
-                              : DHC_ERR_ARGUMENT;
+    dhc_status st = w != NULL
+                        ? dhc_covariate_pose_r2(nj, DHC_COVARIATE_TIME, dhcal_samples_read, ctx,
+                                                s->n, s->flags, &w->ne, &w->fac, &cov->time_r2)
+                        : DHC_ERR_ARGUMENT;
     if (st == DHC_OK && cov->temperature_varies) {
         st = dhc_covariate_pose_r2(nj, DHC_COVARIATE_TEMPERATURE, dhcal_samples_read, ctx, s->n,
                                    s->flags, &w->ne, &w->fac, &cov->temperature_r2);
@@ -363,8 +362,8 @@ int dhcal_run_diagnose(const dhcal_fit *fit, const dhcal_samples *s, dhc_diagnos
         return DHCAL_IO_FAILED;
     }
     dhc_candidate cands[DHC_MAX_CANDIDATES];
-    const size_t nc = dhc_diagnose_candidates(&fit->model, &fit->set, &cov->scope, cands,
-                                              DHC_MAX_CANDIDATES);
+    const size_t nc =
+        dhc_diagnose_candidates(&fit->model, &fit->set, &cov->scope, cands, DHC_MAX_CANDIDATES);
     dhc_diagnose_options opt;
     dhc_diagnose_default_options(&opt);
     opt.noise = fit->noise;
@@ -381,9 +380,8 @@ int dhcal_run_diagnose(const dhcal_fit *fit, const dhcal_samples *s, dhc_diagnos
         snprintf(err->msg, sizeof err->msg, "out of memory");
         return DHCAL_IO_FAILED;
     }
-    const dhc_status st =
-        dhc_diagnose(&fit->model, &fit->set, fit->rep.identifiable, sigma2, cands, nc,
-                     dhcal_samples_read, ctx, s->n, s->flags, &opt, ws, out);
+    const dhc_status st = dhc_diagnose(&fit->model, &fit->set, fit->rep.identifiable, sigma2, cands,
+                                       nc, dhcal_samples_read, ctx, s->n, s->flags, &opt, ws, out);
     free(ws);
     if (st == DHC_ERR_CAPACITY) {
         snprintf(err->msg, sizeof err->msg,
@@ -545,12 +543,12 @@ int dhcal_implausible(const dhc_model *nominal, const dhcal_fit *fit, char *why,
         return 0;
     }
     const uint8_t kind = fit->set.id[k].kind;
-    const int angle = kind == (uint8_t)DHC_P_THETA || kind == (uint8_t)DHC_P_ALPHA ||
-                      kind == (uint8_t)DHC_P_BETA;
+    const int angle =
+        kind == (uint8_t)DHC_P_THETA || kind == (uint8_t)DHC_P_ALPHA || kind == (uint8_t)DHC_P_BETA;
     char name[48];
     (void)dhc_params_name(&fit->set, k, name, sizeof name);
-    snprintf(why, cap, "%s moved %.4g %s from its nominal value (physical bound %.4g)", name,
-             moved, angle ? "deg" : "mm",
+    snprintf(why, cap, "%s moved %.4g %s from its nominal value (physical bound %.4g)", name, moved,
+             angle ? "deg" : "mm",
              angle ? DHCAL_PLAUSIBLE_ANGLE_DEG
                    : DHCAL_PLAUSIBLE_LENGTH_SHARE * dhc_arm_reach(&nominal->arm));
     return 1;
@@ -590,7 +588,7 @@ static void pure_error(const dhcal_samples *s, const double *resid, double *ss, 
     *groups = 0U;
     *rows = 0U;
     size_t *idx = malloc((s->n > 0U ? s->n : 1U) * sizeof *idx);
-    double (*q)[DHC_MAX_JOINTS] = malloc((s->n > 0U ? s->n : 1U) * sizeof *q);
+    double(*q)[DHC_MAX_JOINTS] = malloc((s->n > 0U ? s->n : 1U) * sizeof *q);
     if (idx == NULL || q == NULL) {
         free(idx);
         free(q);
@@ -603,7 +601,7 @@ static void pure_error(const dhcal_samples *s, const double *resid, double *ss, 
             idx[m++] = i;
         }
     }
-    repeat_sort_q = (const double (*)[DHC_MAX_JOINTS])q;
+    repeat_sort_q = (const double(*)[DHC_MAX_JOINTS])q;
     qsort(idx, m, sizeof *idx, compare_poses);
     for (size_t a = 0U; a < m;) {
         size_t b = a + 1U;
@@ -718,9 +716,8 @@ int dhcal_assess(const dhcal_fit *fit, const dhcal_samples *s, dhcal_adequacy *o
         }
     }
     if (out->have_test) {
-        out->verdict = out->lack_of_fit_log10_p < DHCAL_LACK_OF_FIT_LOG10_ALPHA
-                           ? "systematic_error"
-                           : "fits_noise";
+        out->verdict = out->lack_of_fit_log10_p < DHCAL_LACK_OF_FIT_LOG10_ALPHA ? "systematic_error"
+                                                                                : "fits_noise";
     }
     free(resid);
     free(err);
@@ -814,8 +811,8 @@ static int extrapolate_in(const dhcal_fit *fit, const dhcal_samples *s, const dh
         }
         for (size_t r = 0U; r < 3U; ++r) {
             double v;
-            if (dhc_lsq_prediction_variance(&w->fac, sigma2, &DHC_MAT_AT(&jac, r, 0U),
-                                            id_set.count, &v) != DHC_OK) {
+            if (dhc_lsq_prediction_variance(&w->fac, sigma2, &DHC_MAT_AT(&jac, r, 0U), id_set.count,
+                                            &v) != DHC_OK) {
                 return DHCAL_IO_FAILED;
             }
             sum += v;

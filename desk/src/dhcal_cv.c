@@ -19,16 +19,16 @@ _Static_assert(DHCAL_CV_LOO_BELOW <= DHCAL_CV_MAX_FOLDS + 1U &&
 typedef struct {
     dhc_calib_workspace fold_ws; /* a fold's refit */
     dhc_calib_report rep;
-    dhc_model refit_model;       /* ... its estimate */
-    dhc_arm_trig trig;           /* of a model evaluated apart from the accumulation */
-    dhc_normal_eq sys;           /* a fold's step: the other folds' equations */
+    dhc_model refit_model; /* ... its estimate */
+    dhc_arm_trig trig;     /* of a model evaluated apart from the accumulation */
+    dhc_normal_eq sys;     /* a fold's step: the other folds' equations */
     dhc_lsq_factor fac;
     double delta[DHC_MAX_PARAMS];
     double std[DHC_MAX_PARAMS];
     dhc_model trial;
-    dhc_model current;           /* a fold's iterated steps */
+    dhc_model current; /* a fold's iterated steps */
     dhc_model next;
-    dhc_normal_eq all;           /* every row's equations */
+    dhc_normal_eq all; /* every row's equations */
     dhc_lsq_factor fac_all;
     dhc_model step;
 } cv_scratch;
@@ -83,8 +83,7 @@ static void refit_options(const dhc_model *start, const dhc_noise_model *noise,
 /* Refits the rows outside fold f from start into *model; flags (s->n bytes) is scratch. */
 static int refit_fold(const dhc_model *start, const dhc_param_set *set,
                       const dhc_calib_options *opt, const dhcal_samples *s, const cv_folds *cf,
-                      size_t f, uint8_t *flags, cv_scratch *w, dhc_model *model,
-                      dhcal_error *err)
+                      size_t f, uint8_t *flags, cv_scratch *w, dhc_model *model, dhcal_error *err)
 {
     for (size_t i = 0U; i < s->n; ++i) {
         flags[i] = cf->fold_of[i] == f ? (uint8_t)DHC_SAMPLE_EXCLUDED : s->flags[i];
@@ -92,12 +91,12 @@ static int refit_fold(const dhc_model *start, const dhc_param_set *set,
     dhcal_samples fold_samples = *s;
     fold_samples.flags = flags;
     *model = *start;
-    const dhc_status st = dhc_calib_fit(model, set, dhcal_samples_read, &fold_samples, s->n,
-                                        flags, opt, &w->fold_ws, &w->rep);
+    const dhc_status st = dhc_calib_fit(model, set, dhcal_samples_read, &fold_samples, s->n, flags,
+                                        opt, &w->fold_ws, &w->rep);
     if (st != DHC_OK && st != DHC_ERR_NOT_CONVERGED) {
         snprintf(err->msg, sizeof err->msg,
-                 "cross-validation: the rows without fold %zu of %zu cannot be fitted (%s)",
-                 f + 1U, cf->folds, dhc_status_str(st));
+                 "cross-validation: the rows without fold %zu of %zu cannot be fitted (%s)", f + 1U,
+                 cf->folds, dhc_status_str(st));
         return DHCAL_IO_FAILED;
     }
     return DHCAL_IO_OK;
@@ -105,8 +104,8 @@ static int refit_fold(const dhc_model *start, const dhc_param_set *set,
 
 /* The squared position errors of fold f's rows at model, into out->fold_ss[f] and
  * out->fold_rows[f]. */
-static int fold_errors(const dhc_model *model, const dhcal_samples *s, const cv_folds *cf,
-                       size_t f, dhc_arm_trig *trig, dhcal_cv *out, dhcal_error *err)
+static int fold_errors(const dhc_model *model, const dhcal_samples *s, const cv_folds *cf, size_t f,
+                       dhc_arm_trig *trig, dhcal_cv *out, dhcal_error *err)
 {
     dhc_arm_prepare(&model->arm, trig);
     const size_t nj = model->arm.n_joints;
@@ -144,8 +143,8 @@ static void finish(dhcal_cv *out, size_t folds)
 }
 
 int dhcal_cross_validate_refit(const dhc_model *start, const dhc_param_set *set,
-                               const dhc_noise_model *noise, const dhcal_samples *s,
-                               dhcal_cv *out, dhcal_error *err)
+                               const dhc_noise_model *noise, const dhcal_samples *s, dhcal_cv *out,
+                               dhcal_error *err)
 {
     memset(out, 0, sizeof *out);
     cv_folds cf;
@@ -206,8 +205,8 @@ typedef struct {
     int whiten;
     const dhcal_samples *s;
     const cv_folds *cf;
-    double *jac;  /* folds x CV_BATCH_ROWS x set->count */
-    double *r;    /* folds x CV_BATCH_ROWS */
+    double *jac; /* folds x CV_BATCH_ROWS x set->count */
+    double *r;   /* folds x CV_BATCH_ROWS */
     size_t batch[DHCAL_CV_MAX_FOLDS];
     dhc_arm_trig trig; /* of model */
     dhc_model_eval ev;
@@ -221,8 +220,8 @@ static dhc_status flush(fold_pass *fp, size_t f, dhc_normal_eq *ne)
         return DHC_OK;
     }
     dhc_mat jac;
-    dhc_status st = dhc_mat_init(&jac, fp->batch[f], p, fp->jac + f * CV_BATCH_ROWS * p,
-                                 CV_BATCH_ROWS * p);
+    dhc_status st =
+        dhc_mat_init(&jac, fp->batch[f], p, fp->jac + f * CV_BATCH_ROWS * p, CV_BATCH_ROWS * p);
     if (st == DHC_OK) {
         st = dhc_normal_eq_add(&ne[f], &jac, fp->r + f * CV_BATCH_ROWS, NULL, fp->batch[f]);
     }
@@ -340,8 +339,7 @@ static double support_bound(const dhc_calib_options *opt, uint8_t kind)
  * first, at most CV_MAX_HOLDS): hidden from ne's analysis, so its step is 0 and it stays at
  * its start value. */
 static dhc_status hold_unsupported(dhc_normal_eq *ne, const dhc_param_set *set,
-                                   const dhc_calib_options *opt, dhc_lsq_factor *fac,
-                                   double *std)
+                                   const dhc_calib_options *opt, dhc_lsq_factor *fac, double *std)
 {
     uint8_t keep[DHC_MAX_PARAMS];
     for (size_t k = 0U; k < set->count; ++k) {
@@ -371,7 +369,6 @@ static dhc_status hold_unsupported(dhc_normal_eq *ne, const dhc_param_set *set,
     }
     return st;
 }
-
 
 /* At a fold's trial estimate, in one pass over the used rows: the sum of squares of the
  * equations of the rows outside fold f (whitened with the covariance at the start, as the fit
@@ -453,12 +450,10 @@ static void fold_step_ratio(fold_pass *fp, const dhc_normal_eq *ne, const uint8_
  * the other rows leave no redundancy or no damping up to CV_LAMBDA_LAST gives a confirmed
  * step: the refit decides there. *lambda0: the damping to start from (0: none), updated
  * for the next fold. */
-static void fold_step(fold_pass *fp, const dhc_normal_eq *ne, const uint8_t *ident_all,
-                      size_t f, dhcal_cv *out, double *lambda0, int *refit,
-                      dhc_model *estimate)
+static void fold_step(fold_pass *fp, const dhc_normal_eq *ne, const uint8_t *ident_all, size_t f,
+                      dhcal_cv *out, double *lambda0, int *refit, dhc_model *estimate)
 {
-    fold_step_ratio(fp, ne, ident_all, f, out, lambda0, refit, estimate, CV_MIN_GAIN_RATIO,
-                    NULL);
+    fold_step_ratio(fp, ne, ident_all, f, out, lambda0, refit, estimate, CV_MIN_GAIN_RATIO, NULL);
 }
 
 /* fold_step, confirming a step whose gain is at least min_ratio of the promised one; *fit
@@ -498,8 +493,8 @@ static void fold_step_ratio(fold_pass *fp, const dhc_normal_eq *ne, const uint8_
         if (trial == 0U) {
             sf->left = fmax(promised, 0.0) * per_variance;
         }
-        if (ev == DHC_OK && (!(promised > 0.0) ||
-                             (sys->ssr - ssr >= min_ratio * promised && ssr < sys->ssr))) {
+        if (ev == DHC_OK &&
+            (!(promised > 0.0) || (sys->ssr - ssr >= min_ratio * promised && ssr < sys->ssr))) {
             const double miss = fabs(fmax(promised, 0.0) - (sys->ssr - ssr));
             sf->missed = miss * per_variance;
             sf->miss_share = ssr > 0.0 ? miss / ssr : (miss > 0.0 ? HUGE_VAL : 0.0);
@@ -562,8 +557,8 @@ static int iterate_fold(const fold_pass *fp, const dhc_normal_eq *ne, const uint
             return DHCAL_IO_FAILED;
         }
         lambda = 0.0;
-        fold_step_ratio(&at, ne_k, ident_all, f, out, &lambda, &refit, next,
-                        CV_MIN_GAIN_RATIO, &sf);
+        fold_step_ratio(&at, ne_k, ident_all, f, out, &lambda, &refit, next, CV_MIN_GAIN_RATIO,
+                        &sf);
         if (sf.left <= CV_GN_LEFT || sf.missed <= CV_GN_LEFT) {
             double ssr = 0.0;
             /* at the confirmed step, or where it started when the step is within what the
@@ -584,8 +579,7 @@ static int iterate_fold(const fold_pass *fp, const dhc_normal_eq *ne, const uint
 /* The folds in turn: each one's estimate by its step, by iterated steps, or by its refit
  * where steps cannot be trusted, and its rows evaluated there. */
 static int estimate_folds(fold_pass *fp, const dhc_normal_eq *ne, const dhc_noise_model *noise,
-                          dhcal_cv *out, dhc_model *estimate, int *have_estimate,
-                          dhcal_error *err)
+                          dhcal_cv *out, dhc_model *estimate, int *have_estimate, dhcal_error *err)
 {
     dhc_normal_eq *const all = &fp->w->all;
     dhc_lsq_factor *const fac_all = &fp->w->fac_all;
@@ -618,8 +612,8 @@ static int estimate_folds(fold_pass *fp, const dhc_normal_eq *ne, const dhc_nois
             rc = DHCAL_IO_FAILED;
             break;
         }
-        rc = iterate_fold(fp, ne, fac_all->identifiable, f, refit ? NULL : step, out, ne_k,
-                          &done, err);
+        rc = iterate_fold(fp, ne, fac_all->identifiable, f, refit ? NULL : step, out, ne_k, &done,
+                          err);
         if (rc != DHCAL_IO_OK || done) {
             out->iterated_folds += done ? 1U : 0U;
             continue;
@@ -628,9 +622,9 @@ static int estimate_folds(fold_pass *fp, const dhc_normal_eq *ne, const dhc_nois
             refit_options(fp->model, noise, fp->s, &ropt);
             flags = malloc(fp->s->n + 1U);
         }
-        rc = flags != NULL ? refit_fold(fp->model, fp->set, &ropt, fp->s, fp->cf, f, flags,
-                                        fp->w, model, err)
-                           : DHCAL_IO_FAILED;
+        rc = flags != NULL
+                 ? refit_fold(fp->model, fp->set, &ropt, fp->s, fp->cf, f, flags, fp->w, model, err)
+                 : DHCAL_IO_FAILED;
         out->fold_ss[f] = 0.0;
         out->fold_rows[f] = 0U;
         if (rc == DHCAL_IO_OK) {
@@ -642,8 +636,7 @@ static int estimate_folds(fold_pass *fp, const dhc_normal_eq *ne, const dhc_nois
         /* every row's step: the same step the folds take, on all of them */
         int no_step = 1;
         double lambda_all = 0.0;
-        fold_step(fp, ne, fac_all->identifiable, SIZE_MAX, out, &lambda_all, &no_step,
-                  estimate);
+        fold_step(fp, ne, fac_all->identifiable, SIZE_MAX, out, &lambda_all, &no_step, estimate);
         if (have_estimate != NULL) {
             *have_estimate = !no_step;
         }
@@ -653,9 +646,9 @@ static int estimate_folds(fold_pass *fp, const dhc_normal_eq *ne, const dhc_nois
     return rc;
 }
 
-static int cv_run(const dhc_model *start, const dhc_param_set *set,
-                  const dhc_noise_model *noise, const dhcal_samples *s, dhcal_cv *out,
-                  dhc_model *estimate, int *have_estimate, dhcal_error *err);
+static int cv_run(const dhc_model *start, const dhc_param_set *set, const dhc_noise_model *noise,
+                  const dhcal_samples *s, dhcal_cv *out, dhc_model *estimate, int *have_estimate,
+                  dhcal_error *err);
 
 int dhcal_cross_validate(const dhc_model *start, const dhc_param_set *set,
                          const dhc_noise_model *noise, const dhcal_samples *s, dhcal_cv *out,
@@ -665,18 +658,17 @@ int dhcal_cross_validate(const dhc_model *start, const dhc_param_set *set,
 }
 
 int dhcal_cross_validate_step(const dhc_model *start, const dhc_param_set *set,
-                              const dhc_noise_model *noise, const dhcal_samples *s,
-                              dhcal_cv *out, dhc_model *estimate, int *have_estimate,
-                              dhcal_error *err)
+                              const dhc_noise_model *noise, const dhcal_samples *s, dhcal_cv *out,
+                              dhc_model *estimate, int *have_estimate, dhcal_error *err)
 {
     memset(out, 0, sizeof *out);
     return cv_run(start, set, noise, s, out, estimate, have_estimate, err);
 }
 
 /* The accumulation, the folds' estimates and (estimate not NULL) the all-rows step. */
-static int cv_run(const dhc_model *start, const dhc_param_set *set,
-                  const dhc_noise_model *noise, const dhcal_samples *s, dhcal_cv *out,
-                  dhc_model *estimate, int *have_estimate, dhcal_error *err)
+static int cv_run(const dhc_model *start, const dhc_param_set *set, const dhc_noise_model *noise,
+                  const dhcal_samples *s, dhcal_cv *out, dhc_model *estimate, int *have_estimate,
+                  dhcal_error *err)
 {
     if (have_estimate != NULL) {
         *have_estimate = 0;

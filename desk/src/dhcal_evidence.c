@@ -47,8 +47,7 @@ const dhcal_samples *dhcal_workspace_poses(const dhc_model *model, dhcal_range_p
 /* The positioning uncertainty the fit predicts over the poses w across the joint ranges
  * (RMS, mm; dhcal_extrapolate): how far the calibration can be trusted where it will be
  * used. */
-static double workspace_std_on(const dhcal_fit *fit, const dhcal_samples *s,
-                               const dhcal_samples *w)
+static double workspace_std_on(const dhcal_fit *fit, const dhcal_samples *s, const dhcal_samples *w)
 {
     dhcal_extrapolation x;
     return dhcal_extrapolate(fit, s, w, &x) == DHCAL_IO_OK ? x.predicted_std_mm : HUGE_VAL;
@@ -58,9 +57,9 @@ static double workspace_std_on(const dhcal_fit *fit, const dhcal_samples *s,
 
 const char *dhcal_verdict_key(dhcal_verdict v)
 {
-    static const char *const keys[] = {"named",       "runner_up", "look_alike", "screen",
-                                       "not_tried",   "not_excited", "failed",   "geometry",  "unsupported",
-                                       "cv",          "evidence",  "size",       "unphysical"};
+    static const char *const keys[] = {
+        "named",    "runner_up",   "look_alike", "screen",   "not_tried", "not_excited", "failed",
+        "geometry", "unsupported", "cv",         "evidence", "size",      "unphysical"};
     return (size_t)v < sizeof keys / sizeof keys[0] ? keys[v] : "unknown";
 }
 
@@ -110,13 +109,13 @@ static double effect_term_rad(const dhc_model *m, dhc_effect e, size_t j, const 
     const dhc_joint_effects *fx = &m->effect[j];
     switch (e) {
     case DHC_EFFECT_JOINT_SCALE: return fx->scale; /* the ratio error itself */
-    case DHC_EFFECT_JOINT_HARMONIC:
-        return hypot(fx->harmonic_sin_rad, fx->harmonic_cos_rad);
+    case DHC_EFFECT_JOINT_HARMONIC: return hypot(fx->harmonic_sin_rad, fx->harmonic_cos_rad);
     case DHC_EFFECT_JOINT_HARMONIC2:
     case DHC_EFFECT_JOINT_HARMONIC3:
     case DHC_EFFECT_JOINT_HARMONIC4: {
-        const size_t k = e == DHC_EFFECT_JOINT_HARMONIC2 ? 0U
-                         : e == DHC_EFFECT_JOINT_HARMONIC3 ? 1U : 2U;
+        const size_t k = e == DHC_EFFECT_JOINT_HARMONIC2   ? 0U
+                         : e == DHC_EFFECT_JOINT_HARMONIC3 ? 1U
+                                                           : 2U;
         return hypot(fx->harmonic_hi_sin_rad[k], fx->harmonic_hi_cos_rad[k]);
     }
     case DHC_EFFECT_JOINT_BACKLASH: return 0.5 * fx->backlash_rad;
@@ -178,8 +177,7 @@ void dhcal_compliance_columns(const dhc_model *m, const dhcal_samples *s, size_t
 
 /* A compliance candidate's columns (joint j, weight at frame k) that gravity barely loads
  * in these poses leave the set: their coefficient would be fitted to a tiny regressor. */
-static void drop_unexcited_columns(const double share[DHC_MAX_JOINTS], size_t j,
-                                   dhc_param_set *set)
+static void drop_unexcited_columns(const double share[DHC_MAX_JOINTS], size_t j, dhc_param_set *set)
 {
     size_t kept = 0U;
     for (size_t k = 0U; k < set->count; ++k) {
@@ -244,9 +242,8 @@ static void fold_gain_test(const dhcal_cv *without, const dhcal_cv *with, dhcal_
     }
     t->gain_t = mean / se;
     /* P(T > t) = P(F(1, dof) > t^2) / 2 for t > 0 */
-    t->gain_log10_p = t->gain_t > 0.0
-                          ? dhc_f_log10_sf(t->gain_t * t->gain_t, 1U, f - 1U) + log10(0.5)
-                          : 0.0;
+    t->gain_log10_p =
+        t->gain_t > 0.0 ? dhc_f_log10_sf(t->gain_t * t->gain_t, 1U, f - 1U) + log10(0.5) : 0.0;
 }
 
 /* Each used sample's residual (3 values) at model; NULL when memory runs out. */
@@ -312,8 +309,8 @@ typedef struct {
     dhcal_samples *s;
     const dhcal_samples *held;
     const dhcal_fit *fit;
-    const double *base;    /* residuals of the fit's model, data */
-    const double *base_ws; /* ... and over the joint ranges */
+    const double *base;      /* residuals of the fit's model, data */
+    const double *base_ws;   /* ... and over the joint ranges */
     const dhcal_samples *ws; /* the poses across the joint ranges, built once */
     dhcal_trials *out;
 } judge_ctx;
@@ -349,8 +346,8 @@ static void try_one(const judge_ctx *j, const dhc_candidate_result *cand, size_t
     t->cv_gain = j->out->cv.rms_mm > 0.0 ? 1.0 - t->cv.rms_mm / j->out->cv.rms_mm : 0.0;
     fold_gain_test(&j->out->cv, &t->cv, t);
     trial->geometry = fit->geometry;
-    if (dhcal_fit_kept(have_estimate ? &estimate : &fit->model, &set, &fit->noise, j->s,
-                       j->held, trial, &e2) != DHCAL_IO_OK) {
+    if (dhcal_fit_kept(have_estimate ? &estimate : &fit->model, &set, &fit->noise, j->s, j->held,
+                       trial, &e2) != DHCAL_IO_OK) {
         return;
     }
     if (trial->status != DHC_OK) {
@@ -372,17 +369,16 @@ static void try_one(const judge_ctx *j, const dhc_candidate_result *cand, size_t
         return;
     }
     change_of(j->base, r, j->s, &t->tool_rms_mm, &t->tool_max_mm);
-    change_of(j->base_ws, rw, j->ws, &t->range_rms_mm,
-              &t->range_max_mm);
+    change_of(j->base_ws, rw, j->ws, &t->range_rms_mm, &t->range_max_mm);
     for (size_t k = 0U; k < 3U * j->s->n; ++k) {
         field[k] = j->base[k] - r[k];
     }
     free(r);
     free(rw);
-    t->verdict = t->workspace_std_mm <=
-                         DHCAL_EVIDENCE_MAX_UNCERTAINTY_GROWTH * j->out->workspace_std_mm
-                     ? DHCAL_VERDICT_RUNNER_UP /* until judged */
-                     : DHCAL_VERDICT_UNSUPPORTED;
+    t->verdict =
+        t->workspace_std_mm <= DHCAL_EVIDENCE_MAX_UNCERTAINTY_GROWTH * j->out->workspace_std_mm
+            ? DHCAL_VERDICT_RUNNER_UP /* until judged */
+            : DHCAL_VERDICT_UNSUPPORTED;
 }
 
 /* The rules, in the order a person asks: does it help, is it the physics it would be named
@@ -500,8 +496,8 @@ static void settle(const dhc_diagnosis *diag, dhcal_trials *out)
             if (is_look_alike(&out->trial[out->named], c)) {
                 t->verdict = DHCAL_VERDICT_LOOKALIKE;
             }
-        } else if (t->verdict != DHCAL_VERDICT_NAMED &&
-                   out->best_rejected == DHC_MAX_CANDIDATES && diag->c[c].rank > 0U) {
+        } else if (t->verdict != DHCAL_VERDICT_NAMED && out->best_rejected == DHC_MAX_CANDIDATES &&
+                   diag->c[c].rank > 0U) {
             out->best_rejected = c;
         }
     }
@@ -587,10 +583,9 @@ static void run_jobs(judge_job *jobs, size_t count)
 }
 
 int dhcal_judge_candidates(const dhc_model *nominal, const dhcal_fit *fit, const dhcal_cv *cv,
-                           const dhc_diagnosis *diag,
-                           const dhcal_size_reference *reference, dhcal_samples *s,
-                           const dhcal_samples *held, dhcal_trials *out, dhcal_fit *best_fit,
-                           dhcal_error *err)
+                           const dhc_diagnosis *diag, const dhcal_size_reference *reference,
+                           dhcal_samples *s, const dhcal_samples *held, dhcal_trials *out,
+                           dhcal_fit *best_fit, dhcal_error *err)
 {
     memset(out, 0, sizeof *out);
     out->cv = *cv;
@@ -671,17 +666,23 @@ int dhcal_judge_candidates(const dhc_model *nominal, const dhcal_fit *fit, const
 static void magnitude_words(const dhcal_trial *t, dhc_effect e, char *buf, size_t cap)
 {
     if (e == DHC_EFFECT_JOINT_SCALE) {
-        snprintf(buf, cap, "a ratio error of %.2f %% (real gear trains and encoders: %.1f %% "
-                 "at most)", 100.0 * t->magnitude, 100.0 * t->plausible_max);
+        snprintf(buf, cap,
+                 "a ratio error of %.2f %% (real gear trains and encoders: %.1f %% "
+                 "at most)",
+                 100.0 * t->magnitude, 100.0 * t->plausible_max);
     } else if (e == DHC_EFFECT_JOINT_COMPLIANCE) {
-        snprintf(buf, cap, "a deflection of up to %.2f deg (gravity bends real joints by %.1f "
-                 "deg at most)", t->magnitude, t->plausible_max);
+        snprintf(buf, cap,
+                 "a deflection of up to %.2f deg (gravity bends real joints by %.1f "
+                 "deg at most)",
+                 t->magnitude, t->plausible_max);
     } else if (e == DHC_EFFECT_JOINT_BACKLASH) {
         snprintf(buf, cap, "a play of %.2f deg (real gear trains: 0 to %.1f deg)",
                  2.0 * t->magnitude, 2.0 * t->plausible_max);
     } else {
-        snprintf(buf, cap, "an amplitude of %.3f deg (real gears and encoders: %.2f deg at "
-                 "most)", t->magnitude, t->plausible_max);
+        snprintf(buf, cap,
+                 "an amplitude of %.3f deg (real gears and encoders: %.2f deg at "
+                 "most)",
+                 t->magnitude, t->plausible_max);
     }
 }
 
@@ -695,14 +696,18 @@ void dhcal_verdict_words(const dhcal_trials *t, const dhc_diagnosis *diag, size_
     switch (tr->verdict) {
     case DHCAL_VERDICT_NAMED: snprintf(buf, cap, "named"); break;
     case DHCAL_VERDICT_RUNNER_UP:
-        snprintf(buf, cap, "passes every rule; another candidate's gain was surer over the "
-                 "folds (t %.2f here)", tr->gain_t);
+        snprintf(buf, cap,
+                 "passes every rule; another candidate's gain was surer over the "
+                 "folds (t %.2f here)",
+                 tr->gain_t);
         break;
     case DHCAL_VERDICT_LOOKALIKE:
         (void)dhc_effect_label(diag->c[t->named].effect, diag->c[t->named].joint, label,
                                sizeof label);
-        snprintf(buf, cap, "looks like %s over these poses (their tool-error fields correlate "
-                 "above %.1f): %s", label, DHCAL_LOOKALIKE_CORRELATION,
+        snprintf(buf, cap,
+                 "looks like %s over these poses (their tool-error fields correlate "
+                 "above %.1f): %s",
+                 label, DHCAL_LOOKALIKE_CORRELATION,
                  tr->cv.rms_mm > DHCAL_LOOKALIKE_CLEAR_MARGIN * t->trial[t->named].cv.rms_mm
                      ? "the cross-validation prefers the one named clearly"
                      : "these data cannot tell the two apart");
@@ -715,11 +720,11 @@ void dhcal_verdict_words(const dhcal_trials *t, const dhc_diagnosis *diag, size_
                  DHCAL_EVIDENCE_TRIALS);
         break;
     case DHCAL_VERDICT_NOT_EXCITED:
-        snprintf(buf, cap, "not offered: gravity's moment about axis %zu over these poses is "
+        snprintf(buf, cap,
+                 "not offered: gravity's moment about axis %zu over these poses is "
                  "%.1f %% of the reach (below %.0f %%: an axis close to vertical); a fitted "
                  "stiffness there would be another error wearing its name",
-                 cand->joint + 1U, 100.0 * tr->excitation,
-                 100.0 * DHCAL_COMPLIANCE_MIN_EXCITATION);
+                 cand->joint + 1U, 100.0 * tr->excitation, 100.0 * DHCAL_COMPLIANCE_MIN_EXCITATION);
         break;
     case DHCAL_VERDICT_FAILED:
         snprintf(buf, cap, "its refit did not converge, or its cross-validation failed");
@@ -728,37 +733,45 @@ void dhcal_verdict_words(const dhcal_trials *t, const dhc_diagnosis *diag, size_
         snprintf(buf, cap, "its refit is no calibration: %s", tr->geometry_why);
         break;
     case DHCAL_VERDICT_UNSUPPORTED:
-        snprintf(buf, cap, "raises the positioning uncertainty over the joint ranges from %.3f "
+        snprintf(buf, cap,
+                 "raises the positioning uncertainty over the joint ranges from %.3f "
                  "to %.3f mm (more than %.0f %%): the data see it on a slice of its range only",
                  t->workspace_std_mm, tr->workspace_std_mm,
                  100.0 * (DHCAL_EVIDENCE_MAX_UNCERTAINTY_GROWTH - 1.0));
         break;
     case DHCAL_VERDICT_CV:
         if (tr->cv_gain < 0.0) {
-            snprintf(buf, cap, "raises the cross-validated RMS by %.1f %% (%.4f -> %.4f mm): "
-                     "it fits these rows, not the arm", -100.0 * tr->cv_gain, t->cv.rms_mm,
-                     tr->cv.rms_mm);
+            snprintf(buf, cap,
+                     "raises the cross-validated RMS by %.1f %% (%.4f -> %.4f mm): "
+                     "it fits these rows, not the arm",
+                     -100.0 * tr->cv_gain, t->cv.rms_mm, tr->cv.rms_mm);
         } else {
-            snprintf(buf, cap, "lowers the cross-validated RMS by %.1f %% only (%.4f -> %.4f "
-                     "mm; %.0f %% needed)", 100.0 * tr->cv_gain, t->cv.rms_mm, tr->cv.rms_mm,
+            snprintf(buf, cap,
+                     "lowers the cross-validated RMS by %.1f %% only (%.4f -> %.4f "
+                     "mm; %.0f %% needed)",
+                     100.0 * tr->cv_gain, t->cv.rms_mm, tr->cv.rms_mm,
                      100.0 * DHCAL_EVIDENCE_MIN_GAIN);
         }
         break;
     case DHCAL_VERDICT_EVIDENCE:
-        snprintf(buf, cap, "its cross-validated gain is not told from chance over the %zu "
-                 "folds (t %.2f, one-sided log10 p %.2f; p < %.2f needed)", tr->cv.folds,
-                 tr->gain_t, tr->gain_log10_p, DHCAL_EVIDENCE_ALPHA);
+        snprintf(buf, cap,
+                 "its cross-validated gain is not told from chance over the %zu "
+                 "folds (t %.2f, one-sided log10 p %.2f; p < %.2f needed)",
+                 tr->cv.folds, tr->gain_t, tr->gain_log10_p, DHCAL_EVIDENCE_ALPHA);
         break;
     case DHCAL_VERDICT_SIZE:
-        snprintf(buf, cap, "changes the tool by %.4f mm RMS over these poses, below the "
-                 "noise reference %.4f mm (%s)", tr->tool_rms_mm, t->reference.point_mm,
-                 t->reference.source);
+        snprintf(buf, cap,
+                 "changes the tool by %.4f mm RMS over these poses, below the "
+                 "noise reference %.4f mm (%s)",
+                 tr->tool_rms_mm, t->reference.point_mm, t->reference.source);
         break;
     case DHCAL_VERDICT_UNPHYSICAL:
         (void)dhc_effect_label(cand->effect, cand->joint, label, sizeof label);
         magnitude_words(tr, cand->effect, size, sizeof size);
-        snprintf(buf, cap, "a systematic error shaped like %s, of an unphysical size: %s; "
-                 "%s is probably standing in for another error", label, size, label);
+        snprintf(buf, cap,
+                 "a systematic error shaped like %s, of an unphysical size: %s; "
+                 "%s is probably standing in for another error",
+                 label, size, label);
         break;
     default: snprintf(buf, cap, "?"); break;
     }

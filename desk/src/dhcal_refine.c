@@ -44,8 +44,8 @@ static void record_step(dhcal_refine_result *out, const char *added, const char 
  * valley the data barely see (a wrist's twist when q5 follows q1) the fit can run off by
  * tens of degrees for a hundredth of a millimetre. What is held is said in held_why. */
 static int hold_implausible(const dhc_model *nominal, const dhc_noise_model *noise,
-                            dhcal_samples *s, const dhcal_samples *held,
-                            dhcal_refine_result *out, dhcal_error *err)
+                            dhcal_samples *s, const dhcal_samples *held, dhcal_refine_result *out,
+                            dhcal_error *err)
 {
     dhc_param_set set;
     dhcal_fit refit;
@@ -98,10 +98,9 @@ static int hold_implausible(const dhc_model *nominal, const dhc_noise_model *noi
  * (joint ranges, reach, gross errors) decide whether they are few, and it is the start
  * itself when they are not. Every level's fit starts from the same flags; s->flags end as
  * the chosen fit's. */
-static int fit_start(const dhc_model *nominal, const char *effects,
-                     const dhcal_geometry *geometry, const dhc_noise_model *noise,
-                     dhcal_samples *s, const dhcal_samples *held, dhcal_refine_result *out,
-                     dhcal_error *err)
+static int fit_start(const dhc_model *nominal, const char *effects, const dhcal_geometry *geometry,
+                     const dhc_noise_model *noise, dhcal_samples *s, const dhcal_samples *held,
+                     dhcal_refine_result *out, dhcal_error *err)
 {
     dhc_param_set set;
     int rc = dhcal_geometry_set(nominal, DHCAL_GEOMETRY_FULL, &set);
@@ -212,8 +211,10 @@ static int fit_start(const dhc_model *nominal, const char *effects,
     out->geometry_chosen = 1;
     char *w = out->geometry_why;
     const size_t cap = sizeof out->geometry_why;
-    int n = snprintf(w, cap, "%zu equations for %zu parameters: cross-validation chose '%s' "
-                     "(CV RMS", equations, set.count, dhcal_geometry_name((dhcal_geometry)best));
+    int n = snprintf(w, cap,
+                     "%zu equations for %zu parameters: cross-validation chose '%s' "
+                     "(CV RMS",
+                     equations, set.count, dhcal_geometry_name((dhcal_geometry)best));
     for (int g = 0; g < 3 && n > 0 && (size_t)n < cap; ++g) {
         n += out->geometry_cv_mm[g] >= 0.0
                  ? snprintf(w + n, cap - (size_t)n, "%s %s %.4f mm", g == 0 ? "" : ",",
@@ -233,8 +234,7 @@ static void stopped_words(dhcal_refine_result *out)
     const dhcal_trials *t = &out->trials;
     const size_t b = t->best_rejected;
     if (b >= out->diag.count) {
-        snprintf(out->stopped_why, sizeof out->stopped_why,
-                 "no candidate effect is left to try");
+        snprintf(out->stopped_why, sizeof out->stopped_why, "no candidate effect is left to try");
         return;
     }
     char label[64];
@@ -271,8 +271,8 @@ int dhcal_run_refine(const dhc_model *nominal, const char *start_effects,
             break;
         }
         const dhcal_size_reference ref = dhcal_size_reference_of(&out->fit, s, repeatability_mm);
-        if (dhcal_judge_candidates(nominal, &out->fit, &out->cv, &out->diag, &ref, s, held, &out->trials,
-                                   &best, &e2) != DHCAL_IO_OK) {
+        if (dhcal_judge_candidates(nominal, &out->fit, &out->cv, &out->diag, &ref, s, held,
+                                   &out->trials, &best, &e2) != DHCAL_IO_OK) {
             snprintf(out->stopped_why, sizeof out->stopped_why, "%.200s", e2.msg);
             break;
         }

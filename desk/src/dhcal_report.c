@@ -22,8 +22,8 @@ const char *dhcal_outlier_reason(uint8_t flag)
     }
 }
 
-void dhcal_fit_extras_compute(const dhcal_fit *f, const dhcal_samples *s,
-                              const dhcal_samples *held, dhcal_fit_extras *x)
+void dhcal_fit_extras_compute(const dhcal_fit *f, const dhcal_samples *s, const dhcal_samples *held,
+                              dhcal_fit_extras *x)
 {
     memset(x, 0, sizeof *x);
     x->have_adequacy = dhcal_assess(f, s, &x->adequacy) == DHCAL_IO_OK;
@@ -47,7 +47,8 @@ void dhcal_json_extras(cJSON *obj, const dhcal_fit *f, const dhcal_fit_extras *x
         cJSON_AddNumberToObject(obj, "cv_rms_mm", x->cv.rms_mm);
     }
     if (x->have_extrapolation) {
-        cJSON_AddNumberToObject(obj, "heldout_outside_range", (double)x->extrapolation.outside_range);
+        cJSON_AddNumberToObject(obj, "heldout_outside_range",
+                                (double)x->extrapolation.outside_range);
         cJSON_AddNumberToObject(obj, "predicted_std_mm", x->extrapolation.predicted_std_mm);
     }
     if (x->have_adequacy) {
@@ -61,8 +62,8 @@ void dhcal_json_extras(cJSON *obj, const dhcal_fit *f, const dhcal_fit_extras *x
     }
 }
 
-void dhcal_json_fit(cJSON *obj, const dhcal_fit *f, const dhc_model *input,
-                    const dhcal_samples *s, const double *row_err)
+void dhcal_json_fit(cJSON *obj, const dhcal_fit *f, const dhc_model *input, const dhcal_samples *s,
+                    const double *row_err)
 {
     cJSON_AddNumberToObject(obj, "rms_mm", f->rep.rms_mm);
     cJSON_AddNumberToObject(obj, "mean_mm", f->train.mean_mm);
@@ -158,8 +159,7 @@ static void candidate_trial(cJSON *j, const dhc_diagnosis *diag, const dhcal_tri
         cJSON_AddNumberToObject(j, "gain_log10_p",
                                 dhc_is_finite(tr->gain_log10_p) ? tr->gain_log10_p : -300.0);
     }
-    if (tr->tried && tr->verdict != DHCAL_VERDICT_FAILED &&
-        tr->verdict != DHCAL_VERDICT_GEOMETRY) {
+    if (tr->tried && tr->verdict != DHCAL_VERDICT_FAILED && tr->verdict != DHCAL_VERDICT_GEOMETRY) {
         cJSON *tool = cJSON_AddObjectToObject(j, "tool_change");
         cJSON_AddNumberToObject(tool, "rms_mm", tr->tool_rms_mm);
         cJSON_AddNumberToObject(tool, "max_mm", tr->tool_max_mm);
@@ -316,8 +316,7 @@ void dhcal_json_refine(cJSON *obj, const dhcal_refine_result *res)
 
 /* ---------------------------------------------------------------- the diagnosis in words */
 
-static void text_named(FILE *f, const dhc_diagnosis *d, const char *effects,
-                       const dhcal_trials *t)
+static void text_named(FILE *f, const dhc_diagnosis *d, const char *effects, const dhcal_trials *t)
 {
     char label[64];
     if (t->named >= d->count) {
@@ -349,19 +348,25 @@ static void text_named(FILE *f, const dhc_diagnosis *d, const char *effects,
         char other[64];
         (void)dhc_effect_label(o->effect, o->joint, other, sizeof other);
         const dhcal_trial *ot = &t->trial[tr->look_alike[k]];
-        fprintf(f, "look-alike: '%s' changes the tool in nearly the same way over these poses "
-                   "(correlation %.2f; CV RMS %.4f against %.4f mm): ", other,
-                tr->look_alike_r[k], ot->cv.rms_mm, tr->cv.rms_mm);
+        fprintf(f,
+                "look-alike: '%s' changes the tool in nearly the same way over these poses "
+                "(correlation %.2f; CV RMS %.4f against %.4f mm): ",
+                other, tr->look_alike_r[k], ot->cv.rms_mm, tr->cv.rms_mm);
         if (ot->cv.rms_mm > DHCAL_LOOKALIKE_CLEAR_MARGIN * tr->cv.rms_mm) {
-            fprintf(f, "the cross-validation prefers '%s' clearly; `dhcal plan --discriminate "
-                       "%s,%s` proposes poses that would confirm it\n", label, label, other);
+            fprintf(f,
+                    "the cross-validation prefers '%s' clearly; `dhcal plan --discriminate "
+                    "%s,%s` proposes poses that would confirm it\n",
+                    label, label, other);
         } else {
-            fprintf(f, "these data cannot tell the two apart; `dhcal plan --discriminate "
-                       "%s,%s` proposes poses that would\n", label, other);
+            fprintf(f,
+                    "these data cannot tell the two apart; `dhcal plan --discriminate "
+                    "%s,%s` proposes poses that would\n",
+                    label, other);
         }
     }
-    fprintf(f, "next: dhcal fit --effects %s%s%s ... and compare the held-out error (or dhcal "
-               "refine, which repeats this while the evidence holds)\n",
+    fprintf(f,
+            "next: dhcal fit --effects %s%s%s ... and compare the held-out error (or dhcal "
+            "refine, which repeats this while the evidence holds)\n",
             effects != NULL ? effects : "", effects != NULL ? "," : "", label);
 }
 
@@ -369,9 +374,10 @@ void dhcal_text_diagnosis(FILE *f, const dhcal_fit *fit, const dhc_diagnosis *d,
                           const char *effects, const dhcal_trials *t)
 {
     char label[64];
-    fprintf(f, "\ndiagnosis: %zu candidate effects screened by the score test against the "
-               "remaining residual (%s %.4g), the best %u refitted on the same rows and "
-               "cross-validated on the same folds\n",
+    fprintf(f,
+            "\ndiagnosis: %zu candidate effects screened by the score test against the "
+            "remaining residual (%s %.4g), the best %u refitted on the same rows and "
+            "cross-validated on the same folds\n",
             d->count, dhcal_noise_on(&fit->noise) ? "whitened residual sd" : "noise estimate mm",
             sqrt(d->sigma2), DHCAL_EVIDENCE_TRIALS);
     if (t->reference.source != NULL) {
@@ -379,8 +385,8 @@ void dhcal_text_diagnosis(FILE *f, const dhcal_fit *fit, const dhc_diagnosis *d,
                 t->reference.source);
     }
     text_named(f, d, effects, t);
-    fprintf(f, "%-22s %6s %9s %8s %10s %8s %9s  %s\n", "candidate", "params", "log10(p)",
-            "CV gain", "CV RMS mm", "t", "tool mm", "verdict");
+    fprintf(f, "%-22s %6s %9s %8s %10s %8s %9s  %s\n", "candidate", "params", "log10(p)", "CV gain",
+            "CV RMS mm", "t", "tool mm", "verdict");
     size_t unseen = 0U;
     for (size_t k = 0U; k < d->count; ++k) {
         const size_t i = t->order[k];
@@ -393,8 +399,8 @@ void dhcal_text_diagnosis(FILE *f, const dhcal_fit *fit, const dhc_diagnosis *d,
         (void)dhc_effect_label(c->effect, c->joint, label, sizeof label);
         fprintf(f, "%-22s %6zu %9.1f ", label, c->rank, c->log10_p);
         if (tr->tried && tr->cv.folds > 0U) {
-            fprintf(f, "%7.1f%% %10.4f %8.2f %9.4f", 100.0 * tr->cv_gain, tr->cv.rms_mm,
-                    tr->gain_t, tr->tool_rms_mm);
+            fprintf(f, "%7.1f%% %10.4f %8.2f %9.4f", 100.0 * tr->cv_gain, tr->cv.rms_mm, tr->gain_t,
+                    tr->tool_rms_mm);
         } else {
             fprintf(f, "%8s %10s %8s %9s", "", "", "", "");
         }

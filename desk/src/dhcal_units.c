@@ -24,8 +24,8 @@
  * clustered or not (Horn's matrix has eigenvalues in +- pairs when the cloud is flat). */
 static double sym4_largest(double a[4][4], double v[4])
 {
-    double vec[4][4] = {{1.0, 0.0, 0.0, 0.0}, {0.0, 1.0, 0.0, 0.0},
-                        {0.0, 0.0, 1.0, 0.0}, {0.0, 0.0, 0.0, 1.0}};
+    double vec[4][4] = {
+        {1.0, 0.0, 0.0, 0.0}, {0.0, 1.0, 0.0, 0.0}, {0.0, 0.0, 1.0, 0.0}, {0.0, 0.0, 0.0, 1.0}};
     for (int sweep = 0; sweep < 60; ++sweep) {
         double off = 0.0;
         double diag = 0.0;
@@ -44,8 +44,8 @@ static double sym4_largest(double a[4][4], double v[4])
                     continue;
                 }
                 const double theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
-                const double t = (theta >= 0.0 ? 1.0 : -1.0) /
-                                 (fabs(theta) + sqrt(theta * theta + 1.0));
+                const double t =
+                    (theta >= 0.0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1.0));
                 const double c = 1.0 / sqrt(t * t + 1.0);
                 const double s = t * c;
                 for (int k = 0; k < 4; ++k) { /* columns p and q */
@@ -165,8 +165,10 @@ int dhcal_similarity_fit(const double *a, const double *b, size_t n, int mirror,
     out->spread_b = sqrt(sbb / (double)n);
     out->corr = fmin(1.0, lambda / sqrt(saa * sbb));
     out->scale = lambda / saa;
-    out->turn_deg = acos(fmax(-1.0, fmin(1.0, (out->rot[0][0] + out->rot[1][1] +
-                                                out->rot[2][2] - 1.0) / 2.0))) / DHC_DEG;
+    out->turn_deg =
+        acos(
+            fmax(-1.0, fmin(1.0, (out->rot[0][0] + out->rot[1][1] + out->rot[2][2] - 1.0) / 2.0))) /
+        DHC_DEG;
     double rca[3];
     for (size_t r = 0U; r < 3U; ++r) {
         rca[r] = out->rot[r][0] * ca[0] + out->rot[r][1] * ca[1] + out->rot[r][2] * ca[2];
@@ -179,8 +181,7 @@ int dhcal_similarity_fit(const double *a, const double *b, size_t n, int mirror,
         double p[3];
         point_of(a, i, mirror, p);
         for (size_t r = 0U; r < 3U; ++r) {
-            const double ra = out->rot[r][0] * p[0] + out->rot[r][1] * p[1] +
-                              out->rot[r][2] * p[2];
+            const double ra = out->rot[r][0] * p[0] + out->rot[r][1] * p[1] + out->rot[r][2] * p[2];
             const double ds = b[3U * i + r] - out->scale * ra - out->shift[r];
             const double dr = b[3U * i + r] - ra - (cb[r] - rca[r]);
             sim += ds * ds;
@@ -205,13 +206,13 @@ typedef struct {
 typedef struct {
     const dhc_model *model;
     const dhcal_dataset *data;
-    size_t m;    /* rows compared */
-    size_t *idx; /* their indices in data */
-    int wires;   /* L1..L3 against the measurer's predicted lengths */
+    size_t m;     /* rows compared */
+    size_t *idx;  /* their indices in data */
+    int wires;    /* L1..L3 against the measurer's predicted lengths */
     double *meas; /* 3 m, as read */
     double *pred; /* 3 m, the model's at the angles last predicted */
     int have_pred;
-    reading last; /* their reading (factor, ja, jb) */
+    reading last;                 /* their reading (factor, ja, jb) */
     double range[DHC_MAX_JOINTS]; /* each joint's range over the rows, as read (rad) */
 } units_work;
 
@@ -296,8 +297,8 @@ static int predict(units_work *w, const reading *r)
 /* Wire lengths have no frame to align: each wire's variation is compared with its
  * prediction's (a wire's zero reference is free), one scale for all three; the unit scale
  * from the lengths themselves, which sit far from zero. */
-static int wire_fit(const double *meas, const double *pred, size_t m, size_t swap_a,
-                    size_t swap_b, dhcal_similarity *out)
+static int wire_fit(const double *meas, const double *pred, size_t m, size_t swap_a, size_t swap_b,
+                    dhcal_similarity *out)
 {
     memset(out, 0, sizeof *out);
     double mean_m[3] = {0.0, 0.0, 0.0};
@@ -383,8 +384,8 @@ static const char *unit_name(double scale)
     static const struct {
         double factor;
         const char *name;
-    } units[] = {{1000.0, "metres"},  {100.0, "decimetres"}, {10.0, "centimetres"},
-                 {25.4, "inches"},    {304.8, "feet"},       {0.001, "micrometres"}};
+    } units[] = {{1000.0, "metres"}, {100.0, "decimetres"}, {10.0, "centimetres"},
+                 {25.4, "inches"},   {304.8, "feet"},       {0.001, "micrometres"}};
     for (size_t k = 0U; k < sizeof units / sizeof units[0]; ++k) {
         if (fabs(log(scale / units[k].factor)) < log(1.1)) {
             return units[k].name;
@@ -433,8 +434,7 @@ static void check_radians(units_work *w, reading *taken, double *e, dhcal_units_
 
 /* The best exchange of two joint columns that both move, in the reading base: its score
  * (infinite when none is tried), the reading in r and its alignment in f. */
-static double best_joint_swap(units_work *w, const reading *base, reading *r,
-                              dhcal_similarity *f)
+static double best_joint_swap(units_work *w, const reading *base, reading *r, dhcal_similarity *f)
 {
     const size_t nj = w->model->arm.n_joints;
     double best = (double)INFINITY;
@@ -500,8 +500,8 @@ static double direct_rms(const units_work *w, size_t ca, size_t cb)
 /* Names the measured exchange r found (e_read as read, e_swap exchanged). A mirror image of
  * positions is named by the exchange that brings the points onto the model without any
  * alignment, when one does; else as a mirror image. */
-static void say_measured_swap(units_work *w, reading *r, double e_read, double e_swap,
-                              char *cause, size_t cap)
+static void say_measured_swap(units_work *w, reading *r, double e_read, double e_swap, char *cause,
+                              size_t cap)
 {
     static const size_t pairs[3][2] = {{0U, 1U}, {0U, 2U}, {1U, 2U}};
     const char *const names[2][3] = {{"x", "y", "z"}, {"L1", "L2", "L3"}};
@@ -520,10 +520,11 @@ static void say_measured_swap(units_work *w, reading *r, double e_read, double e
             }
         }
         if (!(as_read > DHCAL_UNITS_BETTER_RATIO * named)) {
-            add_cause(cause, cap, "the points are a mirror image of the model's (two of x, "
-                                  "y, z swapped, or one axis reversed): mirrored, they fit "
-                                  "%.3g times better after the best alignment (%.3g %% of "
-                                  "the spread, against %.3g %% as read)",
+            add_cause(cause, cap,
+                      "the points are a mirror image of the model's (two of x, "
+                      "y, z swapped, or one axis reversed): mirrored, they fit "
+                      "%.3g times better after the best alignment (%.3g %% of "
+                      "the spread, against %.3g %% as read)",
                       e_read / e_swap, 100.0 * e_swap, 100.0 * e_read);
             return;
         }
@@ -531,9 +532,10 @@ static void say_measured_swap(units_work *w, reading *r, double e_read, double e
         r->mb = b;
     }
     const char *const *nm = names[w->wires ? 1 : 0];
-    add_cause(cause, cap, "columns %s and %s look swapped: exchanged, they fit the model "
-                          "%.3g times better (%.3g %% of the spread after the best "
-                          "alignment, against %.3g %% as read)",
+    add_cause(cause, cap,
+              "columns %s and %s look swapped: exchanged, they fit the model "
+              "%.3g times better (%.3g %% of the spread after the best "
+              "alignment, against %.3g %% as read)",
               nm[a], nm[b], e_read / e_swap, 100.0 * e_swap, 100.0 * e_read);
 }
 
@@ -560,15 +562,15 @@ static void check_swaps(units_work *w, reading *taken, double *e, dhcal_units_re
             rep->mirror_ratio = *e / em;
         }
         if (ej <= em && *e > DHCAL_UNITS_BETTER_RATIO * ej) {
-            add_cause(cause, cap, "columns q%zu and q%zu look swapped: exchanged, they fit "
-                                  "the model %.3g times better (%.3g %% of the spread after "
-                                  "the best alignment, %.3g mm, against %.3g %% as read)",
-                      rj.ja + 1U, rj.jb + 1U, *e / ej, 100.0 * ej, fj.rms_similarity,
-                      100.0 * *e);
+            add_cause(cause, cap,
+                      "columns q%zu and q%zu look swapped: exchanged, they fit "
+                      "the model %.3g times better (%.3g %% of the spread after "
+                      "the best alignment, %.3g mm, against %.3g %% as read)",
+                      rj.ja + 1U, rj.jb + 1U, *e / ej, 100.0 * ej, fj.rms_similarity, 100.0 * *e);
             *taken = rj;
             *e = ej;
             joint_done = 1;
-        } else if (em < ej && *e > DHCAL_UNITS_BETTER_RATIO * em) {
+        } else if (em<ej && * e> DHCAL_UNITS_BETTER_RATIO * em) {
             say_measured_swap(w, &rm, *e, em, cause, cap);
             *taken = rm;
             *e = em;
@@ -580,8 +582,8 @@ static void check_swaps(units_work *w, reading *taken, double *e, dhcal_units_re
 }
 
 /* The length unit: the similarity scale when the shapes match, else the spreads' ratio. */
-static void check_scale(units_work *w, const reading *taken, double e,
-                        dhcal_units_report *rep, char *cause, size_t cap)
+static void check_scale(units_work *w, const reading *taken, double e, dhcal_units_report *rep,
+                        char *cause, size_t cap)
 {
     dhcal_similarity f;
     memset(&f, 0, sizeof f);
@@ -599,15 +601,16 @@ static void check_scale(units_work *w, const reading *taken, double e,
     }
     const char *unit = unit_name(scale);
     const char *what = w->wires ? "wire lengths" : "positions";
-    const char *how =
-        w->wires ? "the measured lengths have an RMS of" : "the measured cloud spans";
+    const char *how = w->wires ? "the measured lengths have an RMS of" : "the measured cloud spans";
     if (unit != NULL) {
-        add_cause(cause, cap, "%s look like %s: %s %.4g against the model's %.4g mm; dhcal "
-                              "reads mm (scale %.5g)",
+        add_cause(cause, cap,
+                  "%s look like %s: %s %.4g against the model's %.4g mm; dhcal "
+                  "reads mm (scale %.5g)",
                   what, unit, how, f.spread_a, f.spread_b, scale);
     } else {
-        add_cause(cause, cap, "%s are not in mm: %s %.4g against the model's %.4g mm (scale "
-                              "%.4g)",
+        add_cause(cause, cap,
+                  "%s are not in mm: %s %.4g against the model's %.4g mm (scale "
+                  "%.4g)",
                   what, how, f.spread_a, f.spread_b, scale);
     }
 }
@@ -717,10 +720,11 @@ static void check_targets_only(const dhc_model *model, const dhcal_dataset *t,
         reached_as_m += (size_t)(rm > 0.01 * reach && rm <= 1.1 * reach);
     }
     if (10U * nowhere >= 9U * t->n_rows && 10U * reached_as_m >= 9U * t->n_rows) {
-        add_cause(cause, cap, "targets look like metres: read as mm they lie %.4g to %.4g mm "
-                              "from the base origin, where no tool of the model's %.4g mm "
-                              "reach can be, and read as metres %zu of %zu are within its "
-                              "reach; dhcal reads mm",
+        add_cause(cause, cap,
+                  "targets look like metres: read as mm they lie %.4g to %.4g mm "
+                  "from the base origin, where no tool of the model's %.4g mm "
+                  "reach can be, and read as metres %zu of %zu are within its "
+                  "reach; dhcal reads mm",
                   lo, hi, reach, reached_as_m, t->n_rows);
     }
 }

@@ -205,9 +205,14 @@ static int set_option(options *o, const char *key, const char *val)
     struct {
         const char *name;
         const char **dst;
-    } strs[] = {{"port", &o->port},     {"machine", &o->machine},       {"scenario", &o->scenario},
-                {"can", &o->can},       {"nv", &o->nv},                 {"params-out", &o->params_out},
-                {"gpio-chip", &o->gpio_chip}, {"plan", &o->plan}};
+    } strs[] = {{"port", &o->port},
+                {"machine", &o->machine},
+                {"scenario", &o->scenario},
+                {"can", &o->can},
+                {"nv", &o->nv},
+                {"params-out", &o->params_out},
+                {"gpio-chip", &o->gpio_chip},
+                {"plan", &o->plan}};
     for (size_t i = 0U; i < sizeof strs / sizeof strs[0]; ++i) {
         if (strcmp(key, strs[i].name) == 0) {
             if (val[0] == '\0') {
@@ -224,20 +229,28 @@ static int set_option(options *o, const char *key, const char *val)
 }
 
 /* The long options, each with a value except --help (set_option's names). */
-static const struct option long_options[] = {
-    {"machine", required_argument, NULL, 0},
-    {"port", required_argument, NULL, 0},            {"scenario", required_argument, NULL, 0},
-    {"can", required_argument, NULL, 0},             {"can-id-offset", required_argument, NULL, 0},
-    {"reply-timeout-us", required_argument, NULL, 0},
-    {"start-timeout-ms", required_argument, NULL, 0},
-    {"nv", required_argument, NULL, 0},              {"samples", required_argument, NULL, 0},
-    {"plan-seed", required_argument, NULL, 0},       {"run-seed", required_argument, NULL, 0},
-    {"plan-candidates", required_argument, NULL, 0}, {"plan", required_argument, NULL, 0},
-    {"hold-ticks", required_argument, NULL, 0},      {"params-out", required_argument, NULL, 0},
-    {"gpio-chip", required_argument, NULL, 0},       {"enc-lines", required_argument, NULL, 0},
-    {"gpio-watch", required_argument, NULL, 0},      {"gpio-timeout-ms", required_argument, NULL, 0},
-    {"gpio-stall-ms", required_argument, NULL, 0},   {"help", no_argument, NULL, 'h'},
-    {NULL, 0, NULL, 0}};
+static const struct option long_options[] = {{"machine", required_argument, NULL, 0},
+                                             {"port", required_argument, NULL, 0},
+                                             {"scenario", required_argument, NULL, 0},
+                                             {"can", required_argument, NULL, 0},
+                                             {"can-id-offset", required_argument, NULL, 0},
+                                             {"reply-timeout-us", required_argument, NULL, 0},
+                                             {"start-timeout-ms", required_argument, NULL, 0},
+                                             {"nv", required_argument, NULL, 0},
+                                             {"samples", required_argument, NULL, 0},
+                                             {"plan-seed", required_argument, NULL, 0},
+                                             {"run-seed", required_argument, NULL, 0},
+                                             {"plan-candidates", required_argument, NULL, 0},
+                                             {"plan", required_argument, NULL, 0},
+                                             {"hold-ticks", required_argument, NULL, 0},
+                                             {"params-out", required_argument, NULL, 0},
+                                             {"gpio-chip", required_argument, NULL, 0},
+                                             {"enc-lines", required_argument, NULL, 0},
+                                             {"gpio-watch", required_argument, NULL, 0},
+                                             {"gpio-timeout-ms", required_argument, NULL, 0},
+                                             {"gpio-stall-ms", required_argument, NULL, 0},
+                                             {"help", no_argument, NULL, 'h'},
+                                             {NULL, 0, NULL, 0}};
 
 /* The checks of the command line alone; check_merged checks it with the machine's keys. */
 static int parse_args(int argc, char **argv, options *o)
@@ -317,8 +330,8 @@ static int apply_machine(options *o, const dhcal_machine *m)
     if (o->can == NULL) {
         o->can = m->can_interface[0] != '\0' ? m->can_interface : "vcan0";
     }
-    take_number(&o->can_id_offset, o->have_can_id_offset, m->has_can_id_offset,
-                m->can_id_offset, 0U);
+    take_number(&o->can_id_offset, o->have_can_id_offset, m->has_can_id_offset, m->can_id_offset,
+                0U);
     take_number(&o->reply_timeout_us, o->have_reply_timeout, m->can_reply_timeout_us != 0U,
                 m->can_reply_timeout_us, 20000U);
     take_number(&o->start_timeout_ms, o->have_start_timeout, m->has_can_start_timeout,
@@ -332,8 +345,8 @@ static int apply_machine(options *o, const dhcal_machine *m)
     const int machine_counts = !cli_chooses_poses;
     take_number(&o->samples, o->have_samples, machine_counts && m->samples != 0U, m->samples,
                 DHCAL_MACHINE_DEFAULT_SAMPLES);
-    take_number(&o->plan_candidates, o->have_candidates,
-                machine_counts && m->has_plan_candidates, m->plan_candidates, 0U);
+    take_number(&o->plan_candidates, o->have_candidates, machine_counts && m->has_plan_candidates,
+                m->plan_candidates, 0U);
     if (o->plan == NULL && o->plan_candidates != 0U && o->plan_candidates <= o->samples) {
         return usage("%s", "--plan-candidates: more candidates than --samples, or 0");
     }
@@ -402,8 +415,8 @@ static double elapsed_s(const struct timespec *t0)
 static fw_linux_gpio_status open_encoder_lines(const options *o, fw_linux_gpio_enc *enc)
 {
     char why[256];
-    const fw_linux_gpio_status st = fw_linux_gpio_open(enc, o->gpio_chip, o->enc_line[0],
-                                                       o->enc_line[1], why, sizeof why);
+    const fw_linux_gpio_status st =
+        fw_linux_gpio_open(enc, o->gpio_chip, o->enc_line[0], o->enc_line[1], why, sizeof why);
     if (st != FW_LINUX_GPIO_OK) {
         fprintf(stderr, "dhcal-fw: %s\n", why);
     }
@@ -431,8 +444,7 @@ static int run_gpio_watch(const options *o)
     cJSON_AddItemToObject(obj, "lines", cJSON_CreateIntArray(lines, 2));
     cJSON_AddNumberToObject(obj, "edges", (double)r.edges);
     cJSON_AddNumberToObject(obj, "counts", (double)r.counts);
-    cJSON_AddStringToObject(obj, "fault",
-                            r.fault ? fw_fault_name(FW_FAULT_ENCODER_JUMP) : "none");
+    cJSON_AddStringToObject(obj, "fault", r.fault ? fw_fault_name(FW_FAULT_ENCODER_JUMP) : "none");
     cJSON_AddStringToObject(obj, "detail", r.detail);
     (void)dhcal_json_print(obj, "dhcal-fw");
     return r.fault ? EXIT_FAULT : 0;
@@ -511,8 +523,8 @@ static int open_linux_port(const options *o)
     }
     rx[n_rx++] = fw_can_offset_bus_id(offset, FW_CAN_ID_WIRES);
     fw_can_transport tr;
-    const fw_linux_can_status cs = fw_linux_can_open(&can_bus, o->can, rx, n_rx, &tr, why,
-                                                     sizeof why);
+    const fw_linux_can_status cs =
+        fw_linux_can_open(&can_bus, o->can, rx, n_rx, &tr, why, sizeof why);
     if (cs != FW_LINUX_CAN_OK) {
         fprintf(stderr, "dhcal-fw: %s%s\n", why,
                 cs == FW_LINUX_CAN_NO_PF_CAN ? " (this kernel has no SocketCAN)" : "");
@@ -688,8 +700,8 @@ static int run_calibration(options *o)
         fw_sim_io_config(&sf.sc, &sim_io);
         const char *const differs = io_mismatch(&io, &sim_io, machine.n_joints);
         if (differs != NULL) {
-            fprintf(stderr, "dhcal-fw: %s and %s disagree on the %s\n", o->machine,
-                    o->scenario, differs);
+            fprintf(stderr, "dhcal-fw: %s and %s disagree on the %s\n", o->machine, o->scenario,
+                    differs);
             return EXIT_USAGE;
         }
     }
@@ -758,8 +770,8 @@ static int run_calibration(options *o)
     const size_t n_done = job.n_samples;
     const int calibrated = job.calibrated_ok;
     if (fault != FW_FAULT_NONE) {
-        fprintf(stderr, "dhcal-fw: fault %s (index %zu) after %zu samples\n",
-                fw_fault_name(fault), job.ctrl.fault_index, n_done);
+        fprintf(stderr, "dhcal-fw: fault %s (index %zu) after %zu samples\n", fw_fault_name(fault),
+                job.ctrl.fault_index, n_done);
     }
     const int written = print_result(o, fault, n_done, calibrated, &t0);
     fw_linux_nv_close(&nv_file);

@@ -28,9 +28,8 @@ static void release(fw_linux_gpio_enc *enc)
     }
 }
 
-fw_linux_gpio_status fw_linux_gpio_open(fw_linux_gpio_enc *enc, const char *chip,
-                                        unsigned line_a, unsigned line_b, char *why,
-                                        size_t why_cap)
+fw_linux_gpio_status fw_linux_gpio_open(fw_linux_gpio_enc *enc, const char *chip, unsigned line_a,
+                                        unsigned line_b, char *why, size_t why_cap)
 {
     memset(enc, 0, sizeof *enc);
     enc->chip = chip[0] == '/' ? gpiod_chip_open(chip) : gpiod_chip_open_by_name(chip);
@@ -42,8 +41,8 @@ fw_linux_gpio_status fw_linux_gpio_open(fw_linux_gpio_enc *enc, const char *chip
     const unsigned n_lines = gpiod_chip_num_lines(enc->chip);
     for (size_t k = 0U; k < 2U; ++k) {
         if (offsets[k] >= n_lines) {
-            (void)snprintf(why, why_cap, "GPIO chip %s has %u lines: no line %u (encoder %c)",
-                           chip, n_lines, offsets[k], k == 0U ? 'A' : 'B');
+            (void)snprintf(why, why_cap, "GPIO chip %s has %u lines: no line %u (encoder %c)", chip,
+                           n_lines, offsets[k], k == 0U ? 'A' : 'B');
             release(enc);
             return FW_LINUX_GPIO_NO_LINE;
         }
@@ -55,8 +54,8 @@ fw_linux_gpio_status fw_linux_gpio_open(fw_linux_gpio_enc *enc, const char *chip
             return FW_LINUX_GPIO_NO_LINE;
         }
         if (gpiod_line_request_both_edges_events(enc->line[k], consumer) != 0) {
-            (void)snprintf(why, why_cap, "GPIO chip %s: line %u: edge events: %s", chip,
-                           offsets[k], strerror(errno));
+            (void)snprintf(why, why_cap, "GPIO chip %s: line %u: edge events: %s", chip, offsets[k],
+                           strerror(errno));
             gpiod_line_release(enc->line[k]); /* harmless on a line that was never ours */
             enc->line[k] = NULL;
             release(enc);
@@ -67,8 +66,8 @@ fw_linux_gpio_status fw_linux_gpio_open(fw_linux_gpio_enc *enc, const char *chip
     const int a = gpiod_line_get_value(enc->line[0]);
     const int b = gpiod_line_get_value(enc->line[1]);
     if (a < 0 || b < 0) {
-        (void)snprintf(why, why_cap, "GPIO chip %s: reading lines %u,%u: %s", chip, line_a,
-                       line_b, strerror(errno));
+        (void)snprintf(why, why_cap, "GPIO chip %s: reading lines %u,%u: %s", chip, line_a, line_b,
+                       strerror(errno));
         release(enc);
         return FW_LINUX_GPIO_ERR;
     }
@@ -128,7 +127,7 @@ int fw_linux_gpio_poll(fw_linux_gpio_enc *enc, int timeout_ms)
         fw_quad_event q;
         q.line = (uint8_t)k;
         q.edge = (uint8_t)(e->event_type == GPIOD_LINE_EVENT_RISING_EDGE ? FW_QUAD_RISING
-                                                                          : FW_QUAD_FALLING);
+                                                                         : FW_QUAD_FALLING);
         q.t_ns = ts_ns(&e->ts);
         (void)fw_quad_feed(&enc->quad, &q); /* faults latch in enc->quad */
         ++fed;
@@ -141,8 +140,7 @@ void fw_linux_gpio_watch(fw_linux_gpio_enc *enc, int64_t steps, uint32_t timeout
 {
     memset(r, 0, sizeof *r);
     if (stall_ms > 0U) {
-        const struct timespec d = {(time_t)(stall_ms / 1000U),
-                                   (long)(stall_ms % 1000U) * 1000000L};
+        const struct timespec d = {(time_t)(stall_ms / 1000U), (long)(stall_ms % 1000U) * 1000000L};
         (void)nanosleep(&d, NULL);
     }
     for (;;) {

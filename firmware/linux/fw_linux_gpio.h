@@ -39,18 +39,17 @@ typedef struct {
 } fw_linux_gpio_enc;
 
 typedef struct {
-    uint64_t edges;   /* events decoded */
-    int64_t counts;   /* decoder count (x4 steps) */
-    int fault;        /* a missed edge (or an event out of time order) was seen */
-    char detail[96];  /* what happened, one line */
+    uint64_t edges;  /* events decoded */
+    int64_t counts;  /* decoder count (x4 steps) */
+    int fault;       /* a missed edge (or an event out of time order) was seen */
+    char detail[96]; /* what happened, one line */
 } fw_linux_gpio_result;
 
 /* Opens chip (a name such as "gpiochip0", or a /dev path), requests lines a and b for
  * both-edge events as consumer "dhcal-fw", and starts the decoder at their levels with
  * count 0. On failure nothing stays open and why (why_cap bytes) says what is missing. */
-fw_linux_gpio_status fw_linux_gpio_open(fw_linux_gpio_enc *enc, const char *chip,
-                                        unsigned line_a, unsigned line_b, char *why,
-                                        size_t why_cap);
+fw_linux_gpio_status fw_linux_gpio_open(fw_linux_gpio_enc *enc, const char *chip, unsigned line_a,
+                                        unsigned line_b, char *why, size_t why_cap);
 
 /* Waits at most timeout_ms for edges and decodes every pending one. Returns the number of
  * events decoded (0 on timeout), or -1 when reading the lines failed. A decoder fault

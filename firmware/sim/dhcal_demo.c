@@ -92,8 +92,8 @@ static int run_targets(const dhc_model *model, size_t n, uint32_t seed, phase_re
         }
         if (fw_ctrl_move_to(&job.ctrl, q, NULL) != FW_FAULT_NONE ||
             fw_ctrl_hold(&job.ctrl, 100U, NULL) != FW_FAULT_NONE) {
-            fprintf(stderr, "dhcal-demo: fault %s (index %zu)\n",
-                    fw_fault_name(job.ctrl.fault), job.ctrl.fault_index);
+            fprintf(stderr, "dhcal-demo: fault %s (index %zu)\n", fw_fault_name(job.ctrl.fault),
+                    job.ctrl.fault_index);
             return -1;
         }
         dhs_plant_truth t;
@@ -128,14 +128,13 @@ static dhc_status read_job_sample(const void *ctx, size_t index, dhc_sample *out
 /* The noise floor (see the top of this file): lib's positioning uncertainty of the final
  * fit at each target of phase r, with one encoder count per joint (uniform: sd = count /
  * sqrt(12)) for the servo's resolution. */
-static double noise_floor(const dhc_model *m, const dhc_param_set *set,
-                          const dhc_calib_report *fit, const phase_result *r,
-                          const fw_autocal_result *res)
+static double noise_floor(const dhc_model *m, const dhc_param_set *set, const dhc_calib_report *fit,
+                          const phase_result *r, const fw_autocal_result *res)
 {
     static dhc_uncertainty unc;
     if (dhc_uncertainty_from_samples(&unc, m, set, fit->identifiable, read_job_sample, &job,
-                                     job.n_samples, &res->noise,
-                                     DHC_ORIENTATION_WEIGHT_MM_PER_RAD, fit->sigma) != DHC_OK) {
+                                     job.n_samples, &res->noise, DHC_ORIENTATION_WEIGHT_MM_PER_RAD,
+                                     fit->sigma) != DHC_OK) {
         return (double)NAN;
     }
     double encoder_sd[DHC_MAX_JOINTS] = {0.0};
@@ -145,8 +144,7 @@ static double noise_floor(const dhc_model *m, const dhc_param_set *set,
     double ss = 0.0;
     for (size_t t = 0U; t < r->n; ++t) {
         double var = 0.0;
-        if (dhc_uncertainty_tool_point(&unc, m, set, r->q[t], NULL, encoder_sd, &var) !=
-            DHC_OK) {
+        if (dhc_uncertainty_tool_point(&unc, m, set, r->q[t], NULL, encoder_sd, &var) != DHC_OK) {
             return (double)NAN;
         }
         ss += var;
@@ -164,7 +162,8 @@ static void where_it_fails(const dhc_model *m, size_t n, FILE *log)
     for (size_t i = 0U; i < n; ++i) {
         double r[DHC_MAX_ROWS_PER_SAMPLE];
         size_t rows = 0U;
-        if (dhc_model_residual(m, &job.samples[i], DHC_ORIENTATION_WEIGHT_MM_PER_RAD, r, &rows) != DHC_OK) {
+        if (dhc_model_residual(m, &job.samples[i], DHC_ORIENTATION_WEIGHT_MM_PER_RAD, r, &rows) !=
+            DHC_OK) {
             continue;
         }
         double e = 0.0;
@@ -367,29 +366,19 @@ static int parse_options(int argc, char **argv, demo_options *o)
     while ((c = getopt_long(argc, argv, ":h", long_options, NULL)) != -1) {
         int bad = 0;
         switch (c) {
-        case OPT_JSON:
-            o->json = 1;
-            break;
-        case OPT_SCENARIO:
-            o->scenario = optarg;
-            break;
+        case OPT_JSON: o->json = 1; break;
+        case OPT_SCENARIO: o->scenario = optarg; break;
         case OPT_MIXED:
             o->mixed_dirs = 1;
             planned_given = 1;
             break;
-        case OPT_PLAN_FILE:
-            o->plan_file = optarg;
-            break;
-        case OPT_OUT:
-            o->out_dir = optarg;
-            break;
+        case OPT_PLAN_FILE: o->plan_file = optarg; break;
+        case OPT_OUT: o->out_dir = optarg; break;
         case OPT_SAMPLES:
             bad = parse_count(optarg, FW_ACQ_MAX_SAMPLES, &o->n_samples);
             planned_given = 1;
             break;
-        case OPT_TARGETS:
-            bad = parse_count(optarg, MAX_TARGETS, &o->n_targets);
-            break;
+        case OPT_TARGETS: bad = parse_count(optarg, MAX_TARGETS, &o->n_targets); break;
         case OPT_PLAN:
             planned_given = 1;
             bad = parse_count(optarg, FW_PLAN_MAX_CANDIDATES, &o->n_candidates);
@@ -398,26 +387,20 @@ static int parse_options(int argc, char **argv, demo_options *o)
                         optarg, FW_PLAN_MAX_CANDIDATES);
             }
             break;
-        case OPT_EFFECTS:
-            o->effects = optarg;
-            break;
-        case OPT_NO_DIAGNOSE:
-            o->autocal.diagnose = 0;
-            break;
-        case OPT_UNWEIGHTED:
-            o->weighted = 0;
-            break;
+        case OPT_EFFECTS: o->effects = optarg; break;
+        case OPT_NO_DIAGNOSE: o->autocal.diagnose = 0; break;
+        case OPT_UNWEIGHTED: o->weighted = 0; break;
         case OPT_START:
             o->n_start = parse_angles(optarg, o->start_deg);
             if (o->n_start == 0U) {
-                fprintf(stderr, "dhcal-demo: --start-deg: '%s' is not a list of angles in "
-                                "[-720, 720] deg\n", optarg);
+                fprintf(stderr,
+                        "dhcal-demo: --start-deg: '%s' is not a list of angles in "
+                        "[-720, 720] deg\n",
+                        optarg);
                 bad = 1;
             }
             break;
-        case 'h':
-            fputs(usage_text, stdout);
-            return -1;
+        case 'h': fputs(usage_text, stdout); return -1;
         case ':':
             fprintf(stderr, "dhcal-demo: %s needs a value\n", argv[optind - 1]);
             bad = 1;
@@ -442,13 +425,17 @@ static int parse_options(int argc, char **argv, demo_options *o)
         return 2;
     }
     if (o->plan_file != NULL && planned_given) {
-        fprintf(stderr, "dhcal-demo: --plan gives the poses and their directions: not with "
-                        "--samples, --plan-candidates or --mixed-directions\n%s", usage_text);
+        fprintf(stderr,
+                "dhcal-demo: --plan gives the poses and their directions: not with "
+                "--samples, --plan-candidates or --mixed-directions\n%s",
+                usage_text);
         return 2;
     }
     if (o->plan_file == NULL && o->n_candidates != 0U && o->n_candidates <= o->n_samples) {
-        fprintf(stderr, "dhcal-demo: --plan-candidates %zu: need more candidates than the %zu "
-                        "samples\n", o->n_candidates, o->n_samples);
+        fprintf(stderr,
+                "dhcal-demo: --plan-candidates %zu: need more candidates than the %zu "
+                "samples\n",
+                o->n_candidates, o->n_samples);
         return 2;
     }
     if (o->scenario == NULL || o->n_samples < 10U || o->n_samples > FW_ACQ_MAX_SAMPLES ||
@@ -499,14 +486,13 @@ static int set_up(demo_options *o)
         q_start[j] = start_deg[j] * DHC_DEG;
     }
     if (!nominal.measurer.present || fw_sim_init(&sim, &sf.sc, 7U, q_start, &port) != DHC_OK) {
-        fprintf(stderr, "dhcal-demo: %s: the scenario must be an arm with a measurer\n",
-                scenario);
+        fprintf(stderr, "dhcal-demo: %s: the scenario must be an arm with a measurer\n", scenario);
         return 2;
     }
     if (plan_file != NULL) { /* the desk's poses, checked against this arm's joint ranges */
         char why[1200];
-        if (fw_plan_file_load(plan_file, &nominal, 10U, FW_ACQ_MAX_SAMPLES, given_plan,
-                              &n_samples, why, sizeof why) != 0) {
+        if (fw_plan_file_load(plan_file, &nominal, 10U, FW_ACQ_MAX_SAMPLES, given_plan, &n_samples,
+                              why, sizeof why) != 0) {
             fprintf(stderr, "dhcal-demo: --plan: %s\n", why);
             return 2;
         }
@@ -521,8 +507,10 @@ static int set_up(demo_options *o)
     int got;
     while ((got = dhcal_effect_list_next(&cursor, nj, &effect, &joint, &item, &len)) != 0) {
         if (got < 0 || autocal.n_effects == FW_AUTOCAL_MAX_EFFECTS) {
-            fprintf(stderr, "dhcal-demo: --effects: '%.*s' is not an effect of a %zu-joint arm "
-                            "(at most %u)\n", (int)len, item, nj, FW_AUTOCAL_MAX_EFFECTS);
+            fprintf(stderr,
+                    "dhcal-demo: --effects: '%.*s' is not an effect of a %zu-joint arm "
+                    "(at most %u)\n",
+                    (int)len, item, nj, FW_AUTOCAL_MAX_EFFECTS);
             return 2;
         }
         autocal.effect[autocal.n_effects] = effect;
@@ -545,8 +533,7 @@ static int set_up(demo_options *o)
     jc.noise_model = weighted;
     jc.autocal = autocal;
     if (fw_job_boot(&job, &jc, &nominal, &port, &io) != FW_FAULT_NONE) {
-        fprintf(stderr, "dhcal-demo: controller init failed: %s\n",
-                fw_fault_name(job.ctrl.fault));
+        fprintf(stderr, "dhcal-demo: controller init failed: %s\n", fw_fault_name(job.ctrl.fault));
         return 1;
     }
     o->n_samples = n_samples;
@@ -616,15 +603,22 @@ int main(int argc, char **argv)
     }
     const size_t n_done = job.n_samples;
     const double o1 = job.o1;
-    fprintf(log, "(b) %zu samples (%s plan of %zu poses%s%s, observability O1 %.4g over %zu of "
-                 "%zu parameters)\n", n_done,
-            plan_file != NULL ? "the given" : n_candidates > 0U ? "optimal" : "random",
-            job.n_plan, plan_file != NULL ? " from " : n_candidates > 0U ? " out of the "
-                                                                          "candidates" : "",
+    fprintf(log,
+            "(b) %zu samples (%s plan of %zu poses%s%s, observability O1 %.4g over %zu of "
+            "%zu parameters)\n",
+            n_done,
+            plan_file != NULL   ? "the given"
+            : n_candidates > 0U ? "optimal"
+                                : "random",
+            job.n_plan,
+            plan_file != NULL   ? " from "
+            : n_candidates > 0U ? " out of the "
+                                  "candidates"
+                                : "",
             plan_file != NULL ? plan_file : "", o1, job.o1_rank, job.o1_params);
     if (fa != FW_FAULT_NONE) {
-        fprintf(stderr, "dhcal-demo: fault %s (index %zu) during acquisition\n",
-                fw_fault_name(fa), job.ctrl.fault_index);
+        fprintf(stderr, "dhcal-demo: fault %s (index %zu) during acquisition\n", fw_fault_name(fa),
+                job.ctrl.fault_index);
         for (size_t j = 0U; j < nominal.arm.n_joints; ++j) {
             fprintf(stderr, "  joint %zu: error %.2f counts, velocity %.4f rad/s\n", j + 1U,
                     (job.ctrl.q_ref_rad[j] - job.ctrl.q_rad[j]) * io.counts_per_rad[j],
@@ -647,13 +641,16 @@ int main(int argc, char **argv)
         for (size_t j = 0U; j < nominal.arm.n_joints; ++j) {
             fprintf(log, " %.3g", res->noise.joint_rad[j] * 1e6);
         }
-        fprintf(log, " urad (1 count / sqrt 12 with the holds' dither), wires %.4f mm "
-                     "(measured over the holds)\n", res->noise.meas_mm);
+        fprintf(log,
+                " urad (1 count / sqrt 12 with the holds' dither), wires %.4f mm "
+                "(measured over the holds)\n",
+                res->noise.meas_mm);
     }
-    fprintf(log, "(c) geometric fit%s%s: wire residual RMS %.4f mm, max %.4f mm (%zu params, "
-                 "rank %zu)\n", effects != NULL ? " with the configured " : "",
-            effects != NULL ? effects : "", res->geo.rms_mm, res->geo.max_mm, res->geo.n_params,
-            res->geo.rank);
+    fprintf(log,
+            "(c) geometric fit%s%s: wire residual RMS %.4f mm, max %.4f mm (%zu params, "
+            "rank %zu)\n",
+            effects != NULL ? " with the configured " : "", effects != NULL ? effects : "",
+            res->geo.rms_mm, res->geo.max_mm, res->geo.n_params, res->geo.rank);
     if (res->noise.meas_mm > 0.0) {
         fprintf(log, "    whitened residual sd %.3f (1: as the noise model predicts)\n",
                 res->geo.sigma);

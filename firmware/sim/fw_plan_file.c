@@ -10,8 +10,8 @@
 /* The file's 9 decimals of a degree put an end of a range at most this far beyond it. */
 #define PLAN_FILE_END_TOL_RAD 1e-9
 
-int fw_plan_file_load(const char *path, const dhc_model *model, size_t min_poses,
-                      size_t max_poses, fw_pose *poses, size_t *n, char *msg, size_t cap)
+int fw_plan_file_load(const char *path, const dhc_model *model, size_t min_poses, size_t max_poses,
+                      fw_pose *poses, size_t *n, char *msg, size_t cap)
 {
     *n = 0U;
     const size_t nj = model->arm.n_joints;
@@ -28,8 +28,8 @@ int fw_plan_file_load(const char *path, const dhc_model *model, size_t min_poses
                  plan.rows[max_poses].line, max_poses + 1U, max_poses);
         rc = -1;
     } else if (plan.n_rows < min_poses) {
-        snprintf(msg, cap, "%s: %zu poses: the controller's calibration needs at least %zu",
-                 path, plan.n_rows, min_poses);
+        snprintf(msg, cap, "%s: %zu poses: the controller's calibration needs at least %zu", path,
+                 plan.n_rows, min_poses);
         rc = -1;
     }
     for (size_t i = 0U; rc == 0 && i < plan.n_rows; ++i) {
@@ -44,9 +44,11 @@ int fw_plan_file_load(const char *path, const dhc_model *model, size_t min_poses
                 q = jt->max_rad;
             }
             if (!(q >= jt->min_rad && q <= jt->max_rad)) {
-                snprintf(msg, cap, "%s:%zu: q%zu = %.6f deg is outside joint %zu's range "
-                                   "[%g, %g] deg", path, row->line, j + 1U, q / DHC_DEG,
-                         j + 1U, jt->min_rad / DHC_DEG, jt->max_rad / DHC_DEG);
+                snprintf(msg, cap,
+                         "%s:%zu: q%zu = %.6f deg is outside joint %zu's range "
+                         "[%g, %g] deg",
+                         path, row->line, j + 1U, q / DHC_DEG, j + 1U, jt->min_rad / DHC_DEG,
+                         jt->max_rad / DHC_DEG);
                 rc = -1;
             }
             poses[i].q_rad[j] = q;

@@ -19,7 +19,7 @@
  * and its line in msg, e.g.
  *     P.csv:7: q2 = 175.000000 deg is outside joint 2's range [-170, 170] deg
  * (the reader's own messages for syntax, NaN and infinities: "P.csv:4: column 'q1': ..."). */
-int fw_plan_file_load(const char *path, const dhc_model *model, size_t min_poses,
-                      size_t max_poses, fw_pose *poses, size_t *n, char *msg, size_t cap);
+int fw_plan_file_load(const char *path, const dhc_model *model, size_t min_poses, size_t max_poses,
+                      fw_pose *poses, size_t *n, char *msg, size_t cap);
 
 #endif /* FW_PLAN_FILE_H */

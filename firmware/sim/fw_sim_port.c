@@ -28,7 +28,8 @@ static fw_port_status sim_wait_tick(void *ctx, uint64_t *t_us)
  * (65535 -> 0 or back); the plant moves far less than that per tick. */
 static uint32_t wrapped(uint16_t last, uint16_t now)
 {
-    const uint32_t d = now >= last ? (uint32_t)now - (uint32_t)last : (uint32_t)last - (uint32_t)now;
+    const uint32_t d =
+        now >= last ? (uint32_t)now - (uint32_t)last : (uint32_t)last - (uint32_t)now;
     return d > 32768U ? 1U : 0U;
 }
 
@@ -98,8 +99,7 @@ static fw_port_status sim_read_wires(void *ctx, uint16_t counts[3])
             r += s->wire_step_counts;
         }
         counts[k] = (uint16_t)((uint64_t)r & 0xFFFFU);
-        if (s->wire_stuck_tick != 0U && s->ticks >= s->wire_stuck_tick &&
-            k == s->wire_stuck_wire) {
+        if (s->wire_stuck_tick != 0U && s->ticks >= s->wire_stuck_tick && k == s->wire_stuck_wire) {
             if (!s->wire_stuck_latched) {
                 s->wire_stuck_latched = 1;
                 s->wire_stuck_value = counts[k];

@@ -25,7 +25,7 @@ struct fw_sim {
     dhs_plant plant;
     int brakes_released;
     uint8_t nv[FW_SIM_NV_SIZE];
-    uint64_t ticks;                         /* wait_tick calls that advanced the plant */
+    uint64_t ticks; /* wait_tick calls that advanced the plant */
     /* fault injection (tests); the ones at a tick T act on the reads made after the T-th
      * wait_tick (the controller reads its sensors once per tick, right after it) */
     int32_t encoder_offset[DHC_MAX_JOINTS]; /* added to the encoder registers */
@@ -56,15 +56,15 @@ struct fw_sim {
     int nv_cut;
     size_t nv_cut_after;
     int powered_off;
-    size_t nv_bytes_written;                /* bytes that reached the store since init */
+    size_t nv_bytes_written; /* bytes that reached the store since init */
     /* observation (tests) */
     fw_sim_tick_hook tick_hook;
     void *tick_hook_user;
-    uint32_t enc_wraps[DHC_MAX_JOINTS];     /* register wraps seen by the reads (65535 <-> 0) */
+    uint32_t enc_wraps[DHC_MAX_JOINTS]; /* register wraps seen by the reads (65535 <-> 0) */
     uint32_t wire_wraps[3];
     uint16_t enc_last[DHC_MAX_JOINTS];
     uint16_t wire_last[3];
-    int reads_seen;                         /* enc_last / wire_last hold a reading */
+    int reads_seen; /* enc_last / wire_last hold a reading */
 };
 
 /* Starts the plant of sc at q_start (brakes on) with run_seed and fills port. The store

@@ -139,8 +139,8 @@ static fw_fault acquire_checked(fw_ctrl *c, const dhc_model *model, uint32_t hol
     return FW_FAULT_NONE;
 }
 
-fw_fault fw_acquire_one(fw_ctrl *c, const dhc_model *model, uint32_t hold_ticks,
-                        fw_acq_stats *st, dhc_sample *out)
+fw_fault fw_acquire_one(fw_ctrl *c, const dhc_model *model, uint32_t hold_ticks, fw_acq_stats *st,
+                        dhc_sample *out)
 {
     double pred[3];
     return acquire_checked(c, model, hold_ticks, st, out, pred);
@@ -162,8 +162,7 @@ static size_t pair_check(const double ref_w[3], const double ref_pred[3], const 
 }
 
 fw_fault fw_acquire(fw_ctrl *c, const dhc_model *model, const fw_pose *poses, size_t n,
-                    uint32_t hold_ticks, fw_acq_stats *st, dhc_sample *samples,
-                    size_t *n_done)
+                    uint32_t hold_ticks, fw_acq_stats *st, dhc_sample *samples, size_t *n_done)
 {
     /* reference for the pair check: where the arm is now and what its wires read */
     double ref_w[3] = {0.0, 0.0, 0.0};

@@ -25,8 +25,8 @@ static dhc_status read_sample(const void *ctx, size_t index, dhc_sample *out)
 
 /* RMS of the per-sample residual norms; err (may be NULL, n <= FW_ACQ_MAX_SAMPLES) receives
  * the norms of the samples that have a residual, *used how many. */
-static double wire_errors(const dhc_model *model, const dhc_sample *samples, size_t n,
-                          double *err, size_t *used)
+static double wire_errors(const dhc_model *model, const dhc_sample *samples, size_t n, double *err,
+                          size_t *used)
 {
     double ss = 0.0;
     size_t u = 0U;
@@ -85,9 +85,8 @@ void fw_autocal_default_config(fw_autocal_config *cfg)
     cfg->wire_noise_mm = 0.0;
 }
 
-fw_fault fw_autocal(dhc_model *model, const dhc_sample *samples, size_t n,
-                    const fw_nvstore *nv, fw_autocal_workspace *ws, dhc_model *geo_out,
-                    fw_autocal_result *res)
+fw_fault fw_autocal(dhc_model *model, const dhc_sample *samples, size_t n, const fw_nvstore *nv,
+                    fw_autocal_workspace *ws, dhc_model *geo_out, fw_autocal_result *res)
 {
     fw_autocal_config cfg;
     fw_autocal_default_config(&cfg);
@@ -121,27 +120,21 @@ char *fw_autocal_effect_label(const fw_autocal_result *res, char *buf, size_t ca
 fw_fault fw_fault_of_status(dhc_status st)
 {
     switch (st) {
-    case DHC_OK:
-        return FW_FAULT_NONE;
-    case DHC_ERR_NOT_CONVERGED:
-        return FW_FAULT_NOT_CONVERGED;
+    case DHC_OK: return FW_FAULT_NONE;
+    case DHC_ERR_NOT_CONVERGED: return FW_FAULT_NOT_CONVERGED;
     case DHC_ERR_UNDERDETERMINED:
-    case DHC_ERR_NO_DATA:
-        return FW_FAULT_UNDERDETERMINED;
+    case DHC_ERR_NO_DATA: return FW_FAULT_UNDERDETERMINED;
     case DHC_ERR_NONFINITE:
     case DHC_ERR_NOT_SPD:
     case DHC_ERR_SINGULAR:
-    case DHC_ERR_INCONSISTENT:
-        return FW_FAULT_NUMERIC;
-    default:
-        return FW_FAULT_ARGUMENT;
+    case DHC_ERR_INCONSISTENT: return FW_FAULT_NUMERIC;
+    default: return FW_FAULT_ARGUMENT;
     }
 }
 
 fw_fault fw_autocal_configured(const fw_autocal_config *cfg, dhc_model *model,
                                const dhc_sample *samples, size_t n, const fw_nvstore *nv,
-                               fw_autocal_workspace *ws, dhc_model *geo_out,
-                               fw_autocal_result *res)
+                               fw_autocal_workspace *ws, dhc_model *geo_out, fw_autocal_result *res)
 {
     memset(res, 0, sizeof *res);
     res->stored_rms_mm = -1.0;
@@ -176,8 +169,8 @@ fw_fault fw_autocal_configured(const fw_autocal_config *cfg, dhc_model *model,
                 cpr > 0.0 ? sqrt(1.0 / (12.0 * cpr * cpr) + dither * dither) : 0.0;
         }
         opt.noise.meas_mm = cfg->wire_noise_mm > 0.0 ? cfg->wire_noise_mm
-                            : cfg->acq != NULL           ? fw_acq_wire_noise_mm(cfg->acq)
-                                                         : 0.0;
+                            : cfg->acq != NULL       ? fw_acq_wire_noise_mm(cfg->acq)
+                                                     : 0.0;
         if (!(opt.noise.meas_mm > 0.0)) {
             opt.noise.meas_mm = cfg->io->wire_mm_per_count / sqrt(12.0);
         }
@@ -185,20 +178,18 @@ fw_fault fw_autocal_configured(const fw_autocal_config *cfg, dhc_model *model,
         res->noise = opt.noise;
     }
     dhc_param_set set;
-    if (dhc_params_base_model(&set, model) != DHC_OK ||
-        cfg->n_effects > FW_AUTOCAL_MAX_EFFECTS) {
+    if (dhc_params_base_model(&set, model) != DHC_OK || cfg->n_effects > FW_AUTOCAL_MAX_EFFECTS) {
         return FW_FAULT_ARGUMENT;
     }
     for (size_t e = 0U; e < cfg->n_effects; ++e) {
-        if (dhc_params_add_effect(&set, model, cfg->effect[e], cfg->effect_joint[e]) !=
-            DHC_OK) {
+        if (dhc_params_add_effect(&set, model, cfg->effect[e], cfg->effect_joint[e]) != DHC_OK) {
             return FW_FAULT_ARGUMENT;
         }
     }
     memset(ws->flags, 0, sizeof ws->flags);
     ws->geo = *model;
-    const dhc_status fit = dhc_calib_fit(&ws->geo, &set, read_sample, &buf, n, ws->flags, &opt,
-                                         &ws->cal, &res->geo);
+    const dhc_status fit =
+        dhc_calib_fit(&ws->geo, &set, read_sample, &buf, n, ws->flags, &opt, &ws->cal, &res->geo);
     if (fit != DHC_OK) {
         return fw_fault_of_status(fit);
     }
@@ -218,13 +209,12 @@ fw_fault fw_autocal_configured(const fw_autocal_config *cfg, dhc_model *model,
     }
     const size_t nc = 0U;
 #endif
-    res->diagnosis = nc > 0U ? dhc_diagnose(&ws->geo, &set, res->geo.identifiable,
-                                            res->geo.sigma * res->geo.sigma, ws->cands, nc,
-                                            read_sample, &buf, n, ws->flags, &dopt,
-                                            &ws->diag_ws, &ws->diag)
-                             : DHC_OK;
-    if (nc > 0U && res->diagnosis == DHC_OK && ws->diag.count > 0U &&
-        ws->diag.c[0].significant) {
+    res->diagnosis = nc > 0U
+                         ? dhc_diagnose(&ws->geo, &set, res->geo.identifiable,
+                                        res->geo.sigma * res->geo.sigma, ws->cands, nc, read_sample,
+                                        &buf, n, ws->flags, &dopt, &ws->diag_ws, &ws->diag)
+                         : DHC_OK;
+    if (nc > 0U && res->diagnosis == DHC_OK && ws->diag.count > 0U && ws->diag.c[0].significant) {
         res->found = 1;
         res->effect = ws->diag.c[0].effect;
         res->effect_joint = ws->diag.c[0].joint;
@@ -248,8 +238,8 @@ fw_fault fw_autocal_configured(const fw_autocal_config *cfg, dhc_model *model,
      * equations underestimates its error on new data by about sqrt((m - p) / (m + p)). */
     const double m_rows = (double)final_fit->rows;
     const double p_fit = (double)final_fit->rank;
-    res->new_fpe_mm = m_rows > p_fit ? res->new_rms_mm * sqrt((m_rows + p_fit) / (m_rows - p_fit))
-                                     : HUGE_VAL;
+    res->new_fpe_mm =
+        m_rows > p_fit ? res->new_rms_mm * sqrt((m_rows + p_fit) / (m_rows - p_fit)) : HUGE_VAL;
     if (nv == NULL) {
         return FW_FAULT_NONE;
     }

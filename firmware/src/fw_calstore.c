@@ -15,9 +15,10 @@
 #define HI_HARMONICS (DHC_HARMONIC_MAX_ORDER - 1U)
 
 /* The largest payload (DHC_MAX_JOINTS joints) fits the slot. */
-#define JOINT_BYTES(n) (7U * 8U + 1U + 4U * 8U + 2U * HI_HARMONICS * 8U + (n) * 8U)
-#define MAX_PAYLOAD_BYTES \
-    (1U + DHC_MAX_JOINTS * JOINT_BYTES(DHC_MAX_JOINTS) + 18U * 8U + 1U + 25U * 8U + 2U * 8U + 5U * 8U)
+#define JOINT_BYTES(n) (7U * 8U + 1U + 4U * 8U + 2U * HI_HARMONICS * 8U + (n)*8U)
+#define MAX_PAYLOAD_BYTES                                                                     \
+    (1U + DHC_MAX_JOINTS * JOINT_BYTES(DHC_MAX_JOINTS) + 18U * 8U + 1U + 25U * 8U + 2U * 8U + \
+     5U * 8U)
 _Static_assert(MAX_PAYLOAD_BYTES <= FW_CAL_PAYLOAD_MAX, "a full model must fit a slot");
 
 uint32_t fw_crc32(uint32_t crc, const void *data, size_t len)
@@ -125,7 +126,7 @@ size_t fw_cal_encode(const dhc_model *model, uint8_t *buf, size_t cap)
     put_u8(&w, (uint8_t)n);
     for (size_t i = 0U; i < n; ++i) {
         const dhc_joint *j = &model->arm.joint[i];
-        const double v[7] = {j->theta_offset_rad, j->d_mm,    j->a_mm,  j->alpha_rad,
+        const double v[7] = {j->theta_offset_rad, j->d_mm,    j->a_mm,   j->alpha_rad,
                              j->beta_rad,         j->min_rad, j->max_rad};
         put_f64s(&w, v, 7U);
         put_u8(&w, (uint8_t)j->convention);

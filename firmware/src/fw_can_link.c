@@ -269,7 +269,6 @@ fw_port_status fw_can_link_start(fw_can_link *link)
     }
     link->started = 1;
     link->tick = 0U;
-    link->t0_us = link->cfg.clock.now_us != NULL ? link->cfg.clock.now_us(link->cfg.clock.ctx)
-                                                 : 0U;
+    link->t0_us = link->cfg.clock.now_us != NULL ? link->cfg.clock.now_us(link->cfg.clock.ctx) : 0U;
     return sync_and_collect(link);
 }

@@ -7,10 +7,9 @@
 const char *fw_fault_name(fw_fault f)
 {
     static const char *const names[FW_FAULT_COUNT] = {
-        "none",           "encoder_jump",  "tacho_mismatch", "drive_saturated",
-        "wires_inconsistent", "port_timeout", "port_io",     "storage",
-        "settle_timeout", "joint_limit",   "argument",       "not_converged",
-        "underdetermined", "numeric",     "stopped"};
+        "none",         "encoder_jump",  "tacho_mismatch",  "drive_saturated", "wires_inconsistent",
+        "port_timeout", "port_io",       "storage",         "settle_timeout",  "joint_limit",
+        "argument",     "not_converged", "underdetermined", "numeric",         "stopped"};
     return (unsigned)f < (unsigned)FW_FAULT_COUNT ? names[f] : "unknown";
 }
 
@@ -97,8 +96,8 @@ fw_fault fw_ctrl_init(fw_ctrl *c, const fw_port *port, const fw_io_config *io,
     memset(c, 0, sizeof *c);
     c->port = port;
     c->io = io;
-    if (port == NULL || io == NULL || cfg == NULL || q_home_rad == NULL ||
-        port->n_joints == 0U || port->n_joints > DHC_MAX_JOINTS) {
+    if (port == NULL || io == NULL || cfg == NULL || q_home_rad == NULL || port->n_joints == 0U ||
+        port->n_joints > DHC_MAX_JOINTS) {
         c->fault = FW_FAULT_ARGUMENT;
         return c->fault;
     }
@@ -126,10 +125,10 @@ fw_fault fw_ctrl_init(fw_ctrl *c, const fw_port *port, const fw_io_config *io,
     }
     for (size_t k = 0U; k < 3U; ++k) {
         fw_counter_reset(&c->wire[k], w[k], cfg->wire_max_step);
-        const double expected = wire_expected_mm != NULL
-                                    ? (wire_expected_mm[k] - io->wire_ref_mm[k]) /
-                                          io->wire_mm_per_count
-                                    : (double)w[k];
+        const double expected =
+            wire_expected_mm != NULL
+                ? (wire_expected_mm[k] - io->wire_ref_mm[k]) / io->wire_mm_per_count
+                : (double)w[k];
         c->wire_home[k] = home_count(w[k], expected);
     }
     return FW_FAULT_NONE;
@@ -175,8 +174,8 @@ fw_fault fw_ctrl_tick(fw_ctrl *c, const double *q_ref_rad, const double *qd_ref_
             return c->fault;
         }
         const int64_t step = c->wire[k].position - before;
-        const int64_t change = step > c->wire_step[k] ? step - c->wire_step[k]
-                                                      : c->wire_step[k] - step;
+        const int64_t change =
+            step > c->wire_step[k] ? step - c->wire_step[k] : c->wire_step[k] - step;
         c->wire_step[k] = step;
         if (change > c->wire_step_change_max) {
             c->wire_step_change_max = change;
@@ -219,8 +218,8 @@ fw_fault fw_ctrl_tick(fw_ctrl *c, const double *q_ref_rad, const double *qd_ref_
         if (fabs(e) * c->io->counts_per_rad[j] <= 0.5 + 1e-9) {
             e = 0.0;
         }
-        const double u = fw_pid_step(&c->cfg.gains[j], &c->pid[j], e, v_ref - c->qd_tacho_rad_s[j],
-                                     dt);
+        const double u =
+            fw_pid_step(&c->cfg.gains[j], &c->pid[j], e, v_ref - c->qd_tacho_rad_s[j], dt);
         if (c->pid[j].saturated) {
             if (++c->sat_count[j] >= c->cfg.sat_fault_ticks) {
                 fw_ctrl_fault(c, FW_FAULT_DRIVE_SATURATED, j);
@@ -245,8 +244,7 @@ static fw_fault run_segment(fw_ctrl *c, const double *q1)
     fw_segment seg[DHC_MAX_JOINTS];
     double t_end = 0.0;
     for (size_t j = 0U; j < c->n; ++j) {
-        fw_segment_plan(&seg[j], c->q_ref_rad[j], q1[j], c->cfg.v_max_rad_s,
-                        c->cfg.a_max_rad_s2);
+        fw_segment_plan(&seg[j], c->q_ref_rad[j], q1[j], c->cfg.v_max_rad_s, c->cfg.a_max_rad_s2);
         t_end = fmax(t_end, seg[j].duration_s);
     }
     for (size_t j = 0U; j < c->n; ++j) {

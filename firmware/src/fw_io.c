@@ -24,7 +24,8 @@ void fw_io_set_wires(fw_io_config *io, double wheel_radius_mm, double counts_per
 
 uint16_t fw_dac_code(const fw_io_config *io, double volts)
 {
-    /* 12 bits over -fs..+fs; mid-scale 2048 is 0 V. a non-finite command maps to 0 V, the safe one. */
+    /* 12 bits over -fs..+fs; mid-scale 2048 is 0 V. a non-finite command maps to 0 V, the safe one.
+     */
     const double fs = io->dac_v_full_scale;
     const double code = dhc_is_finite(volts) ? (volts / fs + 1.0) * 2048.0 : 2048.0;
     const double clamped = fmin(fmax(round(code), 0.0), 4095.0);

@@ -40,8 +40,8 @@ fw_fault fw_job_boot(fw_job *job, const fw_job_config *cfg, const dhc_model *nom
         return FW_FAULT_ARGUMENT;
     }
     const size_t nj = nominal->arm.n_joints;
-    if (!nominal->measurer.present || nj == 0U || nj > DHC_MAX_JOINTS ||
-        nj > port->n_joints || cfg->n_samples == 0U || cfg->n_samples > FW_ACQ_MAX_SAMPLES) {
+    if (!nominal->measurer.present || nj == 0U || nj > DHC_MAX_JOINTS || nj > port->n_joints ||
+        cfg->n_samples == 0U || cfg->n_samples > FW_ACQ_MAX_SAMPLES) {
         return FW_FAULT_ARGUMENT;
     }
     job->cfg = *cfg;
@@ -119,9 +119,9 @@ fw_fault fw_job_plan(fw_job *job)
         }
 #endif
 #if DHC_WITH_PLAN
-        job->n_plan = fw_plan_select(&job->nominal, &fitted, job->cfg.n_samples,
-                                     job->cfg.plan_candidates, job->cfg.plan_seed,
-                                     job->cfg.mixed_dirs, &job->plan_ws, job->plan);
+        job->n_plan =
+            fw_plan_select(&job->nominal, &fitted, job->cfg.n_samples, job->cfg.plan_candidates,
+                           job->cfg.plan_seed, job->cfg.mixed_dirs, &job->plan_ws, job->plan);
 #else
         return job_fault(job, FW_FAULT_ARGUMENT); /* the library of this build plans not */
 #endif
@@ -138,8 +138,8 @@ fw_fault fw_job_plan(fw_job *job)
     if (have_base) {
         job->o1_params = base.count;
         /* a score, not a gate: a plan the analysis cannot score still runs */
-        (void)fw_plan_observability(&job->nominal, &base, job->plan, job->n_plan,
-                                    &job->plan_ws, &job->o1, &job->o1_rank);
+        (void)fw_plan_observability(&job->nominal, &base, job->plan, job->n_plan, &job->plan_ws,
+                                    &job->o1, &job->o1_rank);
     }
     return FW_FAULT_NONE;
 }
@@ -171,7 +171,7 @@ fw_fault fw_job_acquire_recorded(fw_job *job, const dhc_sample *samples, size_t 
         const dhc_sample *s = &samples[i];
         /* a recording is outside input: the fit's screens expect the acquisition's checks */
         const int ok = s->kind == (uint8_t)DHC_MEAS_WIRES && dhc_is_finite(s->temp_c) &&
-                 dhc_all_finite(s->wire_mm, 3U) && dhc_all_finite(s->q_rad, nj);
+                       dhc_all_finite(s->wire_mm, 3U) && dhc_all_finite(s->q_rad, nj);
         if (!ok) {
             return FW_FAULT_ARGUMENT;
         }
@@ -194,9 +194,8 @@ fw_fault fw_job_calibrate(fw_job *job, const fw_nvstore *nv)
     ac.io = job->cfg.noise_model ? job->io : NULL;
     ac.acq = &job->acq;
     job->calibrated = job->nominal;
-    const fw_fault f = fw_autocal_configured(&ac, &job->calibrated, job->samples,
-                                             job->n_samples, nv, &job->autocal_ws,
-                                             &job->geometric, &job->result);
+    const fw_fault f = fw_autocal_configured(&ac, &job->calibrated, job->samples, job->n_samples,
+                                             nv, &job->autocal_ws, &job->geometric, &job->result);
     job->calibrated_ok = f == FW_FAULT_NONE || f == FW_FAULT_STORAGE;
     /* a calibration that failed leaves the arm where it is, holding: the controller's
      * faults are the motion's, the caller decides what a failed fit means */

@@ -4,7 +4,6 @@
 #include <math.h>
 #include <string.h>
 
-
 static uint32_t rng_next(uint32_t *s)
 {
     uint32_t x = *s;
@@ -34,7 +33,8 @@ size_t fw_plan_poses(const dhc_model *model, size_t n, uint32_t seed, int mixed_
         for (size_t j = 0U; j < nj; ++j) {
             const dhc_joint *jt = &model->arm.joint[j];
             const double margin = 0.1 * (jt->max_rad - jt->min_rad);
-            ps.q_rad[j] = jt->min_rad + margin + rng_unit(&s) * (jt->max_rad - jt->min_rad - 2.0 * margin);
+            ps.q_rad[j] =
+                jt->min_rad + margin + rng_unit(&s) * (jt->max_rad - jt->min_rad - 2.0 * margin);
             const int plus = (rng_next(&s) & 0x100U) != 0U || !mixed_dirs;
             ps.dir[j] = plus ? (int8_t)1 : (int8_t)-1;
         }
@@ -88,9 +88,8 @@ static dhc_status read_pose(const void *ctx, size_t index, dhc_sample *out)
 }
 
 #if DHC_WITH_PLAN
-size_t fw_plan_select(const dhc_model *model, const dhc_param_set *set, size_t n,
-                      size_t candidates, uint32_t seed, int mixed_dirs, fw_plan_workspace *ws,
-                      fw_pose *poses)
+size_t fw_plan_select(const dhc_model *model, const dhc_param_set *set, size_t n, size_t candidates,
+                      uint32_t seed, int mixed_dirs, fw_plan_workspace *ws, fw_pose *poses)
 {
     if (model == NULL || set == NULL || ws == NULL || poses == NULL || n == 0U ||
         n > FW_PLAN_MAX_POSES || candidates > FW_PLAN_MAX_CANDIDATES) {
@@ -102,8 +101,8 @@ size_t fw_plan_select(const dhc_model *model, const dhc_param_set *set, size_t n
      * nothing (docs/cli.md 1.7): every candidate is one where the arm works */
     const dhc_plan_candidates cand = {read_pose, &list, k, k};
     dhc_plan_report rep;
-    if (k < n || dhc_plan_select(model, set, &cand, n, NULL, &ws->lib, ws->chosen, &rep) !=
-                     DHC_OK) {
+    if (k < n ||
+        dhc_plan_select(model, set, &cand, n, NULL, &ws->lib, ws->chosen, &rep) != DHC_OK) {
         return 0U;
     }
     for (size_t i = 0U; i < n; ++i) {
@@ -114,13 +113,12 @@ size_t fw_plan_select(const dhc_model *model, const dhc_param_set *set, size_t n
 #endif
 
 dhc_status fw_plan_observability(const dhc_model *model, const dhc_param_set *set,
-                                 const fw_pose *poses, size_t n, fw_plan_workspace *ws,
-                                 double *o1, size_t *rank)
+                                 const fw_pose *poses, size_t n, fw_plan_workspace *ws, double *o1,
+                                 size_t *rank)
 {
     if (poses == NULL || ws == NULL || model == NULL) {
         return DHC_ERR_ARGUMENT;
     }
     pose_list list = {model, poses};
-    return dhc_plan_observability(model, set, read_pose, &list, NULL, n, &ws->lib, o1,
-                                  rank);
+    return dhc_plan_observability(model, set, read_pose, &list, NULL, n, &ws->lib, o1, rank);
 }

@@ -50,7 +50,7 @@ fw_quad_status fw_quad_feed(fw_quadrature *q, const fw_quad_event *ev)
     /* Counting up the levels go 00 -> 10 -> 11 -> 01: an A edge counts up when A becomes
      * different from B, a B edge when B becomes equal to A. */
     const int up = ev->line == (uint8_t)FW_QUAD_LINE_A ? (q->level_a != q->level_b)
-                                                        : (q->level_b == q->level_a);
+                                                       : (q->level_b == q->level_a);
     q->count += up ? 1 : -1;
     ++q->edges;
     return st;

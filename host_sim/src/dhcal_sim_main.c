@@ -108,23 +108,31 @@ static int next_option(int argc, char **argv, const struct option *longs, const 
     return c;
 }
 
-enum { OPT_HELP = 'h', OPT_WIRES = 256, OPT_SCENARIO, OPT_OUT, OPT_PLAN, OPT_MODEL_OUT,
-       OPT_POSES, OPT_SEED, OPT_EXACT };
+enum {
+    OPT_HELP = 'h',
+    OPT_WIRES = 256,
+    OPT_SCENARIO,
+    OPT_OUT,
+    OPT_PLAN,
+    OPT_MODEL_OUT,
+    OPT_POSES,
+    OPT_SEED,
+    OPT_EXACT
+};
 
 static int parse_options(int argc, char **argv, options *o)
 {
     memset(o, 0, sizeof *o);
-    static const struct option longs[] = {
-        {"help", no_argument, NULL, OPT_HELP},
-        {"wires", no_argument, NULL, OPT_WIRES},
-        {"scenario", required_argument, NULL, OPT_SCENARIO},
-        {"out", required_argument, NULL, OPT_OUT},
-        {"plan", required_argument, NULL, OPT_PLAN},
-        {"model-out", required_argument, NULL, OPT_MODEL_OUT},
-        {"poses", required_argument, NULL, OPT_POSES},
-        {"seed", required_argument, NULL, OPT_SEED},
-        {"exact", no_argument, NULL, OPT_EXACT},
-        {NULL, 0, NULL, 0}};
+    static const struct option longs[] = {{"help", no_argument, NULL, OPT_HELP},
+                                          {"wires", no_argument, NULL, OPT_WIRES},
+                                          {"scenario", required_argument, NULL, OPT_SCENARIO},
+                                          {"out", required_argument, NULL, OPT_OUT},
+                                          {"plan", required_argument, NULL, OPT_PLAN},
+                                          {"model-out", required_argument, NULL, OPT_MODEL_OUT},
+                                          {"poses", required_argument, NULL, OPT_POSES},
+                                          {"seed", required_argument, NULL, OPT_SEED},
+                                          {"exact", no_argument, NULL, OPT_EXACT},
+                                          {NULL, 0, NULL, 0}};
     opterr = 0;
     optind = 1;
     const char *a = NULL;
@@ -132,9 +140,7 @@ static int parse_options(int argc, char **argv, options *o)
     while ((c = next_option(argc, argv, longs, &a)) != -1) {
         const char **slot = NULL;
         switch (c) {
-        case OPT_HELP:
-            fputs(dataset_help, stdout);
-            exit(0);
+        case OPT_HELP: fputs(dataset_help, stdout); exit(0);
         case OPT_WIRES: o->wires = 1; continue;
         case OPT_EXACT: o->exact = 1; continue;
         case OPT_SCENARIO: slot = &o->scenario; break;
@@ -348,9 +354,23 @@ typedef struct {
     int have_lines;
 } bus_config;
 
-enum { BUS_SCENARIO = 256, BUS_CAN, BUS_ID_OFFSET, BUS_GPIO_CHIP, BUS_SEED, BUS_DROP,
-       BUS_STOP_AT, BUS_IDLE_EXIT, BUS_START_WAIT, BUS_LINES, BUS_STEPS, BUS_BURST,
-       BUS_PAUSE, BUS_START_DELAY, BUS_STEP_US };
+enum {
+    BUS_SCENARIO = 256,
+    BUS_CAN,
+    BUS_ID_OFFSET,
+    BUS_GPIO_CHIP,
+    BUS_SEED,
+    BUS_DROP,
+    BUS_STOP_AT,
+    BUS_IDLE_EXIT,
+    BUS_START_WAIT,
+    BUS_LINES,
+    BUS_STEPS,
+    BUS_BURST,
+    BUS_PAUSE,
+    BUS_START_DELAY,
+    BUS_STEP_US
+};
 static const struct option bus_longs[] = {
     {"help", no_argument, NULL, 'h'},
     {"scenario", required_argument, NULL, BUS_SCENARIO},
@@ -428,8 +448,7 @@ static int bus_option(int opt, const char *a, const char *v, const char *given, 
         }
         memcpy(first, v, (size_t)(comma - v));
         first[comma - v] = '\0';
-        if (!parse_ulong(first, 65535U, &la) || !parse_ulong(comma + 1, 65535U, &lb) ||
-            la == lb) {
+        if (!parse_ulong(first, 65535U, &la) || !parse_ulong(comma + 1, 65535U, &lb) || la == lb) {
             return usage_error("--lines: '%s' is not two different offsets A,B", v);
         }
         b->go.line[0] = (unsigned)la;
@@ -456,8 +475,7 @@ static int bus_option(int opt, const char *a, const char *v, const char *given, 
         rc = bus_number(a, v, 10000000U, &n);
         b->go.step_us = (uint32_t)n;
     } break;
-    default:
-        return usage_error("bus: unknown option '%s'", given);
+    default: return usage_error("bus: unknown option '%s'", given);
     }
     return rc;
 }

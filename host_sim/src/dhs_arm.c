@@ -198,8 +198,8 @@ void dhs_arm_pose_from_cs(const dhs_arm *arm, const double *cos_phi, const doubl
             }
             for (size_t a = 0U; a < 3U; ++a) {
                 for (size_t b = a; b < 3U; ++b) {
-                    const double v = ri.m[a][0] * r->m[b][0] + ri.m[a][1] * r->m[b][1] +
-                                     ri.m[a][2] * r->m[b][2];
+                    const double v =
+                        ri.m[a][0] * r->m[b][0] + ri.m[a][1] * r->m[b][1] + ri.m[a][2] * r->m[b][2];
                     iw->m[a][b] = v;
                     iw->m[b][a] = v;
                 }
@@ -272,9 +272,9 @@ void dhs_arm_mass_matrix(const dhs_arm *arm, const dhs_arm_pose *pose, double *m
 void dhs_arm_bias(const dhs_arm *arm, const dhs_arm_pose *pose, const double *dq, double *h_nm)
 {
     const size_t n = arm->n;
-    double w[DHC_MAX_JOINTS][3];   /* angular velocity of link i */
-    double dw[DHC_MAX_JOINTS][3];  /* angular acceleration of link i */
-    double ac[DHC_MAX_JOINTS][3];  /* acceleration of COM i */
+    double w[DHC_MAX_JOINTS][3];  /* angular velocity of link i */
+    double dw[DHC_MAX_JOINTS][3]; /* angular acceleration of link i */
+    double ac[DHC_MAX_JOINTS][3]; /* acceleration of COM i */
     double w_prev[3] = {0.0, 0.0, 0.0};
     double dw_prev[3] = {0.0, 0.0, 0.0};
     /* acceleration of the origin of frame i-1 (on the axis of joint i); gravity enters as

@@ -132,8 +132,7 @@ static void command_watchdog(dhs_bus *bus)
     }
 }
 
-static dhs_bus_status on_sync(dhs_bus *bus, const fw_can_frame *in, dhs_bus_emit emit,
-                              void *ctx)
+static dhs_bus_status on_sync(dhs_bus *bus, const fw_can_frame *in, dhs_bus_emit emit, void *ctx)
 {
     fw_can_sync sync;
     if (fw_can_decode_sync(in, &sync) != FW_CAN_MSG_OK) {
@@ -207,14 +206,11 @@ dhs_bus_status dhs_bus_handle(dhs_bus *bus, const fw_can_frame *in, dhs_bus_emit
         return DHS_BUS_IGNORED;
     }
     switch (fw_can_classify(in->id, NULL)) {
-    case FW_CAN_KIND_SYNC:
-        return on_sync(bus, in, emit, emit_ctx);
-    case FW_CAN_KIND_DRIVE_CMD:
-        return on_command(bus, in);
+    case FW_CAN_KIND_SYNC: return on_sync(bus, in, emit, emit_ctx);
+    case FW_CAN_KIND_DRIVE_CMD: return on_command(bus, in);
     case FW_CAN_KIND_DRIVE_FB:
     case FW_CAN_KIND_WIRES:
-    case FW_CAN_KIND_UNKNOWN:
-        break;
+    case FW_CAN_KIND_UNKNOWN: break;
     }
     return DHS_BUS_IGNORED;
 }

@@ -170,8 +170,7 @@ int dhs_gpio_play(const dhs_gpio_play_options *o, char *why, size_t why_cap)
         (void)snprintf(path, sizeof path, "/sys/bus/gpio/devices/%s/sim_gpio%u", o->chip,
                        o->line[k]);
         if (stat(path, &st) != 0) {
-            (void)snprintf(why, why_cap, "gpio-sim chip %s has no line %u", o->chip,
-                           o->line[k]);
+            (void)snprintf(why, why_cap, "gpio-sim chip %s has no line %u", o->chip, o->line[k]);
             return 2;
         }
     }

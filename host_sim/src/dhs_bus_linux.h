@@ -10,16 +10,16 @@
 #include "dhcal_sim/dhs_scenario.h"
 
 typedef struct {
-    const char *can;          /* interface */
-    uint32_t id_offset;       /* the DBC's identifiers moved by this on the bus */
-    uint64_t run_seed;        /* the plant's (7: dhcal-fw --port sim's default) */
-    uint32_t drop_id;         /* fault: drop the answer frame drop_id (the DBC's id) ... */
-    uint64_t drop_tick;       /* ... to the drop_tick-th SYNC (0: the first) */
-    int drop;                 /* the drop is armed */
-    uint64_t stop_tick;       /* fault: go silent from this SYNC on (the cable pulled) */
+    const char *can;    /* interface */
+    uint32_t id_offset; /* the DBC's identifiers moved by this on the bus */
+    uint64_t run_seed;  /* the plant's (7: dhcal-fw --port sim's default) */
+    uint32_t drop_id;   /* fault: drop the answer frame drop_id (the DBC's id) ... */
+    uint64_t drop_tick; /* ... to the drop_tick-th SYNC (0: the first) */
+    int drop;           /* the drop is armed */
+    uint64_t stop_tick; /* fault: go silent from this SYNC on (the cable pulled) */
     int stop;
-    uint32_t idle_exit_ms;    /* after the first SYNC: quit when the bus is quiet this long */
-    uint32_t start_wait_ms;   /* quit when no SYNC comes within this */
+    uint32_t idle_exit_ms;  /* after the first SYNC: quit when the bus is quiet this long */
+    uint32_t start_wait_ms; /* quit when no SYNC comes within this */
 } dhs_bus_linux_options;
 
 typedef struct {

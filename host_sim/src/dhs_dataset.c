@@ -80,15 +80,15 @@ dhc_status dhs_dataset_at(dhs_dataset *d, const double *target_rad, const int8_t
         const int64_t counts = (int64_t)count_f;
         /* The shaft rests somewhere inside the count the servo holds (exact: on the
          * commanded angle itself, between counts if need be). */
-        const double inside = d->exact ? target_rad[j] * cpr_nom - (double)counts
-                                       : dhs_rng_uniform(&d->noise) - 0.5;
+        const double inside =
+            d->exact ? target_rad[j] * cpr_nom - (double)counts : dhs_rng_uniform(&d->noise) - 0.5;
         row->encoder_counts[j] = counts;
         row->motor_rad[j] = ((double)counts + inside) / dhs_motor_counts_per_rad(jp);
         row->q_rad[j] = d->exact ? target_rad[j] : (double)counts / cpr_nom;
         row->dir[j] = dir[j];
     }
-    const dhc_status st = dhs_static_links(sc, &d->arm, row->motor_rad, row->dir, row->link_rad,
-                                           row->hold_nm);
+    const dhc_status st =
+        dhs_static_links(sc, &d->arm, row->motor_rad, row->dir, row->link_rad, row->hold_nm);
     if (st != DHC_OK) {
         return st;
     }
@@ -96,8 +96,8 @@ dhc_status dhs_dataset_at(dhs_dataset *d, const double *target_rad, const int8_t
     dhs_arm_pose_at(&d->arm, row->link_rad, &pose);
     dhc_vec3_scale(pose.tool_m, 1e3, row->tool_mm);
     for (size_t k = 0U; k < 3U; ++k) {
-        row->xyz_mm[k] = row->tool_mm[k] +
-                         (d->exact ? 0.0 : sc->noise_xyz_mm * dhs_rng_gauss(&d->noise));
+        row->xyz_mm[k] =
+            row->tool_mm[k] + (d->exact ? 0.0 : sc->noise_xyz_mm * dhs_rng_gauss(&d->noise));
     }
     if (sc->measurer.present) {
         if (!d->wires_ready) {

@@ -30,8 +30,8 @@ static void cs_track(dhs_cs *t, double angle)
     }
     const double d2 = d * d;
     /* constant reciprocals: multiplications, not divisions (they cost a fifth of the step) */
-    const double sd = d * (1.0 - d2 * (1.0 / 6.0) *
-                                     (1.0 - d2 * (1.0 / 20.0) * (1.0 - d2 * (1.0 / 42.0))));
+    const double sd =
+        d * (1.0 - d2 * (1.0 / 6.0) * (1.0 - d2 * (1.0 / 20.0) * (1.0 - d2 * (1.0 / 42.0))));
     const double cd = 1.0 - d2 * 0.5 * (1.0 - d2 * (1.0 / 12.0) * (1.0 - d2 * (1.0 / 30.0)));
     const double c = t->c * cd - t->s * sd;
     const double s = t->s * cd + t->c * sd;
@@ -211,7 +211,7 @@ typedef struct {
     size_t n;
     double s[DHC_MAX_JOINTS * DHC_MAX_JOINTS]; /* S, then its Cholesky factor */
     double dinv[DHC_MAX_JOINTS];
-    double d[DHC_MAX_JOINTS];    /* motor diagonal; compliant joints only */
+    double d[DHC_MAX_JOINTS]; /* motor diagonal; compliant joints only */
     double inv_d[DHC_MAX_JOINTS];
     double beta[DHC_MAX_JOINTS]; /* motor-link coupling; 0 out of contact */
 } reduced_system;
@@ -237,8 +237,8 @@ static void reduced_solve(const dhs_plant *p, const reduced_system *r, const dou
 /* Second path: every friction coordinate keeps sliding the way it goes without friction.
  * Applies the full sliding impulses, solves once more, and accepts when no coordinate
  * reversed or stopped. v holds A^-1 b on entry and v+ on success. */
-static int friction_all_sliding(dhs_plant *p, const reduced_system *r, const double *b,
-                                double *v, const double *cap, const size_t *fk, size_t nf)
+static int friction_all_sliding(dhs_plant *p, const reduced_system *r, const double *b, double *v,
+                                const double *cap, const size_t *fk, size_t nf)
 {
     double rhs[DHS_MAX_DOF] = {0.0};
     double imp[DHS_MAX_DOF] = {0.0};
@@ -377,8 +377,8 @@ static void friction_pgs(dhs_plant *p, const reduced_system *r, double *v, const
  *
  * Cheapest path (most steps of a moving arm): every coordinate with friction slid during
  * the last step and still slides the same way. One solve; nothing changes unless it holds. */
-static int friction_keeps_sliding(dhs_plant *p, const reduced_system *r, const double *b,
-                                  double *v, const double *cap)
+static int friction_keeps_sliding(dhs_plant *p, const reduced_system *r, const double *b, double *v,
+                                  const double *cap)
 {
     double rhs[DHS_MAX_DOF] = {0.0};
     double imp[DHS_MAX_DOF] = {0.0};
@@ -442,8 +442,7 @@ static dhc_status step(dhs_plant *p)
     /* -- electrical: exact over the step for the motor speed at its start */
     for (size_t j = 0U; j < n; ++j) {
         const dhs_joint_params *jp = &p->sc.joint[j];
-        const double v =
-            clamp(jp->amp_gain_v_per_v * dac_volts(p, j), -jp->supply_v, jp->supply_v);
+        const double v = clamp(jp->amp_gain_v_per_v * dac_volts(p, j), -jp->supply_v, jp->supply_v);
         const double w =
             p->motor_dof[j] < S ? p->motor_rad_s[j] : jp->gear_ratio * p->link_rad_s[j];
         const double i_ss = (v - jp->ke_v_s_per_rad * w) * p->inv_r[j];
@@ -607,8 +606,8 @@ uint16_t dhs_plant_tacho_adc(dhs_plant *p, size_t j)
     if (jp->tacho_noise_v > 0.0) {
         v += jp->tacho_noise_v * dhs_rng_gauss(&p->sensor_rng);
     }
-    const double code = floor(v / p->sc.adc_range_v * (double)DHS_DAC_ZERO + 0.5) +
-                        (double)DHS_DAC_ZERO;
+    const double code =
+        floor(v / p->sc.adc_range_v * (double)DHS_DAC_ZERO + 0.5) + (double)DHS_DAC_ZERO;
     return (uint16_t)clamp(code, 0.0, (double)(DHS_ADC_CODES - 1U));
 }
 

@@ -7,7 +7,6 @@
 #include "dhcal/dhc_geometry.h"
 #include "dhcal_sim/dhs_rng.h"
 
-
 static void joint_defaults(dhs_joint_params *j)
 {
     memset(j, 0, sizeof *j);
@@ -83,27 +82,46 @@ static int finite_all(const double *v, size_t n)
 }
 
 /* Each check: a condition that must hold and a description naming the field. */
-#define CHECK(cond, text)                                                                  \
-    do {                                                                                   \
-        if (!(cond)) {                                                                     \
-            if (what != NULL) {                                                            \
-                *what = (text);                                                            \
-            }                                                                              \
-            return DHC_ERR_ARGUMENT;                                                       \
-        }                                                                                  \
+#define CHECK(cond, text)            \
+    do {                             \
+        if (!(cond)) {               \
+            if (what != NULL) {      \
+                *what = (text);      \
+            }                        \
+            return DHC_ERR_ARGUMENT; \
+        }                            \
     } while (0)
 
 static dhc_status check_joint(const dhs_joint_params *j, const char **what)
 {
-    const double reals[] = {j->r_ohm, j->l_h, j->ke_v_s_per_rad, j->kt_nm_per_a, j->jm_kgm2,
-                            j->bm_nms_per_rad, j->coulomb_nm, j->brake_nm,
-                            j->amp_gain_v_per_v, j->supply_v, j->current_limit_a,
-                            j->gear_ratio, j->backlash_rad, j->stiffness_nm_per_rad,
-                            j->damping_nms_per_rad, j->mass_kg, j->com_m[0], j->com_m[1],
-                            j->com_m[2], j->inertia_kgm2[0], j->inertia_kgm2[1],
-                            j->inertia_kgm2[2], j->link_coulomb_nm,
-                            j->link_viscous_nms_per_rad, j->tacho_v_s_per_rad,
-                            j->tacho_ripple, j->tacho_noise_v, j->nominal_gear_ratio};
+    const double reals[] = {j->r_ohm,
+                            j->l_h,
+                            j->ke_v_s_per_rad,
+                            j->kt_nm_per_a,
+                            j->jm_kgm2,
+                            j->bm_nms_per_rad,
+                            j->coulomb_nm,
+                            j->brake_nm,
+                            j->amp_gain_v_per_v,
+                            j->supply_v,
+                            j->current_limit_a,
+                            j->gear_ratio,
+                            j->backlash_rad,
+                            j->stiffness_nm_per_rad,
+                            j->damping_nms_per_rad,
+                            j->mass_kg,
+                            j->com_m[0],
+                            j->com_m[1],
+                            j->com_m[2],
+                            j->inertia_kgm2[0],
+                            j->inertia_kgm2[1],
+                            j->inertia_kgm2[2],
+                            j->link_coulomb_nm,
+                            j->link_viscous_nms_per_rad,
+                            j->tacho_v_s_per_rad,
+                            j->tacho_ripple,
+                            j->tacho_noise_v,
+                            j->nominal_gear_ratio};
     if (!finite_all(reals, sizeof reals / sizeof reals[0])) {
         if (what != NULL) {
             *what = "a joint parameter is not finite";
@@ -166,12 +184,22 @@ dhc_status dhs_scenario_check(const dhs_scenario *sc, const char **what, size_t 
     CHECK(sc->n_joints >= 1U && sc->n_joints <= DHC_MAX_JOINTS, "joint count out of range");
     CHECK(sc->nominal.n_joints == sc->n_joints && sc->truth.n_joints == sc->n_joints,
           "nominal and true arm must have the scenario's joint count");
-    const double g[] = {sc->gravity_unit[0], sc->gravity_unit[1], sc->gravity_unit[2],
-                        sc->gravity_mps2, sc->payload_kg, sc->payload_com_m[0],
-                        sc->payload_com_m[1], sc->payload_com_m[2],
-                        sc->payload_inertia_kgm2[0], sc->payload_inertia_kgm2[1],
-                        sc->payload_inertia_kgm2[2], sc->dac_range_v, sc->adc_range_v,
-                        sc->noise_xyz_mm, sc->min_axis_distance_mm, sc->min_anchor_plane_mm};
+    const double g[] = {sc->gravity_unit[0],
+                        sc->gravity_unit[1],
+                        sc->gravity_unit[2],
+                        sc->gravity_mps2,
+                        sc->payload_kg,
+                        sc->payload_com_m[0],
+                        sc->payload_com_m[1],
+                        sc->payload_com_m[2],
+                        sc->payload_inertia_kgm2[0],
+                        sc->payload_inertia_kgm2[1],
+                        sc->payload_inertia_kgm2[2],
+                        sc->dac_range_v,
+                        sc->adc_range_v,
+                        sc->noise_xyz_mm,
+                        sc->min_axis_distance_mm,
+                        sc->min_anchor_plane_mm};
     if (!finite_all(g, sizeof g / sizeof g[0])) {
         if (what != NULL) {
             *what = "a scenario value is not finite";

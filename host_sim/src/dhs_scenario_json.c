@@ -44,9 +44,9 @@ typedef struct {
 static int parse_joint_motor(const dhcal_jctx *c, const cJSON *obj, const char *path,
                              dhs_joint_params *j)
 {
-    static const char *const motor[] = {"r_ohm", "l_h", "ke_v_s_per_rad", "kt_nm_per_a",
-                                        "jm_kgm2", "bm_nms_per_rad", "coulomb_nm",
-                                        "brake_nm"};
+    static const char *const motor[] = {"r_ohm",       "l_h",     "ke_v_s_per_rad",
+                                        "kt_nm_per_a", "jm_kgm2", "bm_nms_per_rad",
+                                        "coulomb_nm",  "brake_nm"};
     char p[DHCAL_JPATH_CAP];
     dhcal_jpath_key(p, path, "motor");
     const cJSON *o = NULL;
@@ -57,12 +57,12 @@ static int parse_joint_motor(const dhcal_jctx *c, const cJSON *obj, const char *
     if (o != NULL &&
         ((rc = get_num(c, o, p, "r_ohm", 0, DHCAL_JPOS, &j->r_ohm)) != DHCAL_IO_OK ||
          (rc = get_num(c, o, p, "l_h", 0, DHCAL_JPOS, &j->l_h)) != DHCAL_IO_OK ||
-         (rc = get_num(c, o, p, "ke_v_s_per_rad", 0, DHCAL_JPOS,
-                       &j->ke_v_s_per_rad)) != DHCAL_IO_OK ||
+         (rc = get_num(c, o, p, "ke_v_s_per_rad", 0, DHCAL_JPOS, &j->ke_v_s_per_rad)) !=
+             DHCAL_IO_OK ||
          (rc = get_num(c, o, p, "kt_nm_per_a", 0, DHCAL_JPOS, &j->kt_nm_per_a)) != DHCAL_IO_OK ||
          (rc = get_num(c, o, p, "jm_kgm2", 0, DHCAL_JPOS, &j->jm_kgm2)) != DHCAL_IO_OK ||
-         (rc = get_num(c, o, p, "bm_nms_per_rad", 0, DHCAL_JNONNEG,
-                       &j->bm_nms_per_rad)) != DHCAL_IO_OK ||
+         (rc = get_num(c, o, p, "bm_nms_per_rad", 0, DHCAL_JNONNEG, &j->bm_nms_per_rad)) !=
+             DHCAL_IO_OK ||
          (rc = get_num(c, o, p, "coulomb_nm", 0, DHCAL_JNONNEG, &j->coulomb_nm)) != DHCAL_IO_OK ||
          (rc = get_num(c, o, p, "brake_nm", 0, DHCAL_JNONNEG, &j->brake_nm)) != DHCAL_IO_OK)) {
         return rc;
@@ -82,11 +82,11 @@ static int parse_joint_amplifier(const dhcal_jctx *c, const cJSON *obj, const ch
         return rc;
     }
     if (o != NULL &&
-        ((rc = get_num(c, o, p, "gain_v_per_v", 0, DHCAL_JPOS,
-                       &j->amp_gain_v_per_v)) != DHCAL_IO_OK ||
+        ((rc = get_num(c, o, p, "gain_v_per_v", 0, DHCAL_JPOS, &j->amp_gain_v_per_v)) !=
+             DHCAL_IO_OK ||
          (rc = get_num(c, o, p, "supply_v", 0, DHCAL_JPOS, &j->supply_v)) != DHCAL_IO_OK ||
-         (rc = get_num(c, o, p, "current_limit_a", 0, DHCAL_JPOS,
-                       &j->current_limit_a)) != DHCAL_IO_OK)) {
+         (rc = get_num(c, o, p, "current_limit_a", 0, DHCAL_JPOS, &j->current_limit_a)) !=
+             DHCAL_IO_OK)) {
         return rc;
     }
     return DHCAL_IO_OK;
@@ -108,8 +108,8 @@ static int parse_joint_gear(const dhcal_jctx *c, const cJSON *obj, const char *p
     if (o != NULL) {
         double backlash_deg = j->backlash_rad / DHC_DEG;
         if ((rc = get_num(c, o, p, "ratio", 0, DHCAL_JPOS, &j->gear_ratio)) != DHCAL_IO_OK ||
-            (rc = get_num(c, o, p, "backlash_deg", 0, DHCAL_JNONNEG,
-                          &backlash_deg)) != DHCAL_IO_OK) {
+            (rc = get_num(c, o, p, "backlash_deg", 0, DHCAL_JNONNEG, &backlash_deg)) !=
+                DHCAL_IO_OK) {
             return rc;
         }
         if (backlash_deg >= 10.0) {
@@ -155,8 +155,8 @@ static int parse_joint_gear(const dhcal_jctx *c, const cJSON *obj, const char *p
                 double s_mrad = 0.0;
                 double c_mrad = 0.0;
                 if ((rc = dhcal_jrequire(c, h, ph, "order")) != DHCAL_IO_OK ||
-                    (rc = dhcal_jopt_whole(c, h, ph, "order", 1.0, 1000.0,
-                                           &order)) != DHCAL_IO_OK ||
+                    (rc = dhcal_jopt_whole(c, h, ph, "order", 1.0, 1000.0, &order)) !=
+                        DHCAL_IO_OK ||
                     (rc = get_num(c, h, ph, "sin_mrad", 0, DHCAL_JANY, &s_mrad)) != DHCAL_IO_OK ||
                     (rc = get_num(c, h, ph, "cos_mrad", 0, DHCAL_JANY, &c_mrad)) != DHCAL_IO_OK) {
                     return rc;
@@ -174,8 +174,8 @@ static int parse_joint_gear(const dhcal_jctx *c, const cJSON *obj, const char *p
     return DHCAL_IO_OK;
 }
 
-static int parse_joint_link(const dhcal_jctx *c, const cJSON *obj, const char *path,
-                            int is_default, dhs_joint_params *j)
+static int parse_joint_link(const dhcal_jctx *c, const cJSON *obj, const char *path, int is_default,
+                            dhs_joint_params *j)
 {
     static const char *const link_all[] = {"mass_kg", "com_mm", "inertia_kgm2", "coulomb_nm",
                                            "viscous_nms_per_rad"};
@@ -194,10 +194,10 @@ static int parse_joint_link(const dhcal_jctx *c, const cJSON *obj, const char *p
         if ((!is_default &&
              ((rc = get_num(c, o, p, "mass_kg", 1, DHCAL_JNONNEG, &j->mass_kg)) != DHCAL_IO_OK ||
               (rc = get_vec3(c, o, p, "com_mm", 1, DHCAL_JANY, com_mm)) != DHCAL_IO_OK)) ||
-            (rc = get_vec3(c, o, p, "inertia_kgm2", 0, DHCAL_JNONNEG,
-                           j->inertia_kgm2)) != DHCAL_IO_OK ||
-            (rc = get_num(c, o, p, "coulomb_nm", 0, DHCAL_JNONNEG,
-                          &j->link_coulomb_nm)) != DHCAL_IO_OK ||
+            (rc = get_vec3(c, o, p, "inertia_kgm2", 0, DHCAL_JNONNEG, j->inertia_kgm2)) !=
+                DHCAL_IO_OK ||
+            (rc = get_num(c, o, p, "coulomb_nm", 0, DHCAL_JNONNEG, &j->link_coulomb_nm)) !=
+                DHCAL_IO_OK ||
             (rc = get_num(c, o, p, "viscous_nms_per_rad", 0, DHCAL_JNONNEG,
                           &j->link_viscous_nms_per_rad)) != DHCAL_IO_OK) {
             return rc;
@@ -241,11 +241,11 @@ static int parse_joint_tacho(const dhcal_jctx *c, const cJSON *obj, const char *
         return rc;
     }
     if (o != NULL) {
-        if ((rc = get_num(c, o, p, "v_s_per_rad", 0, DHCAL_JPOS,
-                          &j->tacho_v_s_per_rad)) != DHCAL_IO_OK ||
+        if ((rc = get_num(c, o, p, "v_s_per_rad", 0, DHCAL_JPOS, &j->tacho_v_s_per_rad)) !=
+                DHCAL_IO_OK ||
             (rc = get_num(c, o, p, "ripple", 0, DHCAL_JNONNEG, &j->tacho_ripple)) != DHCAL_IO_OK ||
-            (rc = get_num(c, o, p, "noise_v", 0, DHCAL_JNONNEG,
-                          &j->tacho_noise_v)) != DHCAL_IO_OK) {
+            (rc = get_num(c, o, p, "noise_v", 0, DHCAL_JNONNEG, &j->tacho_noise_v)) !=
+                DHCAL_IO_OK) {
             return rc;
         }
         if (j->tacho_ripple >= 1.0) {
@@ -298,11 +298,10 @@ static int parse_joint_controller(const dhcal_jctx *c, const cJSON *obj, const c
 static int parse_joint(const dhcal_jctx *c, const cJSON *obj, const char *path, int is_default,
                        dhs_joint_params *j, joint_given *given)
 {
-    static const char *const top[] = {"motor", "amplifier", "gear", "link", "encoder",
-                                      "tacho", "controller", "comment"};
+    static const char *const top[] = {"motor",   "amplifier", "gear",       "link",
+                                      "encoder", "tacho",     "controller", "comment"};
     int rc = dhcal_jcheck_object(c, obj, path, DHCAL_JKEYS(top));
-    if (rc != DHCAL_IO_OK ||
-        (rc = parse_joint_motor(c, obj, path, j)) != DHCAL_IO_OK ||
+    if (rc != DHCAL_IO_OK || (rc = parse_joint_motor(c, obj, path, j)) != DHCAL_IO_OK ||
         (rc = parse_joint_amplifier(c, obj, path, j)) != DHCAL_IO_OK ||
         (rc = parse_joint_gear(c, obj, path, j, given)) != DHCAL_IO_OK ||
         (rc = parse_joint_link(c, obj, path, is_default, j)) != DHCAL_IO_OK ||
@@ -330,8 +329,7 @@ static int parse_truth(const dhcal_jctx *c, const cJSON *root, dhs_scenario *sc)
     if (js != NULL) {
         if (!cJSON_IsArray(js) || (size_t)cJSON_GetArraySize(js) != sc->n_joints) {
             return dhcal_jfail(c, "truth.joints",
-                               "expected an array of %zu objects (one per joint)",
-                        sc->n_joints);
+                               "expected an array of %zu objects (one per joint)", sc->n_joints);
         }
         size_t i = 0U;
         for (const cJSON *e = js->child; e != NULL; e = e->next, ++i) {
@@ -356,8 +354,8 @@ static int parse_truth(const dhcal_jctx *c, const cJSON *root, dhs_scenario *sc)
     }
     dhc_frame base_err;
     int has = 0;
-    if ((rc = dhcal_jframe(c, t, "truth", "base", HUGE_VAL, HUGE_VAL, &base_err,
-                           &has)) != DHCAL_IO_OK) {
+    if ((rc = dhcal_jframe(c, t, "truth", "base", HUGE_VAL, HUGE_VAL, &base_err, &has)) !=
+        DHCAL_IO_OK) {
         return rc;
     }
     if (has) {
@@ -370,8 +368,8 @@ static int parse_truth(const dhcal_jctx *c, const cJSON *root, dhs_scenario *sc)
     }
     dhc_vec3_add(sc->truth.tool_mm, tool, sc->truth.tool_mm);
     const cJSON *sd = NULL;
-    if ((rc = dhcal_jobject(c, t, "truth", "random_sd", 0, DHCAL_JKEYS(jkeys),
-                            &sd)) != DHCAL_IO_OK) {
+    if ((rc = dhcal_jobject(c, t, "truth", "random_sd", 0, DHCAL_JKEYS(jkeys), &sd)) !=
+        DHCAL_IO_OK) {
         return rc;
     }
     if (sd != NULL) {
@@ -391,10 +389,17 @@ static int parse_truth(const dhcal_jctx *c, const cJSON *root, dhs_scenario *sc)
 static int parse_measurer(const dhcal_jctx *c, const cJSON *root, const dhcal_model *model,
                           dhs_scenario *sc)
 {
-    static const char *const keys[] = {"anchor_errors_mm", "frame_error", "wheel_radius_mm",
-                                       "wheel_radius_error", "lines", "counter_bits",
-                                       "zero_length_mm", "zero_length_error_mm",
-                                       "slip_sd_mm_per_sqrt_mm", "noise_mm", "comment"};
+    static const char *const keys[] = {"anchor_errors_mm",
+                                       "frame_error",
+                                       "wheel_radius_mm",
+                                       "wheel_radius_error",
+                                       "lines",
+                                       "counter_bits",
+                                       "zero_length_mm",
+                                       "zero_length_error_mm",
+                                       "slip_sd_mm_per_sqrt_mm",
+                                       "noise_mm",
+                                       "comment"};
     const cJSON *m = NULL;
     int rc = dhcal_jobject(c, root, "", "measurer", 0, DHCAL_JKEYS(keys), &m);
     if (rc != DHCAL_IO_OK) {
@@ -422,8 +427,8 @@ static int parse_measurer(const dhcal_jctx *c, const cJSON *root, const dhcal_mo
     }
     dhc_frame fe;
     int has = 0;
-    if ((rc = dhcal_jframe(c, m, "measurer", "frame_error", HUGE_VAL, HUGE_VAL, &fe,
-                           &has)) != DHCAL_IO_OK) {
+    if ((rc = dhcal_jframe(c, m, "measurer", "frame_error", HUGE_VAL, HUGE_VAL, &fe, &has)) !=
+        DHCAL_IO_OK) {
         return rc;
     }
     if (has) {
@@ -435,23 +440,21 @@ static int parse_measurer(const dhcal_jctx *c, const cJSON *root, const dhcal_mo
     double zero_err[3] = {0.0, 0.0, 0.0};
     if ((rc = get_num(c, m, "measurer", "wheel_radius_mm", 0, DHCAL_JPOS, &mp->wheel_radius_mm)) !=
             DHCAL_IO_OK ||
-        (rc = get_num(c, m, "measurer", "wheel_radius_error", 0, DHCAL_JANY,
-                      &rel)) != DHCAL_IO_OK ||
-        (rc = get_vec3(c, m, "measurer", "zero_length_mm", 0, DHCAL_JNONNEG,
-                       mp->zero_length_true_mm)) !=
+        (rc = get_num(c, m, "measurer", "wheel_radius_error", 0, DHCAL_JANY, &rel)) !=
             DHCAL_IO_OK ||
+        (rc = get_vec3(c, m, "measurer", "zero_length_mm", 0, DHCAL_JNONNEG,
+                       mp->zero_length_true_mm)) != DHCAL_IO_OK ||
         (rc = get_vec3(c, m, "measurer", "zero_length_error_mm", 0, DHCAL_JANY, zero_err)) !=
             DHCAL_IO_OK ||
         (rc = get_num(c, m, "measurer", "slip_sd_mm_per_sqrt_mm", 0, DHCAL_JNONNEG,
                       &mp->slip_sd_mm_per_sqrt_mm)) != DHCAL_IO_OK ||
-        (rc = get_num(c, m, "measurer", "noise_mm", 0, DHCAL_JNONNEG,
-                      &mp->noise_mm)) != DHCAL_IO_OK) {
+        (rc = get_num(c, m, "measurer", "noise_mm", 0, DHCAL_JNONNEG, &mp->noise_mm)) !=
+            DHCAL_IO_OK) {
         return rc;
     }
     if (!(fabs(rel) < 0.5)) {
         return dhcal_jfail(c, "measurer.wheel_radius_error",
-                           "must be within (-0.5, 0.5), got %.17g",
-                    rel);
+                           "must be within (-0.5, 0.5), got %.17g", rel);
     }
     mp->wheel_radius_true_mm = mp->wheel_radius_mm * (1.0 + rel);
     for (size_t k = 0U; k < 3U; ++k) {
@@ -464,8 +467,8 @@ static int parse_measurer(const dhcal_jctx *c, const cJSON *root, const dhcal_mo
         mp->lines = (uint32_t)u;
     }
     if (cJSON_GetObjectItemCaseSensitive(m, "counter_bits") != NULL) {
-        if ((rc = dhcal_jopt_whole(c, m, "measurer", "counter_bits", 1.0, 32.0,
-                                   &u)) != DHCAL_IO_OK) {
+        if ((rc = dhcal_jopt_whole(c, m, "measurer", "counter_bits", 1.0, 32.0, &u)) !=
+            DHCAL_IO_OK) {
             return rc;
         }
         mp->counter_bits = (unsigned)u;
@@ -495,9 +498,9 @@ static int parse_small_sections(const dhcal_jctx *c, const cJSON *root, dhs_scen
         const double ns = floor(step_us * 1e3 + 0.5);
         if (!(step_us >= 1.0 && step_us <= 100.0) || fabs(ns - step_us * 1e3) > 1e-6 ||
             fmod(1e6, ns) > 0.0) {
-            return dhcal_jfail(c, "physics.step_us",
-                        "must divide 1000 us and lie in [1, 100] us (10 kHz or finer), got %.17g",
-                        step_us);
+            return dhcal_jfail(
+                c, "physics.step_us",
+                "must divide 1000 us and lie in [1, 100] us (10 kHz or finer), got %.17g", step_us);
         }
         sc->step_ns = (uint32_t)ns;
     }
@@ -507,12 +510,11 @@ static int parse_small_sections(const dhcal_jctx *c, const cJSON *root, dhs_scen
     dhc_vec3_scale(sc->truth.tool_mm, 1e-3, sc->payload_com_m); /* default: the tool point */
     if (o != NULL) {
         double com_mm[3] = {sc->truth.tool_mm[0], sc->truth.tool_mm[1], sc->truth.tool_mm[2]};
-        if ((rc = get_num(c, o, "payload", "mass_kg", 0, DHCAL_JNONNEG,
-                          &sc->payload_kg)) != DHCAL_IO_OK ||
+        if ((rc = get_num(c, o, "payload", "mass_kg", 0, DHCAL_JNONNEG, &sc->payload_kg)) !=
+                DHCAL_IO_OK ||
             (rc = get_vec3(c, o, "payload", "com_mm", 0, DHCAL_JANY, com_mm)) != DHCAL_IO_OK ||
             (rc = get_vec3(c, o, "payload", "inertia_kgm2", 0, DHCAL_JNONNEG,
-                           sc->payload_inertia_kgm2)) !=
-                DHCAL_IO_OK) {
+                           sc->payload_inertia_kgm2)) != DHCAL_IO_OK) {
             return rc;
         }
         dhc_vec3_scale(com_mm, 1e-3, sc->payload_com_m);
@@ -521,28 +523,26 @@ static int parse_small_sections(const dhcal_jctx *c, const cJSON *root, dhs_scen
         return rc;
     }
     if (o != NULL &&
-        ((rc = get_num(c, o, "drive", "dac_range_v", 0, DHCAL_JPOS,
-                       &sc->dac_range_v)) != DHCAL_IO_OK ||
-         (rc = get_num(c, o, "drive", "adc_range_v", 0, DHCAL_JPOS,
-                       &sc->adc_range_v)) != DHCAL_IO_OK)) {
+        ((rc = get_num(c, o, "drive", "dac_range_v", 0, DHCAL_JPOS, &sc->dac_range_v)) !=
+             DHCAL_IO_OK ||
+         (rc = get_num(c, o, "drive", "adc_range_v", 0, DHCAL_JPOS, &sc->adc_range_v)) !=
+             DHCAL_IO_OK)) {
         return rc;
     }
     if ((rc = dhcal_jobject(c, root, "", "noise", 0, DHCAL_JKEYS(noise), &o)) != DHCAL_IO_OK) {
         return rc;
     }
-    if (o != NULL &&
-        (rc = get_num(c, o, "noise", "xyz_mm", 0, DHCAL_JNONNEG,
-                      &sc->noise_xyz_mm)) != DHCAL_IO_OK) {
+    if (o != NULL && (rc = get_num(c, o, "noise", "xyz_mm", 0, DHCAL_JNONNEG, &sc->noise_xyz_mm)) !=
+                         DHCAL_IO_OK) {
         return rc;
     }
     if ((rc = dhcal_jobject(c, root, "", "poses", 0, DHCAL_JKEYS(poses), &o)) != DHCAL_IO_OK) {
         return rc;
     }
-    if (o != NULL &&
-        ((rc = get_num(c, o, "poses", "min_axis_distance_mm", 0, DHCAL_JNONNEG,
-                       &sc->min_axis_distance_mm)) != DHCAL_IO_OK ||
-         (rc = get_num(c, o, "poses", "min_anchor_plane_mm", 0, DHCAL_JNONNEG,
-                       &sc->min_anchor_plane_mm)) != DHCAL_IO_OK)) {
+    if (o != NULL && ((rc = get_num(c, o, "poses", "min_axis_distance_mm", 0, DHCAL_JNONNEG,
+                                    &sc->min_axis_distance_mm)) != DHCAL_IO_OK ||
+                      (rc = get_num(c, o, "poses", "min_anchor_plane_mm", 0, DHCAL_JNONNEG,
+                                    &sc->min_anchor_plane_mm)) != DHCAL_IO_OK)) {
         return rc;
     }
     return DHCAL_IO_OK;
@@ -550,9 +550,9 @@ static int parse_small_sections(const dhcal_jctx *c, const cJSON *root, dhs_scen
 
 static int parse_root(const dhcal_jctx *c, const cJSON *root, dhs_scenario_file *out)
 {
-    static const char *const keys[] = {"name", "comment", "seed", "model", "truth", "physics",
-                                       "joint_defaults", "joints", "payload", "drive",
-                                       "measurer", "noise", "poses"};
+    static const char *const keys[] = {"name",     "comment",        "seed",   "model",   "truth",
+                                       "physics",  "joint_defaults", "joints", "payload", "drive",
+                                       "measurer", "noise",          "poses"};
     int rc = dhcal_jcheck_object(c, root, "", DHCAL_JKEYS(keys));
     if (rc != DHCAL_IO_OK) {
         return rc;
@@ -560,8 +560,8 @@ static int parse_root(const dhcal_jctx *c, const cJSON *root, dhs_scenario_file 
     /* seed, model first: everything else is sized by the model */
     uint64_t seed = 0U;
     if ((rc = dhcal_jrequire(c, root, "", "seed")) != DHCAL_IO_OK ||
-        (rc = dhcal_jopt_whole(c, root, "", "seed", 0.0, 9007199254740992.0,
-                               &seed)) != DHCAL_IO_OK) {
+        (rc = dhcal_jopt_whole(c, root, "", "seed", 0.0, 9007199254740992.0, &seed)) !=
+            DHCAL_IO_OK) {
         return rc;
     }
     const cJSON *m = cJSON_GetObjectItemCaseSensitive(root, "model");
@@ -572,7 +572,7 @@ static int parse_root(const dhcal_jctx *c, const cJSON *root, dhs_scenario_file 
         return dhcal_jfail(c, "model", "expected the path of a model file, got %s", dhcal_jtype(m));
     }
     if ((rc = dhcal_jfile_beside(c, "model", m->valuestring, out->model_path,
-                                  sizeof out->model_path)) != DHCAL_IO_OK) {
+                                 sizeof out->model_path)) != DHCAL_IO_OK) {
         return rc;
     }
     dhcal_error merr;
@@ -590,7 +590,7 @@ static int parse_root(const dhcal_jctx *c, const cJSON *root, dhs_scenario_file 
     if (name != NULL) {
         if (!cJSON_IsString(name) || strlen(name->valuestring) >= sizeof sc->name) {
             return dhcal_jfail(c, "name", "expected a string of at most %zu characters",
-                        sizeof sc->name - 1U);
+                               sizeof sc->name - 1U);
         }
         (void)snprintf(sc->name, sizeof sc->name, "%s", name->valuestring);
     } else {
@@ -629,7 +629,7 @@ static int parse_root(const dhcal_jctx *c, const cJSON *root, dhs_scenario_file 
     }
     if ((size_t)cJSON_GetArraySize(joints) != sc->n_joints) {
         return dhcal_jfail(c, "joints", "expected %zu entries (the model has %zu joints), got %d",
-                    sc->n_joints, sc->n_joints, cJSON_GetArraySize(joints));
+                           sc->n_joints, sc->n_joints, cJSON_GetArraySize(joints));
     }
     size_t i = 0U;
     for (const cJSON *e = joints->child; e != NULL; e = e->next, ++i) {

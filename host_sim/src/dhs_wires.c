@@ -85,8 +85,8 @@ int64_t dhs_wires_counts(const dhs_wires *w, size_t k, dhs_rng *rng)
 
 uint32_t dhs_wires_register(const dhs_wires *w, int64_t counts)
 {
-    const uint64_t mask = w->counter_bits >= 32U ? 0xFFFFFFFFULL
-                                                  : ((1ULL << w->counter_bits) - 1ULL);
+    const uint64_t mask =
+        w->counter_bits >= 32U ? 0xFFFFFFFFULL : ((1ULL << w->counter_bits) - 1ULL);
     /* int64 -> uint64 is reduction modulo 2^64, so negative counts wrap as hardware does. */
     return (uint32_t)((uint64_t)counts & mask);
 }

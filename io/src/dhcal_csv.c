@@ -61,7 +61,7 @@ static int next_line(csv_reader *r, int *got)
         any = 1;
         if (r->len + take > DHCAL_CSV_MAX_LINE) {
             return dhcal_error_set(r->err, DHCAL_IO_BAD_INPUT, "%s:%zu: line longer than %u bytes",
-                             r->path, r->line_no + 1U, DHCAL_CSV_MAX_LINE);
+                                   r->path, r->line_no + 1U, DHCAL_CSV_MAX_LINE);
         }
         if (r->len + take + 1U > r->cap) {
             size_t cap = r->cap;
@@ -74,7 +74,7 @@ static int next_line(csv_reader *r, int *got)
             char *const grown = realloc(r->buf, cap);
             if (grown == NULL) {
                 return dhcal_error_set(r->err, DHCAL_IO_FAILED, "%s:%zu: out of memory", r->path,
-                                 r->line_no + 1U);
+                                       r->line_no + 1U);
             }
             r->buf = grown;
             r->cap = cap;
@@ -88,7 +88,7 @@ static int next_line(csv_reader *r, int *got)
     }
     if (ferror(r->f)) {
         return dhcal_error_set(r->err, DHCAL_IO_BAD_INPUT, "%s:%zu: read error: %s", r->path,
-                         r->line_no + 1U, strerror(errno));
+                               r->line_no + 1U, strerror(errno));
     }
     if (!any) {
         return DHCAL_IO_OK;
@@ -113,13 +113,13 @@ static int next_line(csv_reader *r, int *got)
         const unsigned char b = (unsigned char)r->buf[k];
         if (b == 0U) {
             return dhcal_error_set(r->err, DHCAL_IO_BAD_INPUT,
-                             "%s:%zu: NUL byte at column %zu (binary file?)", r->path,
-                             r->line_no, k + 1U);
+                                   "%s:%zu: NUL byte at column %zu (binary file?)", r->path,
+                                   r->line_no, k + 1U);
         }
         if ((b < 0x20U && b != '\t') || b == 0x7fU) {
             return dhcal_error_set(r->err, DHCAL_IO_BAD_INPUT,
-                             "%s:%zu: control byte 0x%02x at column %zu (binary file?)",
-                             r->path, r->line_no, (unsigned)b, k + 1U);
+                                   "%s:%zu: control byte 0x%02x at column %zu (binary file?)",
+                                   r->path, r->line_no, (unsigned)b, k + 1U);
         }
     }
     *got = 1;
@@ -214,24 +214,15 @@ static const char *const QUAT_NAMES[4] = {"qw", "qx", "qy", "qz"};
 static const char *col_name(csv_col c, char buf[16])
 {
     switch (c.kind) {
-    case COL_Q:
-        (void)snprintf(buf, 16U, "q%zu", c.idx + 1U);
-        return buf;
-    case COL_XYZ:
-        return XYZ_NAMES[c.idx];
-    case COL_WIRE:
-        return WIRE_NAMES[c.idx];
-    case COL_QUAT:
-        return QUAT_NAMES[c.idx];
-    case COL_DIR:
-        (void)snprintf(buf, 16U, "dir%zu", c.idx + 1U);
-        return buf;
-    case COL_TIME:
-        return "t_s";
+    case COL_Q: (void)snprintf(buf, 16U, "q%zu", c.idx + 1U); return buf;
+    case COL_XYZ: return XYZ_NAMES[c.idx];
+    case COL_WIRE: return WIRE_NAMES[c.idx];
+    case COL_QUAT: return QUAT_NAMES[c.idx];
+    case COL_DIR: (void)snprintf(buf, 16U, "dir%zu", c.idx + 1U); return buf;
+    case COL_TIME: return "t_s";
     case COL_TEMP:
     case COL_KIND_COUNT:
-    default:
-        return "temp_c";
+    default: return "temp_c";
     }
 }
 
@@ -304,7 +295,7 @@ typedef struct {
     csv_col cols[CSV_MAX_COLS];
     size_t header_line;
     int has_quat;
-    int plan; /* a pose plan: q and dir columns only, each dir column on its own */
+    int plan;    /* a pose plan: q and dir columns only, each dir column on its own */
     int targets; /* compensation targets: x,y,z; q1..qN, qw..qz, dir1..dirN optional */
     span *spans;
     size_t spans_cap;
@@ -333,8 +324,8 @@ static int check_group(csv_ctx *c, const size_t *seen, size_t n, col_kind kind, 
                         : kind == COL_QUAT ? "qw,qx,qy,qz"
                                            : "dir1..dirN";
     return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
-                     "%s:%zu: column group %s is incomplete: missing '%s'", c->rd.path,
-                     c->header_line, group, col_name((csv_col){kind, first_missing}, nb));
+                           "%s:%zu: column group %s is incomplete: missing '%s'", c->rd.path,
+                           c->header_line, group, col_name((csv_col){kind, first_missing}, nb));
 }
 
 static int parse_header(csv_ctx *c, dhcal_dataset *data)
@@ -352,7 +343,7 @@ static int parse_header(csv_ctx *c, dhcal_dataset *data)
         const span f = c->spans[k];
         if (f.n == 0U) {
             return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
-                             "%s:%zu: header column %zu has no name", path, line, k + 1U);
+                                   "%s:%zu: header column %zu has no name", path, line, k + 1U);
         }
         csv_col col = {COL_Q, 0U};
         size_t beyond = 0U;
@@ -360,40 +351,40 @@ static int parse_header(csv_ctx *c, dhcal_dataset *data)
         if (cls == 0 && memchr(f.s, ';', f.n) != NULL) {
             /* "q1;q2;q3;x;y;z": a spreadsheet's export in a locale that writes a decimal comma */
             return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
-                             "%s:%zu: unknown column '%s': the file looks separated by ';', "
-                             "dhcal reads ',' between values and '.' in numbers "
-                             "(docs/formats.md 3)",
-                             path, line, dhcal_quote(f.s, f.n, sb));
+                                   "%s:%zu: unknown column '%s': the file looks separated by ';', "
+                                   "dhcal reads ',' between values and '.' in numbers "
+                                   "(docs/formats.md 3)",
+                                   path, line, dhcal_quote(f.s, f.n, sb));
         }
         if (cls < 0) {
             return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
-                             "%s:%zu: column '%s' is beyond the model's %zu joints", path, line,
-                             dhcal_quote(f.s, f.n, sb), c->n_joints);
+                                   "%s:%zu: column '%s' is beyond the model's %zu joints", path,
+                                   line, dhcal_quote(f.s, f.n, sb), c->n_joints);
         }
-        if (c->targets && (cls == 0 || col.kind == COL_WIRE || col.kind == COL_TEMP ||
-                           col.kind == COL_TIME)) {
+        if (c->targets &&
+            (cls == 0 || col.kind == COL_WIRE || col.kind == COL_TEMP || col.kind == COL_TIME)) {
             return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
-                             "%s:%zu: unknown column '%s' (targets have x,y,z and optionally "
-                             "qw,qx,qy,qz, q1..q%zu, dir1..dir%zu)",
-                             path, line, dhcal_quote(f.s, f.n, sb), c->n_joints, c->n_joints);
+                                   "%s:%zu: unknown column '%s' (targets have x,y,z and optionally "
+                                   "qw,qx,qy,qz, q1..q%zu, dir1..dir%zu)",
+                                   path, line, dhcal_quote(f.s, f.n, sb), c->n_joints, c->n_joints);
         }
         if (cls == 0 && !c->plan) {
             return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
-                             "%s:%zu: unknown column '%s' (known: q1..q%zu, x,y,z, L1,L2,L3, "
-                             "qw,qx,qy,qz, dir1..dir%zu, temp_c, t_s)",
-                             path, line, dhcal_quote(f.s, f.n, sb), c->n_joints, c->n_joints);
+                                   "%s:%zu: unknown column '%s' (known: q1..q%zu, x,y,z, L1,L2,L3, "
+                                   "qw,qx,qy,qz, dir1..dir%zu, temp_c, t_s)",
+                                   path, line, dhcal_quote(f.s, f.n, sb), c->n_joints, c->n_joints);
         }
         if (cls == 0 || (c->plan && col.kind != COL_Q && col.kind != COL_DIR)) {
             return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
-                             "%s:%zu: unknown column '%s' (a pose plan has q1..q%zu and "
-                             "optionally any of dir1..dir%zu)",
-                             path, line, dhcal_quote(f.s, f.n, sb), c->n_joints, c->n_joints);
+                                   "%s:%zu: unknown column '%s' (a pose plan has q1..q%zu and "
+                                   "optionally any of dir1..dir%zu)",
+                                   path, line, dhcal_quote(f.s, f.n, sb), c->n_joints, c->n_joints);
         }
         size_t *const slot = &seen[col.kind][col.idx];
         if (*slot != 0U) {
             return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
-                             "%s:%zu: column '%s' repeated (columns %zu and %zu)", path, line,
-                             dhcal_quote(f.s, f.n, sb), *slot, k + 1U);
+                                   "%s:%zu: column '%s' repeated (columns %zu and %zu)", path, line,
+                                   dhcal_quote(f.s, f.n, sb), *slot, k + 1U);
         }
         *slot = k + 1U;
         /* Cannot overflow: every column is distinct, CSV_MAX_COLS counts them all. */
@@ -403,8 +394,8 @@ static int parse_header(csv_ctx *c, dhcal_dataset *data)
     for (size_t j = 0U; !c->targets && j < c->n_joints; ++j) {
         if (seen[COL_Q][j] == 0U) {
             return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
-                             "%s:%zu: missing column 'q%zu' (the model has %zu joints)", path,
-                             line, j + 1U, c->n_joints);
+                                   "%s:%zu: missing column 'q%zu' (the model has %zu joints)", path,
+                                   line, j + 1U, c->n_joints);
         }
     }
     if (c->plan) {
@@ -414,8 +405,8 @@ static int parse_header(csv_ctx *c, dhcal_dataset *data)
         }
         return DHCAL_IO_OK;
     }
-    int rc = c->targets ? check_group(c, seen[COL_Q], c->n_joints, COL_Q, &data->has_q)
-                        : DHCAL_IO_OK;
+    int rc =
+        c->targets ? check_group(c, seen[COL_Q], c->n_joints, COL_Q, &data->has_q) : DHCAL_IO_OK;
     if (rc == DHCAL_IO_OK) {
         rc = check_group(c, seen[COL_XYZ], 3U, COL_XYZ, &data->has_xyz);
     }
@@ -433,11 +424,12 @@ static int parse_header(csv_ctx *c, dhcal_dataset *data)
     }
     if (c->targets && !data->has_xyz) {
         return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
-                         "%s:%zu: missing columns x,y,z (the target tool point, mm)", path, line);
+                               "%s:%zu: missing columns x,y,z (the target tool point, mm)", path,
+                               line);
     }
     if (!data->has_xyz && !data->has_wires) {
         return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
-                         "%s:%zu: no position columns: need x,y,z or L1,L2,L3", path, line);
+                               "%s:%zu: no position columns: need x,y,z or L1,L2,L3", path, line);
     }
     data->has_temp = seen[COL_TEMP][0] != 0U;
     data->has_time = seen[COL_TIME][0] != 0U;
@@ -536,7 +528,7 @@ static int parse_value(csv_ctx *c, csv_col col, span f, double *out)
     const char *const name = col_name(col, nb);
     if (f.n == 0U) {
         return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT, "%s:%zu: column '%s': empty field",
-                         c->rd.path, c->rd.line_no, name);
+                               c->rd.path, c->rd.line_no, name);
     }
     char *end = NULL;
     const double v = strtod(f.s, &end);
@@ -544,13 +536,13 @@ static int parse_value(csv_ctx *c, csv_col col, span f, double *out)
     if (whole && !isfinite(v)) {
         /* "nan", "inf", "1e999": strtod takes them all, the data cannot. */
         return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
-                         "%s:%zu: column '%s': \"%s\" is not a finite number", c->rd.path,
-                         c->rd.line_no, name, dhcal_quote(f.s, f.n, sb));
+                               "%s:%zu: column '%s': \"%s\" is not a finite number", c->rd.path,
+                               c->rd.line_no, name, dhcal_quote(f.s, f.n, sb));
     }
     if (!whole || !is_decimal(f.s)) {
         return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
-                         "%s:%zu: column '%s': \"%s\" is not a number", c->rd.path,
-                         c->rd.line_no, name, dhcal_quote(f.s, f.n, sb));
+                               "%s:%zu: column '%s': \"%s\" is not a number", c->rd.path,
+                               c->rd.line_no, name, dhcal_quote(f.s, f.n, sb));
     }
     *out = v;
     return DHCAL_IO_OK;
@@ -562,23 +554,17 @@ static int parse_value(csv_ctx *c, csv_col col, span f, double *out)
 static const char *value_rule(col_kind kind, double v)
 {
     switch (kind) {
-    case COL_Q:
-        return v < -CSV_Q_MAX_DEG || v > CSV_Q_MAX_DEG ? "[-720, 720] deg" : NULL;
-    case COL_XYZ:
-        return v < -LEN_MAX_MM || v > LEN_MAX_MM ? "[-1e5, 1e5] mm" : NULL;
-    case COL_WIRE:
-        return !(v > 0.0) || v > LEN_MAX_MM ? "(0, 1e5] mm" : NULL;
-    case COL_QUAT:
-        return NULL;
+    case COL_Q: return v < -CSV_Q_MAX_DEG || v > CSV_Q_MAX_DEG ? "[-720, 720] deg" : NULL;
+    case COL_XYZ: return v < -LEN_MAX_MM || v > LEN_MAX_MM ? "[-1e5, 1e5] mm" : NULL;
+    case COL_WIRE: return !(v > 0.0) || v > LEN_MAX_MM ? "(0, 1e5] mm" : NULL;
+    case COL_QUAT: return NULL;
     case COL_DIR:
         /* Exactly -1 or +1; written as two comparisons because of -Wfloat-equal. */
         return (v >= 1.0 && v <= 1.0) || (v >= -1.0 && v <= -1.0) ? NULL : "-1 or +1";
-    case COL_TIME:
-        return v < -TIME_MAX_S || v > TIME_MAX_S ? "[-1e9, 1e9] s" : NULL;
+    case COL_TIME: return v < -TIME_MAX_S || v > TIME_MAX_S ? "[-1e9, 1e9] s" : NULL;
     case COL_TEMP:
     case COL_KIND_COUNT:
-    default:
-        return v < TEMP_MIN_C || v > TEMP_MAX_C ? "[-60, 150] degC" : NULL;
+    default: return v < TEMP_MIN_C || v > TEMP_MAX_C ? "[-60, 150] degC" : NULL;
     }
 }
 
@@ -587,7 +573,8 @@ static int out_of_range(csv_ctx *c, csv_col col, span f, const char *range)
     char nb[16];
     char sb[DHCAL_QUOTE_CAP];
     return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT, "%s:%zu: column '%s': %s is outside %s",
-                     c->rd.path, c->rd.line_no, col_name(col, nb), dhcal_quote(f.s, f.n, sb), range);
+                           c->rd.path, c->rd.line_no, col_name(col, nb), dhcal_quote(f.s, f.n, sb),
+                           range);
 }
 
 /* A value that kept its column's rule, into the row (angles to radians). */
@@ -611,12 +598,12 @@ static int parse_row(csv_ctx *c, dhcal_row *row)
     const size_t n = split_fields(c->rd.buf, c->rd.len, &c->spans, &c->spans_cap);
     if (n == 0U) {
         return dhcal_error_set(c->rd.err, DHCAL_IO_FAILED, "%s:%zu: out of memory", c->rd.path,
-                         c->rd.line_no);
+                               c->rd.line_no);
     }
     if (n != c->n_cols) {
         return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
-                         "%s:%zu: %zu fields, but the header (line %zu) has %zu columns",
-                         c->rd.path, c->rd.line_no, n, c->header_line, c->n_cols);
+                               "%s:%zu: %zu fields, but the header (line %zu) has %zu columns",
+                               c->rd.path, c->rd.line_no, n, c->header_line, c->n_cols);
     }
     memset(row, 0, sizeof *row);
     row->line = c->rd.line_no;
@@ -633,8 +620,8 @@ static int parse_row(csv_ctx *c, dhcal_row *row)
             char nb[16];
             char sb[DHCAL_QUOTE_CAP];
             return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
-                             "%s:%zu: column '%s': %s is not -1 or +1", c->rd.path,
-                             c->rd.line_no, col_name(col, nb), dhcal_quote(f.s, f.n, sb));
+                                   "%s:%zu: column '%s': %s is not -1 or +1", c->rd.path,
+                                   c->rd.line_no, col_name(col, nb), dhcal_quote(f.s, f.n, sb));
         }
         if (rule != NULL) {
             return out_of_range(c, col, f, rule);
@@ -648,9 +635,9 @@ static int parse_row(csv_ctx *c, dhcal_row *row)
                                  row->quat[2] * row->quat[2] + row->quat[3] * row->quat[3]);
         if (!(fabs(norm - 1.0) <= UNIT_NORM_TOL)) {
             return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
-                             "%s:%zu: quaternion qw,qx,qy,qz has norm %.6g, not 1 "
-                             "(tolerance 1e-3)",
-                             c->rd.path, c->rd.line_no, norm);
+                                   "%s:%zu: quaternion qw,qx,qy,qz has norm %.6g, not 1 "
+                                   "(tolerance 1e-3)",
+                                   c->rd.path, c->rd.line_no, norm);
         }
         for (size_t i = 0U; i < 4U; ++i) {
             row->quat[i] /= norm;
@@ -698,7 +685,7 @@ static int csv_read_all(csv_ctx *c, dhcal_dataset *data)
         dhcal_row *row = NULL;
         if (!push_row(data, &rows_cap, &row)) {
             return dhcal_error_set(c->rd.err, DHCAL_IO_FAILED, "%s:%zu: out of memory for %zu rows",
-                             c->rd.path, c->rd.line_no, data->n_rows + 1U);
+                                   c->rd.path, c->rd.line_no, data->n_rows + 1U);
         }
         rc = parse_row(c, row);
         if (rc != DHCAL_IO_OK) {
@@ -712,29 +699,28 @@ static int csv_read_all(csv_ctx *c, dhcal_dataset *data)
     if (!have_header) {
         if (c->rd.line_no == 0U) {
             return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT, "%s: empty file (no header line)",
-                             c->rd.path);
+                                   c->rd.path);
         }
         return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
-                         "%s:%zu: end of file before the header line (only comments or blank "
-                         "lines)",
-                         c->rd.path, c->rd.line_no);
+                               "%s:%zu: end of file before the header line (only comments or blank "
+                               "lines)",
+                               c->rd.path, c->rd.line_no);
     }
     if (data->n_rows == 0U) {
         return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT, "%s:%zu: header but no data rows",
-                         c->rd.path, c->header_line);
+                               c->rd.path, c->header_line);
     }
     return DHCAL_IO_OK;
 }
 
 enum { LOAD_MEASUREMENTS = 0, LOAD_PLAN, LOAD_TARGETS };
 
-static int load(const char *path, size_t n_joints, int what, dhcal_dataset *data,
-                dhcal_error *err)
+static int load(const char *path, size_t n_joints, int what, dhcal_dataset *data, dhcal_error *err)
 {
     memset(data, 0, sizeof *data);
     if (n_joints == 0U || n_joints > DHC_MAX_JOINTS) {
         return dhcal_error_set(err, DHCAL_IO_FAILED, "%s: joint count %zu outside 1..%u", path,
-                         n_joints, DHC_MAX_JOINTS);
+                               n_joints, DHC_MAX_JOINTS);
     }
     csv_ctx *const c = calloc(1U, sizeof *c);
     if (c == NULL) {
@@ -758,7 +744,7 @@ static int load(const char *path, size_t n_joints, int what, dhcal_dataset *data
         }
     } else if (c->rd.f == NULL) {
         rc = dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s: cannot open: %s", path,
-                       strerror(open_errno));
+                             strerror(open_errno));
     } else {
         data->n_joints = n_joints;
         rc = csv_read_all(c, data);

@@ -118,9 +118,8 @@ int dhcal_samples_errors(const dhc_model *model, const dhcal_samples *s, double 
     return dhcal_samples_errors_known(model, s, NULL, resid, err_mm, stats);
 }
 
-int dhcal_samples_errors_known(const dhc_model *model, const dhcal_samples *s,
-                               const double *known, double *resid, double *err_mm,
-                               dhcal_error_stats *stats)
+int dhcal_samples_errors_known(const dhc_model *model, const dhcal_samples *s, const double *known,
+                               double *resid, double *err_mm, dhcal_error_stats *stats)
 {
     if (model->arm.n_joints == 0U || model->arm.n_joints > DHC_MAX_JOINTS) {
         return DHCAL_IO_FAILED;
@@ -134,10 +133,9 @@ int dhcal_samples_errors_known(const dhc_model *model, const dhcal_samples *s,
         size_t rows;
         if (known != NULL && s->flags[i] == (uint8_t)DHC_SAMPLE_USED) {
             memcpy(r, known + 3U * i, 3U * sizeof r[0]);
-        } else if (dhc_model_residual_prepared(model, &trig, &s->samples[i],
-                                               sincos != NULL ? sincos + 2U * nj * i : NULL,
-                                               DHC_ORIENTATION_WEIGHT_MM_PER_RAD, r,
-                                               &rows) != DHC_OK) {
+        } else if (dhc_model_residual_prepared(
+                       model, &trig, &s->samples[i], sincos != NULL ? sincos + 2U * nj * i : NULL,
+                       DHC_ORIENTATION_WEIGHT_MM_PER_RAD, r, &rows) != DHC_OK) {
             return DHCAL_IO_FAILED;
         }
         if (resid != NULL) {

@@ -3,8 +3,8 @@
 
 #include <string.h>
 
-int dhcal_effect_list_next(const char **cursor, size_t n_joints, dhc_effect *effect,
-                           size_t *joint, const char **item, size_t *len)
+int dhcal_effect_list_next(const char **cursor, size_t n_joints, dhc_effect *effect, size_t *joint,
+                           const char **item, size_t *len)
 {
     const char *p = *cursor;
     if (p == NULL || *p == '\0') {

@@ -17,7 +17,6 @@
 /* One write() at most: below SSIZE_MAX everywhere (Linux moves at most ~2 GiB per call). */
 #define FILE_MAX_CHUNK ((size_t)1 << 30)
 
-
 /* 0, or -1 with errno set. */
 static int write_all(int fd, const char *p, size_t n)
 {
@@ -98,12 +97,11 @@ int dhcal_file_write_atomic(const char *path, const char *data, size_t len, dhca
             saved = errno;
         }
         if (saved != 0) {
-            rc = dhcal_error_set(err, DHCAL_IO_FAILED,
-                                 "%s: cannot write temporary file '%s': %s", path, tmp,
-                                 strerror(saved));
+            rc = dhcal_error_set(err, DHCAL_IO_FAILED, "%s: cannot write temporary file '%s': %s",
+                                 path, tmp, strerror(saved));
         } else if (rename(tmp, path) != 0) {
-            rc = dhcal_error_set(err, DHCAL_IO_FAILED, "%s: cannot replace it with '%s': %s",
-                                 path, tmp, strerror(errno));
+            rc = dhcal_error_set(err, DHCAL_IO_FAILED, "%s: cannot replace it with '%s': %s", path,
+                                 tmp, strerror(errno));
         } else {
             sync_parent_dir(path);
         }

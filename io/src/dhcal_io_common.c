@@ -51,8 +51,8 @@ int dhcal_find_name(const char *name, const char *const *names, size_t n, size_t
     return 0;
 }
 
-int dhcal_read_whole(const char *path, size_t max_bytes, const char *what, char **text,
-                     size_t *len, dhcal_error *err)
+int dhcal_read_whole(const char *path, size_t max_bytes, const char *what, char **text, size_t *len,
+                     dhcal_error *err)
 {
     *text = NULL;
     *len = 0U;
@@ -79,12 +79,12 @@ int dhcal_read_whole(const char *path, size_t max_bytes, const char *what, char 
         const size_t got = fread(buf + n, 1U, cap - 1U - n, f);
         n += got;
         if (n > max_bytes) {
-            rc = dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s: larger than %zu bytes: not %s",
-                                 path, max_bytes, what);
+            rc = dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s: larger than %zu bytes: not %s", path,
+                                 max_bytes, what);
         } else if (got == 0U) {
             if (ferror(f)) {
                 rc = dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s: read error: %s", path,
-                               strerror(errno));
+                                     strerror(errno));
             }
             break;
         }

@@ -31,7 +31,7 @@ int dhcal_find_name(const char *name, const char *const *names, size_t n, size_t
  * the NUL), growing it as it reads. DHCAL_IO_BAD_INPUT with "path: ..." when the file
  * cannot be opened or read or is larger than max_bytes ("not <what>"); DHCAL_IO_FAILED
  * when out of memory. */
-int dhcal_read_whole(const char *path, size_t max_bytes, const char *what, char **text,
-                     size_t *len, dhcal_error *err);
+int dhcal_read_whole(const char *path, size_t max_bytes, const char *what, char **text, size_t *len,
+                     dhcal_error *err);
 
 #endif /* DHCAL_IO_COMMON_H */

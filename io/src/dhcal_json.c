@@ -92,7 +92,7 @@ int dhcal_jcheck_object(const dhcal_jctx *c, const cJSON *obj, const char *path,
 {
     if (!cJSON_IsObject(obj)) {
         return dhcal_jfail(c, path[0] != '\0' ? path : "(top level)", "expected an object, got %s",
-                     dhcal_jtype(obj));
+                           dhcal_jtype(obj));
     }
     char kp[DHCAL_JPATH_CAP];
     for (const cJSON *e = obj->child; e != NULL; e = e->next) {
@@ -103,8 +103,8 @@ int dhcal_jcheck_object(const dhcal_jctx *c, const cJSON *obj, const char *path,
             size_t used = 0U;
             list[0] = '\0';
             for (size_t k = 0U; k < n_allowed && used < sizeof list; ++k) {
-                const int w = snprintf(list + used, sizeof list - used, "%s%s",
-                                       k > 0U ? ", " : "", allowed[k]);
+                const int w = snprintf(list + used, sizeof list - used, "%s%s", k > 0U ? ", " : "",
+                                       allowed[k]);
                 if (w < 0) {
                     break;
                 }
@@ -151,8 +151,8 @@ typedef struct {
     dhcal_jrule rule;
 } bounds;
 
-static int check_number(const dhcal_jctx *c, const cJSON *item, const char *path,
-                        const bounds *b, double *out)
+static int check_number(const dhcal_jctx *c, const cJSON *item, const char *path, const bounds *b,
+                        double *out)
 {
     if (!cJSON_IsNumber(item)) {
         return dhcal_jfail(c, path, "expected a number, got %s", dhcal_jtype(item));
@@ -169,7 +169,7 @@ static int check_number(const dhcal_jctx *c, const cJSON *item, const char *path
     }
     if (v < b->lo || v > b->hi) {
         return dhcal_jfail(c, path, "%.15g is outside [%g, %g]%s%s", v, b->lo, b->hi,
-                     b->unit[0] != '\0' ? " " : "", b->unit);
+                           b->unit[0] != '\0' ? " " : "", b->unit);
     }
     *out = v;
     return DHCAL_IO_OK;
@@ -216,7 +216,7 @@ static bounds sign_rule(dhcal_jrule rule)
 }
 
 int dhcal_jnumber(const dhcal_jctx *c, const cJSON *item, const char *path, double lo, double hi,
-                   const char *unit, double *out)
+                  const char *unit, double *out)
 {
     const bounds b = range(lo, hi, unit);
     return check_number(c, item, path, &b, out);
@@ -248,7 +248,7 @@ int dhcal_jwhole(const dhcal_jctx *c, const cJSON *item, const char *path, doubl
 }
 
 int dhcal_jvector(const dhcal_jctx *c, const cJSON *item, const char *path, size_t n, double lo,
-                   double hi, const char *unit, double *out)
+                  double hi, const char *unit, double *out)
 {
     const bounds b = range(lo, hi, unit);
     return check_vector(c, item, path, n, &b, out);
@@ -269,7 +269,7 @@ int dhcal_jpoints(const dhcal_jctx *c, const cJSON *item, const char *path, size
 
 /* Optional member: absent leaves *out untouched. */
 int dhcal_jopt_number(const dhcal_jctx *c, const cJSON *obj, const char *parent, const char *key,
-                       double lo, double hi, const char *unit, double *out)
+                      double lo, double hi, const char *unit, double *out)
 {
     const cJSON *const item = cJSON_GetObjectItemCaseSensitive(obj, key);
     if (item == NULL) {
@@ -281,7 +281,7 @@ int dhcal_jopt_number(const dhcal_jctx *c, const cJSON *obj, const char *parent,
 }
 
 int dhcal_jreq_number(const dhcal_jctx *c, const cJSON *obj, const char *parent, const char *key,
-                       double lo, double hi, const char *unit, double *out)
+                      double lo, double hi, const char *unit, double *out)
 {
     if (cJSON_GetObjectItemCaseSensitive(obj, key) == NULL) {
         char kp[DHCAL_JPATH_CAP];
@@ -292,7 +292,7 @@ int dhcal_jreq_number(const dhcal_jctx *c, const cJSON *obj, const char *parent,
 }
 
 int dhcal_jopt_vector(const dhcal_jctx *c, const cJSON *obj, const char *parent, const char *key,
-                       size_t n, double lo, double hi, const char *unit, double *out)
+                      size_t n, double lo, double hi, const char *unit, double *out)
 {
     const cJSON *const item = cJSON_GetObjectItemCaseSensitive(obj, key);
     if (item == NULL) {
@@ -403,8 +403,8 @@ static void line_col(const char *text, size_t pos, size_t *line, size_t *col)
 /* Length of a NaN / Infinity token (optional sign) at s[0..n), 0 if there is none. */
 static size_t nonfinite_token(const char *s, size_t n)
 {
-    static const char *const words[] = {"Infinity", "infinity", "inf", "Inf", "INF",
-                                        "NaN",      "nan",      "NAN"};
+    static const char *const words[] = {"Infinity", "infinity", "inf", "Inf",
+                                        "INF",      "NaN",      "nan", "NAN"};
     const size_t k = n > 0U && (s[0] == '-' || s[0] == '+') ? 1U : 0U;
     for (size_t w = 0U; w < sizeof words / sizeof words[0]; ++w) {
         const size_t len = strlen(words[w]);
@@ -464,16 +464,16 @@ static int find_mark(const cJSON *root, char out[DHCAL_JPATH_CAP])
 
 /* A NaN or Infinity token of tok bytes at text[pos] stopped the parse: named by its JSON
  * path, found by a second parse with the token replaced by a marker string, and its line. */
-static int nonfinite_error(const char *path, const char *text, size_t len, size_t pos,
-                           size_t tok, size_t line, size_t col, dhcal_error *err)
+static int nonfinite_error(const char *path, const char *text, size_t len, size_t pos, size_t tok,
+                           size_t line, size_t col, dhcal_error *err)
 {
     const size_t cap = len + sizeof NAN_MARK + 3U;
     char *const copy = malloc(cap);
     if (copy == NULL) {
         return dhcal_error_set(err, DHCAL_IO_FAILED, "%s: out of memory", path);
     }
-    (void)snprintf(copy, cap, "%.*s\"%s\"%.*s", (int)pos, text, NAN_MARK,
-                   (int)(len - pos - tok), text + pos + tok);
+    (void)snprintf(copy, cap, "%.*s\"%s\"%.*s", (int)pos, text, NAN_MARK, (int)(len - pos - tok),
+                   text + pos + tok);
     cJSON *const again = cJSON_ParseWithOpts(copy, NULL, 1);
     char where[DHCAL_JPATH_CAP] = "";
     const int found = again != NULL && find_mark(again, where);
@@ -501,8 +501,8 @@ static int parse_text(const char *path, const char *text, size_t len, cJSON **ro
         if ((b < 0x20U && b != '\t' && b != '\n' && b != '\r') || b == 0x7fU) {
             line_col(text, k, &line, &col);
             return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
-                             "%s:%zu:%zu: %s byte 0x%02x (binary file?)", path, line, col,
-                             b == 0U ? "NUL" : "control", (unsigned)b);
+                                   "%s:%zu:%zu: %s byte 0x%02x (binary file?)", path, line, col,
+                                   b == 0U ? "NUL" : "control", (unsigned)b);
         }
     }
     size_t first = 0U;
@@ -512,7 +512,7 @@ static int parse_text(const char *path, const char *text, size_t len, cJSON **ro
     }
     if (first == len) {
         return dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s: empty file (expected a JSON object)",
-                         path);
+                               path);
     }
     const char *end = NULL;
     /* The length includes the terminator: with require_null_terminated, cJSON 1.7 checks
@@ -532,11 +532,12 @@ static int parse_text(const char *path, const char *text, size_t len, cJSON **ro
         const size_t rest = len - pos;
         if (rest == 0U) {
             return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
-                             "%s:%zu:%zu: JSON syntax error: unexpected end of file", path,
-                             line, col);
+                                   "%s:%zu:%zu: JSON syntax error: unexpected end of file", path,
+                                   line, col);
         }
         return dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s:%zu:%zu: JSON syntax error near '%s'",
-                         path, line, col, dhcal_quote(text + pos, rest < 20U ? rest : 20U, sb));
+                               path, line, col,
+                               dhcal_quote(text + pos, rest < 20U ? rest : 20U, sb));
     }
     return DHCAL_IO_OK;
 }

@@ -10,28 +10,26 @@
 #include "dhcal_io_common.h"
 #include "dhcal_io/dhcal_model_map.h"
 
-
-static const char *const TOP_KEYS[] = {"comment", "name",     "model",   "n_joints",
-                                       "start_pose_deg", "joints", "drives", "measurer",
-                                       "can",     "gpio",     "store", "params_out",
-                                       "acquisition"};
+static const char *const TOP_KEYS[] = {
+    "comment",  "name", "model", "n_joints", "start_pose_deg", "joints",     "drives",
+    "measurer", "can",  "gpio",  "store",    "params_out",     "acquisition"};
 static const char *const JOINT_KEYS[] = {"comment", "encoder_counts_per_rev", "gear_ratio",
                                          "tacho_v_s_per_rad"};
-static const char *const DRIVE_KEYS[] = {"comment", "dac_range_v", "adc_range_v",
-                                         "max_speed_deg_s", "max_accel_deg_s2"};
+static const char *const DRIVE_KEYS[] = {"comment", "dac_range_v", "adc_range_v", "max_speed_deg_s",
+                                         "max_accel_deg_s2"};
 static const char *const MEASURER_KEYS[] = {"comment", "wheel_radius_mm", "counts_per_rev",
                                             "zero_length_mm"};
 static const char *const CAN_KEYS[] = {"comment", "interface", "id_offset", "reply_timeout_us",
                                        "start_timeout_ms"};
-static const char *const ACQUISITION_KEYS[] = {"comment", "samples", "plan_seed",
-                                               "plan_candidates", "plan", "hold_ticks"};
+static const char *const ACQUISITION_KEYS[] = {"comment",         "samples", "plan_seed",
+                                               "plan_candidates", "plan",    "hold_ticks"};
 static const char *const GPIO_KEYS[] = {"comment", "chip", "encoder_lines"};
 
 /* Largest CAN identifier offset: the protocol's identifiers stay 11-bit (fw_can_offset.h). */
 #define CAN_ID_OFFSET_MAX 1535.0
 
-static int opt_string(const dhcal_jctx *c, const cJSON *obj, const char *parent,
-                      const char *key, char *out, size_t cap)
+static int opt_string(const dhcal_jctx *c, const cJSON *obj, const char *parent, const char *key,
+                      char *out, size_t cap)
 {
     const cJSON *const item = cJSON_GetObjectItemCaseSensitive(obj, key);
     if (item == NULL) {
@@ -66,8 +64,9 @@ static int load_model(dhcal_jctx *c, const cJSON *root, dhcal_machine *m)
 {
     const cJSON *const item = cJSON_GetObjectItemCaseSensitive(root, "model");
     if (item == NULL) {
-        return dhcal_jfail(c, "model", "required key missing (a model file's path, or the "
-                                       "model object)");
+        return dhcal_jfail(c, "model",
+                           "required key missing (a model file's path, or the "
+                           "model object)");
     }
     static dhcal_model file_model; /* about 10 KiB: off the stack */
     int rc;
@@ -76,7 +75,7 @@ static int load_model(dhcal_jctx *c, const cJSON *root, dhcal_machine *m)
             return dhcal_jfail(c, "model", "empty path");
         }
         if ((rc = dhcal_jfile_beside(c, "model", item->valuestring, m->model_path,
-                                      sizeof m->model_path)) != DHCAL_IO_OK) {
+                                     sizeof m->model_path)) != DHCAL_IO_OK) {
             return rc;
         }
         dhcal_error merr;
@@ -98,8 +97,9 @@ static int load_model(dhcal_jctx *c, const cJSON *root, dhcal_machine *m)
         return rc;
     }
     if (!m->model.measurer.present) {
-        return dhcal_jfail(c, "model", "the model has no 'measurer': the controller calibrates "
-                                       "against the draw-wire measurer");
+        return dhcal_jfail(c, "model",
+                           "the model has no 'measurer': the controller calibrates "
+                           "against the draw-wire measurer");
     }
     return DHCAL_IO_OK;
 }
@@ -115,8 +115,8 @@ static int load_joints(dhcal_jctx *c, const cJSON *root, dhcal_machine *m)
                            dhcal_jtype(joints));
     }
     if (dhcal_jcount(joints) != m->n_joints) {
-        return dhcal_jfail(c, "joints", "%zu joint objects for n_joints %zu",
-                           dhcal_jcount(joints), m->n_joints);
+        return dhcal_jfail(c, "joints", "%zu joint objects for n_joints %zu", dhcal_jcount(joints),
+                           m->n_joints);
     }
     char ip[DHCAL_JPATH_CAP];
     size_t i = 0U;
@@ -129,8 +129,7 @@ static int load_joints(dhcal_jctx *c, const cJSON *root, dhcal_machine *m)
                                    &m->encoder_counts_per_rev[i]);
         }
         if (rc == DHCAL_IO_OK) {
-            rc = dhcal_jreq_number(c, j, ip, "gear_ratio", 1e-6, 1e6, "",
-                                   &m->gear_ratio[i]);
+            rc = dhcal_jreq_number(c, j, ip, "gear_ratio", 1e-6, 1e6, "", &m->gear_ratio[i]);
         }
         if (rc == DHCAL_IO_OK) {
             rc = dhcal_jreq_number(c, j, ip, "tacho_v_s_per_rad", 1e-9, 1e3, "V s/rad",
@@ -171,8 +170,9 @@ static int load_measurer(const dhcal_jctx *c, const cJSON *root, dhcal_machine *
 {
     const cJSON *const w = cJSON_GetObjectItemCaseSensitive(root, "measurer");
     if (w == NULL) {
-        return dhcal_jfail(c, "measurer", "required key missing (wheel_radius_mm, "
-                                          "counts_per_rev)");
+        return dhcal_jfail(c, "measurer",
+                           "required key missing (wheel_radius_mm, "
+                           "counts_per_rev)");
     }
     int rc = dhcal_jcheck_object(c, w, "measurer", DHCAL_JKEYS(MEASURER_KEYS));
     if (rc == DHCAL_IO_OK) {
@@ -191,8 +191,8 @@ static int load_measurer(const dhcal_jctx *c, const cJSON *root, dhcal_machine *
 }
 
 /* An optional whole number in [lo, hi] at parent.key; *has says whether it was given. */
-static int opt_whole(const dhcal_jctx *c, const cJSON *obj, const char *parent,
-                     const char *key, double lo, double hi, unsigned *out, int *has)
+static int opt_whole(const dhcal_jctx *c, const cJSON *obj, const char *parent, const char *key,
+                     double lo, double hi, unsigned *out, int *has)
 {
     const cJSON *const item = cJSON_GetObjectItemCaseSensitive(obj, key);
     if (item == NULL) {
@@ -236,8 +236,7 @@ static int load_can(const dhcal_jctx *c, const cJSON *root, dhcal_machine *m)
                        &m->has_can_id_offset);
     }
     if (rc == DHCAL_IO_OK) {
-        rc = opt_whole(c, can, "can", "reply_timeout_us", 1.0, 1e7, &m->can_reply_timeout_us,
-                       NULL);
+        rc = opt_whole(c, can, "can", "reply_timeout_us", 1.0, 1e7, &m->can_reply_timeout_us, NULL);
     }
     if (rc == DHCAL_IO_OK) {
         rc = opt_whole(c, can, "can", "start_timeout_ms", 0.0, 6e5, &m->can_start_timeout_ms,
@@ -268,8 +267,8 @@ static int load_gpio(const dhcal_jctx *c, const cJSON *root, dhcal_machine *m)
     for (size_t k = 0U; k < 2U && rc == DHCAL_IO_OK; ++k) {
         char ip[DHCAL_JPATH_CAP];
         dhcal_jpath_index(ip, "gpio.encoder_lines", k);
-        rc = whole_number(c, cJSON_GetArrayItem(lines, (int)k), ip, 0.0, 65535.0,
-                          &m->gpio_lines[k]);
+        rc =
+            whole_number(c, cJSON_GetArrayItem(lines, (int)k), ip, 0.0, 65535.0, &m->gpio_lines[k]);
     }
     if (rc == DHCAL_IO_OK && m->gpio_lines[0] == m->gpio_lines[1]) {
         return dhcal_jfail(c, "gpio.encoder_lines", "A and B are the same line");
@@ -308,8 +307,9 @@ static int load_acquisition(const dhcal_jctx *c, const cJSON *root, dhcal_machin
         return rc;
     }
     if (m->plan_path[0] != '\0' && (m->samples != 0U || m->has_plan_candidates)) {
-        return dhcal_jfail(c, "acquisition.plan", "the plan gives the poses: not with "
-                                                  "'samples' or 'plan_candidates'");
+        return dhcal_jfail(c, "acquisition.plan",
+                           "the plan gives the poses: not with "
+                           "'samples' or 'plan_candidates'");
     }
     const unsigned samples = m->samples != 0U ? m->samples : DHCAL_MACHINE_DEFAULT_SAMPLES;
     if (m->plan_candidates != 0U && m->plan_candidates <= samples) {
@@ -367,12 +367,12 @@ static int load_root(dhcal_jctx *c, const cJSON *root, dhcal_machine *m)
     c->n_joints = n;
     const cJSON *const start = cJSON_GetObjectItemCaseSensitive(root, "start_pose_deg");
     if (rc == DHCAL_IO_OK && start == NULL) {
-        return dhcal_jfail(c, "start_pose_deg", "required key missing (where the arm stands "
-                                                "when the controller starts)");
+        return dhcal_jfail(c, "start_pose_deg",
+                           "required key missing (where the arm stands "
+                           "when the controller starts)");
     }
     if (rc == DHCAL_IO_OK) {
-        rc = dhcal_jvector(c, start, "start_pose_deg", n, -720.0, 720.0, "deg",
-                           m->start_pose_rad);
+        rc = dhcal_jvector(c, start, "start_pose_deg", n, -720.0, 720.0, "deg", m->start_pose_rad);
     }
     for (size_t j = 0U; j < n && rc == DHCAL_IO_OK; ++j) {
         m->start_pose_rad[j] *= DHC_DEG;

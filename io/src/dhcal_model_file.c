@@ -63,11 +63,11 @@ static int load_joint(const dhcal_jctx *c, const cJSON *j, const char *path, dhc
     }
     if (rc == DHCAL_IO_OK) {
         rc = dhcal_jopt_number(c, j, path, "min_deg", -MODEL_LIMIT_MAX_DEG, MODEL_LIMIT_MAX_DEG,
-                         "deg", &lo);
+                               "deg", &lo);
     }
     if (rc == DHCAL_IO_OK) {
         rc = dhcal_jopt_number(c, j, path, "max_deg", -MODEL_LIMIT_MAX_DEG, MODEL_LIMIT_MAX_DEG,
-                         "deg", &hi);
+                               "deg", &hi);
     }
     if (rc == DHCAL_IO_OK && !(lo < hi)) {
         rc = dhcal_jfail(c, path, "min_deg %.15g is not below max_deg %.15g", lo, hi);
@@ -110,9 +110,9 @@ static int load_measurer(const dhcal_jctx *c, const cJSON *m, dhcal_model *model
         dhc_vec3_sub(an[PAIRS[p][1]], an[PAIRS[p][0]], d);
         if (dhc_vec3_norm(d) < ANCHOR_MIN_DIST_MM) {
             return dhcal_jfail(c, "measurer.anchors_mm",
-                         "anchors_mm[%zu] and anchors_mm[%zu] are the same point (need three "
-                         "distinct, non-collinear anchors)",
-                         PAIRS[p][0], PAIRS[p][1]);
+                               "anchors_mm[%zu] and anchors_mm[%zu] are the same point (need three "
+                               "distinct, non-collinear anchors)",
+                               PAIRS[p][0], PAIRS[p][1]);
         }
     }
     double e1[3];
@@ -123,7 +123,7 @@ static int load_measurer(const dhcal_jctx *c, const cJSON *m, dhcal_model *model
     dhc_vec3_cross(e1, e2, cr);
     if (dhc_vec3_norm(cr) <= ANCHOR_SIN_TOL * dhc_vec3_norm(e1) * dhc_vec3_norm(e2)) {
         return dhcal_jfail(c, "measurer.anchors_mm",
-                     "the three anchors are collinear (trilateration needs a triangle)");
+                           "the three anchors are collinear (trilateration needs a triangle)");
     }
     model->has_measurer = 1;
     return dhcal_jframe(c, m, "measurer", "frame", LEN_MAX_MM, MODEL_ANGLE_MAX_DEG,
@@ -143,8 +143,8 @@ size_t dhcal_effect_catalogue(char *buf, size_t cap)
     size_t pos = 0U;
     for (size_t i = 0U; dhc_effect_at(i) != NULL; ++i) {
         const dhc_effect_info *fx = dhc_effect_at(i);
-        const int n = snprintf(buf + (pos < cap ? pos : cap), pos < cap ? cap - pos : 0U,
-                               "%s%s%s", i == 0U ? "" : ", ", fx->name, fx->per_joint ? ":i" : "");
+        const int n = snprintf(buf + (pos < cap ? pos : cap), pos < cap ? cap - pos : 0U, "%s%s%s",
+                               i == 0U ? "" : ", ", fx->name, fx->per_joint ? ":i" : "");
         pos += n > 0 ? (size_t)n : 0U;
     }
     return pos;
@@ -168,7 +168,7 @@ static int load_effects(const dhcal_jctx *c, const cJSON *fx, dhcal_model *model
             char known[512];
             (void)dhcal_effect_catalogue(known, sizeof known);
             return dhcal_jfail(c, kp, "unknown effect (known: %s; 1 <= i <= %zu)", known,
-                         c->n_joints);
+                               c->n_joints);
         }
         if (model->n_effects == DHCAL_MAX_EFFECTS) {
             return dhcal_jfail(c, "effects", "more than %u effects", DHCAL_MAX_EFFECTS);
@@ -207,15 +207,17 @@ static int load_root(dhcal_jctx *c, const cJSON *root, dhcal_model *model)
     }
     const cJSON *const joints = cJSON_GetObjectItemCaseSensitive(root, "joints");
     if (!cJSON_IsArray(joints)) {
-        return dhcal_jfail(c, "joints", "expected an array of joint objects, got %s", dhcal_jtype(joints));
+        return dhcal_jfail(c, "joints", "expected an array of joint objects, got %s",
+                           dhcal_jtype(joints));
     }
     const size_t n = dhcal_jcount(joints);
     if (n == 0U) {
         return dhcal_jfail(c, "joints", "empty array (a model needs 1..%u joints)", DHC_MAX_JOINTS);
     }
     if (n > DHC_MAX_JOINTS) {
-        return dhcal_jfail(c, "joints", "%zu joints, this build supports at most %u (DHC_MAX_JOINTS)",
-                     n, DHC_MAX_JOINTS);
+        return dhcal_jfail(c, "joints",
+                           "%zu joints, this build supports at most %u (DHC_MAX_JOINTS)", n,
+                           DHC_MAX_JOINTS);
     }
     c->n_joints = n;
     (void)dhc_arm_init(&model->arm, n); /* cannot fail: 1 <= n <= DHC_MAX_JOINTS */
@@ -242,7 +244,7 @@ static int load_root(dhcal_jctx *c, const cJSON *root, dhcal_model *model)
         memcpy(model->name, name->valuestring, len + 1U);
     }
     rc = dhcal_jopt_vector(c, root, "", "tool_mm", 3U, -LEN_MAX_MM, LEN_MAX_MM, "mm",
-                     model->arm.tool_mm);
+                           model->arm.tool_mm);
     if (rc == DHCAL_IO_OK) {
         rc = dhcal_jframe(c, root, "", "base", LEN_MAX_MM, MODEL_ANGLE_MAX_DEG, &model->arm.base,
                           NULL);
@@ -270,8 +272,8 @@ static int load_root(dhcal_jctx *c, const cJSON *root, dhcal_model *model)
     return rc;
 }
 
-int dhcal_model_from_json(const char *file, const char *jpath, const cJSON *obj,
-                          dhcal_model *model, dhcal_error *err)
+int dhcal_model_from_json(const char *file, const char *jpath, const cJSON *obj, dhcal_model *model,
+                          dhcal_error *err)
 {
     memset(model, 0, sizeof *model);
     model->gravity[2] = -1.0;
@@ -445,7 +447,7 @@ static int model_writable(const dhcal_model *m, char *where, size_t cap)
                                         "beta_deg",         "min_deg", "max_deg"};
     for (size_t i = 0U; i < m->arm.n_joints; ++i) {
         const dhc_joint *const j = &m->arm.joint[i];
-        const double v[7] = {j->theta_offset_rad, j->d_mm,    j->a_mm,  j->alpha_rad,
+        const double v[7] = {j->theta_offset_rad, j->d_mm,    j->a_mm,   j->alpha_rad,
                              j->beta_rad,         j->min_rad, j->max_rad};
         for (size_t k = 0U; k < 7U; ++k) {
             if (!isfinite(v[k])) {
@@ -481,8 +483,8 @@ static int model_writable(const dhcal_model *m, char *where, size_t cap)
         const dhcal_effect_value *const e = &m->effects[i];
         if (memchr(e->name, '\0', sizeof e->name) == NULL || e->name[0] == '\0' ||
             e->n_values == 0U || e->n_values > DHCAL_MAX_EFFECT_VALUES) {
-            (void)snprintf(where, cap, "effects[%zu]: empty or unterminated name, or %zu values",
-                           i, e->n_values);
+            (void)snprintf(where, cap, "effects[%zu]: empty or unterminated name, or %zu values", i,
+                           e->n_values);
             return 0;
         }
         if (!dhc_all_finite(e->values, e->n_values)) {
@@ -513,4 +515,3 @@ int dhcal_model_save(const char *path, const dhcal_model *model, dhcal_error *er
     free(sb.p);
     return rc;
 }
-

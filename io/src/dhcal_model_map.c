@@ -7,12 +7,10 @@
 
 #include "dhcal/dhc_params.h"
 
-
-static int bad(dhcal_error *err, const char *path, const char *name, const char *what,
-               size_t got)
+static int bad(dhcal_error *err, const char *path, const char *name, const char *what, size_t got)
 {
-    snprintf(err->msg, sizeof err->msg, "%s: effects.%s: %s (got %zu values)", path, name,
-             what, got);
+    snprintf(err->msg, sizeof err->msg, "%s: effects.%s: %s (got %zu values)", path, name, what,
+             got);
     return DHCAL_IO_BAD_INPUT;
 }
 
@@ -27,8 +25,8 @@ static void expected_values(const dhc_param_set *set, const dhc_effect_info *fx,
     for (size_t k = 0U; k < set->count && pos < sizeof list; ++k) {
         char name[32];
         (void)dhc_params_name(set, k, name, sizeof name);
-        pos += (size_t)snprintf(list + pos, sizeof list - pos, "%s%s%s", k == 0U ? "" : ", ",
-                                name, dhc_params_in_degrees(set, k) ? "_deg" : "");
+        pos += (size_t)snprintf(list + pos, sizeof list - pos, "%s%s%s", k == 0U ? "" : ", ", name,
+                                dhc_params_in_degrees(set, k) ? "_deg" : "");
     }
     if (fx->reference == DHC_EFFECT_REF_TIME) {
         (void)snprintf(buf, cap, "expected [%s, t0_s]", list);
@@ -45,8 +43,7 @@ static int effect_to_lib(const dhcal_model *file, const dhcal_effect_value *ev, 
 {
     dhc_effect effect;
     size_t j;
-    if (dhc_effect_parse(ev->name, strlen(ev->name), file->arm.n_joints, &effect, &j) !=
-        DHC_OK) {
+    if (dhc_effect_parse(ev->name, strlen(ev->name), file->arm.n_joints, &effect, &j) != DHC_OK) {
         return bad(err, path, ev->name, "unknown effect", ev->n_values);
     }
     const dhc_effect_info *fx = dhc_effect_info_of(effect);
@@ -88,8 +85,7 @@ static int effect_to_lib(const dhcal_model *file, const dhcal_effect_value *ev, 
     return DHCAL_IO_OK;
 }
 
-int dhcal_model_to_lib(const dhcal_model *file, const char *path, dhc_model *out,
-                       dhcal_error *err)
+int dhcal_model_to_lib(const dhcal_model *file, const char *path, dhc_model *out, dhcal_error *err)
 {
     if (dhc_model_init(out, file->arm.n_joints) != DHC_OK) {
         snprintf(err->msg, sizeof err->msg, "%s: joints: unsupported joint count %zu", path,
@@ -141,8 +137,7 @@ static void effect_from_lib(const dhc_model *m, const dhc_effect_info *fx, size_
     out->n_effects++;
 }
 
-void dhcal_model_from_lib(const dhc_model *m, const dhcal_model *template_model,
-                          dhcal_model *out)
+void dhcal_model_from_lib(const dhc_model *m, const dhcal_model *template_model, dhcal_model *out)
 {
     *out = *template_model;
     out->arm = m->arm;

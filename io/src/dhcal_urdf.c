@@ -147,8 +147,7 @@ static int load_doc(const char *path, urdf_doc *d, dhcal_error *err)
             msg[--n] = '\0';
         }
         xmlFreeParserCtxt(ctxt);
-        return dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s:%ld: XML error: %s", path, line,
-                               msg);
+        return dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s:%ld: XML error: %s", path, line, msg);
     }
     xmlFreeParserCtxt(ctxt);
     d->robot = xmlDocGetRootElement(d->doc);
@@ -176,8 +175,8 @@ static int load_doc(const char *path, urdf_doc *d, dhcal_error *err)
             l->node = c;
             l->name = attribute(c, "name");
             if (l->name == NULL) {
-                rc = dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s:%ld: <link> without a name",
-                                     path, line_of(c));
+                rc = dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s:%ld: <link> without a name", path,
+                                     line_of(c));
                 free_doc(d);
                 return rc;
             }
@@ -239,8 +238,7 @@ static int index_doc(urdf_doc *d, dhcal_error *err)
     return DHCAL_IO_OK;
 }
 
-static const struct name_index *look_up(const struct name_index *sorted, size_t n,
-                                        const char *name)
+static const struct name_index *look_up(const struct name_index *sorted, size_t n, const char *name)
 {
     return n > 0U && sorted != NULL
                ? bsearch(name, sorted, n, sizeof(struct name_index), name_vs_entry)
@@ -439,8 +437,8 @@ static int find_chain(const urdf_doc *d, const char *base, const char *tip, size
     for (size_t k = 0U; k < 2U; ++k) {
         if (find_link(d, named[k]) == NULL) {
             char quoted[DHCAL_QUOTE_CAP];
-            return dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s:%ld: the robot has no link '%s' (%s)",
-                                   d->path, robot_line,
+            return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
+                                   "%s:%ld: the robot has no link '%s' (%s)", d->path, robot_line,
                                    dhcal_quote(named[k], strlen(named[k]), quoted), option[k]);
         }
     }
@@ -450,11 +448,11 @@ static int find_chain(const urdf_doc *d, const char *base, const char *tip, size
         for (size_t e = 0U; e < 2U; ++e) {
             if (find_link(d, ends[e]) == NULL) {
                 char quoted[DHCAL_QUOTE_CAP];
-                return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
-                                       "%s:%ld: joint '%s': %s link '%s' is not a link of the robot",
-                                       d->path, line_of(j->node), j->name,
-                                       e == 0U ? "parent" : "child",
-                                       dhcal_quote(ends[e], strlen(ends[e]), quoted));
+                return dhcal_error_set(
+                    err, DHCAL_IO_BAD_INPUT,
+                    "%s:%ld: joint '%s': %s link '%s' is not a link of the robot", d->path,
+                    line_of(j->node), j->name, e == 0U ? "parent" : "child",
+                    dhcal_quote(ends[e], strlen(ends[e]), quoted));
             }
         }
     }
@@ -497,8 +495,8 @@ static int find_chain(const urdf_doc *d, const char *base, const char *tip, size
 
 /* The model file's length ranges; a defect is named at the joint (or the tip link) whose
  * geometry made it. */
-static int arm_in_ranges(const urdf_doc *d, const dhc_arm *arm,
-                         const dhcal_urdf_import_report *rep, long tip_line, dhcal_error *err)
+static int arm_in_ranges(const urdf_doc *d, const dhc_arm *arm, const dhcal_urdf_import_report *rep,
+                         long tip_line, dhcal_error *err)
 {
     for (size_t i = 0U; i < arm->n_joints; ++i) {
         if (fabs(arm->joint[i].a_mm) > LEN_MAX_MM || fabs(arm->joint[i].d_mm) > LEN_MAX_MM) {
@@ -667,8 +665,8 @@ static void put_origin(dhcal_text *t, const dhc_frame *f)
     dhcal_text_str(t, "\"/>\n");
 }
 
-static void put_fixed_joint(dhcal_text *t, const char *name, const char *parent,
-                            const char *child, const dhc_frame *origin)
+static void put_fixed_joint(dhcal_text *t, const char *name, const char *parent, const char *child,
+                            const dhc_frame *origin)
 {
     dhcal_text_printf(t, "  <link name=\"%s\"/>\n", child);
     dhcal_text_printf(t, "  <joint name=\"%s\" type=\"fixed\">\n", name);
@@ -728,11 +726,10 @@ int dhcal_urdf_export(const char *path, const dhcal_model *model, const char *so
         dhcal_text_str(&t, " from ");
         put_comment_text(&t, source);
     }
-    dhcal_text_str(&t,
-                   ". Link i is DH frame i-1 turned by joint i; flange is DH frame N; tool0 is "
-                   "the model's tool point (tool_mm), oriented as frame N. Units: metres, "
-                   "radians. Joint effort and velocity limits are not in a model: 0 written. "
-                   "-->\n<robot name=\"");
+    dhcal_text_str(&t, ". Link i is DH frame i-1 turned by joint i; flange is DH frame N; tool0 is "
+                       "the model's tool point (tool_mm), oriented as frame N. Units: metres, "
+                       "radians. Joint effort and velocity limits are not in a model: 0 written. "
+                       "-->\n<robot name=\"");
     put_escaped(&t, model->name[0] != '\0' ? model->name : "dhcal_model");
     dhcal_text_str(&t, "\">\n");
     put_not_geometry(&t, model);

@@ -44,8 +44,7 @@ static void snap_joint(dhc_joint *j)
 }
 
 /* The rotation with columns x, y, z. */
-static void rot_from_columns(const double x[3], const double y[3], const double z[3],
-                             dhc_mat3 *r)
+static void rot_from_columns(const double x[3], const double y[3], const double z[3], dhc_mat3 *r)
 {
     for (size_t k = 0U; k < 3U; ++k) {
         r->m[k][0] = x[k];
@@ -85,8 +84,8 @@ static void inner_joint(const double p[3], const double u[3], dhc_joint *j)
          * (foot p + r u), closest points of two skew lines. x_i = e_z x u / s, so alpha_i
          * lies in (0, pi) and a_i carries the sign. */
         const double b = u[2];
-        const double dz = -p[2];                  /* e_z . (0 - p) */
-        const double e = -dhc_vec3_dot(u, p);     /* u . (0 - p) */
+        const double dz = -p[2];              /* e_z . (0 - p) */
+        const double e = -dhc_vec3_dot(u, p); /* u . (0 - p) */
         const double den = 1.0 - b * b;
         const double t = (b * e - dz) / den;
         const double r = (e - b * dz) / den;
@@ -124,7 +123,7 @@ static void inner_joint(const double p[3], const double u[3], dhc_joint *j)
  * axis) b = 0. d_N and a_N: the tip's origin in the turned frame, its y part left to tool_mm. */
 static void last_joint(const dhc_frame *tip, dhc_joint *j)
 {
-    const double (*m)[3] = tip->rot.m;
+    const double(*m)[3] = tip->rot.m;
     const double sin_alpha = m[2][1];
     const double cos_alpha = hypot(m[2][0], m[2][2]);
     double theta;
@@ -248,5 +247,5 @@ dhcal_urdf_chain_status dhcal_urdf_chain_to_arm(const dhcal_urdf_joint *joints, 
         }
     }
     return vec3_finite(arm->tool_mm) && frame_finite(&arm->base) ? DHCAL_URDF_CHAIN_OK
-                                                                  : DHCAL_URDF_CHAIN_NONFINITE;
+                                                                 : DHCAL_URDF_CHAIN_NONFINITE;
 }

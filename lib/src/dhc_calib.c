@@ -94,14 +94,13 @@ static double current_decrement(const fit_context *fc)
 {
     double decrement;
     return dhc_lsq_decrement(&fc->ws->ne, &fc->ws->fac, &decrement) == DHC_OK ? decrement
-                                                                             : HUGE_VAL;
+                                                                              : HUGE_VAL;
 }
 
 /* Convergence relative to the noise the fit estimates, before a step: the decrement is
  * below (noise_rel_tol sigma)^2, i.e. what is left is under noise_rel_tol standard errors
  * (Mahalanobis). */
-static int nothing_left_to_gain(const fit_context *fc, const pass_totals *tot,
-                                double decrement)
+static int nothing_left_to_gain(const fit_context *fc, const pass_totals *tot, double decrement)
 {
     const double tol = fc->opt->noise_rel_tol;
     const double sigma2 = residual_variance(fc, tot);
@@ -126,7 +125,6 @@ static int little_left_to_gain(const fit_context *fc, const pass_totals *tot, do
     return q * gain / (1.0 - q) <= tol * sigma2;
 }
 
-
 /* The identifiability checks of one fit_to_convergence: how many at a converged estimate
  * freed parameters, and whether LM may still free them between its steps (when any check
  * is allowed; not after a roll-back, see roll_back_early). Freeing between steps counts no
@@ -136,8 +134,8 @@ typedef struct {
     int early;
 } freeing;
 
-static dhc_status free_identifiable(const fit_context *fc, dhc_calib_report *rep,
-                                    uint8_t *mark, size_t *freed);
+static dhc_status free_identifiable(const fit_context *fc, dhc_calib_report *rep, uint8_t *mark,
+                                    size_t *freed);
 
 /* A step that turns a link angle (theta, alpha, beta) by more than this corrects no drawing
  * (the plausible bound is 30 deg): along a direction the data barely see (theta of the last
@@ -161,7 +159,9 @@ static int link_angle_step_too_far(const dhc_param_set *set, const double *delta
 #else
 static int link_angle_step_too_far(const dhc_param_set *set, const double *delta, size_t p)
 {
-    (void)set; (void)delta; (void)p;
+    (void)set;
+    (void)delta;
+    (void)p;
     return 0; /* the controller's planned poses: no guard */
 }
 #endif
@@ -310,8 +310,8 @@ static int may_free(const fit_context *fc, const dhc_calib_report *rep, const ui
     return !rep->identifiable[k] && !rep->unsupported[k] && (mark == NULL || !rotation);
 }
 
-static dhc_status free_identifiable(const fit_context *fc, dhc_calib_report *rep,
-                                    uint8_t *mark, size_t *freed)
+static dhc_status free_identifiable(const fit_context *fc, dhc_calib_report *rep, uint8_t *mark,
+                                    size_t *freed)
 {
     dhc_calib_workspace *const ws = fc->ws;
     *freed = 0U;
@@ -324,8 +324,8 @@ static dhc_status free_identifiable(const fit_context *fc, dhc_calib_report *rep
     }
     /* Freed only with a clear margin: an exact dependence (d1 and the base along axis 1)
      * leaves a rounding-level pivot that the plain tolerance can take at another estimate. */
-    dhc_status st = dhc_lsq_analyse(&ws->ne, fmin(fc->opt->rank_rel_tol * FREE_TOL_FACTOR, 0.5),
-                                    &ws->fac);
+    dhc_status st =
+        dhc_lsq_analyse(&ws->ne, fmin(fc->opt->rank_rel_tol * FREE_TOL_FACTOR, 0.5), &ws->fac);
     if (st != DHC_OK) {
         return st;
     }
@@ -435,7 +435,8 @@ static dhc_status roll_back_early(const fit_context *fc, dhc_calib_report *rep, 
 static int undo_early_freeing(const fit_context *fc, dhc_calib_report *rep)
 {
 #if !DHC_WITH_ROBUST_START
-    (void)fc; (void)rep;
+    (void)fc;
+    (void)rep;
     return 0; /* the controller's planned poses: no guard */
 #else
     dhc_calib_workspace *const ws = fc->ws;
@@ -459,8 +460,8 @@ static int undo_early_freeing(const fit_context *fc, dhc_calib_report *rep)
  * at the converged estimate (again while that frees parameters, at most
  * max_identifiability_checks times), then the worst unsupported link parameter held and the
  * fit repeated (at most MAX_HOLDS times). */
-static dhc_status fit_to_convergence(const fit_context *fc, dhc_calib_report *rep,
-                                     pass_totals *tot, int accumulated, int *converged)
+static dhc_status fit_to_convergence(const fit_context *fc, dhc_calib_report *rep, pass_totals *tot,
+                                     int accumulated, int *converged)
 {
     freeing fr = {0U, 1};
     size_t holds = 0U;
@@ -558,14 +559,13 @@ static dhc_status robust_start(const fit_context *fc, dhc_calib_report *rep, pas
     /* ws->current is still the caller's model (fc->input): no copy, the M4 stack is small */
     *moved = 1;
     for (size_t step = 0U; step < ROBUST_CSTEPS && st == DHC_OK; ++step) {
-        st = dhc_fit_scan_errors(fc, &ws->current, NULL, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED,
-                                 &scan);
+        st = dhc_fit_scan_errors(fc, &ws->current, NULL, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, &scan);
         if (st == DHC_OK) {
             st = dhc_fit_quantile_error2(fc, &ws->current, NULL, &scan, ROBUST_KEEP, &level);
         }
         if (st == DHC_OK) {
-            st = dhc_fit_scan_errors(fc, &ws->current, NULL, level,
-                                     (uint8_t)DHC_SAMPLE_ROBUST, &scan);
+            st = dhc_fit_scan_errors(fc, &ws->current, NULL, level, (uint8_t)DHC_SAMPLE_ROBUST,
+                                     &scan);
         }
         int converged = 0;
         if (st == DHC_OK) {
@@ -630,8 +630,7 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
         return DHC_ERR_CAPACITY;
     }
     int whiten = 0;
-    if (dhc_noise_model_check(&opt->noise, model->arm.n_joints,
-                              &whiten) != DHC_OK) {
+    if (dhc_noise_model_check(&opt->noise, model->arm.n_joints, &whiten) != DHC_OK) {
         return DHC_ERR_ARGUMENT;
     }
     if (!DHC_WITH_ROBUST_START && opt->robust_start) {
@@ -677,8 +676,7 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
 
     int converged = 0;
     for (size_t round = 0U; round <= opt->max_outlier_rounds; ++round) {
-        st = fit_to_convergence(&fc, rep, &tot, round == 0U && accumulated && !moved,
-                                &converged);
+        st = fit_to_convergence(&fc, rep, &tot, round == 0U && accumulated && !moved, &converged);
         if (st != DHC_OK) {
             return st;
         }
@@ -711,4 +709,3 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
     *model = ws->current;
     return converged ? DHC_OK : DHC_ERR_NOT_CONVERGED;
 }
-

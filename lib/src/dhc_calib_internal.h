@@ -57,8 +57,8 @@ typedef struct {
     uint8_t *flags;
     const dhc_calib_options *opt;
     dhc_calib_workspace *ws;
-    int whiten;              /* the noise model is on */
-    const dhc_model *input;  /* the caller's model: where held parameters stay */
+    int whiten;             /* the noise model is on */
+    const dhc_model *input; /* the caller's model: where held parameters stay */
 } fit_context;
 
 typedef struct {
@@ -70,16 +70,16 @@ typedef struct {
 
 typedef struct {
     double ssr;
-    double pos_ss;     /* sum of squared position errors, mm^2 */
-    double rot_ss;     /* sum of squared orientation errors, rad^2 */
+    double pos_ss; /* sum of squared position errors, mm^2 */
+    double rot_ss; /* sum of squared orientation errors, rad^2 */
     double max_pos;
     size_t samples;
     size_t pose_samples;
     size_t rows;
     data_traits traits;
-    double max_e2;     /* largest squared sample error, as sample_error2 defines it ... */
-    int own_weights;   /* ... when 1: each sample whitened at the model itself */
-    int errors_kept;   /* 1: the pass left each sample's error in opt->sample_error2 */
+    double max_e2;      /* largest squared sample error, as sample_error2 defines it ... */
+    int own_weights;    /* ... when 1: each sample whitened at the model itself */
+    int errors_kept;    /* 1: the pass left each sample's error in opt->sample_error2 */
     int residuals_kept; /* ... and its residual in opt->sample_residual */
 } pass_totals;
 
@@ -87,8 +87,7 @@ typedef struct {
  * (dhc_calib_pass.c). dhc_fit_data_pass_weighted whitens each sample with the covariance at
  * `weights` (with the noise model on), dhc_fit_data_pass at the model itself. */
 dhc_status dhc_fit_data_pass_weighted(const fit_context *fc, const dhc_model *model,
-                                      const dhc_model *weights, int accumulate,
-                                      pass_totals *tot);
+                                      const dhc_model *weights, int accumulate, pass_totals *tot);
 static inline dhc_status dhc_fit_data_pass(const fit_context *fc, const dhc_model *model,
                                            int accumulate, pass_totals *tot)
 {
@@ -106,8 +105,8 @@ dhc_status dhc_fit_structural_rank(const fit_context *fc, const dhc_model *model
 /* What one scan of the used samples' squared errors e2 found. */
 typedef struct {
     size_t used;
-    size_t pose;      /* pose samples among them (not counted from kept errors) */
-    size_t at_most;   /* samples with e2 <= the scan's limit */
+    size_t pose;    /* pose samples among them (not counted from kept errors) */
+    size_t at_most; /* samples with e2 <= the scan's limit */
     double max_e2;
 } error_scan;
 
@@ -122,14 +121,13 @@ static inline int dhc_fit_redundant(const pass_totals *tot, const dhc_calib_repo
  * controller's) they are the screen file's own, which the compiler may specialise. */
 #if DHC_WITH_ROBUST_START
 #define DHC_ROBUST_SHARED
-dhc_status dhc_fit_scan_errors(const fit_context *fc, const dhc_model *model,
-                               const pass_totals *at, double limit2, uint8_t mark,
-                               error_scan *out);
+dhc_status dhc_fit_scan_errors(const fit_context *fc, const dhc_model *model, const pass_totals *at,
+                               double limit2, uint8_t mark, error_scan *out);
 dhc_status dhc_fit_quantile_error2(const fit_context *fc, const dhc_model *model,
                                    const pass_totals *at, const error_scan *all, double share,
                                    double *median);
-dhc_status dhc_fit_scan_all(const fit_context *fc, const dhc_model *model,
-                            const pass_totals *tot, error_scan *out);
+dhc_status dhc_fit_scan_all(const fit_context *fc, const dhc_model *model, const pass_totals *tot,
+                            error_scan *out);
 dhc_status dhc_fit_robust_sigma(const fit_context *fc, const dhc_model *model,
                                 const pass_totals *tot, double *sigma, size_t *used);
 #else
@@ -137,6 +135,5 @@ dhc_status dhc_fit_robust_sigma(const fit_context *fc, const dhc_model *model,
 #endif
 dhc_status dhc_fit_flag_outliers(const fit_context *fc, const dhc_model *model,
                                  const pass_totals *tot, size_t *flagged);
-
 
 #endif /* DHC_CALIB_INTERNAL_H */

@@ -26,8 +26,8 @@ static void note_traits(data_traits *t, const dhc_sample *s, size_t n_joints, in
 static dhc_status add_batch(dhc_calib_workspace *ws, const double *r, size_t rows)
 {
     dhc_mat jac;
-    dhc_status st = dhc_mat_init(&jac, rows, ws->ne.n, ws->jac_buf,
-                                 sizeof ws->jac_buf / sizeof ws->jac_buf[0]);
+    dhc_status st =
+        dhc_mat_init(&jac, rows, ws->ne.n, ws->jac_buf, sizeof ws->jac_buf / sizeof ws->jac_buf[0]);
     if (st == DHC_OK) {
         st = dhc_normal_eq_add(&ws->ne, &jac, r, NULL, rows);
     }
@@ -39,8 +39,7 @@ static dhc_status add_batch(dhc_calib_workspace *ws, const double *r, size_t row
  * minimises the objective whose gradient it steps along and stops where that gradient
  * vanishes (the weighted fit's fixed point). */
 dhc_status dhc_fit_data_pass_weighted(const fit_context *fc, const dhc_model *model,
-                                      const dhc_model *weights, int accumulate,
-                                      pass_totals *tot)
+                                      const dhc_model *weights, int accumulate, pass_totals *tot)
 {
     dhc_calib_workspace *const ws = fc->ws;
     const size_t p = fc->set->count;
@@ -116,18 +115,18 @@ dhc_status dhc_fit_data_pass_weighted(const fit_context *fc, const dhc_model *mo
             memcpy(r_weights, r, sizeof ws->weights_residual);
             if (weights != model && s->kind == (uint8_t)DHC_MEAS_POSE) {
                 st = dhc_model_residual_prepared(weights, weights_trig, s,
-                                                 sample_sincos(fc->opt, model->arm.n_joints, i),
-                                                 w, r_weights, &weights_rows);
+                                                 sample_sincos(fc->opt, model->arm.n_joints, i), w,
+                                                 r_weights, &weights_rows);
             }
             if (st == DHC_OK) {
-                st = dhc_sample_whiten(weights, weights_trig, &ws->eval, s, &fc->opt->noise,
-                                       w, r_weights, rw, accumulate ? &jac : NULL);
+                st = dhc_sample_whiten(weights, weights_trig, &ws->eval, s, &fc->opt->noise, w,
+                                       r_weights, rw, accumulate ? &jac : NULL);
             }
         }
         if (st != DHC_OK) {
             /* the rows before it first, as one sample at a time would have */
-            const dhc_status before = accumulate && batch > 0U ? add_batch(ws, batch_r, batch)
-                                                               : DHC_OK;
+            const dhc_status before =
+                accumulate && batch > 0U ? add_batch(ws, batch_r, batch) : DHC_OK;
             return before != DHC_OK ? before : st;
         }
         if (accumulate) {
@@ -213,11 +212,10 @@ dhc_status dhc_fit_structural_rank(const fit_context *fc, const dhc_model *model
             s->q_rad[i] = j->min_rad + (j->max_rad - j->min_rad) * next_uniform(&state);
             s->dir[i] = (int8_t)(traits->dir_seen[i] ? (next_uniform(&state) < 0.5 ? -1 : 1) : 0);
         }
-        s->temp_c = traits->temp_min_c +
-                    (traits->temp_max_c - traits->temp_min_c) * next_uniform(&state);
+        s->temp_c =
+            traits->temp_min_c + (traits->temp_max_c - traits->temp_min_c) * next_uniform(&state);
         dhc_mat jac;
-        st = dhc_mat_init(&jac, rows, p, ws->jac_buf,
-                          sizeof ws->jac_buf / sizeof ws->jac_buf[0]);
+        st = dhc_mat_init(&jac, rows, p, ws->jac_buf, sizeof ws->jac_buf / sizeof ws->jac_buf[0]);
         dhc_prediction pred;
         if (st == DHC_OK) {
             st = dhc_model_jacobian_prepared(model, &ws->trig, fc->set, s, NULL, w, &jac, &pred,

@@ -31,8 +31,7 @@ static dhc_status sample_error2(const fit_context *fc, const dhc_model *model,
         /* screened in units of each sample's own noise: a sample at a pose where the joint
          * noise maps large is not an outlier for being larger */
         st = dhc_sample_whiten(model, &fc->ws->trig, &fc->ws->eval, &fc->ws->sample,
-                               &fc->opt->noise, fc->opt->orientation_weight_mm_per_rad, r, r,
-                               NULL);
+                               &fc->opt->noise, fc->opt->orientation_weight_mm_per_rad, r, r, NULL);
     }
     if (st != DHC_OK) {
         return st;
@@ -140,8 +139,8 @@ dhc_status dhc_fit_quantile_error2(const fit_context *fc, const dhc_model *model
             below[m] += below[m - 1U]; /* now: errors at or below mid[m] */
         }
         size_t m = (QUANTILE_POINTS - 1U) / 2U;
-        for (size_t d = 0U; d < QUANTILE_LEVELS && it < MEDIAN_BISECTIONS &&
-                            hi - lo > MEDIAN_REL_PRECISION * hi;
+        for (size_t d = 0U;
+             d < QUANTILE_LEVELS && it < MEDIAN_BISECTIONS && hi - lo > MEDIAN_REL_PRECISION * hi;
              ++d, ++it) {
             const size_t step = ((size_t)1U << (QUANTILE_LEVELS - 1U - d)) / 2U;
             if (below[m] >= half) {

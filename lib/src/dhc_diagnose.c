@@ -133,8 +133,8 @@ static double ln_incomplete_beta(size_t na, size_t nb, double x)
 {
     const double a = 0.5 * (double)na;
     const double b = 0.5 * (double)nb;
-    const double ln_front = a * log(x) + b * log1p(-x) + ln_gamma_half(na + nb) -
-                            ln_gamma_half(na) - ln_gamma_half(nb);
+    const double ln_front =
+        a * log(x) + b * log1p(-x) + ln_gamma_half(na + nb) - ln_gamma_half(na) - ln_gamma_half(nb);
     if (x < (a + 1.0) / (a + b + 2.0)) {
         return ln_front + ln_beta_fraction(a, b, x) - log(a);
     }
@@ -241,8 +241,15 @@ dhc_status dhc_covariate_pose_r2(size_t n_joints, dhc_covariate which, dhc_sampl
                                  const void *ctx, size_t n, const uint8_t *flags, dhc_normal_eq *ne,
                                  dhc_lsq_factor *fac, double *r2)
 {
-    (void)n_joints; (void)which; (void)read; (void)ctx; (void)n; (void)flags; (void)ne;
-    (void)fac; (void)r2;
+    (void)n_joints;
+    (void)which;
+    (void)read;
+    (void)ctx;
+    (void)n;
+    (void)flags;
+    (void)ne;
+    (void)fac;
+    (void)r2;
     return DHC_ERR_ARGUMENT; /* left out of this build (DHC_WITH_SESSION_TESTS 0) */
 }
 #endif /* DHC_WITH_SESSION_TESTS */
@@ -261,8 +268,7 @@ static int base_has_effect(const dhc_param_set *base, dhc_effect e, size_t joint
 }
 
 size_t dhc_diagnose_candidates(const dhc_model *model, const dhc_param_set *base,
-                               const dhc_candidate_scope *scope, dhc_candidate *out,
-                               size_t cap)
+                               const dhc_candidate_scope *scope, dhc_candidate *out, size_t cap)
 {
     if (model == NULL || base == NULL || scope == NULL || out == NULL) {
         return 0U;
@@ -339,8 +345,8 @@ static dhc_status prepare_batch(batch_state *b)
         b->rank_a = 0U;
         return DHC_OK;
     }
-    dhc_status st = dhc_mat_init(&b->a, b->nb, b->nb, ws->factor,
-                                 sizeof ws->factor / sizeof ws->factor[0]);
+    dhc_status st =
+        dhc_mat_init(&b->a, b->nb, b->nb, ws->factor, sizeof ws->factor / sizeof ws->factor[0]);
     if (st != DHC_OK) {
         return st;
     }
@@ -376,8 +382,7 @@ static dhc_status score_columns(const batch_state *b, const size_t *cols, size_t
     }
     double h[KMAX];
     dhc_mat s;
-    dhc_status st = dhc_mat_init(&s, k, k, ws->schur,
-                                 sizeof ws->schur / sizeof ws->schur[0]);
+    dhc_status st = dhc_mat_init(&s, k, k, ws->schur, sizeof ws->schur / sizeof ws->schur[0]);
     if (st != DHC_OK) {
         return st;
     }
@@ -405,8 +410,9 @@ static dhc_status score_columns(const batch_state *b, const size_t *cols, size_t
     }
     /* Pivots are the column shares left outside the base span (scaled, 1 = all of it). */
     size_t accepted = 0U;
-    while (accepted < r && DHC_MAT_AT(&s, accepted, accepted) * DHC_MAT_AT(&s, accepted, accepted) >=
-                               b->opt->separable_tol) {
+    while (accepted < r &&
+           DHC_MAT_AT(&s, accepted, accepted) * DHC_MAT_AT(&s, accepted, accepted) >=
+               b->opt->separable_tol) {
         accepted++;
     }
     double hp[KMAX];
@@ -454,8 +460,7 @@ static dhc_status accumulate(const dhc_model *model, dhc_sample_reader read, con
         size_t k = dhc_sample_rows(&ws->sample);
         dhc_mat jac;
         if (st == DHC_OK) {
-            st = dhc_mat_init(&jac, k, p, ws->jac_buf,
-                              sizeof ws->jac_buf / sizeof ws->jac_buf[0]);
+            st = dhc_mat_init(&jac, k, p, ws->jac_buf, sizeof ws->jac_buf / sizeof ws->jac_buf[0]);
         }
         if (st == DHC_OK) {
             /* residual and slope from one evaluation, as the fit linearises them */
@@ -609,11 +614,10 @@ static dhc_status find_lookalikes(const dhc_model *model, const dhc_param_set *b
 }
 
 dhc_status dhc_diagnose(const dhc_model *model, const dhc_param_set *base,
-                        const uint8_t *identifiable, double sigma2,
-                        const dhc_candidate *candidates, size_t n_candidates,
-                        dhc_sample_reader read, const void *ctx, size_t n, const uint8_t *flags,
-                        const dhc_diagnose_options *opt, dhc_diagnose_workspace *ws,
-                        dhc_diagnosis *out)
+                        const uint8_t *identifiable, double sigma2, const dhc_candidate *candidates,
+                        size_t n_candidates, dhc_sample_reader read, const void *ctx, size_t n,
+                        const uint8_t *flags, const dhc_diagnose_options *opt,
+                        dhc_diagnose_workspace *ws, dhc_diagnosis *out)
 {
     if (model == NULL || base == NULL || identifiable == NULL || candidates == NULL ||
         read == NULL || flags == NULL || opt == NULL || ws == NULL || out == NULL ||
@@ -624,8 +628,7 @@ dhc_status dhc_diagnose(const dhc_model *model, const dhc_param_set *base,
         return DHC_ERR_CAPACITY;
     }
     int on = 0; /* checked once here; accumulate whitens each sample when it is on */
-    if (dhc_noise_model_check(&opt->noise, model->arm.n_joints,
-                              &on) != DHC_OK) {
+    if (dhc_noise_model_check(&opt->noise, model->arm.n_joints, &on) != DHC_OK) {
         return DHC_ERR_ARGUMENT;
     }
     memset(out, 0, sizeof *out);
@@ -690,14 +693,23 @@ dhc_status dhc_diagnose(const dhc_model *model, const dhc_param_set *base,
  * list is not defined: "none" would read as "nothing found"). */
 
 dhc_status dhc_diagnose(const dhc_model *model, const dhc_param_set *base,
-                        const uint8_t *identifiable, double sigma2,
-                        const dhc_candidate *candidates, size_t n_candidates,
-                        dhc_sample_reader read, const void *ctx, size_t n, const uint8_t *flags,
-                        const dhc_diagnose_options *opt, dhc_diagnose_workspace *ws,
-                        dhc_diagnosis *out)
+                        const uint8_t *identifiable, double sigma2, const dhc_candidate *candidates,
+                        size_t n_candidates, dhc_sample_reader read, const void *ctx, size_t n,
+                        const uint8_t *flags, const dhc_diagnose_options *opt,
+                        dhc_diagnose_workspace *ws, dhc_diagnosis *out)
 {
-    (void)model; (void)base; (void)identifiable; (void)sigma2; (void)candidates;
-    (void)n_candidates; (void)read; (void)ctx; (void)n; (void)flags; (void)opt; (void)ws;
+    (void)model;
+    (void)base;
+    (void)identifiable;
+    (void)sigma2;
+    (void)candidates;
+    (void)n_candidates;
+    (void)read;
+    (void)ctx;
+    (void)n;
+    (void)flags;
+    (void)opt;
+    (void)ws;
     if (out != NULL) {
         out->count = 0U;
     }

@@ -19,21 +19,22 @@ static const dhc_effect_info catalogue[] = {
 #if DHC_WITH_EFFECT_BASE_FRAME
     {"base_frame",
      SUMMARY("a constant shift and a rotation growing with distance (robot or measurer placement)"),
-     DHC_EFFECT_BASE_FRAME, 0U, KINDS(DHC_P_BASE_X, DHC_P_BASE_RZ), 0U, 1U, 0U,
-     DHC_EFFECT_REF_NONE, 1U},
+     DHC_EFFECT_BASE_FRAME, 0U, KINDS(DHC_P_BASE_X, DHC_P_BASE_RZ), 0U, 1U, 0U, DHC_EFFECT_REF_NONE,
+     1U},
 #endif
     {"tool_offset", SUMMARY("an error vector that turns with the last link (tool point unknown)"),
-     DHC_EFFECT_TOOL_OFFSET, 0U, KINDS(DHC_P_TOOL_X, DHC_P_TOOL_Z), 0U, 1U, 0U,
-     DHC_EFFECT_REF_NONE, 1U},
+     DHC_EFFECT_TOOL_OFFSET, 0U, KINDS(DHC_P_TOOL_X, DHC_P_TOOL_Z), 0U, 1U, 0U, DHC_EFFECT_REF_NONE,
+     1U},
 #if DHC_WITH_EFFECT_JOINT_SCALE
     {"joint_scale",
      SUMMARY("a joint error growing in proportion to the joint angle (gear ratio or encoder "
-     "resolution)"),
+             "resolution)"),
      DHC_EFFECT_JOINT_SCALE, 1U, KINDS(DHC_P_JOINT_SCALE, DHC_P_JOINT_SCALE), 0U, 1U,
      DHC_NEEDS_ANGLE_RANGE, DHC_EFFECT_REF_NONE, 0U},
 #endif
 #if DHC_WITH_EFFECT_JOINT_HARMONIC
-    {"joint_harmonic", SUMMARY("a joint error periodic in the joint angle (encoder or gear eccentricity)"),
+    {"joint_harmonic",
+     SUMMARY("a joint error periodic in the joint angle (encoder or gear eccentricity)"),
      DHC_EFFECT_JOINT_HARMONIC, 1U, KINDS(DHC_P_HARMONIC_SIN, DHC_P_HARMONIC_COS), 0U, 1U,
      DHC_NEEDS_ANGLE_RANGE, DHC_EFFECT_REF_NONE, 0U},
     {"joint_harmonic2",
@@ -77,7 +78,7 @@ static const dhc_effect_info catalogue[] = {
 #if DHC_WITH_EFFECT_DRIFT
     {"drift_scale",
      SUMMARY("errors growing over the session in proportion to the distance from the base (warming "
-     "arm)"),
+             "arm)"),
      DHC_EFFECT_DRIFT_SCALE, 0U, KINDS(DHC_P_DRIFT_SCALE, DHC_P_DRIFT_SCALE), 0U, 1U,
      DHC_NEEDS_TIME, DHC_EFFECT_REF_TIME, 0U},
     {"drift_offset", SUMMARY("a constant error growing over the session (measurer or base moving)"),
@@ -221,7 +222,11 @@ size_t dhc_effect_label(dhc_effect effect, size_t joint, char *buf, size_t cap)
 dhc_status dhc_effect_parse(const char *text, size_t len, size_t n_joints, dhc_effect *effect,
                             size_t *joint)
 {
-    (void)text; (void)len; (void)n_joints; (void)effect; (void)joint;
+    (void)text;
+    (void)len;
+    (void)n_joints;
+    (void)effect;
+    (void)joint;
     return DHC_ERR_ARGUMENT; /* left out of this build (DHC_WITH_NAMES 0) */
 }
 #endif /* DHC_WITH_NAMES */

@@ -48,8 +48,7 @@ static void lower_sym_swap(dhc_mat *a, size_t p, size_t q)
     DHC_MAT_AT(a, q, q) = t;
 }
 
-dhc_status dhc_chol_pivoted(dhc_mat *a, size_t *perm, size_t perm_len, double rel_tol,
-                            size_t *rank)
+dhc_status dhc_chol_pivoted(dhc_mat *a, size_t *perm, size_t perm_len, double rel_tol, size_t *rank)
 {
     if (!mat_valid(a) || perm == NULL || rank == NULL) {
         return DHC_ERR_ARGUMENT;
@@ -185,8 +184,8 @@ static void copy_vec(const double *src, double *dst, size_t n)
 }
 
 /* The checked solves: L y = b (forward), then L^T x = y (backward), as asked. */
-static dhc_status checked_solve(const dhc_mat *l, size_t k, const double *b, double *x,
-                                size_t len, int forward, int backward)
+static dhc_status checked_solve(const dhc_mat *l, size_t k, const double *b, double *x, size_t len,
+                                int forward, int backward)
 {
     const dhc_status st = check_solve(l, k, b, x, len);
     if (st != DHC_OK) {
@@ -203,14 +202,12 @@ static dhc_status checked_solve(const dhc_mat *l, size_t k, const double *b, dou
     return DHC_OK;
 }
 
-dhc_status dhc_tri_lower_solve(const dhc_mat *l, size_t k, const double *b, double *y,
-                               size_t len)
+dhc_status dhc_tri_lower_solve(const dhc_mat *l, size_t k, const double *b, double *y, size_t len)
 {
     return checked_solve(l, k, b, y, len, 1, 0);
 }
 
-dhc_status dhc_tri_lower_t_solve(const dhc_mat *l, size_t k, const double *y, double *x,
-                                 size_t len)
+dhc_status dhc_tri_lower_t_solve(const dhc_mat *l, size_t k, const double *y, double *x, size_t len)
 {
     return checked_solve(l, k, y, x, len, 0, 1);
 }
@@ -221,23 +218,33 @@ dhc_status dhc_chol_solve(const dhc_mat *l, size_t k, const double *b, double *x
 }
 #else
 /* Left out of this build (DHC_WITH_MATRIX_OPS 0): the fit solves on its kernels. */
-dhc_status dhc_tri_lower_solve(const dhc_mat *l, size_t k, const double *b, double *y,
-                               size_t len)
+dhc_status dhc_tri_lower_solve(const dhc_mat *l, size_t k, const double *b, double *y, size_t len)
 {
-    (void)l; (void)k; (void)b; (void)y; (void)len;
+    (void)l;
+    (void)k;
+    (void)b;
+    (void)y;
+    (void)len;
     return DHC_ERR_ARGUMENT;
 }
 
-dhc_status dhc_tri_lower_t_solve(const dhc_mat *l, size_t k, const double *y, double *x,
-                                 size_t len)
+dhc_status dhc_tri_lower_t_solve(const dhc_mat *l, size_t k, const double *y, double *x, size_t len)
 {
-    (void)l; (void)k; (void)y; (void)x; (void)len;
+    (void)l;
+    (void)k;
+    (void)y;
+    (void)x;
+    (void)len;
     return DHC_ERR_ARGUMENT;
 }
 
 dhc_status dhc_chol_solve(const dhc_mat *l, size_t k, const double *b, double *x, size_t len)
 {
-    (void)l; (void)k; (void)b; (void)x; (void)len;
+    (void)l;
+    (void)k;
+    (void)b;
+    (void)x;
+    (void)len;
     return DHC_ERR_ARGUMENT;
 }
 #endif /* DHC_WITH_MATRIX_OPS */

@@ -123,8 +123,8 @@ void dhc_rot_mul(const dhc_mat3 *a, const dhc_mat3 *b, dhc_mat3 *out)
 {
     for (size_t i = 0U; i < 3U; ++i) {
         for (size_t j = 0U; j < 3U; ++j) {
-            out->m[i][j] = a->m[i][0] * b->m[0][j] + a->m[i][1] * b->m[1][j] +
-                           a->m[i][2] * b->m[2][j];
+            out->m[i][j] =
+                a->m[i][0] * b->m[0][j] + a->m[i][1] * b->m[1][j] + a->m[i][2] * b->m[2][j];
         }
     }
 }
@@ -134,8 +134,8 @@ void dhc_rot_tmul(const dhc_mat3 *a, const dhc_mat3 *b, dhc_mat3 *out)
 {
     for (size_t i = 0U; i < 3U; ++i) {
         for (size_t j = 0U; j < 3U; ++j) {
-            out->m[i][j] = a->m[0][i] * b->m[0][j] + a->m[1][i] * b->m[1][j] +
-                           a->m[2][i] * b->m[2][j];
+            out->m[i][j] =
+                a->m[0][i] * b->m[0][j] + a->m[1][i] * b->m[1][j] + a->m[2][i] * b->m[2][j];
         }
     }
 }
@@ -146,8 +146,8 @@ void dhc_rot_mul_t(const dhc_mat3 *a, const dhc_mat3 *b, dhc_mat3 *out)
 {
     for (size_t i = 0U; i < 3U; ++i) {
         for (size_t j = 0U; j < 3U; ++j) {
-            out->m[i][j] = a->m[i][0] * b->m[j][0] + a->m[i][1] * b->m[j][1] +
-                           a->m[i][2] * b->m[j][2];
+            out->m[i][j] =
+                a->m[i][0] * b->m[j][0] + a->m[i][1] * b->m[j][1] + a->m[i][2] * b->m[j][2];
         }
     }
 }

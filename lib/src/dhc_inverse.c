@@ -144,8 +144,8 @@ static dhc_status linearize(const dhc_model *model, const dhc_sample *s, double 
 
 /* g = J^T r, the direction of steepest descent of |r|^2 / 2 in q, without the joints held
  * at a limit it pushes against (pinned[i] = 1 for those, their g_i = 0). */
-static void free_descent(const dhc_arm *arm, const double *q, const dhc_mat *jac,
-                         const double *r, double *g, int *pinned)
+static void free_descent(const dhc_arm *arm, const double *q, const dhc_mat *jac, const double *r,
+                         double *g, int *pinned)
 {
     for (size_t i = 0U; i < jac->cols; ++i) {
         g[i] = 0.0;
@@ -246,7 +246,7 @@ dhc_status dhc_model_inverse(const dhc_model *model, const dhc_sample *target,
         return st;
     }
     const double w = opt->weight_mm_per_rad;
-    dhc_sample s = *target; /* s.q_rad: the angles being tried */
+    dhc_sample s = *target;           /* s.q_rad: the angles being tried */
     double q[DHC_MAX_JOINTS] = {0.0}; /* the best so far */
     memcpy(q, s.q_rad, sizeof q);
     for (size_t i = 0U; i < n; ++i) {
@@ -255,8 +255,7 @@ dhc_status dhc_model_inverse(const dhc_model *model, const dhc_sample *target,
     }
     double jac_buf[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_JOINTS];
     dhc_mat jac;
-    (void)dhc_mat_init(&jac, dhc_sample_rows(&s), n, jac_buf,
-                       sizeof jac_buf / sizeof jac_buf[0]);
+    (void)dhc_mat_init(&jac, dhc_sample_rows(&s), n, jac_buf, sizeof jac_buf / sizeof jac_buf[0]);
     double r[DHC_MAX_ROWS_PER_SAMPLE] = {0.0};
     double err2 = 0.0;
     dhc_arm_prepare(arm, &ws->trig);

@@ -32,9 +32,9 @@ static int is_geometric(uint8_t kind)
  *   v: y after Rz Rx(alpha): axis of beta, through origin of frame i */
 /* inline: returned through memory, its 3-vectors are read back as pairs, and the stores
  * cannot forward to those loads (a stall per column) */
-static inline void geometric_column(const dhc_arm *arm, const dhc_frame *f,
-                                    double axes[][2][3], const double p[3],
-                                    const dhc_param_id *id, double dp[3], double dw[3])
+static inline void geometric_column(const dhc_arm *arm, const dhc_frame *f, double axes[][2][3],
+                                    const double p[3], const dhc_param_id *id, double dp[3],
+                                    double dw[3])
 {
     dhc_vec3_set(dp, 0.0, 0.0, 0.0);
     dhc_vec3_set(dw, 0.0, 0.0, 0.0);
@@ -164,29 +164,28 @@ static void wire_rows(const dhc_model *model, const dhc_param_id *id, const doub
 
 static dhc_status jacobian_prepared(const dhc_model *model, const dhc_arm_trig *trig,
                                     const dhc_param_set *set, const dhc_sample *s,
-                                    const double *sincos_q, double weight_mm_per_rad,
-                                    dhc_mat *jac, dhc_prediction *pr, dhc_model_eval *ev);
+                                    const double *sincos_q, double weight_mm_per_rad, dhc_mat *jac,
+                                    dhc_prediction *pr, dhc_model_eval *ev);
 
 dhc_status dhc_model_jacobian_prepared(const dhc_model *model, const dhc_arm_trig *trig,
                                        const dhc_param_set *set, const dhc_sample *s,
                                        const double *sincos_q, double weight_mm_per_rad,
                                        dhc_mat *jac, dhc_prediction *pred, dhc_model_eval *ev)
 {
-    if (model == NULL || trig == NULL || set == NULL || s == NULL || pred == NULL ||
-        ev == NULL) {
+    if (model == NULL || trig == NULL || set == NULL || s == NULL || pred == NULL || ev == NULL) {
         return DHC_ERR_ARGUMENT;
     }
     const dhc_status st = check_jac(jac, dhc_sample_rows(s), set->count);
-    return st == DHC_OK ? jacobian_prepared(model, trig, set, s, sincos_q, weight_mm_per_rad,
-                                            jac, pred, ev)
-                        : st;
+    return st == DHC_OK
+               ? jacobian_prepared(model, trig, set, s, sincos_q, weight_mm_per_rad, jac, pred, ev)
+               : st;
 }
 
 /* dhc_model_jacobian after its argument checks, at the caller's trigonometry. */
 static dhc_status jacobian_prepared(const dhc_model *model, const dhc_arm_trig *trig,
                                     const dhc_param_set *set, const dhc_sample *s,
-                                    const double *sincos_q, double weight_mm_per_rad,
-                                    dhc_mat *jac, dhc_prediction *pr, dhc_model_eval *ev)
+                                    const double *sincos_q, double weight_mm_per_rad, dhc_mat *jac,
+                                    dhc_prediction *pr, dhc_model_eval *ev)
 {
     const dhc_status st =
         dhc_model_evaluate_prepared(model, trig, s, sincos_q, set_has_compliance(set), ev, pr);
@@ -253,10 +252,10 @@ static dhc_status jacobian_prepared(const dhc_model *model, const dhc_arm_trig *
 }
 
 dhc_status dhc_model_linearize_prepared(const dhc_model *model, const dhc_arm_trig *trig,
-                                       const dhc_param_set *set, const dhc_sample *s,
-                                       const double *sincos_q, double weight_mm_per_rad,
-                                       double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows,
-                                       dhc_mat *jac, dhc_model_eval *ev)
+                                        const dhc_param_set *set, const dhc_sample *s,
+                                        const double *sincos_q, double weight_mm_per_rad,
+                                        double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows,
+                                        dhc_mat *jac, dhc_model_eval *ev)
 {
     if (model == NULL || trig == NULL || set == NULL || s == NULL || ev == NULL) {
         return DHC_ERR_ARGUMENT;
@@ -310,8 +309,7 @@ static dhc_status check_arm(const dhc_arm *arm)
 
 dhc_status dhc_identification_jacobian(const dhc_arm *arm, const dhc_param_set *set,
                                        const double *q_rad, size_t q_len, int with_orientation,
-                                       dhc_mat *jac, double tool_world_mm[3],
-                                       dhc_mat3 *tool_rot)
+                                       dhc_mat *jac, double tool_world_mm[3], dhc_mat3 *tool_rot)
 {
     if (set == NULL || q_rad == NULL) {
         return DHC_ERR_ARGUMENT;
@@ -367,9 +365,8 @@ dhc_status dhc_identification_jacobian(const dhc_arm *arm, const dhc_param_set *
     return DHC_OK;
 }
 
-dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set,
-                              const dhc_sample *s, double weight_mm_per_rad, dhc_mat *jac,
-                              dhc_prediction *pred)
+dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set, const dhc_sample *s,
+                              double weight_mm_per_rad, dhc_mat *jac, dhc_prediction *pred)
 {
     if (model == NULL || set == NULL || s == NULL) {
         return DHC_ERR_ARGUMENT;
@@ -404,8 +401,8 @@ dhc_status dhc_joint_jacobian(const dhc_arm *arm, const double *q_rad, size_t q_
         const dhc_param_id theta = {(uint8_t)DHC_P_THETA, (uint8_t)i, 0U};
         offsets.id[i] = theta;
     }
-    return dhc_identification_jacobian(arm, &offsets, q_rad, q_len, with_orientation, jac,
-                                       NULL, NULL);
+    return dhc_identification_jacobian(arm, &offsets, q_rad, q_len, with_orientation, jac, NULL,
+                                       NULL);
 }
 
 dhc_status dhc_model_linearize(const dhc_model *model, const dhc_param_set *set,
@@ -428,26 +425,39 @@ dhc_status dhc_model_linearize(const dhc_model *model, const dhc_param_set *set,
  * take their Jacobians at the prepared trigonometry (dhc_model_jacobian_prepared). */
 dhc_status dhc_identification_jacobian(const dhc_arm *arm, const dhc_param_set *set,
                                        const double *q_rad, size_t q_len, int with_orientation,
-                                       dhc_mat *jac, double tool_world_mm[3],
-                                       dhc_mat3 *tool_rot)
+                                       dhc_mat *jac, double tool_world_mm[3], dhc_mat3 *tool_rot)
 {
-    (void)arm; (void)set; (void)q_rad; (void)q_len; (void)with_orientation; (void)jac;
-    (void)tool_world_mm; (void)tool_rot;
+    (void)arm;
+    (void)set;
+    (void)q_rad;
+    (void)q_len;
+    (void)with_orientation;
+    (void)jac;
+    (void)tool_world_mm;
+    (void)tool_rot;
     return DHC_ERR_ARGUMENT;
 }
 
-dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set,
-                              const dhc_sample *s, double weight_mm_per_rad, dhc_mat *jac,
-                              dhc_prediction *pred)
+dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set, const dhc_sample *s,
+                              double weight_mm_per_rad, dhc_mat *jac, dhc_prediction *pred)
 {
-    (void)model; (void)set; (void)s; (void)weight_mm_per_rad; (void)jac; (void)pred;
+    (void)model;
+    (void)set;
+    (void)s;
+    (void)weight_mm_per_rad;
+    (void)jac;
+    (void)pred;
     return DHC_ERR_ARGUMENT;
 }
 
 dhc_status dhc_joint_jacobian(const dhc_arm *arm, const double *q_rad, size_t q_len,
                               int with_orientation, dhc_mat *jac)
 {
-    (void)arm; (void)q_rad; (void)q_len; (void)with_orientation; (void)jac;
+    (void)arm;
+    (void)q_rad;
+    (void)q_len;
+    (void)with_orientation;
+    (void)jac;
     return DHC_ERR_ARGUMENT;
 }
 
@@ -455,7 +465,13 @@ dhc_status dhc_model_linearize(const dhc_model *model, const dhc_param_set *set,
                                const dhc_sample *s, double weight_mm_per_rad,
                                double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows, dhc_mat *jac)
 {
-    (void)model; (void)set; (void)s; (void)weight_mm_per_rad; (void)r; (void)rows; (void)jac;
+    (void)model;
+    (void)set;
+    (void)s;
+    (void)weight_mm_per_rad;
+    (void)r;
+    (void)rows;
+    (void)jac;
     return DHC_ERR_ARGUMENT;
 }
 #endif /* DHC_WITH_DESK_KINEMATICS */

@@ -3,7 +3,6 @@
 
 #include <math.h>
 
-
 dhc_status dhc_arm_init(dhc_arm *arm, size_t n_joints)
 {
     if (arm == NULL) {
@@ -51,8 +50,7 @@ void dhc_arm_choose_conventions(dhc_arm *arm, double parallel_tol)
 }
 
 #if DHC_WITH_DESK_KINEMATICS
-static void joint_transform(const dhc_joint *j, double q_rad, double length_scale,
-                            dhc_frame *out)
+static void joint_transform(const dhc_joint *j, double q_rad, double length_scale, dhc_frame *out)
 {
     const double phi = q_rad + j->theta_offset_rad;
     dhc_mat3 rz;
@@ -87,9 +85,9 @@ dhc_status dhc_forward_frames(const dhc_arm *arm, const double *q_rad, size_t q_
     return dhc_forward_frames_scaled(arm, 1.0, q_rad, q_len, frames, frames_len, tool_world_mm);
 }
 
-dhc_status dhc_forward_frames_scaled(const dhc_arm *arm, double length_scale,
-                                     const double *q_rad, size_t q_len, dhc_frame *frames,
-                                     size_t frames_len, double tool_world_mm[3])
+dhc_status dhc_forward_frames_scaled(const dhc_arm *arm, double length_scale, const double *q_rad,
+                                     size_t q_len, dhc_frame *frames, size_t frames_len,
+                                     double tool_world_mm[3])
 {
     if (arm == NULL || q_rad == NULL || frames == NULL) {
         return DHC_ERR_ARGUMENT;
@@ -139,29 +137,45 @@ dhc_status dhc_forward(const dhc_arm *arm, const double *q_rad, size_t q_len, dh
  * prepared trigonometry (dhc_arm_prepare, dhc_forward_frames_trig). */
 dhc_status dhc_joint_transform(const dhc_arm *arm, size_t i, double q_rad, dhc_frame *out)
 {
-    (void)arm; (void)i; (void)q_rad; (void)out;
+    (void)arm;
+    (void)i;
+    (void)q_rad;
+    (void)out;
     return DHC_ERR_ARGUMENT;
 }
 
 dhc_status dhc_forward_frames(const dhc_arm *arm, const double *q_rad, size_t q_len,
                               dhc_frame *frames, size_t frames_len, double tool_world_mm[3])
 {
-    (void)arm; (void)q_rad; (void)q_len; (void)frames; (void)frames_len; (void)tool_world_mm;
+    (void)arm;
+    (void)q_rad;
+    (void)q_len;
+    (void)frames;
+    (void)frames_len;
+    (void)tool_world_mm;
     return DHC_ERR_ARGUMENT;
 }
 
-dhc_status dhc_forward_frames_scaled(const dhc_arm *arm, double length_scale,
-                                     const double *q_rad, size_t q_len, dhc_frame *frames,
-                                     size_t frames_len, double tool_world_mm[3])
+dhc_status dhc_forward_frames_scaled(const dhc_arm *arm, double length_scale, const double *q_rad,
+                                     size_t q_len, dhc_frame *frames, size_t frames_len,
+                                     double tool_world_mm[3])
 {
-    (void)arm; (void)length_scale; (void)q_rad; (void)q_len; (void)frames; (void)frames_len;
+    (void)arm;
+    (void)length_scale;
+    (void)q_rad;
+    (void)q_len;
+    (void)frames;
+    (void)frames_len;
     (void)tool_world_mm;
     return DHC_ERR_ARGUMENT;
 }
 
 dhc_status dhc_forward(const dhc_arm *arm, const double *q_rad, size_t q_len, dhc_frame *tool)
 {
-    (void)arm; (void)q_rad; (void)q_len; (void)tool;
+    (void)arm;
+    (void)q_rad;
+    (void)q_len;
+    (void)tool;
     return DHC_ERR_ARGUMENT;
 }
 #endif /* DHC_WITH_DESK_KINEMATICS */
@@ -329,7 +343,8 @@ dhc_status dhc_arm_to_standard_dh(const dhc_arm *arm, dhc_arm *out)
 #else
 dhc_status dhc_arm_to_standard_dh(const dhc_arm *arm, dhc_arm *out)
 {
-    (void)arm; (void)out;
+    (void)arm;
+    (void)out;
     return DHC_ERR_ARGUMENT; /* left out of this build (DHC_WITH_CONVERSIONS 0) */
 }
 #endif /* DHC_WITH_CONVERSIONS */

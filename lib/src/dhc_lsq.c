@@ -99,8 +99,8 @@ DHC_AVX2 static double square_sum_avx2(const dhc_mat *jac, const double *r, size
  * batch and each equation's entries feed 32 products. The upper triangle is the caller's
  * transposed copy: the blocks across the diagonal hold a few upper entries too, the same
  * products in the same order, so the copy leaves them as they are. */
-DHC_AVX2 static void add_unweighted_avx2(dhc_normal_eq *ne, const dhc_mat *jac,
-                                         const double *r, size_t k)
+DHC_AVX2 static void add_unweighted_avx2(dhc_normal_eq *ne, const dhc_mat *jac, const double *r,
+                                         size_t k)
 {
     const size_t n = ne->n;
     double *const jtj = ne->jtj;
@@ -177,9 +177,8 @@ dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double
         for (size_t e = 0U; e < k; ++e) {
             if (!(w[e] > 0.0) || !dhc_is_finite(w[e])) {
                 /* a NaN or infinite entry elsewhere is reported first, as it always was */
-                return dhc_all_finite(jac->data, k * n) && dhc_all_finite(r, k)
-                           ? DHC_ERR_ARGUMENT
-                           : DHC_ERR_NONFINITE;
+                return dhc_all_finite(jac->data, k * n) && dhc_all_finite(r, k) ? DHC_ERR_ARGUMENT
+                                                                                : DHC_ERR_NONFINITE;
             }
         }
     }
@@ -282,8 +281,8 @@ dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double
                     out[j] = ((out[j] + a0 * x0) + a1 * x1) + a2 * x2;
                     next[j] = ((next[j] + b0 * x0) + b1 * x1) + b2 * x2;
                 }
-                next[i + 1U] = ((next[i + 1U] + b0 * r0[i + 1U]) + b1 * r1[i + 1U]) +
-                               b2 * r2[i + 1U];
+                next[i + 1U] =
+                    ((next[i + 1U] + b0 * r0[i + 1U]) + b1 * r1[i + 1U]) + b2 * r2[i + 1U];
                 ++i;
                 continue;
             }
@@ -386,8 +385,8 @@ double dhc_lsq_predicted_decrease(const dhc_normal_eq *ne, const double *delta)
     return 2.0 * lin - quad;
 }
 
-dhc_status dhc_lsq_step(const dhc_normal_eq *ne, dhc_lsq_factor *fac, double lambda,
-                        double *delta, size_t len)
+dhc_status dhc_lsq_step(const dhc_normal_eq *ne, dhc_lsq_factor *fac, double lambda, double *delta,
+                        size_t len)
 {
     if (!ne_valid(ne) || !fac_valid(fac) || delta == NULL) {
         return DHC_ERR_ARGUMENT;
@@ -451,8 +450,7 @@ dhc_status dhc_lsq_step(const dhc_normal_eq *ne, dhc_lsq_factor *fac, double lam
     return DHC_OK;
 }
 
-dhc_status dhc_lsq_decrement(const dhc_normal_eq *ne, const dhc_lsq_factor *fac,
-                             double *decrement)
+dhc_status dhc_lsq_decrement(const dhc_normal_eq *ne, const dhc_lsq_factor *fac, double *decrement)
 {
     if (!ne_valid(ne) || !fac_valid(fac) || decrement == NULL) {
         return DHC_ERR_ARGUMENT;
@@ -512,8 +510,8 @@ dhc_status dhc_lsq_std_errors(const dhc_lsq_factor *fac, double sigma2, double *
 }
 
 #if DHC_WITH_UNCERTAINTY
-dhc_status dhc_lsq_prediction_variance(const dhc_lsq_factor *fac, double sigma2,
-                                       const double *row, size_t len, double *variance)
+dhc_status dhc_lsq_prediction_variance(const dhc_lsq_factor *fac, double sigma2, const double *row,
+                                       size_t len, double *variance)
 {
     if (!fac_valid(fac) || row == NULL || variance == NULL) {
         return DHC_ERR_ARGUMENT;
@@ -543,10 +541,14 @@ dhc_status dhc_lsq_prediction_variance(const dhc_lsq_factor *fac, double sigma2,
     return dhc_is_finite(*variance) ? DHC_OK : DHC_ERR_NONFINITE;
 }
 #else
-dhc_status dhc_lsq_prediction_variance(const dhc_lsq_factor *fac, double sigma2,
-                                       const double *row, size_t len, double *variance)
+dhc_status dhc_lsq_prediction_variance(const dhc_lsq_factor *fac, double sigma2, const double *row,
+                                       size_t len, double *variance)
 {
-    (void)fac; (void)sigma2; (void)row; (void)len; (void)variance;
+    (void)fac;
+    (void)sigma2;
+    (void)row;
+    (void)len;
+    (void)variance;
     return DHC_ERR_ARGUMENT; /* left out of this build (DHC_WITH_UNCERTAINTY 0) */
 }
 #endif /* DHC_WITH_UNCERTAINTY */
@@ -592,7 +594,12 @@ dhc_status dhc_lsq_confounded(const dhc_normal_eq *ne, const dhc_lsq_factor *fac
 dhc_status dhc_lsq_confounded(const dhc_normal_eq *ne, const dhc_lsq_factor *fac, size_t j,
                               uint8_t *partner, size_t len, size_t *count)
 {
-    (void)ne; (void)fac; (void)j; (void)partner; (void)len; (void)count;
+    (void)ne;
+    (void)fac;
+    (void)j;
+    (void)partner;
+    (void)len;
+    (void)count;
     return DHC_ERR_ARGUMENT; /* left out of this build (DHC_WITH_REPORT_EXTRAS 0) */
 }
 #endif /* DHC_WITH_REPORT_EXTRAS */

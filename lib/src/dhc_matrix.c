@@ -148,25 +148,34 @@ dhc_status dhc_mat_vec(const dhc_mat *a, const double *x, size_t x_len, double *
  * kernels (dhc_normal_eq_add, dhc_tri_*), never on these. */
 dhc_status dhc_mat_mul(const dhc_mat *a, const dhc_mat *b, dhc_mat *out)
 {
-    (void)a; (void)b; (void)out;
+    (void)a;
+    (void)b;
+    (void)out;
     return DHC_ERR_ARGUMENT;
 }
 
 dhc_status dhc_mat_tmul(const dhc_mat *a, const dhc_mat *b, dhc_mat *out)
 {
-    (void)a; (void)b; (void)out;
+    (void)a;
+    (void)b;
+    (void)out;
     return DHC_ERR_ARGUMENT;
 }
 
 dhc_status dhc_mat_transpose(const dhc_mat *a, dhc_mat *out)
 {
-    (void)a; (void)out;
+    (void)a;
+    (void)out;
     return DHC_ERR_ARGUMENT;
 }
 
 dhc_status dhc_mat_vec(const dhc_mat *a, const double *x, size_t x_len, double *y, size_t y_len)
 {
-    (void)a; (void)x; (void)x_len; (void)y; (void)y_len;
+    (void)a;
+    (void)x;
+    (void)x_len;
+    (void)y;
+    (void)y_len;
     return DHC_ERR_ARGUMENT;
 }
 #endif /* DHC_WITH_MATRIX_OPS */

@@ -91,8 +91,8 @@ static void moments_from_frames(const dhc_model *model, const dhc_frame *f,
             /* A point on the axis (o_{i+1} on z_i when a_{i+1} = 0) has no moment about it;
              * the products leave rounding of ~eps |lever| |g| instead, a column of noise that
              * the scaled rank test would take for a parameter. Zero at working precision. */
-            const double rounding = 64.0 * DBL_EPSILON * dhc_vec3_norm(lever) *
-                                    dhc_vec3_norm(model->gravity);
+            const double rounding =
+                64.0 * DBL_EPSILON * dhc_vec3_norm(lever) * dhc_vec3_norm(model->gravity);
             tau[i][j] = fabs(t) > rounding ? t : 0.0;
         }
     }
@@ -119,7 +119,10 @@ dhc_status dhc_model_gravity_moments(const dhc_model *model, double length_scale
                                      const double *q_rad,
                                      double tau[DHC_MAX_JOINTS][DHC_MAX_JOINTS])
 {
-    (void)model; (void)length_scale; (void)q_rad; (void)tau;
+    (void)model;
+    (void)length_scale;
+    (void)q_rad;
+    (void)tau;
     return DHC_ERR_ARGUMENT; /* left out (DHC_WITH_DESK_KINEMATICS 0): dhc_model_evaluate's */
 }
 #endif /* DHC_WITH_DESK_KINEMATICS */
@@ -214,9 +217,9 @@ static int carries_left_out_effect(const dhc_model *model)
         left_out |= !DHC_WITH_EFFECT_JOINT_COMPLIANCE && compliance > 0.0;
     }
     const dhc_measurer_model *m = &model->measurer;
-    left_out |= !DHC_WITH_EFFECT_MEASURER && (fabs(m->scale) > 0.0 || fabs(m->offset_mm[0]) > 0.0 ||
-                                              fabs(m->offset_mm[1]) > 0.0 ||
-                                              fabs(m->offset_mm[2]) > 0.0);
+    left_out |=
+        !DHC_WITH_EFFECT_MEASURER && (fabs(m->scale) > 0.0 || fabs(m->offset_mm[0]) > 0.0 ||
+                                      fabs(m->offset_mm[1]) > 0.0 || fabs(m->offset_mm[2]) > 0.0);
     left_out |= !DHC_WITH_EFFECT_THERMAL && fabs(model->thermal_per_k) > 0.0;
     left_out |= !DHC_WITH_EFFECT_DRIFT &&
                 (fabs(model->drift_scale_per_s) > 0.0 || fabs(model->drift_mm_per_s[0]) > 0.0 ||
@@ -227,8 +230,7 @@ static int carries_left_out_effect(const dhc_model *model)
 
 dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_trig *trig,
                                        const dhc_sample *s, const double *sincos_q,
-                                       int need_moments, dhc_model_eval *ev,
-                                       dhc_prediction *out)
+                                       int need_moments, dhc_model_eval *ev, dhc_prediction *out)
 {
     if (ev == NULL || out == NULL || trig == NULL) {
         return DHC_ERR_ARGUMENT;
@@ -260,8 +262,8 @@ dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_tri
         cos_q[i] = sincos_q != NULL ? sincos_q[2U * i + 1U] : cos(s->q_rad[i]);
     }
     if (ev->has_moments) {
-        dhc_forward_frames_trig(&model->arm, trig, ev->length_scale, sin_q, cos_q, ev->frames,
-                                NULL, NULL);
+        dhc_forward_frames_trig(&model->arm, trig, ev->length_scale, sin_q, cos_q, ev->frames, NULL,
+                                NULL);
         moments_from_frames(model, ev->frames, ev->tau);
     }
     for (size_t i = 0U; i < DHC_MAX_JOINTS; ++i) {
@@ -299,8 +301,8 @@ dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_tri
             cos_q[i] = cos(out->q_eff_rad[i]);
         }
     }
-    dhc_forward_frames_trig(&model->arm, trig, ev->length_scale, sin_q, cos_q, ev->frames,
-                            ev->axes, out->p_mm);
+    dhc_forward_frames_trig(&model->arm, trig, ev->length_scale, sin_q, cos_q, ev->frames, ev->axes,
+                            out->p_mm);
     out->rot = ev->frames[n].rot;
     dhc_vec3_copy(out->p_mm, out->p_arm_mm);
     dhc_model_drift(model, s->t_s, out->p_arm_mm, out->p_mm);
@@ -362,9 +364,8 @@ dhc_status dhc_model_tool_point(const dhc_model *model, const double *q_rad, con
     return st;
 }
 
-dhc_status dhc_model_residual(const dhc_model *model, const dhc_sample *s,
-                              double weight_mm_per_rad, double r[DHC_MAX_ROWS_PER_SAMPLE],
-                              size_t *rows)
+dhc_status dhc_model_residual(const dhc_model *model, const dhc_sample *s, double weight_mm_per_rad,
+                              double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows)
 {
     if (r == NULL || rows == NULL) {
         return DHC_ERR_ARGUMENT;
@@ -377,8 +378,8 @@ dhc_status dhc_model_residual(const dhc_model *model, const dhc_sample *s,
 
 dhc_status dhc_model_residual_prepared(const dhc_model *model, const dhc_arm_trig *trig,
                                        const dhc_sample *s, const double *sincos_q,
-                                       double weight_mm_per_rad,
-                                       double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows)
+                                       double weight_mm_per_rad, double r[DHC_MAX_ROWS_PER_SAMPLE],
+                                       size_t *rows)
 {
     if (r == NULL || rows == NULL || model == NULL) {
         return DHC_ERR_ARGUMENT;

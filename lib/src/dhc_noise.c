@@ -34,13 +34,13 @@ dhc_status dhc_noise_model_check(const dhc_noise_model *noise, size_t n_joints, 
 }
 
 #if DHC_WITH_EIV
-dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_arm_trig *trig,
-                             dhc_model_eval *ev, const dhc_sample *s,
-                             const dhc_noise_model *noise, double weight_mm_per_rad,
-                             const double *r_model, double *r, dhc_mat *jac)
+dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_arm_trig *trig, dhc_model_eval *ev,
+                             const dhc_sample *s, const dhc_noise_model *noise,
+                             double weight_mm_per_rad, const double *r_model, double *r,
+                             dhc_mat *jac)
 {
-    if (model == NULL || trig == NULL || ev == NULL || s == NULL || r == NULL ||
-        r_model == NULL || noise == NULL) {
+    if (model == NULL || trig == NULL || ev == NULL || s == NULL || r == NULL || r_model == NULL ||
+        noise == NULL) {
         return DHC_ERR_ARGUMENT;
     }
     const double *const joint_noise_rad = noise->joint_rad;
@@ -110,12 +110,18 @@ dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_arm_trig *trig,
     return DHC_OK;
 }
 #else
-dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_arm_trig *trig,
-                             dhc_model_eval *ev, const dhc_sample *s,
-                             const dhc_noise_model *noise, double weight_mm_per_rad,
-                             const double *r_model, double *r, dhc_mat *jac)
+dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_arm_trig *trig, dhc_model_eval *ev,
+                             const dhc_sample *s, const dhc_noise_model *noise,
+                             double weight_mm_per_rad, const double *r_model, double *r,
+                             dhc_mat *jac)
 {
-    (void)trig; (void)ev; (void)s; (void)weight_mm_per_rad; (void)r_model; (void)r; (void)jac;
+    (void)trig;
+    (void)ev;
+    (void)s;
+    (void)weight_mm_per_rad;
+    (void)r_model;
+    (void)r;
+    (void)jac;
     if (model == NULL || noise == NULL) {
         return DHC_ERR_ARGUMENT;
     }

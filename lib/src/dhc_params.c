@@ -198,8 +198,7 @@ double dhc_params_value(const dhc_param_set *set, const dhc_model *model, size_t
     return slot != NULL ? *slot : 0.0;
 }
 
-dhc_status dhc_params_set_value(const dhc_param_set *set, dhc_model *model, size_t k,
-                                double value)
+dhc_status dhc_params_set_value(const dhc_param_set *set, dhc_model *model, size_t k, double value)
 {
     if (set == NULL || model == NULL || k >= set->count ||
         set->id[k].kind >= (uint8_t)DHC_P_KIND_COUNT) {
@@ -291,12 +290,31 @@ static size_t put_uint(char *buf, size_t cap, size_t pos, unsigned v)
 
 size_t dhc_params_name(const dhc_param_set *set, size_t k, char *buf, size_t cap)
 {
-    static const char *const names[DHC_P_KIND_COUNT] = {
-        "theta",        "d",            "a",           "alpha",          "beta",
-        "base_x",       "base_y",       "base_z",      "base_rx",        "base_ry",
-        "base_rz",      "tool_x",       "tool_y",      "tool_z",         "scale",
-        "harmonic_sin", "harmonic_cos", "backlash",    "compliance",     "measurer_scale",
-        "measurer_offset", "anchor",    "thermal_scale", "drift_scale",  "drift_offset"};
+    static const char *const names[DHC_P_KIND_COUNT] = {"theta",
+                                                        "d",
+                                                        "a",
+                                                        "alpha",
+                                                        "beta",
+                                                        "base_x",
+                                                        "base_y",
+                                                        "base_z",
+                                                        "base_rx",
+                                                        "base_ry",
+                                                        "base_rz",
+                                                        "tool_x",
+                                                        "tool_y",
+                                                        "tool_z",
+                                                        "scale",
+                                                        "harmonic_sin",
+                                                        "harmonic_cos",
+                                                        "backlash",
+                                                        "compliance",
+                                                        "measurer_scale",
+                                                        "measurer_offset",
+                                                        "anchor",
+                                                        "thermal_scale",
+                                                        "drift_scale",
+                                                        "drift_offset"};
     static const char axes[3] = {'x', 'y', 'z'};
     if (set == NULL || buf == NULL || cap == 0U || k >= set->count ||
         set->id[k].kind >= (uint8_t)DHC_P_KIND_COUNT) {

@@ -184,8 +184,7 @@ static int load_rows(const dhc_model *model, const dhc_param_set *set,
                      const dhc_plan_candidates *cand, size_t c, const double *store,
                      dhc_plan_workspace *ws, dhc_status *st)
 {
-    const dhc_status js =
-        candidate_jacobian(model, set, cand->read, cand->ctx, c, store, ws);
+    const dhc_status js = candidate_jacobian(model, set, cand->read, cand->ctx, c, store, ws);
     if (js == DHC_ERR_NONFINITE) {
         return 0;
     }
@@ -219,9 +218,8 @@ static int is_chosen(const size_t *chosen, size_t n, size_t c)
  * gain; *best = k when none can be evaluated. */
 static dhc_status best_candidate(const dhc_model *model, const dhc_param_set *set,
                                  const dhc_plan_candidates *cand, const double *store,
-                                 dhc_plan_workspace *ws,
-                                 const size_t *chosen, size_t n_chosen, size_t *best,
-                                 double *best_gain)
+                                 dhc_plan_workspace *ws, const size_t *chosen, size_t n_chosen,
+                                 size_t *best, double *best_gain)
 {
     dhc_status st = DHC_OK;
     *best = cand->count;
@@ -248,8 +246,7 @@ static dhc_status best_candidate(const dhc_model *model, const dhc_param_set *se
 /* The candidates where the arm works: all of them unless the caller says fewer. */
 static size_t workspace_count(const dhc_plan_candidates *cand)
 {
-    return cand->workspace == 0U || cand->workspace > cand->count ? cand->count
-                                                                   : cand->workspace;
+    return cand->workspace == 0U || cand->workspace > cand->count ? cand->count : cand->workspace;
 }
 
 /* ws->info (lower triangle, row stride DHC_MAX_PARAMS) += the candidate's J^T J. */
@@ -269,8 +266,8 @@ static void gather_workspace(dhc_plan_workspace *ws, size_t p)
  * and from it the parameters kept (what a plan of any of them can identify, as its fit
  * will), and the workspace candidates' information: the columns' scales and W. */
 static dhc_status survey(const dhc_model *model, const dhc_param_set *set,
-                         const dhc_plan_candidates *cand, double *store,
-                         dhc_plan_workspace *ws, size_t *usable)
+                         const dhc_plan_candidates *cand, double *store, dhc_plan_workspace *ws,
+                         size_t *usable)
 {
     const size_t p = set->count;
     if (p == 0U || p > DHC_MAX_PARAMS) {
@@ -285,8 +282,7 @@ static dhc_status survey(const dhc_model *model, const dhc_param_set *set,
     ws->rows_per_pose = 0U;
     *usable = 0U;
     for (size_t c = 0U; c < cand->count && st == DHC_OK; ++c) {
-        const dhc_status js =
-            candidate_jacobian(model, set, cand->read, cand->ctx, c, NULL, ws);
+        const dhc_status js = candidate_jacobian(model, set, cand->read, cand->ctx, c, NULL, ws);
         if (ws->rows_per_pose == 0U && (js == DHC_OK || js == DHC_ERR_NONFINITE)) {
             ws->rows_per_pose = dhc_sample_rows(&ws->sample);
         }
@@ -413,7 +409,8 @@ static dhc_status exchange(const dhc_model *model, const dhc_param_set *set,
             if (st != DHC_OK) {
                 return st;
             }
-            const int better = best < cand->count && best_gain > own + PLAN_MIN_GAIN * (1.0 + fabs(own));
+            const int better =
+                best < cand->count && best_gain > own + PLAN_MIN_GAIN * (1.0 + fabs(own));
             if (better) {
                 chosen[i] = best;
                 ++swapped;
@@ -464,8 +461,7 @@ dhc_status dhc_plan_select(const dhc_model *model, const dhc_param_set *set,
         size_t best = cand->count;
         double best_gain;
         if (st == DHC_OK) {
-            st = best_candidate(model, set, cand, rows_store, ws, chosen, got, &best,
-                                &best_gain);
+            st = best_candidate(model, set, cand, rows_store, ws, chosen, got, &best, &best_gain);
         }
         if (st == DHC_OK && best == cand->count) {
             st = DHC_ERR_ARGUMENT; /* fewer usable candidates than asked for */

@@ -7,28 +7,17 @@ const char *dhc_status_str(dhc_status status)
 {
     /* No default label: -Wswitch then names any enumerator added without a phrase. */
     switch (status) {
-    case DHC_OK:
-        return "ok";
-    case DHC_ERR_ARGUMENT:
-        return "invalid argument";
-    case DHC_ERR_DIMENSION:
-        return "dimension mismatch";
-    case DHC_ERR_CAPACITY:
-        return "capacity exceeded";
-    case DHC_ERR_NONFINITE:
-        return "non-finite value";
-    case DHC_ERR_NOT_SPD:
-        return "not positive definite";
-    case DHC_ERR_SINGULAR:
-        return "singular";
-    case DHC_ERR_INCONSISTENT:
-        return "inconsistent measurements";
-    case DHC_ERR_UNDERDETERMINED:
-        return "underdetermined";
-    case DHC_ERR_NOT_CONVERGED:
-        return "not converged";
-    case DHC_ERR_NO_DATA:
-        return "no data";
+    case DHC_OK: return "ok";
+    case DHC_ERR_ARGUMENT: return "invalid argument";
+    case DHC_ERR_DIMENSION: return "dimension mismatch";
+    case DHC_ERR_CAPACITY: return "capacity exceeded";
+    case DHC_ERR_NONFINITE: return "non-finite value";
+    case DHC_ERR_NOT_SPD: return "not positive definite";
+    case DHC_ERR_SINGULAR: return "singular";
+    case DHC_ERR_INCONSISTENT: return "inconsistent measurements";
+    case DHC_ERR_UNDERDETERMINED: return "underdetermined";
+    case DHC_ERR_NOT_CONVERGED: return "not converged";
+    case DHC_ERR_NO_DATA: return "no data";
     }
     /* A value cast from an integer outside the enumeration (a corrupted or foreign code). */
     return "unknown status";

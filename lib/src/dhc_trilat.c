@@ -131,9 +131,8 @@ dhc_status dhc_trilat_world(const dhc_measurer *m, const double len_mm[3], doubl
 void dhc_trilat_lengths(const dhc_measurer *m, const double q_world_mm[3], double len_mm[3])
 {
     DHC_ASSERT(m != NULL && q_world_mm != NULL && len_mm != NULL);
-    const double anchors[3][3] = {{0.0, 0.0, m->a_mm},
-                                  {0.0, m->b_mm, m->c_mm},
-                                  {0.0, -m->b_mm, m->c_mm}};
+    const double anchors[3][3] = {
+        {0.0, 0.0, m->a_mm}, {0.0, m->b_mm, m->c_mm}, {0.0, -m->b_mm, m->c_mm}};
     for (size_t k = 0U; k < 3U; ++k) {
         double anchor_world[3];
         double d[3];
@@ -194,27 +193,37 @@ dhc_status dhc_model_wire_point(const dhc_model *model, const double wire_mm[3],
 dhc_status dhc_trilat_local(const dhc_measurer *m, const double len_mm[3], double tol_mm2,
                             double q_meas_mm[3])
 {
-    (void)m; (void)len_mm; (void)tol_mm2; (void)q_meas_mm;
+    (void)m;
+    (void)len_mm;
+    (void)tol_mm2;
+    (void)q_meas_mm;
     return DHC_ERR_ARGUMENT;
 }
 
 dhc_status dhc_trilat_world(const dhc_measurer *m, const double len_mm[3], double tol_mm2,
                             double q_world_mm[3])
 {
-    (void)m; (void)len_mm; (void)tol_mm2; (void)q_world_mm;
+    (void)m;
+    (void)len_mm;
+    (void)tol_mm2;
+    (void)q_world_mm;
     return DHC_ERR_ARGUMENT;
 }
 
 dhc_status dhc_measurer_of_model(const dhc_measurer_model *mm, dhc_measurer *out)
 {
-    (void)mm; (void)out;
+    (void)mm;
+    (void)out;
     return DHC_ERR_ARGUMENT;
 }
 
 dhc_status dhc_model_wire_point(const dhc_model *model, const double wire_mm[3], double tol_mm2,
                                 double p_world_mm[3])
 {
-    (void)model; (void)wire_mm; (void)tol_mm2; (void)p_world_mm;
+    (void)model;
+    (void)wire_mm;
+    (void)tol_mm2;
+    (void)p_world_mm;
     return DHC_ERR_ARGUMENT;
 }
 #endif /* DHC_WITH_TRILATERATION */

@@ -58,8 +58,8 @@ dhc_status dhc_uncertainty_from_samples(dhc_uncertainty *u, const dhc_model *mod
         }
         if (st == DHC_OK && noise_on) {
             memset(r, 0, sizeof u->r); /* the rows only: the residual is not needed */
-            st = dhc_sample_whiten(model, &u->trig, &u->eval, &u->sample, used,
-                                   weight_mm_per_rad, r, r, &jac);
+            st = dhc_sample_whiten(model, &u->trig, &u->eval, &u->sample, used, weight_mm_per_rad,
+                                   r, r, &jac);
         }
         if (st == DHC_OK) {
             memset(r, 0, sizeof u->r);
@@ -147,8 +147,15 @@ dhc_status dhc_uncertainty_from_samples(dhc_uncertainty *u, const dhc_model *mod
                                         const dhc_noise_model *noise, double weight_mm_per_rad,
                                         double sigma)
 {
-    (void)model; (void)set; (void)use; (void)read; (void)ctx; (void)n; (void)noise;
-    (void)weight_mm_per_rad; (void)sigma;
+    (void)model;
+    (void)set;
+    (void)use;
+    (void)read;
+    (void)ctx;
+    (void)n;
+    (void)noise;
+    (void)weight_mm_per_rad;
+    (void)sigma;
     if (u != NULL) {
         u->fac.n = 0U;
     }
@@ -160,7 +167,12 @@ dhc_status dhc_uncertainty_tool_point(dhc_uncertainty *u, const dhc_model *model
                                       const int8_t *dir, const double *joint_sd_rad,
                                       double *variance_mm2)
 {
-    (void)u; (void)model; (void)set; (void)q_rad; (void)dir; (void)joint_sd_rad;
+    (void)u;
+    (void)model;
+    (void)set;
+    (void)q_rad;
+    (void)dir;
+    (void)joint_sd_rad;
     (void)variance_mm2;
     return DHC_ERR_ARGUMENT;
 }

@@ -172,8 +172,8 @@ void dhcal_py_rows_free(void *rows)
 static int rows_to_dataset(const dhcal_py_model *m, const dhcal_py_rows *r, const char *name,
                            dhcal_dataset *data, dhcal_error *e)
 {
-    const dhcal_arrays a = {name,   r->n_rows,  m->lib.arm.n_joints, r->q_deg, r->xyz_mm,
-                            r->dir, r->temp_c, r->t_s,              r->wires_mm};
+    const dhcal_arrays a = {name,      r->n_rows, m->lib.arm.n_joints, r->q_deg, r->xyz_mm, r->dir,
+                            r->temp_c, r->t_s,    r->wires_mm};
     return dhcal_dataset_from_arrays(&a, data, e);
 }
 
@@ -197,8 +197,7 @@ static int open_session(const dhcal_py_model *m, const dhcal_py_rows *train,
 }
 
 /* The calibrated model as `--out` writes it, and as loading that file gives it back. */
-static dhcal_py_model *fitted_model(const dhcal_py_model *m, const dhcal_fit *fit,
-                                    dhcal_error *e)
+static dhcal_py_model *fitted_model(const dhcal_py_model *m, const dhcal_fit *fit, dhcal_error *e)
 {
     static dhcal_model out;
     dhcal_model_from_lib(&fit->model, &m->file, &out);
@@ -271,8 +270,8 @@ static int run_refine(const dhcal_py_model *m, dhcal_session *s, const char *eff
 {
     static dhcal_refine_result res;
     static dhcal_fit_extras extras;
-    int rc = dhcal_run_refine(&m->lib, effects, geometry != NULL ? &s->geometry : NULL,
-                              &s->noise, s->repeatability_mm, max_steps, &s->samples,
+    int rc = dhcal_run_refine(&m->lib, effects, geometry != NULL ? &s->geometry : NULL, &s->noise,
+                              s->repeatability_mm, max_steps, &s->samples,
                               s->have_held ? &s->held : NULL, &res, e);
     if (rc != DHCAL_IO_OK) {
         return rc;
@@ -305,8 +304,8 @@ static int run_refine(const dhcal_py_model *m, dhcal_session *s, const char *eff
 
 int dhcal_py_run(const char *command, const dhcal_py_model *m, const dhcal_py_rows *train,
                  const dhcal_py_rows *held, const char *effects, const char *noise,
-                 const char *geometry, int cv, char **report, dhcal_py_model **fitted,
-                 char *err, size_t err_cap)
+                 const char *geometry, int cv, char **report, dhcal_py_model **fitted, char *err,
+                 size_t err_cap)
 {
     *report = NULL;
     *fitted = NULL;
@@ -327,8 +326,8 @@ int dhcal_py_run(const char *command, const dhcal_py_model *m, const dhcal_py_ro
     }
     if (rc == DHCAL_IO_OK) {
         rc = is_fit ? run_fit(m, &s, effects, cv, obj, &fit, &e)
-                    : run_refine(m, &s, effects, geometry,
-                                 is_refine ? DHCAL_REFINE_MAX_STEPS : 0U, obj, &fit, &e);
+                    : run_refine(m, &s, effects, geometry, is_refine ? DHCAL_REFINE_MAX_STEPS : 0U,
+                                 obj, &fit, &e);
     }
     if (rc == DHCAL_IO_OK) {
         *report = cJSON_PrintUnformatted(obj);
@@ -354,8 +353,7 @@ int dhcal_py_run(const char *command, const dhcal_py_model *m, const dhcal_py_ro
 }
 
 int dhcal_py_units_check(const dhcal_py_model *m, const dhcal_py_rows *train,
-                         const dhcal_py_rows *held, const char *effects, char *err,
-                         size_t err_cap)
+                         const dhcal_py_rows *held, const char *effects, char *err, size_t err_cap)
 {
     static dhcal_dataset sets[2];
     const dhcal_py_rows *rows[2] = {train, held};
@@ -366,8 +364,8 @@ int dhcal_py_units_check(const dhcal_py_model *m, const dhcal_py_rows *train,
     for (size_t k = 0U; k < 2U && rc == DHCAL_IO_OK; ++k) {
         if (rows[k] != NULL) {
             const dhcal_py_rows *r = rows[k];
-            const dhcal_arrays a = {names[k], r->n_rows,  m->lib.arm.n_joints,
-                                    r->q_deg, r->xyz_mm,  r->dir,
+            const dhcal_arrays a = {names[k],  r->n_rows, m->lib.arm.n_joints,
+                                    r->q_deg,  r->xyz_mm, r->dir,
                                     r->temp_c, r->t_s,    r->wires_mm};
             rc = dhcal_dataset_from_arrays(&a, &sets[k], &e);
         }

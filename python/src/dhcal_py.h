@@ -62,9 +62,8 @@ DHCAL_PY_API int dhcal_py_rows_load(const char *path, const dhcal_py_model *m, v
                                     size_t *n_rows, int *columns, char *err, size_t err_cap);
 /* Copies the rows out; angles in degrees (radians / DHC_DEG: within an ulp of the file's).
  * Arrays of absent columns may be NULL. */
-DHCAL_PY_API void dhcal_py_rows_copy(const void *rows, double *q_deg, double *xyz_mm,
-                                     double *dir, double *temp_c, double *t_s,
-                                     double *wires_mm);
+DHCAL_PY_API void dhcal_py_rows_copy(const void *rows, double *q_deg, double *xyz_mm, double *dir,
+                                     double *temp_c, double *t_s, double *wires_mm);
 DHCAL_PY_API void dhcal_py_rows_free(void *rows);
 
 /* Runs command "fit", "diagnose" or "refine" as the program runs it with --json: the model
@@ -77,9 +76,8 @@ DHCAL_PY_API void dhcal_py_rows_free(void *rows);
  * calibration (the program prints its report and exits 1 then); or 1 or 2 without one. */
 DHCAL_PY_API int dhcal_py_run(const char *command, const dhcal_py_model *m,
                               const dhcal_py_rows *train, const dhcal_py_rows *held,
-                              const char *effects, const char *noise, const char *geometry,
-                              int cv, char **report, dhcal_py_model **fitted, char *err,
-                              size_t err_cap);
+                              const char *effects, const char *noise, const char *geometry, int cv,
+                              char **report, dhcal_py_model **fitted, char *err, size_t err_cap);
 
 /* The program's units-and-frames check (tools/dhcal/dhcal_units.h) before any fit: the
  * model's reach, then the rows train and held (NULL: none) against the nominal model m:
@@ -88,8 +86,8 @@ DHCAL_PY_API int dhcal_py_run(const char *command, const dhcal_py_model *m,
  * another frame than the model's base. Returns 0, or 2 with the cause in err (worded for
  * Python: check_units=False goes on), or 1 when out of memory. */
 DHCAL_PY_API int dhcal_py_units_check(const dhcal_py_model *m, const dhcal_py_rows *train,
-                                      const dhcal_py_rows *held, const char *effects,
-                                      char *err, size_t err_cap);
+                                      const dhcal_py_rows *held, const char *effects, char *err,
+                                      size_t err_cap);
 
 /* Frees text this library returned. */
 DHCAL_PY_API void dhcal_py_free(char *text);

@@ -16,15 +16,14 @@
 #include "dhcal/dhc_trilat.h"
 #include "unity.h"
 
-#if DHC_WITH_DIAGNOSE || DHC_WITH_SESSION_TESTS || DHC_WITH_UNCERTAINTY || DHC_WITH_EIV ||   \
-    DHC_WITH_POSE_SAMPLES || DHC_WITH_ROBUST_START || DHC_WITH_EFFECT_SUMMARIES ||              \
-    DHC_WITH_CONVERSIONS || DHC_WITH_INVERSE || DHC_WITH_PLAN || DHC_WITH_REPORT_EXTRAS ||    \
+#if DHC_WITH_DIAGNOSE || DHC_WITH_SESSION_TESTS || DHC_WITH_UNCERTAINTY || DHC_WITH_EIV || \
+    DHC_WITH_POSE_SAMPLES || DHC_WITH_ROBUST_START || DHC_WITH_EFFECT_SUMMARIES ||         \
+    DHC_WITH_CONVERSIONS || DHC_WITH_INVERSE || DHC_WITH_PLAN || DHC_WITH_REPORT_EXTRAS || \
     DHC_WITH_NAMES || DHC_WITH_MATRIX_OPS || DHC_WITH_DESK_KINEMATICS || DHC_WITH_TRILATERATION
 #error "this test is built with every DHC_WITH_* feature 0"
 #endif
-#if DHC_WITH_EFFECT_BASE_FRAME || DHC_WITH_EFFECT_JOINT_SCALE ||                             \
-    DHC_WITH_EFFECT_JOINT_HARMONIC ||                                                          \
-    DHC_WITH_EFFECT_JOINT_BACKLASH || DHC_WITH_EFFECT_MEASURER || DHC_WITH_EFFECT_THERMAL ||   \
+#if DHC_WITH_EFFECT_BASE_FRAME || DHC_WITH_EFFECT_JOINT_SCALE || DHC_WITH_EFFECT_JOINT_HARMONIC || \
+    DHC_WITH_EFFECT_JOINT_BACKLASH || DHC_WITH_EFFECT_MEASURER || DHC_WITH_EFFECT_THERMAL ||       \
     DHC_WITH_EFFECT_DRIFT || !DHC_WITH_EFFECT_JOINT_COMPLIANCE
 #error "this test is built with joint_compliance the only effect"
 #endif
@@ -50,9 +49,9 @@ static dhc_status calibrate(size_t n, size_t poses, uint64_t seed, dhc_arm *arm)
     dhc_calib_options opt;
     dhc_calib_default_options(&opt);
     opt.robust_start = 0;
-    const dhc_status st = dhc_calib_fit(&model, &paper.set, test_read_sample, &paper.data,
-                                        paper.data.n, paper.data.flags, &opt, &paper.ws,
-                                        &paper.rep);
+    const dhc_status st =
+        dhc_calib_fit(&model, &paper.set, test_read_sample, &paper.data, paper.data.n,
+                      paper.data.flags, &opt, &paper.ws, &paper.rep);
     *arm = model.arm;
     return st;
 }
@@ -102,13 +101,13 @@ static void test_a_noise_model_or_a_robust_start_is_refused(void)
     const dhc_model before = model;
     opt.noise = noise;
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
-                      dhc_calib_fit(&model, &paper.set, test_read_sample, &paper.data,
-                                    paper.data.n, paper.data.flags, &opt, &paper.ws, &paper.rep));
+                      dhc_calib_fit(&model, &paper.set, test_read_sample, &paper.data, paper.data.n,
+                                    paper.data.flags, &opt, &paper.ws, &paper.rep));
     dhc_calib_default_options(&opt);
     opt.robust_start = 1;
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
-                      dhc_calib_fit(&model, &paper.set, test_read_sample, &paper.data,
-                                    paper.data.n, paper.data.flags, &opt, &paper.ws, &paper.rep));
+                      dhc_calib_fit(&model, &paper.set, test_read_sample, &paper.data, paper.data.n,
+                                    paper.data.flags, &opt, &paper.ws, &paper.rep));
     TEST_ASSERT_EQUAL_MEMORY(&before, &model, sizeof model);
 }
 
@@ -140,14 +139,13 @@ static void test_the_diagnosis_and_the_uncertainty_are_refused(void)
     memset(&dopt, 0, sizeof dopt);
     diagnosis.count = 7U;
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
-                      dhc_diagnose(&model, &paper.set, paper.rep.identifiable, 1.0, candidates,
-                                   1U, test_read_sample, &paper.data, paper.data.n,
-                                   paper.data.flags, &dopt, &dws, &diagnosis));
+                      dhc_diagnose(&model, &paper.set, paper.rep.identifiable, 1.0, candidates, 1U,
+                                   test_read_sample, &paper.data, paper.data.n, paper.data.flags,
+                                   &dopt, &dws, &diagnosis));
     TEST_ASSERT_EQUAL_size_t(0U, diagnosis.count);
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
-                      dhc_uncertainty_from_samples(&unc, &model, &paper.set, NULL,
-                                                   test_read_sample, &paper.data, paper.data.n,
-                                                   NULL, 1000.0, 0.01));
+                      dhc_uncertainty_from_samples(&unc, &model, &paper.set, NULL, test_read_sample,
+                                                   &paper.data, paper.data.n, NULL, 1000.0, 0.01));
 }
 
 static dhc_plan_workspace plan_ws;
@@ -161,14 +159,13 @@ static void test_pose_selection_is_refused_its_score_kept(void)
     size_t chosen[5];
     dhc_plan_report rep;
     const dhc_plan_candidates plan_cand = {test_read_sample, &paper.data, paper.data.n, 0U};
-    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
-                      dhc_plan_select(&model, &paper.set, &plan_cand, 5U, NULL, &plan_ws,
-                                      chosen, &rep));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_plan_select(&model, &paper.set, &plan_cand, 5U, NULL,
+                                                        &plan_ws, chosen, &rep));
     double o1 = 0.0;
     size_t rank = 0U;
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_observability(&model, &paper.set, test_read_sample,
-                                                     &paper.data, NULL, paper.data.n, &plan_ws,
-                                                     &o1, &rank));
+    TEST_ASSERT_EQUAL(DHC_OK,
+                      dhc_plan_observability(&model, &paper.set, test_read_sample, &paper.data,
+                                             NULL, paper.data.n, &plan_ws, &o1, &rank));
     TEST_ASSERT_TRUE(o1 > 0.0 && rank > 0U);
 }
 
@@ -218,11 +215,10 @@ static void test_parameters_of_effects_left_out_are_refused(void)
     dhc_param_set set;
     TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &m));
     const size_t base = set.count;
-    const dhc_effect out[] = {DHC_EFFECT_BASE_FRAME, DHC_EFFECT_JOINT_SCALE,
-                              DHC_EFFECT_JOINT_HARMONIC,
-                              DHC_EFFECT_JOINT_BACKLASH, DHC_EFFECT_MEASURER_SCALE,
-                              DHC_EFFECT_MEASURER_ANCHORS, DHC_EFFECT_THERMAL_SCALE,
-                              DHC_EFFECT_DRIFT_OFFSET};
+    const dhc_effect out[] = {DHC_EFFECT_BASE_FRAME,     DHC_EFFECT_JOINT_SCALE,
+                              DHC_EFFECT_JOINT_HARMONIC, DHC_EFFECT_JOINT_BACKLASH,
+                              DHC_EFFECT_MEASURER_SCALE, DHC_EFFECT_MEASURER_ANCHORS,
+                              DHC_EFFECT_THERMAL_SCALE,  DHC_EFFECT_DRIFT_OFFSET};
     for (size_t k = 0U; k < sizeof out / sizeof out[0]; ++k) {
         TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_params_add_effect(&set, &m, out[k], 0U));
     }
@@ -290,9 +286,9 @@ static void test_the_compliance_built_predicts_and_fits(void)
     dhc_calib_options opt;
     dhc_calib_default_options(&opt);
     opt.robust_start = 0;
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_calib_fit(&model, &paper.set, test_read_sample, &paper.data,
-                                            paper.data.n, paper.data.flags, &opt, &paper.ws,
-                                            &paper.rep));
+    TEST_ASSERT_EQUAL(DHC_OK,
+                      dhc_calib_fit(&model, &paper.set, test_read_sample, &paper.data, paper.data.n,
+                                    paper.data.flags, &opt, &paper.ws, &paper.rep));
     TEST_ASSERT_TRUE(paper.rep.rms_mm < 1e-7);
     TEST_ASSERT_DOUBLE_WITHIN(1e-11, 2.0e-6, model.effect[1].compliance[1]);
     TEST_ASSERT_DOUBLE_WITHIN(1e-11, 1.0e-6, model.effect[1].compliance[2]);

@@ -73,7 +73,7 @@ static int encode(char *word[MAX_FIELDS], size_t n)
         print_frame(fw_can_encode_drive_cmd((size_t)v[0], &m, &f), &f);
     } else if (strcmp(word[1], "fb") == 0 && n == 9U) {
         const fw_can_drive_fb m = {(uint16_t)v[1], (uint16_t)v[2], (uint8_t)v[3],
-                                   (uint8_t)v[4], (uint8_t)v[5], (uint16_t)v[6]};
+                                   (uint8_t)v[4],  (uint8_t)v[5],  (uint16_t)v[6]};
         print_frame(fw_can_encode_drive_fb((size_t)v[0], &m, &f), &f);
     } else if (strcmp(word[1], "wires") == 0 && n == 6U) {
         const fw_can_wires m = {{(uint16_t)v[0], (uint16_t)v[1], (uint16_t)v[2]}, (uint16_t)v[3]};
@@ -147,8 +147,7 @@ static int decode(char *word[MAX_FIELDS], size_t n)
         }
         break;
     }
-    case FW_CAN_KIND_UNKNOWN:
-        break;
+    case FW_CAN_KIND_UNKNOWN: break;
     }
     if (st != FW_CAN_MSG_OK) {
         printf("err %s\n", fw_can_msg_status_name(st));

@@ -18,7 +18,7 @@ void tearDown(void) {}
 /* RAM standing in for flash or EEPROM; the power fails after `budget` written bytes. */
 typedef struct {
     uint8_t mem[REGION];
-    size_t budget;  /* bytes that may still be written before the cut */
+    size_t budget; /* bytes that may still be written before the cut */
     int powered;
     size_t written; /* bytes written since power-up */
 } fake_nv;
@@ -113,7 +113,8 @@ static void assert_same_model(const dhc_model *a, const dhc_model *b)
     TEST_ASSERT_EQUAL_MEMORY(a->arm.tool_mm, b->arm.tool_mm, sizeof a->arm.tool_mm);
     TEST_ASSERT_EQUAL_MEMORY(a->gravity, b->gravity, sizeof a->gravity);
     TEST_ASSERT_EQUAL(a->measurer.present, b->measurer.present);
-    TEST_ASSERT_EQUAL_MEMORY(a->measurer.anchor_mm, b->measurer.anchor_mm, sizeof a->measurer.anchor_mm);
+    TEST_ASSERT_EQUAL_MEMORY(a->measurer.anchor_mm, b->measurer.anchor_mm,
+                             sizeof a->measurer.anchor_mm);
     TEST_ASSERT_EQUAL_MEMORY(&a->measurer.frame, &b->measurer.frame, sizeof a->measurer.frame);
     TEST_ASSERT_EQUAL_DOUBLE(a->measurer.scale, b->measurer.scale);
     TEST_ASSERT_EQUAL_DOUBLE(a->thermal_per_k, b->thermal_per_k);
@@ -158,8 +159,8 @@ static void test_every_effect_the_diagnosis_offers_is_stored(void)
     dhc_param_set base;
     TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&base, &m));
     static dhc_candidate cands[DHC_MAX_CANDIDATES];
-    const size_t nc = dhc_diagnose_candidates(&m, &base, &fw_autocal_scope, cands,
-                                              DHC_MAX_CANDIDATES);
+    const size_t nc =
+        dhc_diagnose_candidates(&m, &base, &fw_autocal_scope, cands, DHC_MAX_CANDIDATES);
     TEST_ASSERT_GREATER_THAN(10U, nc);
     for (size_t c = 0U; c < nc; ++c) {
         dhc_param_set set;
@@ -225,8 +226,8 @@ static void test_a_version_1_record_still_loads(void)
     payload[len++] = (uint8_t)n;
     for (size_t i = 0U; i < n; ++i) {
         const dhc_joint *j = &m.arm.joint[i];
-        const double v[7] = {j->theta_offset_rad, j->d_mm, j->a_mm, j->alpha_rad, j->beta_rad,
-                             j->min_rad, j->max_rad};
+        const double v[7] = {j->theta_offset_rad, j->d_mm,    j->a_mm,   j->alpha_rad,
+                             j->beta_rad,         j->min_rad, j->max_rad};
         len += put_doubles(payload + len, v, 7U);
         payload[len++] = (uint8_t)j->convention;
         const dhc_joint_effects *fx = &m.effect[i];
@@ -265,8 +266,10 @@ static void test_a_version_1_record_still_loads(void)
     static dhc_model expect;
     expect = m;
     for (size_t i = 0U; i < n; ++i) {
-        memset(expect.effect[i].harmonic_hi_sin_rad, 0, sizeof expect.effect[i].harmonic_hi_sin_rad);
-        memset(expect.effect[i].harmonic_hi_cos_rad, 0, sizeof expect.effect[i].harmonic_hi_cos_rad);
+        memset(expect.effect[i].harmonic_hi_sin_rad, 0,
+               sizeof expect.effect[i].harmonic_hi_sin_rad);
+        memset(expect.effect[i].harmonic_hi_cos_rad, 0,
+               sizeof expect.effect[i].harmonic_hi_cos_rad);
     }
     expect.drift_scale_per_s = 0.0;
     memset(expect.drift_mm_per_s, 0, sizeof expect.drift_mm_per_s);
@@ -367,8 +370,8 @@ static void test_a_corrupted_newest_record_falls_back_to_the_previous(void)
     const fw_nvstore s = store_of(&dev);
     const dhc_model a = sample_model(1.0);
     const dhc_model b = sample_model(2.0);
-    TEST_ASSERT_EQUAL(FW_CAL_OK, fw_cal_save(&s, &a, NULL)); /* slot A, seq 1 */
-    TEST_ASSERT_EQUAL(FW_CAL_OK, fw_cal_save(&s, &b, NULL)); /* slot B, seq 2 */
+    TEST_ASSERT_EQUAL(FW_CAL_OK, fw_cal_save(&s, &a, NULL));       /* slot A, seq 1 */
+    TEST_ASSERT_EQUAL(FW_CAL_OK, fw_cal_save(&s, &b, NULL));       /* slot B, seq 2 */
     dev.mem[FW_CAL_SLOT_SIZE + FW_CAL_HEADER_SIZE + 37U] ^= 0x10U; /* one bit in B */
     dhc_model got;
     uint32_t seq = 0U;
@@ -393,8 +396,8 @@ static void test_sequence_numbers_wrap(void)
     uint8_t h[FW_CAL_HEADER_SIZE];
     memcpy(h, dev.mem, sizeof h);
     h[8] = h[9] = h[10] = h[11] = 0xFFU;
-    const uint32_t len = (uint32_t)h[12] | (uint32_t)h[13] << 8 | (uint32_t)h[14] << 16 |
-                         (uint32_t)h[15] << 24;
+    const uint32_t len =
+        (uint32_t)h[12] | (uint32_t)h[13] << 8 | (uint32_t)h[14] << 16 | (uint32_t)h[15] << 24;
     const uint32_t crc = fw_crc32(fw_crc32(0U, h, 16U), dev.mem + FW_CAL_HEADER_SIZE, len);
     for (unsigned k = 0U; k < 4U; ++k) {
         h[16U + k] = (uint8_t)(crc >> (8U * k));

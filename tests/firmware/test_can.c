@@ -132,9 +132,12 @@ static void test_every_field_round_trips_at_its_boundaries(void)
                 TEST_ASSERT_EQUAL_UINT8(cmd.enable, c2.enable);
                 TEST_ASSERT_EQUAL_UINT16(cmd.tick, c2.tick);
 
-                const fw_can_drive_fb fb = {u16s[(i * 3U + flags) % N_OF(u16s)], codes[i],
-                                            (uint8_t)(flags & 1U), (uint8_t)((flags >> 1) & 1U),
-                                            (uint8_t)((flags >> 2) & 1U), tick};
+                const fw_can_drive_fb fb = {u16s[(i * 3U + flags) % N_OF(u16s)],
+                                            codes[i],
+                                            (uint8_t)(flags & 1U),
+                                            (uint8_t)((flags >> 1) & 1U),
+                                            (uint8_t)((flags >> 2) & 1U),
+                                            tick};
                 TEST_ASSERT_EQUAL(FW_CAN_MSG_OK, fw_can_encode_drive_fb(j, &fb, &f));
                 fw_can_drive_fb b2;
                 TEST_ASSERT_EQUAL(FW_CAN_MSG_OK, fw_can_decode_drive_fb(&f, &jj, &b2));
@@ -193,18 +196,10 @@ static void test_wrong_length_is_rejected_and_nothing_written(void)
             size_t j = 77U;
             fw_can_msg_status st = FW_CAN_MSG_OK;
             switch (m) {
-            case 0U:
-                st = fw_can_decode_sync(&f, &out.sync);
-                break;
-            case 1U:
-                st = fw_can_decode_drive_cmd(&f, &j, &out.cmd);
-                break;
-            case 2U:
-                st = fw_can_decode_drive_fb(&f, &j, &out.fb);
-                break;
-            default:
-                st = fw_can_decode_wires(&f, &out.wires);
-                break;
+            case 0U: st = fw_can_decode_sync(&f, &out.sync); break;
+            case 1U: st = fw_can_decode_drive_cmd(&f, &j, &out.cmd); break;
+            case 2U: st = fw_can_decode_drive_fb(&f, &j, &out.fb); break;
+            default: st = fw_can_decode_wires(&f, &out.wires); break;
             }
             TEST_ASSERT_EQUAL(FW_CAN_MSG_ERR_DLC, st);
             TEST_ASSERT_EQUAL_size_t(77U, j);
@@ -216,8 +211,8 @@ static void test_wrong_length_is_rejected_and_nothing_written(void)
 static void test_foreign_ids_are_rejected_and_classified_unknown(void)
 {
     const uint8_t zeros[8] = {0};
-    const uint32_t foreign[] = {0x000U, 0x07FU, 0x081U, 0x0FFU, 0x103U, 0x17FU, 0x183U,
-                                0x1FFU, 0x201U, 0x7FFU, 0x880U, 0x10000180U};
+    const uint32_t foreign[] = {0x000U, 0x07FU, 0x081U, 0x0FFU, 0x103U, 0x17FU,
+                                0x183U, 0x1FFU, 0x201U, 0x7FFU, 0x880U, 0x10000180U};
     for (size_t i = 0U; i < N_OF(foreign); ++i) {
         TEST_ASSERT_EQUAL(FW_CAN_KIND_UNKNOWN, fw_can_classify(foreign[i], NULL));
         fw_can_frame f = make_frame(foreign[i], 2U, zeros);
@@ -358,8 +353,8 @@ static void test_decoded_count_follows_the_shaft_through_reversals(void)
         TEST_ASSERT_EQUAL_INT64(truth_after[i], q.count);
         lo = truth_after[i] < lo ? truth_after[i] : lo;
         hi = truth_after[i] > hi ? truth_after[i] : hi;
-        if (i >= 2U && (truth_after[i] - truth_after[i - 1U]) != (truth_after[i - 1U] -
-                                                                   truth_after[i - 2U])) {
+        if (i >= 2U &&
+            (truth_after[i] - truth_after[i - 1U]) != (truth_after[i - 1U] - truth_after[i - 2U])) {
             ++reversals;
         }
     }

@@ -233,7 +233,8 @@ static void test_io_scaling_from_the_drive_data(void)
     fw_io_config conv;
     memset(&conv, 0, sizeof conv);
     fw_io_set_joint(&conv, 1U, 2000.0, 100.0, 0.029);
-    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 200000.0, conv.counts_per_rad[1] * 2.0 * 3.14159265358979323846);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6, 200000.0,
+                              conv.counts_per_rad[1] * 2.0 * 3.14159265358979323846);
     TEST_ASSERT_DOUBLE_WITHIN(1e-12, 2.9, conv.tacho_v_per_rad_s[1]);
     TEST_ASSERT_EQUAL_DOUBLE(0.0, conv.counts_per_rad[0]);
     const double zero[3] = {100.0, 200.0, 300.0};

@@ -28,13 +28,13 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
-#define FZ_CHECK(cond)                                                                      \
-    do {                                                                                    \
-        if (!(cond)) {                                                                      \
+#define FZ_CHECK(cond)                                                                       \
+    do {                                                                                     \
+        if (!(cond)) {                                                                       \
             (void)fprintf(stderr, "%s:%d: fuzz property violated: %s\n", __FILE__, __LINE__, \
-                          #cond);                                                           \
-            abort();                                                                        \
-        }                                                                                   \
+                          #cond);                                                            \
+            abort();                                                                         \
+        }                                                                                    \
     } while (0)
 
 /* 1 when n bytes at p are all zero: what a loader that failed must leave of its output. */
@@ -91,9 +91,9 @@ static inline uint64_t fz_u64(fz_reader *r)
 static inline double fz_double(fz_reader *r)
 {
     static const double special[16] = {
-        0.0,     -0.0,     1.0,         -1.0,         (double)INFINITY, -(double)INFINITY,
-        (double)NAN, DBL_MAX, -DBL_MAX, DBL_MIN,      DBL_TRUE_MIN, DBL_EPSILON,
-        1e154,   1e-154,   0.5,         1e-9};
+        0.0,         -0.0,    1.0,      -1.0,    (double)INFINITY, -(double)INFINITY,
+        (double)NAN, DBL_MAX, -DBL_MAX, DBL_MIN, DBL_TRUE_MIN,     DBL_EPSILON,
+        1e154,       1e-154,  0.5,      1e-9};
     const uint8_t tag = fz_u8(r);
     switch (tag & 3U) {
     case 0U: {

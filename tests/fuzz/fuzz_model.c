@@ -63,8 +63,7 @@ static void check_loaded(const dhcal_model *m)
     FZ_CHECK(close_abs(g, 1.0, 1e-12));
     FZ_CHECK(m->n_effects <= DHCAL_MAX_EFFECTS);
     for (size_t e = 0U; e < m->n_effects; ++e) {
-        FZ_CHECK(m->effects[e].n_values >= 1U &&
-                 m->effects[e].n_values <= DHCAL_MAX_EFFECT_VALUES);
+        FZ_CHECK(m->effects[e].n_values >= 1U && m->effects[e].n_values <= DHCAL_MAX_EFFECT_VALUES);
     }
 }
 

@@ -215,8 +215,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     /* Random poses only with the default pose limits: a file that raises them can exclude
      * the work space, and 100000 rejected draws are a slow input, not a finding. */
-    const int limits_set = !(sc->min_axis_distance_mm <= 150.0) ||
-                           !(sc->min_anchor_plane_mm <= 150.0);
+    const int limits_set =
+        !(sc->min_axis_distance_mm <= 150.0) || !(sc->min_anchor_plane_mm <= 150.0);
     run_dataset(sc, mid, limits_set);
     run_plant(sc, mid);
     return 0;

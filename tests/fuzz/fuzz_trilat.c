@@ -44,8 +44,8 @@ static void check_lengths(const double anchors[3][3], const double q[3], const d
     }
     const double bound = tol_mm2 + 64.0 * DBL_EPSILON * size2;
     for (size_t k = 0U; k < 3U; ++k) {
-        const double d2 = sq(q[0] - anchors[k][0]) + sq(q[1] - anchors[k][1]) +
-                          sq(q[2] - anchors[k][2]);
+        const double d2 =
+            sq(q[0] - anchors[k][0]) + sq(q[1] - anchors[k][1]) + sq(q[2] - anchors[k][2]);
         if (!(fabs(d2 - sq(len[k])) <= bound)) {
             (void)fprintf(stderr, "wire %zu: d^2 %.17g, L^2 %.17g, bound %.3g\n", k + 1U, d2,
                           sq(len[k]), bound);
@@ -105,8 +105,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     const double anchors[3][3] = {
         {0.0, 0.0, m.a_mm}, {0.0, m.b_mm, m.c_mm}, {0.0, -m.b_mm, m.c_mm}};
-    double size2 = sq(local[0]) + sq(local[1]) + sq(local[2]) + sq(m.a_mm) + sq(m.b_mm) +
-                   sq(m.c_mm);
+    double size2 =
+        sq(local[0]) + sq(local[1]) + sq(local[2]) + sq(m.a_mm) + sq(m.b_mm) + sq(m.c_mm);
     for (size_t k = 0U; k < 3U; ++k) {
         size2 += sq(len[k]);
     }

@@ -21,8 +21,7 @@ static dhcal_model again;
 static void tool_point(const dhc_arm *arm, const double *q, double p[3])
 {
     dhc_frame frames[DHC_MAX_JOINTS + 1U];
-    FZ_CHECK(dhc_forward_frames(arm, q, arm->n_joints, frames, arm->n_joints + 1U, p) ==
-             DHC_OK);
+    FZ_CHECK(dhc_forward_frames(arm, q, arm->n_joints, frames, arm->n_joints + 1U, p) == DHC_OK);
 }
 
 static void check_same_tool_points(const dhc_arm *a, const dhc_arm *b)

@@ -40,7 +40,7 @@ static double one_run(const dhs_scenario *sc)
     for (unsigned ms = 0U; ms < SIM_SECONDS * 1000U; ++ms) {
         const double t = (double)ms * 1e-3;
         const double target[3] = {1.2 * sin(0.5 * t), 1.2 + 0.6 * sin(0.37 * t),
-                                   -0.5 + 0.8 * sin(0.61 * t)};
+                                  -0.5 + 0.8 * sin(0.61 * t)};
         sim_servo_tick(&servo, &plant, target);
         if (dhs_plant_advance(&plant, 1000U) != DHC_OK) {
             return -1.0;
@@ -101,8 +101,7 @@ int main(int argc, char **argv)
     if (best < 0.0) {
         return 1;
     }
-    printf("goal %.0f x real time: %s in this run\n", goal,
-           best >= goal ? "met" : "NOT met");
+    printf("goal %.0f x real time: %s in this run\n", goal, best >= goal ? "met" : "NOT met");
     if (min_factor > 0.0 && best < min_factor) {
         printf("bench_sim: FAILED: best run below %.0f x real time\n", min_factor);
         return 1;

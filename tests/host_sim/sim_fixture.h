@@ -18,8 +18,8 @@
 #define SIM_DEG DHC_DEG
 
 enum {
-    SIM_FIXTURE_RIGID = 0,       /* stiff exact arm: geometry errors only */
-    SIM_FIXTURE_ALL_EFFECTS = 1  /* backlash + TE on 1, compliance on 2, TE on 3, slip */
+    SIM_FIXTURE_RIGID = 0,      /* stiff exact arm: geometry errors only */
+    SIM_FIXTURE_ALL_EFFECTS = 1 /* backlash + TE on 1, compliance on 2, TE on 3, slip */
 };
 
 /* Table 3 nominal geometry, joint ranges of host_sim/scenarios/paper-3dof-model.json. */
@@ -145,7 +145,7 @@ typedef struct {
     uint16_t last[DHC_MAX_JOINTS];
     int64_t counts[DHC_MAX_JOINTS];
     double kp_v_per_rad;
-    double kv_v_s_per_rad;   /* per rad/s of motor speed */
+    double kv_v_s_per_rad; /* per rad/s of motor speed */
     size_t n;
 } sim_servo;
 
@@ -190,8 +190,8 @@ static inline void sim_servo_tick(sim_servo *s, dhs_plant *p, const double *targ
         const dhs_joint_params *jp = &p->sc.joint[j];
         const double q = sim_servo_angle(s, p, j);
         const uint16_t adc = dhs_plant_tacho_adc(p, j);
-        const double w_motor = ((double)adc - 2048.0) / 2048.0 * p->sc.adc_range_v /
-                               jp->tacho_v_s_per_rad;
+        const double w_motor =
+            ((double)adc - 2048.0) / 2048.0 * p->sc.adc_range_v / jp->tacho_v_s_per_rad;
         const double u = s->kp_v_per_rad * (target_rad[j] - q) - s->kv_v_s_per_rad * w_motor;
         double code = floor(u / p->sc.dac_range_v * 2048.0 + 0.5) + 2048.0;
         code = code < 0.0 ? 0.0 : (code > 4095.0 ? 4095.0 : code);

@@ -59,10 +59,10 @@ static void test_settled_plant_rests_where_the_dataset_mode_says(void)
     dhs_arm_setup(&arm, &sc);
 
     /* targets over the work space, each joint approached from a chosen side */
-    const double targets[6][3] = {{0.8, 0.4, 0.9},  {-1.5, 1.9, -1.2}, {2.4, 0.9, 0.3},
-                                  {-0.3, 2.6, -2.0}, {1.2, 0.1, 1.8},  {-2.6, 1.4, -0.4}};
-    const int8_t dirs[6][3] = {{1, 1, -1}, {-1, 1, 1},  {1, -1, -1},
-                               {-1, -1, 1}, {1, 1, 1}, {-1, -1, -1}};
+    const double targets[6][3] = {{0.8, 0.4, 0.9},   {-1.5, 1.9, -1.2}, {2.4, 0.9, 0.3},
+                                  {-0.3, 2.6, -2.0}, {1.2, 0.1, 1.8},   {-2.6, 1.4, -0.4}};
+    const int8_t dirs[6][3] = {{1, 1, -1},  {-1, 1, 1}, {1, -1, -1},
+                               {-1, -1, 1}, {1, 1, 1},  {-1, -1, -1}};
     double here[3] = {start[0], start[1], start[2]};
     double worst_link = 0.0;
     double worst_exact_mm = 0.0;

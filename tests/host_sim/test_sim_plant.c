@@ -309,14 +309,14 @@ static void test_backlash_shows_the_expected_hysteresis_loop(void)
     sim_servo servo;
     sim_servo_init(&servo, &plant, &q0);
 
-    const double amp = 0.02;       /* rad at the joint, > b */
+    const double amp = 0.02; /* rad at the joint, > b */
     const double period_ms = 8000.0;
     double lag_min = 1.0;
     double lag_max = -1.0;
     double lag_fwd = 0.0;
     double lag_back = 0.0;
-    double u_top = -1.0;   /* highest gear output of the second period */
-    double q_top = -1.0;   /* highest link angle */
+    double u_top = -1.0; /* highest gear output of the second period */
+    double q_top = -1.0; /* highest link angle */
     double dead_travel = -1.0;
     for (unsigned ms = 0U; ms < 16000U; ++ms) {
         const double ph = fmod((double)ms, period_ms) / period_ms; /* triangle wave */
@@ -351,8 +351,8 @@ static void test_backlash_shows_the_expected_hysteresis_loop(void)
     printf("backlash loop: lag up %.4f mrad, down %.4f mrad (expected +-%.4f); loop width "
            "%.4f mrad (expected b + 2 Fc/k = %.4f); gear travel before the link follows a "
            "reversal %.4f mrad\n",
-           1e3 * lag_fwd, 1e3 * lag_back, 1e3 * width / 2.0, 1e3 * (lag_max - lag_min),
-           1e3 * width, 1e3 * dead_travel);
+           1e3 * lag_fwd, 1e3 * lag_back, 1e3 * width / 2.0, 1e3 * (lag_max - lag_min), 1e3 * width,
+           1e3 * dead_travel);
     TEST_ASSERT_DOUBLE_WITHIN(0.02 * width, width / 2.0, lag_fwd);
     TEST_ASSERT_DOUBLE_WITHIN(0.02 * width, -width / 2.0, lag_back);
     TEST_ASSERT_DOUBLE_WITHIN(0.05 * width, width, lag_max - lag_min);

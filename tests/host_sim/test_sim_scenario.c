@@ -43,26 +43,65 @@ static void test_defaults_are_physics_md_plant_table(void)
 }
 
 typedef void (*breaker)(dhs_scenario *s);
-static void neg_mass(dhs_scenario *s) { s->joint[1].mass_kg = -1.0; }
-static void neg_stiffness(dhs_scenario *s) { s->joint[2].stiffness_nm_per_rad = -5.0; }
-static void nan_ratio(dhs_scenario *s) { s->joint[0].gear_ratio = (double)NAN; }
+static void neg_mass(dhs_scenario *s)
+{
+    s->joint[1].mass_kg = -1.0;
+}
+static void neg_stiffness(dhs_scenario *s)
+{
+    s->joint[2].stiffness_nm_per_rad = -5.0;
+}
+static void nan_ratio(dhs_scenario *s)
+{
+    s->joint[0].gear_ratio = (double)NAN;
+}
 /* a fuzzer's 2.2e105: its encoder counts outgrew 64 bits */
-static void huge_ratio(dhs_scenario *s) { s->joint[1].gear_ratio = 2.2e105; }
-static void zero_r(dhs_scenario *s) { s->joint[0].r_ohm = 0.0; }
-static void rigid_backlash(dhs_scenario *s) { s->joint[1].backlash_rad = 0.001; }
+static void huge_ratio(dhs_scenario *s)
+{
+    s->joint[1].gear_ratio = 2.2e105;
+}
+static void zero_r(dhs_scenario *s)
+{
+    s->joint[0].r_ohm = 0.0;
+}
+static void rigid_backlash(dhs_scenario *s)
+{
+    s->joint[1].backlash_rad = 0.001;
+}
 static void rigid_te(dhs_scenario *s)
 {
     s->joint[2].n_harmonics = 1U;
     s->joint[2].te[0].order = 1U;
     s->joint[2].te[0].sin_rad = 1e-4;
 }
-static void slow_step(dhs_scenario *s) { s->step_ns = 200000U; }
-static void odd_step(dhs_scenario *s) { s->step_ns = 30000U; }
-static void bad_gravity(dhs_scenario *s) { s->gravity_unit[2] = -2.0; }
-static void neg_noise(dhs_scenario *s) { s->noise_xyz_mm = -0.1; }
-static void neg_payload(dhs_scenario *s) { s->payload_kg = -0.5; }
-static void bad_wheel(dhs_scenario *s) { s->measurer.wheel_radius_true_mm = 0.0; }
-static void fast_motor(dhs_scenario *s) { s->joint[1].l_h = 1e-4; } /* L/(5R) = 13 us */
+static void slow_step(dhs_scenario *s)
+{
+    s->step_ns = 200000U;
+}
+static void odd_step(dhs_scenario *s)
+{
+    s->step_ns = 30000U;
+}
+static void bad_gravity(dhs_scenario *s)
+{
+    s->gravity_unit[2] = -2.0;
+}
+static void neg_noise(dhs_scenario *s)
+{
+    s->noise_xyz_mm = -0.1;
+}
+static void neg_payload(dhs_scenario *s)
+{
+    s->payload_kg = -0.5;
+}
+static void bad_wheel(dhs_scenario *s)
+{
+    s->measurer.wheel_radius_true_mm = 0.0;
+}
+static void fast_motor(dhs_scenario *s)
+{
+    s->joint[1].l_h = 1e-4;
+} /* L/(5R) = 13 us */
 
 static void test_bad_values_are_refused_and_named(void)
 {
@@ -71,14 +110,13 @@ static void test_bad_values_are_refused_and_named(void)
         size_t joint;
         const char *word;
     } cases[] = {
-        {neg_mass, 2U, "mass_kg"},          {neg_stiffness, 3U, "stiffness"},
-        {nan_ratio, 1U, "finite"},          {zero_r, 1U, "r_ohm"},
-        {huge_ratio, 2U, "gear_ratio"},
-        {rigid_backlash, 2U, "backlash"},   {rigid_te, 3U, "transmission"},
-        {slow_step, 0U, "step"},            {odd_step, 0U, "step"},
-        {bad_gravity, 0U, "gravity"},       {neg_noise, 0U, "noise"},
-        {neg_payload, 0U, "payload"},       {bad_wheel, 0U, "wheel"},
-        {fast_motor, 2U, "L/(5R)"},
+        {neg_mass, 2U, "mass_kg"},      {neg_stiffness, 3U, "stiffness"},
+        {nan_ratio, 1U, "finite"},      {zero_r, 1U, "r_ohm"},
+        {huge_ratio, 2U, "gear_ratio"}, {rigid_backlash, 2U, "backlash"},
+        {rigid_te, 3U, "transmission"}, {slow_step, 0U, "step"},
+        {odd_step, 0U, "step"},         {bad_gravity, 0U, "gravity"},
+        {neg_noise, 0U, "noise"},       {neg_payload, 0U, "payload"},
+        {bad_wheel, 0U, "wheel"},       {fast_motor, 2U, "L/(5R)"},
     };
     for (size_t k = 0U; k < sizeof cases / sizeof cases[0]; ++k) {
         sim_fixture_paper_arm(&sc, SIM_FIXTURE_RIGID);

@@ -124,7 +124,7 @@ static void test_dead_zone_side_follows_approach_unloaded_and_gravity_loaded(voi
 static void test_dataset_reports_the_encoder_through_the_nominal_conversion(void)
 {
     sim_fixture_paper_arm(&sc, SIM_FIXTURE_RIGID);
-    sc.joint[0].gear_ratio = 100.2; /* a belt stage 0.2 % off: joint_scale */
+    sc.joint[0].gear_ratio = 100.2;   /* a belt stage 0.2 % off: joint_scale */
     sc.joint[2].encoder_lines = 512U; /* wrong encoder fitted */
     TEST_ASSERT_EQUAL(DHC_OK, dhs_dataset_init(&ds, &sc, 3U));
     for (unsigned k = 0U; k < 200U; ++k) {
@@ -132,8 +132,8 @@ static void test_dataset_reports_the_encoder_through_the_nominal_conversion(void
         TEST_ASSERT_EQUAL(DHC_OK, dhs_dataset_next(&ds, &r));
         for (size_t j = 0U; j < 3U; ++j) {
             const dhs_joint_params *jp = &sc.joint[j];
-            const double cpr_nom = 4.0 * (double)jp->nominal_encoder_lines *
-                                   jp->nominal_gear_ratio / (2.0 * SIM_PI);
+            const double cpr_nom =
+                4.0 * (double)jp->nominal_encoder_lines * jp->nominal_gear_ratio / (2.0 * SIM_PI);
             TEST_ASSERT_DOUBLE_WITHIN(1e-15, (double)r.encoder_counts[j] / cpr_nom, r.q_rad[j]);
             /* the shaft sits inside the count the controller reads */
             const double counts = r.motor_rad[j] * 4.0 * (double)jp->encoder_lines / (2.0 * SIM_PI);

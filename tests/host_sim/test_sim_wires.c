@@ -32,9 +32,9 @@ static void test_lengths_are_distances_to_the_anchors_in_the_world(void)
     double len[3];
     dhs_wires_lengths(&w, p, len);
     for (size_t k = 0U; k < 3U; ++k) {
-        const double ref = sqrt((p[0] - a[k][0]) * (p[0] - a[k][0]) +
-                                (p[1] - a[k][1]) * (p[1] - a[k][1]) +
-                                (p[2] - a[k][2]) * (p[2] - a[k][2]));
+        const double ref =
+            sqrt((p[0] - a[k][0]) * (p[0] - a[k][0]) + (p[1] - a[k][1]) * (p[1] - a[k][1]) +
+                 (p[2] - a[k][2]) * (p[2] - a[k][2]));
         TEST_ASSERT_DOUBLE_WITHIN(1e-9, ref, len[k]);
         /* referenced at zero length 0 with an exact wheel: counts give the length back */
         const int64_t c = dhs_wires_counts(&w, k, NULL);
@@ -65,8 +65,8 @@ static void test_counter_register_wraps_at_its_width(void)
 static void test_wheel_radius_scales_and_zero_length_offsets(void)
 {
     paper_measurer();
-    sc.measurer.wheel_radius_true_mm = 10.01;     /* +0.1 %: reads 0.1 % short */
-    sc.measurer.zero_length_true_mm[1] = 200.0;   /* wire 2 zeroed at 200 mm ... */
+    sc.measurer.wheel_radius_true_mm = 10.01;      /* +0.1 %: reads 0.1 % short */
+    sc.measurer.zero_length_true_mm[1] = 200.0;    /* wire 2 zeroed at 200 mm ... */
     sc.measurer.zero_length_nominal_mm[1] = 201.5; /* ... believed to be 201.5 */
     dhs_wires w;
     const double p0[3] = {400.0, 0.0, 500.0};

@@ -45,7 +45,8 @@ int main(int argc, char **argv)
     char why[200];
     if (!fw_linux_can_supported(why, sizeof why)) {
         printf("SKIP: %s: this kernel has no SocketCAN; the linux_port_vm test runs the port "
-               "on a kernel that has it\n", why);
+               "on a kernel that has it\n",
+               why);
         return SKIP;
     }
     static fw_linux_can ctrl;
@@ -129,8 +130,7 @@ int main(int argc, char **argv)
     overrun |= after == FW_CAN_OVERRUN;
     check(overrun && node.overruns == 1U && node.drops_seen > 0U && r.data[0] == 0xEEU,
           "frames the kernel dropped are reported once, with the next frame (FW_CAN_OVERRUN)");
-    printf("  (%d of 200 frames kept, kernel drop counter %u)\n", kept,
-           (unsigned)node.drops_seen);
+    printf("  (%d of 200 frames kept, kernel drop counter %u)\n", kept, (unsigned)node.drops_seen);
     const fw_can_frame bad = {0x900U, 1U, {0U, 0U, 0U, 0U, 0U, 0U, 0U, 0U}};
     check(tc.send(tc.ctx, &bad) == FW_CAN_ERR_IO, "an id beyond 11 bits is refused");
     fw_linux_can_close(&ctrl);

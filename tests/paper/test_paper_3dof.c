@@ -59,11 +59,13 @@ static void test_identifiable_parameters_match_table1(void)
     dhc_arm dh;
     TEST_ASSERT_EQUAL(DHC_OK, dhc_arm_to_standard_dh(&cal, &dh));
     for (size_t i = 0U; i < 3U; ++i) {
-        TEST_ASSERT_DOUBLE_WITHIN(1e-6, TEST_PAPER_OFFSET_DEG, dh.joint[i].theta_offset_rad / TEST_DEG);
+        TEST_ASSERT_DOUBLE_WITHIN(1e-6, TEST_PAPER_OFFSET_DEG,
+                                  dh.joint[i].theta_offset_rad / TEST_DEG);
         TEST_ASSERT_DOUBLE_WITHIN(1e-6, TEST_TABLE1[i].a_mm, dh.joint[i].a_mm);
         TEST_ASSERT_DOUBLE_WITHIN(1e-6, TEST_TABLE1[i].d_mm, dh.joint[i].d_mm);
         if (i < 2U) { /* alpha3 is not identifiable from positions */
-            TEST_ASSERT_DOUBLE_WITHIN(1e-6, TEST_TABLE1[i].alpha_deg, dh.joint[i].alpha_rad / TEST_DEG);
+            TEST_ASSERT_DOUBLE_WITHIN(1e-6, TEST_TABLE1[i].alpha_deg,
+                                      dh.joint[i].alpha_rad / TEST_DEG);
         }
     }
 }
@@ -101,9 +103,8 @@ static void test_tool_point_trades_off_against_link_parameters(void)
     dhc_calib_options opt;
     dhc_calib_default_options(&opt);
     TEST_ASSERT_EQUAL(DHC_OK,
-                      dhc_calib_fit(&model, &paper.set, test_read_sample, &paper.data,
-                                    paper.data.n, paper.data.flags, &opt, &paper.ws,
-                                    &paper.rep));
+                      dhc_calib_fit(&model, &paper.set, test_read_sample, &paper.data, paper.data.n,
+                                    paper.data.flags, &opt, &paper.ws, &paper.rep));
     const dhc_arm cal = model.arm;
     TEST_ASSERT_EQUAL(15U, paper.rep.n_params);
     TEST_ASSERT_EQUAL(paper.rep.structural_rank, paper.rep.rank);

@@ -63,9 +63,9 @@ static void test_parameters_identifiable_at_the_estimate_are_freed(void)
     off_axis.joint[5].a_mm = 0.5;
     dhc_model start = test_model_of(&off_axis);
     TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&paper.set, &start));
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_calib_fit(&start, &paper.set, test_read_sample, &paper.data,
-                                            paper.data.n, paper.data.flags, &opt, &paper.ws,
-                                            &paper.rep));
+    TEST_ASSERT_EQUAL(DHC_OK,
+                      dhc_calib_fit(&start, &paper.set, test_read_sample, &paper.data, paper.data.n,
+                                    paper.data.flags, &opt, &paper.ws, &paper.rep));
     TEST_ASSERT_EQUAL(0U, paper.rep.freed);
     const size_t iterations_free = paper.rep.iterations;
     for (size_t checks = 0U; checks < 2U; ++checks) {
@@ -75,10 +75,9 @@ static void test_parameters_identifiable_at_the_estimate_are_freed(void)
         for (size_t i = 0U; i < paper.data.n; ++i) {
             paper.data.flags[i] = (uint8_t)DHC_SAMPLE_USED;
         }
-        TEST_ASSERT_EQUAL(DHC_OK,
-                          dhc_calib_fit(&model, &paper.set, test_read_sample, &paper.data,
-                                        paper.data.n, paper.data.flags, &opt, &paper.ws,
-                                        &paper.rep));
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_calib_fit(&model, &paper.set, test_read_sample, &paper.data,
+                                                paper.data.n, paper.data.flags, &opt, &paper.ws,
+                                                &paper.rep));
         test_rng fresh = {0xF00DULL};
         double max_mm;
         double max_rad;
@@ -105,7 +104,8 @@ static void test_calibrated_parameters_in_table1_convention_match_table1(void)
     dhc_arm dh;
     TEST_ASSERT_EQUAL(DHC_OK, dhc_arm_to_standard_dh(&cal, &dh));
     for (size_t i = 0U; i < 6U; ++i) {
-        TEST_ASSERT_DOUBLE_WITHIN(1e-6, TEST_PAPER_OFFSET_DEG, dh.joint[i].theta_offset_rad / TEST_DEG);
+        TEST_ASSERT_DOUBLE_WITHIN(1e-6, TEST_PAPER_OFFSET_DEG,
+                                  dh.joint[i].theta_offset_rad / TEST_DEG);
         TEST_ASSERT_DOUBLE_WITHIN(1e-6, TEST_TABLE1[i].alpha_deg, dh.joint[i].alpha_rad / TEST_DEG);
         TEST_ASSERT_DOUBLE_WITHIN(1e-6, TEST_TABLE1[i].a_mm, dh.joint[i].a_mm);
         TEST_ASSERT_DOUBLE_WITHIN(1e-6, TEST_TABLE1[i].d_mm, dh.joint[i].d_mm);

@@ -20,20 +20,21 @@ typedef struct {
 } test_dh_row;
 
 /* Paper Table 1: the actual 6-DOF arm. */
-static const test_dh_row TEST_TABLE1[6] = {
-    {91.2, 101.0, 201.0}, {1.0, 104.0, 2.0}, {1.8, 102.0, 100.1},
-    {-92.1, -1.0, 12.0},  {-0.8, 14.0, 110.0}, {91.1, 3.0, 2.1}};
+static const test_dh_row TEST_TABLE1[6] = {{91.2, 101.0, 201.0}, {1.0, 104.0, 2.0},
+                                           {1.8, 102.0, 100.1},  {-92.1, -1.0, 12.0},
+                                           {-0.8, 14.0, 110.0},  {91.1, 3.0, 2.1}};
 /* Paper Table 2: the initially assumed (nominal) 6-DOF arm. */
-static const test_dh_row TEST_TABLE2[6] = {
-    {90.0, 100.0, 200.0}, {0.0, 100.0, 0.0}, {0.0, 100.0, 100.0},
-    {-90.0, 0.0, 10.0},   {0.0, 10.0, 100.0}, {90.0, 0.0, 0.0}};
+static const test_dh_row TEST_TABLE2[6] = {{90.0, 100.0, 200.0}, {0.0, 100.0, 0.0},
+                                           {0.0, 100.0, 100.0},  {-90.0, 0.0, 10.0},
+                                           {0.0, 10.0, 100.0},   {90.0, 0.0, 0.0}};
 /* Paper Table 3: the built 3-DOF arm (design values). */
-static const test_dh_row TEST_TABLE3[3] = {{90.0, 0.0, 433.0}, {0.0, 400.0, 0.0}, {0.0, 345.0, 0.0}};
+static const test_dh_row TEST_TABLE3[3] = {
+    {90.0, 0.0, 433.0}, {0.0, 400.0, 0.0}, {0.0, 345.0, 0.0}};
 /* Paper section 3: "the joint-variable errors are all 2 deg". */
 #define TEST_PAPER_OFFSET_DEG 2.0
 
 static inline void test_arm_from_table(dhc_arm *arm, const test_dh_row *rows, size_t n,
-                                double theta_offset_deg)
+                                       double theta_offset_deg)
 {
     (void)dhc_arm_init(arm, n);
     for (size_t i = 0U; i < n; ++i) {

@@ -64,8 +64,8 @@ static inline void test_measure_model(test_dataset *d, const dhc_model *truth, s
 }
 
 /* The same for an arm without effects. */
-static inline void test_measure(test_dataset *d, const dhc_arm *truth, size_t n,
-                                dhc_meas_kind kind, test_rng *rng)
+static inline void test_measure(test_dataset *d, const dhc_arm *truth, size_t n, dhc_meas_kind kind,
+                                test_rng *rng)
 {
     const dhc_model m = test_model_of(truth);
     test_measure_model(d, &m, n, kind, rng);
@@ -89,8 +89,8 @@ static inline void test_tool_frame(const dhc_arm *arm, const double *q, dhc_fram
 }
 
 /* Largest position (mm) and orientation (rad) difference of two arms over fresh poses. */
-static inline void test_compare_arms(const dhc_arm *a, const dhc_arm *b, size_t poses, test_rng *rng,
-                              double *max_mm, double *max_rad)
+static inline void test_compare_arms(const dhc_arm *a, const dhc_arm *b, size_t poses,
+                                     test_rng *rng, double *max_mm, double *max_rad)
 {
     *max_mm = 0.0;
     *max_rad = 0.0;

@@ -56,8 +56,8 @@ typedef struct {
 __attribute__((section(".isr_vector"), used)) static const vector_table vectors = {
     .initial_sp = __handler_stack_top,
     .handler = {dhc_target_reset, dhc_target_fault, dhc_target_fault, dhc_target_fault,
-                dhc_target_fault, dhc_target_fault, 0, 0, 0, 0, dhc_target_fault,
-                dhc_target_fault, 0, dhc_target_fault, dhc_target_fault},
+                dhc_target_fault, dhc_target_fault, 0, 0, 0, 0, dhc_target_fault, dhc_target_fault,
+                0, dhc_target_fault, dhc_target_fault},
 };
 
 void dhc_target_run(void)

@@ -29,9 +29,7 @@ void setUp(void)
     memset(&g_fit, 0, sizeof g_fit);
 }
 
-void tearDown(void)
-{
-}
+void tearDown(void) {}
 
 /* n measurements of truth at random poses over its joint ranges: the tool point (or the
  * pose), each coordinate with Gaussian noise of noise_mm, each joint angle read with
@@ -72,22 +70,20 @@ static double fit_and_compare(const dhc_model *nominal, const char *effects,
 {
     dhcal_error err;
     memset(&err, 0, sizeof err);
-    TEST_ASSERT_EQUAL_MESSAGE(DHCAL_IO_OK,
-                              dhcal_run_fit(nominal, effects, DHCAL_GEOMETRY_FULL, noise, &g_s,
-                                            NULL, &g_fit, &err),
-                              err.msg);
+    TEST_ASSERT_EQUAL_MESSAGE(
+        DHCAL_IO_OK,
+        dhcal_run_fit(nominal, effects, DHCAL_GEOMETRY_FULL, noise, &g_s, NULL, &g_fit, &err),
+        err.msg);
     TEST_ASSERT_EQUAL(DHC_OK, g_fit.status);
     static dhc_param_set set;
     dhcal_set_without_held(&g_fit, &set); /* the set refine cross-validates */
     dhcal_cv fast;
     dhcal_cv refit;
-    TEST_ASSERT_EQUAL_MESSAGE(DHCAL_IO_OK,
-                              dhcal_cross_validate(&g_fit.model, &set, noise, &g_s, &fast, &err),
-                              err.msg);
-    TEST_ASSERT_EQUAL_MESSAGE(DHCAL_IO_OK,
-                              dhcal_cross_validate_refit(&g_fit.model, &set, noise, &g_s, &refit,
-                                                         &err),
-                              err.msg);
+    TEST_ASSERT_EQUAL_MESSAGE(
+        DHCAL_IO_OK, dhcal_cross_validate(&g_fit.model, &set, noise, &g_s, &fast, &err), err.msg);
+    TEST_ASSERT_EQUAL_MESSAGE(
+        DHCAL_IO_OK, dhcal_cross_validate_refit(&g_fit.model, &set, noise, &g_s, &refit, &err),
+        err.msg);
     /* the same folds over the same rows */
     TEST_ASSERT_EQUAL_size_t(folds, fast.folds);
     TEST_ASSERT_EQUAL_size_t(folds, refit.folds);
@@ -182,23 +178,21 @@ static void test_curved_candidate_iterates(void)
     const dhc_model nominal = test_paper3_model();
     dhcal_error err;
     memset(&err, 0, sizeof err);
-    TEST_ASSERT_EQUAL_MESSAGE(DHCAL_IO_OK,
-                              dhcal_run_fit(&nominal, NULL, DHCAL_GEOMETRY_FULL, NULL, &g_s,
-                                            NULL, &g_fit, &err),
-                              err.msg);
+    TEST_ASSERT_EQUAL_MESSAGE(
+        DHCAL_IO_OK,
+        dhcal_run_fit(&nominal, NULL, DHCAL_GEOMETRY_FULL, NULL, &g_s, NULL, &g_fit, &err),
+        err.msg);
     static dhc_param_set set;
     dhcal_set_without_held(&g_fit, &set);
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(&set, &g_fit.model,
-                                                    DHC_EFFECT_JOINT_COMPLIANCE, 1U));
+    TEST_ASSERT_EQUAL(DHC_OK,
+                      dhc_params_add_effect(&set, &g_fit.model, DHC_EFFECT_JOINT_COMPLIANCE, 1U));
     dhcal_cv fast;
     dhcal_cv refit;
-    TEST_ASSERT_EQUAL_MESSAGE(DHCAL_IO_OK,
-                              dhcal_cross_validate(&g_fit.model, &set, NULL, &g_s, &fast, &err),
-                              err.msg);
-    TEST_ASSERT_EQUAL_MESSAGE(DHCAL_IO_OK,
-                              dhcal_cross_validate_refit(&g_fit.model, &set, NULL, &g_s, &refit,
-                                                         &err),
-                              err.msg);
+    TEST_ASSERT_EQUAL_MESSAGE(
+        DHCAL_IO_OK, dhcal_cross_validate(&g_fit.model, &set, NULL, &g_s, &fast, &err), err.msg);
+    TEST_ASSERT_EQUAL_MESSAGE(
+        DHCAL_IO_OK, dhcal_cross_validate_refit(&g_fit.model, &set, NULL, &g_s, &refit, &err),
+        err.msg);
     TEST_ASSERT_TRUE_MESSAGE(fast.iterated_folds > 0U, "no fold needed its steps iterated");
     TEST_ASSERT_EQUAL_size_t_MESSAGE(0U, fast.refit_folds, "the fast path fell back to refits");
     TEST_ASSERT_FLOAT_WITHIN(AGREE * refit.rms_mm, refit.rms_mm, fast.rms_mm);

@@ -21,14 +21,13 @@
 #include "dhc_test_files.h"
 #include "unity.h"
 
-
 static char g_dir[256];
 static char g_path[512];
 static dhcal_error g_err;
 static dhcal_dataset g_data;
 static dhcal_model g_model;
-static dhcal_text g_text;   /* what the CSV writer tests write */
-static uint64_t g_rng;      /* their values' generator */
+static dhcal_text g_text; /* what the CSV writer tests write */
+static uint64_t g_rng;    /* their values' generator */
 
 void setUp(void)
 {
@@ -130,8 +129,8 @@ static void test_csv_numbers_are_strtods_to_the_bit(void)
 {
     static char text[1U << 18];
     static char fields[600][3][40];
-    const char *const formats[] = {"%.12f", "%.9f", "%.3f", "%+.6f", "%.17g", "%.0f.",
-                                   "%.15g", "%.16f", "%.6e", "%.2f"};
+    const char *const formats[] = {"%.12f", "%.9f",  "%.3f",  "%+.6f", "%.17g",
+                                   "%.0f.", "%.15g", "%.16f", "%.6e",  "%.2f"};
     size_t len = (size_t)snprintf(text, sizeof text, "q1,x,y,z\n");
     uint64_t state = 0x9E3779B97F4A7C15ULL;
     for (size_t row = 0U; row < 600U; ++row) {
@@ -160,8 +159,8 @@ static void test_csv_numbers_are_strtods_to_the_bit(void)
             const double expect = strtod(fields[row][k], NULL);
             char why[160];
             (void)snprintf(why, sizeof why, "row %zu: \"%s\"", row, fields[row][k]);
-            TEST_ASSERT_EQUAL_MEMORY_MESSAGE(&expect, &g_data.rows[row].xyz_mm[k],
-                                             sizeof expect, why);
+            TEST_ASSERT_EQUAL_MEMORY_MESSAGE(&expect, &g_data.rows[row].xyz_mm[k], sizeof expect,
+                                             why);
         }
     }
 }
@@ -171,10 +170,18 @@ static void test_csv_numbers_are_strtods_to_the_bit(void)
  * zeros, a leading sign before the point, a trailing point. */
 static void test_csv_fast_path_edges_are_strtods_to_the_bit(void)
 {
-    static const char *const fields[] = {
-        "90071.99254740992", "90071.99254740993", "-90071.99254740993",
-        "0.000000000000000001", "00000000000000000001.5", "0.0000000000000000001",
-        "-0", "-0.0", "+.5", "5.", "-.25", "99999.99999999999999"};
+    static const char *const fields[] = {"90071.99254740992",
+                                         "90071.99254740993",
+                                         "-90071.99254740993",
+                                         "0.000000000000000001",
+                                         "00000000000000000001.5",
+                                         "0.0000000000000000001",
+                                         "-0",
+                                         "-0.0",
+                                         "+.5",
+                                         "5.",
+                                         "-.25",
+                                         "99999.99999999999999"};
     const size_t n = sizeof fields / sizeof fields[0];
     static char text[2048];
     size_t len = (size_t)snprintf(text, sizeof text, "q1,x,y,z\n");
@@ -231,7 +238,8 @@ static void test_csv_short_and_long_rows(void)
 
 static void test_csv_not_a_number(void)
 {
-    csv_bad("q1,q2,x,y,z\n1,2,3,4,5\n1,abc,3,4,5\n", 2U, 3U, "column 'q2': \"abc\" is not a number");
+    csv_bad("q1,q2,x,y,z\n1,2,3,4,5\n1,abc,3,4,5\n", 2U, 3U,
+            "column 'q2': \"abc\" is not a number");
     dhcal_dataset_free(&g_data);
     csv_bad("q1,x,y,z\n1,2,3 4,4\n", 1U, 2U, "column 'y': \"3 4\" is not a number");
     dhcal_dataset_free(&g_data);
@@ -248,14 +256,12 @@ static void test_csv_not_a_number(void)
 
 static void test_csv_nan_inf_and_overflow_are_rejected(void)
 {
-    static const char *const BAD[] = {"nan", "NaN", "-nan", "inf", "-Infinity", "1e999",
-                                      "-1e400"};
+    static const char *const BAD[] = {"nan", "NaN", "-nan", "inf", "-Infinity", "1e999", "-1e400"};
     for (size_t i = 0U; i < sizeof BAD / sizeof BAD[0]; ++i) {
         char text[128];
         char needle[64];
         (void)snprintf(text, sizeof text, "q1,x,y,z\n0,0,0,0\n# c\n1,%s,3,4\n", BAD[i]);
-        (void)snprintf(needle, sizeof needle, "column 'x': \"%s\" is not a finite number",
-                       BAD[i]);
+        (void)snprintf(needle, sizeof needle, "column 'x': \"%s\" is not a finite number", BAD[i]);
         csv_bad(text, 1U, 4U, needle);
         dhcal_dataset_free(&g_data);
     }
@@ -494,8 +500,7 @@ static void test_csv_joint_count_outside_limits_is_a_caller_error(void)
 {
     const char *const p = write_text("d.csv", "q1,x,y,z\n1,2,3,4\n");
     TEST_ASSERT_EQUAL_INT(DHCAL_IO_FAILED, dhcal_csv_load(p, 0U, &g_data, &g_err));
-    TEST_ASSERT_EQUAL_INT(DHCAL_IO_FAILED,
-                          dhcal_csv_load(p, DHC_MAX_JOINTS + 1U, &g_data, &g_err));
+    TEST_ASSERT_EQUAL_INT(DHCAL_IO_FAILED, dhcal_csv_load(p, DHC_MAX_JOINTS + 1U, &g_data, &g_err));
     assert_msg_has("joint count");
     TEST_ASSERT_NULL(g_data.rows);
 }
@@ -713,13 +718,11 @@ static void test_plan_has_no_measurements_and_dirs_of_its_own(void)
 
 /* ------------------------------------------------------------------ model helpers */
 
-static const char *const J3 =
-    "[{\"alpha_deg\": 90, \"a_mm\": 0, \"d_mm\": 433},"
-    " {\"alpha_deg\": 0, \"a_mm\": 400, \"d_mm\": 0},"
-    " {\"alpha_deg\": 0, \"a_mm\": 345, \"d_mm\": 0}]";
+static const char *const J3 = "[{\"alpha_deg\": 90, \"a_mm\": 0, \"d_mm\": 433},"
+                              " {\"alpha_deg\": 0, \"a_mm\": 400, \"d_mm\": 0},"
+                              " {\"alpha_deg\": 0, \"a_mm\": 345, \"d_mm\": 0}]";
 
-static void model_bad_bytes(const char *bytes, size_t len, const char *where,
-                            const char *needle)
+static void model_bad_bytes(const char *bytes, size_t len, const char *where, const char *needle)
 {
     const char *const p = write_bytes("m.json", bytes, len);
     char prefix[600];
@@ -747,8 +750,7 @@ static void model_bad_with(const char *extra, const char *where, const char *nee
 static void model_ok(const char *json)
 {
     const char *const p = write_text("m.json", json);
-    TEST_ASSERT_EQUAL_INT_MESSAGE(DHCAL_IO_OK, dhcal_model_load(p, &g_model, &g_err),
-                                  g_err.msg);
+    TEST_ASSERT_EQUAL_INT_MESSAGE(DHCAL_IO_OK, dhcal_model_load(p, &g_model, &g_err), g_err.msg);
 }
 
 /* ------------------------------------------------------------------ model: file level */
@@ -769,8 +771,8 @@ static void test_model_empty_file(void)
 
 static void test_model_syntax_error_reports_line_and_column(void)
 {
-    model_bad("{\n  \"joints\": [\n    {\"alpha_deg\": 90,, \"a_mm\": 0}\n  ]\n}\n", ":3:",
-              "JSON syntax error");
+    model_bad("{\n  \"joints\": [\n    {\"alpha_deg\": 90,, \"a_mm\": 0}\n  ]\n}\n",
+              ":3:", "JSON syntax error");
     model_bad("{\"joints\": [{\"alpha_deg\": 9O}]}", ":1:", "JSON syntax error near '");
     model_bad("{\"joints\": [", ":1:", "JSON syntax error");
     model_bad("{\"joints\": []} trailing", ":1:", "JSON syntax error near 'trailing'");
@@ -782,11 +784,12 @@ static void test_model_syntax_error_reports_line_and_column(void)
  * (cJSON stops at the token, so a plain syntax error could only give the position). */
 static void test_model_nan_and_infinity_name_their_path(void)
 {
-    model_bad("{\"joints\": [{\"alpha_deg\": 90, \"a_mm\": 0, \"d_mm\": 1},\n"
-              " {\"alpha_deg\": NaN, \"a_mm\": 0, \"d_mm\": 1}]}",
-              ": joints[1].alpha_deg: ", "NaN is not a number (JSON has no NaN or Infinity; line 2:16)");
-    model_bad("{\"tool_mm\": [0, -Infinity, 0], \"joints\": []}", ": tool_mm[1]: ",
-              "-Infinity is not a number");
+    model_bad(
+        "{\"joints\": [{\"alpha_deg\": 90, \"a_mm\": 0, \"d_mm\": 1},\n"
+        " {\"alpha_deg\": NaN, \"a_mm\": 0, \"d_mm\": 1}]}",
+        ": joints[1].alpha_deg: ", "NaN is not a number (JSON has no NaN or Infinity; line 2:16)");
+    model_bad("{\"tool_mm\": [0, -Infinity, 0], \"joints\": []}",
+              ": tool_mm[1]: ", "-Infinity is not a number");
     /* a token the marker parse cannot place (the file is broken elsewhere too): position only */
     model_bad("{\"joints\": [inf,", ":1:13: ", "inf is not a number");
     /* a word that only starts like one is a plain syntax error */
@@ -831,9 +834,10 @@ static void test_model_too_large(void)
 static void test_model_wrong_types(void)
 {
     model_bad("[1, 2]", ": (top level): ", "expected an object, got an array");
-    model_bad("{\"joints\": {}}", ": joints: ", "expected an array of joint objects, got an object");
-    model_bad("{\"joints\": [{\"alpha_deg\": 1, \"a_mm\": 2, \"d_mm\": 3}, 5]}", ": joints[1]: ",
-              "expected an object, got a number");
+    model_bad("{\"joints\": {}}",
+              ": joints: ", "expected an array of joint objects, got an object");
+    model_bad("{\"joints\": [{\"alpha_deg\": 1, \"a_mm\": 2, \"d_mm\": 3}, 5]}",
+              ": joints[1]: ", "expected an object, got a number");
     model_bad("{\"joints\": [{\"alpha_deg\": \"90\", \"a_mm\": 2, \"d_mm\": 3}]}",
               ": joints[0].alpha_deg: ", "expected a number, got a string");
     model_bad_with(", \"name\": 5", ": name: ", "expected a string, got a number");
@@ -841,8 +845,8 @@ static void test_model_wrong_types(void)
     model_bad_with(", \"tool_mm\": [0, null, 0]", ": tool_mm[1]: ", "expected a number, got null");
     model_bad_with(", \"tool_mm\": 0", ": tool_mm: ", "expected an array of 3 numbers");
     model_bad_with(", \"base\": [0]", ": base: ", "expected an object, got an array");
-    model_bad_with(", \"base\": {\"rpy_deg\": [0, true, 0]}", ": base.rpy_deg[1]: ",
-                   "got a boolean");
+    model_bad_with(", \"base\": {\"rpy_deg\": [0, true, 0]}",
+                   ": base.rpy_deg[1]: ", "got a boolean");
     model_bad_with(", \"gravity\": \"down\"", ": gravity: ", "got a string");
     model_bad_with(", \"measurer\": []", ": measurer: ", "expected an object");
     model_bad_with(", \"effects\": []", ": effects: ", "expected an object, got an array");
@@ -863,8 +867,9 @@ static void test_model_too_many_joints(void)
     char json[4096];
     size_t o = (size_t)snprintf(json, sizeof json, "{\"joints\": [");
     for (size_t i = 0U; i <= DHC_MAX_JOINTS; ++i) {
-        o += (size_t)snprintf(json + o, sizeof json - o,
-                              "%s{\"alpha_deg\": 90, \"a_mm\": 1, \"d_mm\": 2}", i > 0U ? ", " : "");
+        o +=
+            (size_t)snprintf(json + o, sizeof json - o,
+                             "%s{\"alpha_deg\": 90, \"a_mm\": 1, \"d_mm\": 2}", i > 0U ? ", " : "");
     }
     (void)snprintf(json + o, sizeof json - o, "]}");
     char needle[64];
@@ -875,15 +880,16 @@ static void test_model_too_many_joints(void)
 
 static void test_model_required_joint_keys(void)
 {
-    model_bad("{\"joints\": [{\"alpha_deg\": 0, \"d_mm\": 3}]}", ": joints[0].a_mm: ",
-              "required key missing");
-    model_bad("{\"joints\": [{\"a_mm\": 0, \"d_mm\": 3}]}", ": joints[0].alpha_deg: ",
-              "required key missing");
+    model_bad("{\"joints\": [{\"alpha_deg\": 0, \"d_mm\": 3}]}",
+              ": joints[0].a_mm: ", "required key missing");
+    model_bad("{\"joints\": [{\"a_mm\": 0, \"d_mm\": 3}]}",
+              ": joints[0].alpha_deg: ", "required key missing");
 }
 
 static void test_model_unknown_keys_are_rejected_with_path(void)
 {
-    model_bad_with(", \"colour\": \"red\"", ": colour: ", "unknown key (allowed here: name, joints");
+    model_bad_with(", \"colour\": \"red\"",
+                   ": colour: ", "unknown key (allowed here: name, joints");
     model_bad("{\"Joints\": []}", ": Joints: ", "unknown key");
     model_bad("{\"joints\": [{\"alpha_deg\": 0, \"a_mm\": 1, \"d_mm\": 3},"
               " {\"alpha\": 0, \"a_mm\": 1, \"d_mm\": 3}]}",
@@ -899,8 +905,8 @@ static void test_model_repeated_key(void)
 {
     model_bad("{\"joints\": [{\"alpha_deg\": 0, \"a_mm\": 1, \"a_mm\": 2, \"d_mm\": 3}]}",
               ": joints[0].a_mm: ", "key repeated");
-    model_bad_with(", \"tool_mm\": [0, 0, 0], \"tool_mm\": [0, 0, 1]", ": tool_mm: ",
-                   "key repeated");
+    model_bad_with(", \"tool_mm\": [0, 0, 0], \"tool_mm\": [0, 0, 1]",
+                   ": tool_mm: ", "key repeated");
 }
 
 static void test_model_values_out_of_range(void)
@@ -930,8 +936,8 @@ static void test_model_measurer_anchors(void)
                    ": measurer.anchors_mm: ", "collinear");
     model_bad_with(", \"measurer\": {\"anchors_mm\": [[0,0,1200],[0,600,300],[0,0,1200]]}",
                    ": measurer.anchors_mm: ", "anchors_mm[0] and anchors_mm[2] are the same");
-    model_bad_with(", \"measurer\": {\"frame\": {}}", ": measurer.anchors_mm: ",
-                   "required key missing");
+    model_bad_with(", \"measurer\": {\"frame\": {}}",
+                   ": measurer.anchors_mm: ", "required key missing");
     model_bad_with(", \"measurer\": {\"anchors_mm\": [[0,0,1],[0,1,0]]}",
                    ": measurer.anchors_mm: ", "expected 3 points, got 2");
     model_bad_with(", \"measurer\": {\"anchors_mm\": [[0,0,1],[0,1],[0,-1,0]]}",
@@ -958,20 +964,20 @@ static void test_model_measurer_without_frame_sits_at_world_origin(void)
 
 static void test_model_effects_are_validated(void)
 {
-    model_bad_with(", \"effects\": {\"joint_wobble:1\": [1]}", ": effects.joint_wobble:1: ",
-                   "unknown effect");
-    model_bad_with(", \"effects\": {\"joint_scale\": [1]}", ": effects.joint_scale: ",
-                   "unknown effect");
-    model_bad_with(", \"effects\": {\"joint_scale:4\": [1]}", ": effects.joint_scale:4: ",
-                   "1 <= i <= 3");
-    model_bad_with(", \"effects\": {\"base_frame:1\": [1]}", ": effects.base_frame:1: ",
-                   "unknown effect");
-    model_bad_with(", \"effects\": {\"tool_offset\": 3}", ": effects.tool_offset: ",
-                   "expected an array of numbers, got a number");
-    model_bad_with(", \"effects\": {\"tool_offset\": []}", ": effects.tool_offset: ",
-                   "0 values, expected 1..32");
-    model_bad_with(", \"effects\": {\"tool_offset\": [1, \"2\"]}", ": effects.tool_offset[1]: ",
-                   "expected a number, got a string");
+    model_bad_with(", \"effects\": {\"joint_wobble:1\": [1]}",
+                   ": effects.joint_wobble:1: ", "unknown effect");
+    model_bad_with(", \"effects\": {\"joint_scale\": [1]}",
+                   ": effects.joint_scale: ", "unknown effect");
+    model_bad_with(", \"effects\": {\"joint_scale:4\": [1]}",
+                   ": effects.joint_scale:4: ", "1 <= i <= 3");
+    model_bad_with(", \"effects\": {\"base_frame:1\": [1]}",
+                   ": effects.base_frame:1: ", "unknown effect");
+    model_bad_with(", \"effects\": {\"tool_offset\": 3}",
+                   ": effects.tool_offset: ", "expected an array of numbers, got a number");
+    model_bad_with(", \"effects\": {\"tool_offset\": []}",
+                   ": effects.tool_offset: ", "0 values, expected 1..32");
+    model_bad_with(", \"effects\": {\"tool_offset\": [1, \"2\"]}",
+                   ": effects.tool_offset[1]: ", "expected a number, got a string");
     model_bad_with(", \"effects\": {\"measurer_scale\": [1], \"measurer_scale\": [2]}",
                    ": effects.measurer_scale: ", "key repeated");
     char json[1024];
@@ -1003,15 +1009,16 @@ static void test_model_minimal_gets_the_defaults(void)
 
 static void test_model_full_file_loads_exactly(void)
 {
-    model_ok("{\"name\": \"full \\\"one\\\"\",\n"
-             " \"joints\": [{\"alpha_deg\": 90, \"a_mm\": 0.5, \"d_mm\": 433,"
-             " \"theta_offset_deg\": -2, \"min_deg\": -170, \"max_deg\": 170},\n"
-             "  {\"alpha_deg\": 0.01, \"a_mm\": 400, \"d_mm\": 0, \"beta_deg\": 0.25},\n"
-             "  {\"alpha_deg\": 0, \"a_mm\": 345, \"d_mm\": 0, \"beta_deg\": 1}],\n"
-             " \"tool_mm\": [1, 2, 3.25],\n"
-             " \"base\": {\"xyz_mm\": [10, 20, 30]},\n"
-             " \"gravity\": [0, 0.0006, -1],\n"
-             " \"effects\": {\"joint_compliance:2\": [1e-06, 2e-06], \"tool_offset\": [1, 2, 3]}}\n");
+    model_ok(
+        "{\"name\": \"full \\\"one\\\"\",\n"
+        " \"joints\": [{\"alpha_deg\": 90, \"a_mm\": 0.5, \"d_mm\": 433,"
+        " \"theta_offset_deg\": -2, \"min_deg\": -170, \"max_deg\": 170},\n"
+        "  {\"alpha_deg\": 0.01, \"a_mm\": 400, \"d_mm\": 0, \"beta_deg\": 0.25},\n"
+        "  {\"alpha_deg\": 0, \"a_mm\": 345, \"d_mm\": 0, \"beta_deg\": 1}],\n"
+        " \"tool_mm\": [1, 2, 3.25],\n"
+        " \"base\": {\"xyz_mm\": [10, 20, 30]},\n"
+        " \"gravity\": [0, 0.0006, -1],\n"
+        " \"effects\": {\"joint_compliance:2\": [1e-06, 2e-06], \"tool_offset\": [1, 2, 3]}}\n");
     TEST_ASSERT_EQUAL_STRING("full \"one\"", g_model.name);
     const dhc_joint *const j = g_model.arm.joint;
     TEST_ASSERT_DOUBLE_WITHIN(0.0, 90.0 * TEST_DEG, j[0].alpha_rad);
@@ -1027,9 +1034,9 @@ static void test_model_full_file_loads_exactly(void)
     TEST_ASSERT_EQUAL_INT(DHC_CONV_DH, j[2].convention);     /* last joint */
     TEST_ASSERT_DOUBLE_WITHIN(0.0, 3.25, g_model.arm.tool_mm[2]);
     TEST_ASSERT_DOUBLE_WITHIN(0.0, 20.0, g_model.arm.base.pos[1]);
-    TEST_ASSERT_DOUBLE_WITHIN(1e-15, 1.0,
-                              sqrt(g_model.gravity[1] * g_model.gravity[1] +
-                                   g_model.gravity[2] * g_model.gravity[2]));
+    TEST_ASSERT_DOUBLE_WITHIN(
+        1e-15, 1.0,
+        sqrt(g_model.gravity[1] * g_model.gravity[1] + g_model.gravity[2] * g_model.gravity[2]));
     TEST_ASSERT_EQUAL_size_t(2U, g_model.n_effects);
     TEST_ASSERT_EQUAL_STRING("joint_compliance:2", g_model.effects[0].name);
     TEST_ASSERT_EQUAL_size_t(2U, g_model.effects[0].n_values);
@@ -1240,7 +1247,8 @@ static void test_save_writes_the_schema(void)
                                       "\"theta_offset_deg\": 0, \"beta_deg\": 0,\n"));
     TEST_ASSERT_NOT_NULL(strstr(text, "\"anchors_mm\": [[0, 0, 1200], [0, 600, 300], "
                                       "[0, -600, 300]]"));
-    TEST_ASSERT_NOT_NULL(strstr(text, "\"frame\": {\"xyz_mm\": [1300, 0, 0], \"rpy_deg\": [0, 0, 180]}"));
+    TEST_ASSERT_NOT_NULL(
+        strstr(text, "\"frame\": {\"xyz_mm\": [1300, 0, 0], \"rpy_deg\": [0, 0, 180]}"));
     TEST_ASSERT_NOT_NULL(strstr(text, "\"min_deg\": -170, \"max_deg\": 170}"));
     TEST_ASSERT_NULL(strstr(text, "effects"));
     const char *const first_beta = strstr(text, "beta_deg");

@@ -86,9 +86,7 @@ static void fill(size_t n, size_t nj)
             const double q = g_q[k] * 3.14159265358979323846 / 180.0;
             g_appr[k] = (signed char)(i % 3U == 0U ? 0 : (i % 3U == 1U ? 1 : -1));
             g_mo[k] = j == 0U ? 0.0 : 300.0 * cos(q);
-            g_je[k] = j == 0U   ? 0.05 * (double)g_appr[k]
-                      : j == 1U ? 0.002 * g_mo[k]
-                                : 0.3 * sin(q);
+            g_je[k] = j == 0U ? 0.05 * (double)g_appr[k] : j == 1U ? 0.002 * g_mo[k] : 0.3 * sin(q);
         }
         const double q2 = g_q[i * nj + (nj > 1U ? 1U : 0U)] * 3.14159265358979323846 / 180.0;
         const double bl = (i % 2U) != 0U ? 0.1 : -0.1;
@@ -112,10 +110,23 @@ static void fill(size_t n, size_t nj)
     g_cand[1].explained = 0.12;
     (void)snprintf(g_cand[2].label, sizeof g_cand[2].label, "thermal");
     g_cand[2].explained = 0.01;
-    const dhcal_plot_data d = {"test arm", n, nj, g_q, g_rb, g_ra, g_eb, g_ea,
+    const dhcal_plot_data d = {"test arm",
+                               n,
+                               nj,
+                               g_q,
+                               g_rb,
+                               g_ra,
+                               g_eb,
+                               g_ea,
                                n > 0U ? sqrt(sb / (double)n) : 0.0,
                                n > 0U ? sqrt(sa / (double)n) : 0.0,
-                               0, "joint_compliance:2", g_cand, 3U, g_je, g_mo, g_appr};
+                               0,
+                               "joint_compliance:2",
+                               g_cand,
+                               3U,
+                               g_je,
+                               g_mo,
+                               g_appr};
     g_d = d;
 }
 
@@ -152,8 +163,8 @@ static size_t entity_len(const char *s)
     if (s[1] == '#') {
         size_t i = s[2] == 'x' ? 3U : 2U;
         const size_t start = i;
-        while ((s[i] >= '0' && s[i] <= '9') || (start == 3U && ((s[i] >= 'a' && s[i] <= 'f') ||
-                                                               (s[i] >= 'A' && s[i] <= 'F')))) {
+        while ((s[i] >= '0' && s[i] <= '9') ||
+               (start == 3U && ((s[i] >= 'a' && s[i] <= 'f') || (s[i] >= 'A' && s[i] <= 'F')))) {
             i++;
         }
         return i > start && s[i] == ';' ? i + 1U : 0U;
@@ -396,8 +407,8 @@ static void test_python_check_rejects_a_broken_file(void)
     }
     TEST_ASSERT_EQUAL_INT(0, mkdir(g_out, 0777));
     test_write_file(out_path("bad.svg"), "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"10\" "
-                                    "height=\"10\" viewBox=\"0 0 10 10\"><circle cx=\"nan\" "
-                                    "cy=\"1\" r=\"1\"/></svg>");
+                                         "height=\"10\" viewBox=\"0 0 10 10\"><circle cx=\"nan\" "
+                                         "cy=\"1\" r=\"1\"/></svg>");
     TEST_ASSERT_FALSE(python_check("bad.svg 2>/dev/null"));
     test_write_file(out_path("bad.svg"), "<svg><text>a & b</text></svg>");
     TEST_ASSERT_FALSE(python_check("bad.svg 2>/dev/null"));
@@ -429,7 +440,8 @@ static void test_markup_in_labels_is_escaped(void)
 
 static void test_control_bytes_and_broken_utf8_do_not_break_the_xml(void)
 {
-    g_d.title = "\x01" "bell\x07 tab\t \xff\xfe caf\xc3\xa9 \xc3( \xed\xa0\x80 \xef\xbf\xbe end\xe2\x82";
+    g_d.title = "\x01"
+                "bell\x07 tab\t \xff\xfe caf\xc3\xa9 \xc3( \xed\xa0\x80 \xef\xbf\xbe end\xe2\x82";
     TEST_ASSERT_EQUAL_INT(DHCAL_IO_OK, dhcal_plot_write(g_out, &g_d, &g_err));
     check_all(10U, 3U, 3U);
     char *const r = slurp(out_path("residuals.svg"));
@@ -462,20 +474,20 @@ static void test_candidate_label_filling_its_array_is_read_to_the_end_only(void)
     memset(expect, 'L', 64U);
     memcpy(expect + 64U, "</text>", 8U);
     TEST_ASSERT_NOT_NULL(strstr(c, expect));
-    TEST_ASSERT_NULL(strstr(c, "LLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLL"));
+    TEST_ASSERT_NULL(
+        strstr(c, "LLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLLL"));
     free(c);
 }
 
 static void test_every_non_finite_input_is_bad_input_and_writes_nothing(void)
 {
-    double *const fields[] = {&g_q[4],    &g_rb[7],           &g_ra[29],
-                              &g_eb[9],   &g_ea[0],           &g_je[5],
-                              &g_mo[28],  &g_d.rms_before_mm, &g_d.rms_after_mm,
-                              &g_cand[2].explained};
-    const char *const names[] = {"q_deg[1][1]",    "resid_before[2][1]", "resid_after[9][2]",
-                                 "err_before[9]",  "err_after[0]",       "joint_err_deg[1][2]",
-                                 "moment_mm[9][1]", "rms_before_mm",     "rms_after_mm",
-                                 "candidates[2].explained"};
+    double *const fields[] = {
+        &g_q[4],  &g_rb[7],  &g_ra[29],          &g_eb[9],          &g_ea[0],
+        &g_je[5], &g_mo[28], &g_d.rms_before_mm, &g_d.rms_after_mm, &g_cand[2].explained};
+    const char *const names[] = {
+        "q_deg[1][1]",  "resid_before[2][1]",     "resid_after[9][2]", "err_before[9]",
+        "err_after[0]", "joint_err_deg[1][2]",    "moment_mm[9][1]",   "rms_before_mm",
+        "rms_after_mm", "candidates[2].explained"};
     const double bad[3] = {(double)NAN, (double)INFINITY, -(double)INFINITY};
     for (size_t f = 0U; f < sizeof fields / sizeof fields[0]; ++f) {
         for (size_t b = 0U; b < 3U; ++b) {

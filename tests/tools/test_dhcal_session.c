@@ -26,14 +26,11 @@ static void open_session(dhcal_session *s, const char *rows)
 {
     dhcal_error err;
     memset(&err, 0, sizeof err);
+    TEST_ASSERT_EQUAL_MESSAGE(
+        DHCAL_IO_OK, dhcal_session_begin(s, &g_file, MODEL, NULL, NULL, NULL, &err), err.msg);
     TEST_ASSERT_EQUAL_MESSAGE(DHCAL_IO_OK,
-                              dhcal_session_begin(s, &g_file, MODEL, NULL, NULL, NULL, &err),
-                              err.msg);
-    TEST_ASSERT_EQUAL_MESSAGE(DHCAL_IO_OK,
-                              dhcal_csv_load(rows, s->model.arm.n_joints, &s->data, &err),
-                              err.msg);
-    TEST_ASSERT_EQUAL_MESSAGE(DHCAL_IO_OK, dhcal_session_build_rows(s, rows, NULL, &err),
-                              err.msg);
+                              dhcal_csv_load(rows, s->model.arm.n_joints, &s->data, &err), err.msg);
+    TEST_ASSERT_EQUAL_MESSAGE(DHCAL_IO_OK, dhcal_session_build_rows(s, rows, NULL, &err), err.msg);
 }
 
 /* refine on the session, its JSON report (caller frees; NULL when it failed). */

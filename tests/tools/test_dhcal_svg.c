@@ -54,7 +54,9 @@ static void test_appends_grow_the_buffer_to_the_concatenation(void)
 static void test_text_is_escaped_and_cut_to_whole_characters(void)
 {
     reset();
-    const char in[] = "a<b>&\"'\t\x01" "\xc3\xa9" "\xff";
+    const char in[] = "a<b>&\"'\t\x01"
+                      "\xc3\xa9"
+                      "\xff";
     dhcal_svg_put_text(&g_t, in, strlen(in), SIZE_MAX);
     TEST_ASSERT_EQUAL_STRING("a&lt;b&gt;&amp;&quot;&apos; ?\xc3\xa9?", g_t.p);
     /* e-acute is one character of two bytes */
@@ -131,7 +133,11 @@ static void test_axes_cover_the_data_in_round_whole_steps(void)
 
 static void test_pixels_map_the_axes_onto_the_frame(void)
 {
-    const dhcal_svg_frame f = {50.0, 70.0, 400.0, 200.0, dhcal_svg_make_axis(-10.0, 30.0, 4.0, 0),
+    const dhcal_svg_frame f = {50.0,
+                               70.0,
+                               400.0,
+                               200.0,
+                               dhcal_svg_make_axis(-10.0, 30.0, 4.0, 0),
                                dhcal_svg_make_axis(0.0, 1.0, 5.0, 0)};
     TEST_ASSERT_DOUBLE_WITHIN(1e-12, 50.0, dhcal_svg_px_x(&f, f.ax.lo));
     TEST_ASSERT_DOUBLE_WITHIN(1e-12, 450.0, dhcal_svg_px_x(&f, f.ax.hi));

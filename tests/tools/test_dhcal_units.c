@@ -50,13 +50,14 @@ static void rodrigues(const double axis[3], double angle, double r[3][3])
     r[2][1] += s * k[0];
 }
 
-static void transform(const double *a, size_t n, double r[3][3], double scale,
-                      const double t[3], double *b)
+static void transform(const double *a, size_t n, double r[3][3], double scale, const double t[3],
+                      double *b)
 {
     for (size_t i = 0U; i < n; ++i) {
         for (int k = 0; k < 3; ++k) {
             b[3U * i + (size_t)k] = scale * (r[k][0] * a[3U * i] + r[k][1] * a[3U * i + 1U] +
-                                             r[k][2] * a[3U * i + 2U]) + t[k];
+                                             r[k][2] * a[3U * i + 2U]) +
+                                    t[k];
         }
     }
 }
@@ -180,8 +181,7 @@ static void test_noisy_clouds_agree_with_the_singular_values(void)
     TEST_ASSERT_TRUE(m.corr < 0.9 * f.corr); /* the mirror image does not fit */
     /* the residuals as stated: spread_b sqrt(1 - corr^2), and the rigid one from its own
      * optimum, sum |a|^2 + sum |b|^2 - 2 lambda */
-    TEST_ASSERT_DOUBLE_WITHIN(1e-9, f.spread_b * sqrt(1.0 - f.corr * f.corr),
-                              f.rms_similarity);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-9, f.spread_b * sqrt(1.0 - f.corr * f.corr), f.rms_similarity);
     const double rigid = sqrt(f.spread_a * f.spread_a + f.spread_b * f.spread_b -
                               2.0 * f.corr * f.spread_a * f.spread_b);
     TEST_ASSERT_DOUBLE_WITHIN(1e-9, rigid, f.rms_rigid);
@@ -198,8 +198,7 @@ static void test_noisy_clouds_agree_with_the_singular_values(void)
         double rt[3][3];
         for (int i = 0; i < 3; ++i) {
             for (int j = 0; j < 3; ++j) {
-                rt[i][j] = rr[i][0] * f.rot[0][j] + rr[i][1] * f.rot[1][j] +
-                           rr[i][2] * f.rot[2][j];
+                rt[i][j] = rr[i][0] * f.rot[0][j] + rr[i][1] * f.rot[1][j] + rr[i][2] * f.rot[2][j];
             }
         }
         static double c[3 * N];
@@ -354,8 +353,8 @@ static void test_the_check_names_each_mistake(void)
         double p[3];
         memcpy(p, r[i].xyz_mm, sizeof p);
         for (int k = 0; k < 3; ++k) {
-            r[i].xyz_mm[k] = turn[k][0] * p[0] + turn[k][1] * p[1] + turn[k][2] * p[2] +
-                             (k == 0 ? 2000.0 : 0.0);
+            r[i].xyz_mm[k] =
+                turn[k][0] * p[0] + turn[k][1] * p[1] + turn[k][2] * p[2] + (k == 0 ? 2000.0 : 0.0);
         }
     }
     (void)check(&m, r, NULL, "another frame");
@@ -379,8 +378,7 @@ static void test_a_single_joint_sweep_is_no_swap(void)
         r[i].q_rad[0] = 0.3;
         r[i].q_rad[1] = (20.0 + 120.0 * (double)i / (double)N) * DHC_DEG;
         r[i].q_rad[2] = -0.5;
-        TEST_ASSERT_EQUAL_INT(DHC_OK,
-                              dhc_model_tool_point(&truth, r[i].q_rad, NULL, r[i].xyz_mm));
+        TEST_ASSERT_EQUAL_INT(DHC_OK, dhc_model_tool_point(&truth, r[i].q_rad, NULL, r[i].xyz_mm));
     }
     (void)check(&m, r, NULL, NULL);
 }
@@ -398,12 +396,10 @@ static void test_a_model_in_metres_is_named(void)
     TEST_ASSERT_EQUAL_INT(DHCAL_IO_BAD_INPUT, dhcal_units_check_model(&m, "M.json", NULL, &err));
     TEST_ASSERT_NOT_NULL(strstr(err.msg, "M.json: the model's lengths look like metres"));
     TEST_ASSERT_EQUAL_INT(DHCAL_IO_BAD_INPUT,
-                          dhcal_units_check_height(&m, "M.json", -HUGE_VAL, "--min-z", NULL,
-                                                   &err));
+                          dhcal_units_check_height(&m, "M.json", -HUGE_VAL, "--min-z", NULL, &err));
     arm(&m);
     TEST_ASSERT_EQUAL_INT(DHCAL_IO_OK,
-                          dhcal_units_check_height(&m, "M.json", -HUGE_VAL, "--min-z", NULL,
-                                                   &err));
+                          dhcal_units_check_height(&m, "M.json", -HUGE_VAL, "--min-z", NULL, &err));
     TEST_ASSERT_EQUAL_INT(DHCAL_IO_OK,
                           dhcal_units_check_height(&m, "M.json", 0.0, "--min-z", NULL, &err));
     TEST_ASSERT_EQUAL_INT(DHCAL_IO_OK,

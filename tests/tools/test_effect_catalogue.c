@@ -18,7 +18,6 @@
 #include "dhc_test_files.h"
 #include "unity.h"
 
-
 static char g_dir[256];
 static char g_path[512];
 

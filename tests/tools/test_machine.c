@@ -18,7 +18,6 @@
 #include "dhc_test_files.h"
 #include "unity.h"
 
-
 static char g_dir[256];
 static char g_path[512];
 static char g_model_path[512];
@@ -181,8 +180,7 @@ static void expect_bad(const char *from, const char *to, const char *want)
 {
     const char *const path = machine_with(from, to);
     memset(&g_err, 0, sizeof g_err);
-    TEST_ASSERT_EQUAL_MESSAGE(DHCAL_IO_BAD_INPUT, dhcal_machine_load(path, &g_machine, &g_err),
-                              to);
+    TEST_ASSERT_EQUAL_MESSAGE(DHCAL_IO_BAD_INPUT, dhcal_machine_load(path, &g_machine, &g_err), to);
     TEST_ASSERT_NOT_NULL_MESSAGE(strstr(g_err.msg, "machine.json"), g_err.msg);
     TEST_ASSERT_NOT_NULL_MESSAGE(strstr(g_err.msg, want), g_err.msg);
     /* nothing half-loaded */
@@ -192,18 +190,19 @@ static void expect_bad(const char *from, const char *to, const char *want)
 static void test_bad_input_names_file_and_place(void)
 {
     expect_bad("\"gear_ratio\": 50", "\"gear_ratio\": 0", "joints[1].gear_ratio: 0 is outside");
-    expect_bad("\"gear_ratio\": 50", "\"gear_ratio\": 1e999", "joints[1].gear_ratio: number out "
-                                                             "of range");
+    expect_bad("\"gear_ratio\": 50", "\"gear_ratio\": 1e999",
+               "joints[1].gear_ratio: number out "
+               "of range");
     expect_bad("\"gear_ratio\": 50", "\"gear_ratio\": \"50\"", "expected a number, got a string");
-    expect_bad("\"gear_ratio\": 50", "\"gear_ratio\": 50, \"gear\": 2", "joints[1].gear: unknown key");
+    expect_bad("\"gear_ratio\": 50", "\"gear_ratio\": 50, \"gear\": 2",
+               "joints[1].gear: unknown key");
     expect_bad("\"n_joints\": 2", "\"n_joints\": 3", "n_joints: 3, but the model has 2 joints");
     expect_bad("\"n_joints\": 2", "\"n_joints\": 2.5", "n_joints: 2.5 is not a whole number");
     expect_bad("[10, -20]", "[10]", "start_pose_deg: expected 2 numbers, got 1");
     expect_bad("\"id_offset\": 32", "\"id_offset\": 2000", "can.id_offset: 2000 is outside");
     expect_bad("[4, 5]", "[4, 4]", "gpio.encoder_lines: A and B are the same line");
     expect_bad("\"model\": \"m.json\"", "\"model\": \"nothere.json\"", "model: ");
-    expect_bad("\"model\": \"m.json\"", "\"model\": {\"joints\": []}",
-               "model.joints: empty array");
+    expect_bad("\"model\": \"m.json\"", "\"model\": {\"joints\": []}", "model.joints: empty array");
     expect_bad("\"model\": \"m.json\"", "\"model\": 7", "model: expected a model file's path");
     expect_bad("\"dac_range_v\": 10, ", "", "drives.dac_range_v: required key missing");
     expect_bad("\"store\": \"cal/dhcal-fw.nv\"", "\"store\": \"\"", "store: expected 1..");

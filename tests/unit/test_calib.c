@@ -154,9 +154,9 @@ static void test_caller_tables_give_the_same_fit(void)
                 if (data.flags[i] != (uint8_t)DHC_SAMPLE_USED) {
                     continue;
                 }
-                TEST_ASSERT_EQUAL(DHC_OK, dhc_model_residual(&fitted, &data.s[i],
-                                                             opt.orientation_weight_mm_per_rad,
-                                                             r, &rows));
+                TEST_ASSERT_EQUAL(DHC_OK,
+                                  dhc_model_residual(&fitted, &data.s[i],
+                                                     opt.orientation_weight_mm_per_rad, r, &rows));
                 TEST_ASSERT_EQUAL_MEMORY(r, &residuals[3U * i], 3U * sizeof r[0]);
             }
         }
@@ -263,7 +263,7 @@ static void test_gross_rows_are_screened_with_their_reasons(void)
     test_rng rng = {51ULL};
     test_measure(&data, &truth, 40U, DHC_MEAS_POSITION, &rng);
     add_noise(&data, 0.05, &rng);
-    data.s[5].q_rad[0] = 300.0 * TEST_DEG;        /* placeholder angles: beyond +-170 */
+    data.s[5].q_rad[0] = 300.0 * TEST_DEG;              /* placeholder angles: beyond +-170 */
     dhc_vec3_set(data.s[11].p_mm, 900.0, 900.0, 700.0); /* 1.46 m from the base origin */
     data.s[23].p_mm[1] += 30.0;
     dhc_calib_options opt;
@@ -362,7 +362,7 @@ static void test_failures_leave_the_arm_unchanged(void)
     TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &model));
 
     TEST_ASSERT_EQUAL(DHC_ERR_INCONSISTENT, dhc_calib_fit(&model, &set, failing_reader, NULL,
-                                                         data.n, data.flags, &opt, &ws, &rep));
+                                                          data.n, data.flags, &opt, &ws, &rep));
     TEST_ASSERT_EQUAL_MEMORY(&model_before, &model, sizeof model);
 
     data.s[9].p_mm[1] = (double)NAN;
@@ -375,12 +375,12 @@ static void test_failures_leave_the_arm_unchanged(void)
     TEST_ASSERT_EQUAL(DHC_ERR_NO_DATA, fit(&arm, &opt));
     TEST_ASSERT_EQUAL_MEMORY(&nominal, &arm, sizeof arm);
 
-    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_calib_fit(&model, &set, NULL, &data, data.n,
-                                                     data.flags, &opt, &ws, &rep));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_calib_fit(&model, &set, NULL, &data, data.n, data.flags,
+                                                      &opt, &ws, &rep));
     dhc_param_set empty;
     dhc_params_clear(&empty);
     TEST_ASSERT_EQUAL(DHC_ERR_CAPACITY, dhc_calib_fit(&model, &empty, test_read_sample, &data,
-                                                     data.n, data.flags, &opt, &ws, &rep));
+                                                      data.n, data.flags, &opt, &ws, &rep));
     TEST_ASSERT_EQUAL_MEMORY(&model_before, &model, sizeof model);
 }
 

@@ -97,12 +97,13 @@ static void fit_and_diagnose(dhc_model *fitted)
     TEST_ASSERT_EQUAL(DHC_OK, dhc_calib_fit(fitted, &set, test_read_sample, &data, data.n,
                                             data.flags, &opt, &cws, &rep));
     dhc_candidate cands[DHC_MAX_CANDIDATES];
-    const size_t nc = dhc_diagnose_candidates(fitted, &set, &test_no_covariates, cands, DHC_MAX_CANDIDATES);
+    const size_t nc =
+        dhc_diagnose_candidates(fitted, &set, &test_no_covariates, cands, DHC_MAX_CANDIDATES);
     dhc_diagnose_options dopt;
     dhc_diagnose_default_options(&dopt);
     TEST_ASSERT_EQUAL(DHC_OK, dhc_diagnose(fitted, &set, rep.identifiable, rep.sigma * rep.sigma,
-                                           cands, nc, test_read_sample, &data, data.n,
-                                           data.flags, &dopt, &dws, &diag));
+                                           cands, nc, test_read_sample, &data, data.n, data.flags,
+                                           &dopt, &dws, &diag));
     TEST_ASSERT_EQUAL(nc, diag.count);
 }
 
@@ -201,18 +202,21 @@ static void test_bad_arguments_are_refused(void)
     dhc_candidate c = {DHC_EFFECT_JOINT_SCALE, 0U};
     dhc_diagnose_options dopt;
     dhc_diagnose_default_options(&dopt);
-    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_diagnose(&m, &set, ident, 0.0, &c, 1U, test_read_sample,
-                                                     &data, data.n, data.flags, &dopt, &dws, &diag));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
+                      dhc_diagnose(&m, &set, ident, 0.0, &c, 1U, test_read_sample, &data, data.n,
+                                   data.flags, &dopt, &dws, &diag));
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
                       dhc_diagnose(&m, &set, ident, (double)NAN, &c, 1U, test_read_sample, &data,
                                    data.n, data.flags, &dopt, &dws, &diag));
     /* A candidate already in the base set is a caller error. */
     TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(&set, &m, DHC_EFFECT_JOINT_SCALE, 0U));
-    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_diagnose(&m, &set, ident, 1.0, &c, 1U, test_read_sample,
-                                                     &data, data.n, data.flags, &dopt, &dws, &diag));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
+                      dhc_diagnose(&m, &set, ident, 1.0, &c, 1U, test_read_sample, &data, data.n,
+                                   data.flags, &dopt, &dws, &diag));
     /* ... and the candidate list leaves it out. */
     dhc_candidate cands[DHC_MAX_CANDIDATES];
-    const size_t nc = dhc_diagnose_candidates(&m, &set, &test_no_covariates, cands, DHC_MAX_CANDIDATES);
+    const size_t nc =
+        dhc_diagnose_candidates(&m, &set, &test_no_covariates, cands, DHC_MAX_CANDIDATES);
     for (size_t i = 0U; i < nc; ++i) {
         TEST_ASSERT_FALSE(cands[i].effect == DHC_EFFECT_JOINT_SCALE && cands[i].joint == 0U);
         TEST_ASSERT_TRUE(cands[i].effect != DHC_EFFECT_MEASURER_SCALE); /* no wire data */
@@ -291,8 +295,8 @@ static void test_time_in_step_with_the_pose(void)
     for (size_t i = 0U; i < data.n; ++i) {
         data.s[i].t_s = 3600.0 * test_uniform(&rng);
     }
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_covariate_pose_r2(nj, DHC_COVARIATE_TIME, test_read_sample,
-                                                    &data, data.n, data.flags, &ne, &fac, &r2));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_covariate_pose_r2(nj, DHC_COVARIATE_TIME, test_read_sample, &data,
+                                                    data.n, data.flags, &ne, &fac, &r2));
     TEST_ASSERT_DOUBLE_WITHIN(1e-9, fmax(r2_by_gram_schmidt(&data, nj, 1), 0.0), r2);
     TEST_ASSERT_TRUE(r2 < 0.1);
     /* a sweep: rows sorted by joint 2, time the row number (plus a little jitter) */
@@ -306,17 +310,16 @@ static void test_time_in_step_with_the_pose(void)
     for (size_t i = 0U; i < data.n; ++i) {
         data.s[i].t_s = (double)i + test_range(&rng, -5.0, 5.0);
     }
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_covariate_pose_r2(nj, DHC_COVARIATE_TIME, test_read_sample,
-                                                    &data, data.n, data.flags, &ne, &fac, &r2));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_covariate_pose_r2(nj, DHC_COVARIATE_TIME, test_read_sample, &data,
+                                                    data.n, data.flags, &ne, &fac, &r2));
     TEST_ASSERT_DOUBLE_WITHIN(1e-9, r2_by_gram_schmidt(&data, nj, 1), r2);
     TEST_ASSERT_TRUE(r2 > DHC_COVARIATE_IN_STEP_R2);
     /* a temperature that is an exact function of the pose */
     for (size_t i = 0U; i < data.n; ++i) {
         data.s[i].temp_c = 20.0 + 2.0 * sin(data.s[i].q_rad[0]) - cos(data.s[i].q_rad[2]);
     }
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_covariate_pose_r2(nj, DHC_COVARIATE_TEMPERATURE,
-                                                    test_read_sample, &data, data.n, data.flags,
-                                                    &ne, &fac, &r2));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_covariate_pose_r2(nj, DHC_COVARIATE_TEMPERATURE, test_read_sample,
+                                                    &data, data.n, data.flags, &ne, &fac, &r2));
     TEST_ASSERT_DOUBLE_WITHIN(1e-9, 1.0, r2);
     /* rows left out do not count; a constant, or too few rows, is in step */
     for (size_t i = 0U; i < data.n; ++i) {
@@ -324,22 +327,20 @@ static void test_time_in_step_with_the_pose(void)
     }
     data.s[3].temp_c = (double)NAN;
     data.flags[3] = (uint8_t)DHC_SAMPLE_OUTLIER;
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_covariate_pose_r2(nj, DHC_COVARIATE_TEMPERATURE,
-                                                    test_read_sample, &data, data.n, data.flags,
-                                                    &ne, &fac, &r2));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_covariate_pose_r2(nj, DHC_COVARIATE_TEMPERATURE, test_read_sample,
+                                                    &data, data.n, data.flags, &ne, &fac, &r2));
     TEST_ASSERT_EQUAL_DOUBLE(1.0, r2);
     r2 = 0.0;
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_covariate_pose_r2(nj, DHC_COVARIATE_TIME, test_read_sample,
-                                                    &data, 1U + 2U * nj, data.flags, &ne, &fac,
-                                                    &r2));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_covariate_pose_r2(nj, DHC_COVARIATE_TIME, test_read_sample, &data,
+                                                    1U + 2U * nj, data.flags, &ne, &fac, &r2));
     TEST_ASSERT_EQUAL_DOUBLE(1.0, r2);
     data.flags[3] = (uint8_t)DHC_SAMPLE_USED;
     TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE,
                       dhc_covariate_pose_r2(nj, DHC_COVARIATE_TEMPERATURE, test_read_sample, &data,
                                             data.n, data.flags, &ne, &fac, &r2));
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
-                      dhc_covariate_pose_r2(0U, DHC_COVARIATE_TIME, test_read_sample, &data,
-                                            data.n, data.flags, &ne, &fac, &r2));
+                      dhc_covariate_pose_r2(0U, DHC_COVARIATE_TIME, test_read_sample, &data, data.n,
+                                            data.flags, &ne, &fac, &r2));
     /* the candidate list follows the scope */
     TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &m));
     dhc_candidate cands[DHC_MAX_CANDIDATES];
@@ -348,14 +349,14 @@ static void test_time_in_step_with_the_pose(void)
     size_t thermal = 0U;
     const size_t nc = dhc_diagnose_candidates(&m, &set, &timed, cands, DHC_MAX_CANDIDATES);
     for (size_t i = 0U; i < nc; ++i) {
-        drift += cands[i].effect == DHC_EFFECT_DRIFT_SCALE ||
-                 cands[i].effect == DHC_EFFECT_DRIFT_OFFSET;
+        drift +=
+            cands[i].effect == DHC_EFFECT_DRIFT_SCALE || cands[i].effect == DHC_EFFECT_DRIFT_OFFSET;
         thermal += cands[i].effect == DHC_EFFECT_THERMAL_SCALE;
     }
     TEST_ASSERT_EQUAL(2U, drift);
     TEST_ASSERT_EQUAL(1U, thermal);
-    const size_t nc0 = dhc_diagnose_candidates(&m, &set, &test_no_covariates, cands,
-                                               DHC_MAX_CANDIDATES);
+    const size_t nc0 =
+        dhc_diagnose_candidates(&m, &set, &test_no_covariates, cands, DHC_MAX_CANDIDATES);
     TEST_ASSERT_EQUAL(nc - 3U, nc0);
 }
 

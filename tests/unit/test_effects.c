@@ -27,11 +27,11 @@ typedef struct {
 } documented_effect;
 
 static const documented_effect DOCUMENTED[] = {
-    {"base_frame", 0, 6},       {"tool_offset", 0, 3},        {"joint_scale", 1, 1},
-    {"joint_harmonic", 1, 2},   {"joint_harmonic2", 1, 2},    {"joint_harmonic3", 1, 2},
-    {"joint_harmonic4", 1, 2},  {"joint_backlash", 1, 1},     {"joint_compliance", 1, -1},
-    {"measurer_scale", 0, 1},   {"measurer_offset", 0, 3},    {"measurer_anchors", 0, 9},
-    {"thermal_scale", 0, 1},    {"drift_scale", 0, 1},        {"drift_offset", 0, 3},
+    {"base_frame", 0, 6},      {"tool_offset", 0, 3},     {"joint_scale", 1, 1},
+    {"joint_harmonic", 1, 2},  {"joint_harmonic2", 1, 2}, {"joint_harmonic3", 1, 2},
+    {"joint_harmonic4", 1, 2}, {"joint_backlash", 1, 1},  {"joint_compliance", 1, -1},
+    {"measurer_scale", 0, 1},  {"measurer_offset", 0, 3}, {"measurer_anchors", 0, 9},
+    {"thermal_scale", 0, 1},   {"drift_scale", 0, 1},     {"drift_offset", 0, 3},
 };
 #define N_DOCUMENTED (sizeof DOCUMENTED / sizeof DOCUMENTED[0])
 
@@ -57,8 +57,8 @@ static dhc_model catalogue_model(void)
 /* What a data set may lack (one at a time), as the table's DHC_NEEDS_* bits. */
 typedef struct {
     unsigned lacking;
-    size_t joint;   /* the joint whose angle range or directions are lacking */
-    uint8_t kind;   /* dhc_meas_kind of every sample */
+    size_t joint; /* the joint whose angle range or directions are lacking */
+    uint8_t kind; /* dhc_meas_kind of every sample */
 } data_spec;
 
 static dhc_sample sample_of(test_rng *rng, const dhc_model *m, const data_spec *spec)
@@ -168,7 +168,8 @@ static void test_every_name_parses_back_to_its_effect(void)
                                   dhc_effect_parse(name, strlen(name), N_JOINTS, &e, &joint));
             TEST_ASSERT_EQUAL_size_t(0U, joint);
             const size_t n = label_of(name, '1', text, sizeof text);
-            TEST_ASSERT_EQUAL_INT(DHC_ERR_ARGUMENT, dhc_effect_parse(text, n, N_JOINTS, &e, &joint));
+            TEST_ASSERT_EQUAL_INT(DHC_ERR_ARGUMENT,
+                                  dhc_effect_parse(text, n, N_JOINTS, &e, &joint));
         }
         TEST_ASSERT_EQUAL_STRING(name, dhc_effect_name(e));
     }
@@ -189,8 +190,8 @@ static void test_labels_parse_back_and_fit_their_buffer(void)
             TEST_ASSERT_EQUAL_size_t(strlen(label), len);
             dhc_effect parsed;
             size_t parsed_joint;
-            TEST_ASSERT_EQUAL(DHC_OK, dhc_effect_parse(label, len, DHC_MAX_JOINTS, &parsed,
-                                                       &parsed_joint));
+            TEST_ASSERT_EQUAL(DHC_OK,
+                              dhc_effect_parse(label, len, DHC_MAX_JOINTS, &parsed, &parsed_joint));
             TEST_ASSERT_EQUAL(effect, parsed);
             TEST_ASSERT_EQUAL_size_t(dhc_effect_is_per_joint(effect) ? joint : 0U, parsed_joint);
         }
@@ -234,7 +235,8 @@ static void test_parameter_counts_are_the_independent_columns_of_the_jacobian(vo
         }
     }
     TEST_ASSERT_EQUAL_size_t(8U + 6U * 7U, checked);
-    TEST_ASSERT_EQUAL_size_t(0U, dhc_effect_param_count(DHC_EFFECT_JOINT_SCALE, N_JOINTS, N_JOINTS));
+    TEST_ASSERT_EQUAL_size_t(0U,
+                             dhc_effect_param_count(DHC_EFFECT_JOINT_SCALE, N_JOINTS, N_JOINTS));
     TEST_ASSERT_EQUAL_size_t(0U, dhc_effect_param_count(DHC_EFFECT_COUNT, N_JOINTS, 0U));
 }
 

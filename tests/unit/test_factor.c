@@ -67,8 +67,8 @@ static double max_abs(const dhc_mat *a)
 }
 
 /* (P^T A P)_ij = sum_{m < rank} L_im L_jm, for every i, j (the remainder is rounding). */
-static void assert_reconstructs(const dhc_mat *a, const dhc_mat *l, const size_t *perm,
-                                size_t rank, double rel_tol)
+static void assert_reconstructs(const dhc_mat *a, const dhc_mat *l, const size_t *perm, size_t rank,
+                                double rel_tol)
 {
     const size_t n = a->rows;
     const double tol = rel_tol * max_abs(a);
@@ -111,8 +111,7 @@ static dhc_tri transposed_layout(const dhc_mat *a, size_t n, double *block, doub
 
 static double tri_entry(const dhc_tri *t, size_t i, size_t m)
 {
-    return m == i ? t->diag[i * t->diag_stride]
-                  : t->off[i * t->row_stride + m * t->col_stride];
+    return m == i ? t->diag[i * t->diag_stride] : t->off[i * t->row_stride + m * t->col_stride];
 }
 
 /* The diagonal of A^-1 by Gauss-Jordan elimination with partial pivoting on [A | I]. */

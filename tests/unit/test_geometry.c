@@ -90,9 +90,9 @@ static void rodrigues_reference(const double u[3], double t, dhc_mat3 *r)
 
 static void random_frame(dhc_frame *f)
 {
-    const double xyz[3] = {uniform(-500.0, 500.0), uniform(-500.0, 500.0),
-                           uniform(-500.0, 500.0)};
-    const double rpy[3] = {uniform(-TEST_PI, TEST_PI), uniform(-1.5, 1.5), uniform(-TEST_PI, TEST_PI)};
+    const double xyz[3] = {uniform(-500.0, 500.0), uniform(-500.0, 500.0), uniform(-500.0, 500.0)};
+    const double rpy[3] = {uniform(-TEST_PI, TEST_PI), uniform(-1.5, 1.5),
+                           uniform(-TEST_PI, TEST_PI)};
     dhc_frame_from_xyz_rpy(xyz, rpy, f);
 }
 
@@ -210,11 +210,9 @@ static void test_rotation_products_match_explicit_sums(void)
         dhc_rot_apply(&a, v, av);
         dhc_rot_apply_t(&a, v, atv);
         for (size_t i = 0U; i < 3U; ++i) {
-            TEST_ASSERT_DOUBLE_WITHIN(1e-13,
-                                      a.m[i][0] * v[0] + a.m[i][1] * v[1] + a.m[i][2] * v[2],
+            TEST_ASSERT_DOUBLE_WITHIN(1e-13, a.m[i][0] * v[0] + a.m[i][1] * v[1] + a.m[i][2] * v[2],
                                       av[i]);
-            TEST_ASSERT_DOUBLE_WITHIN(1e-13,
-                                      a.m[0][i] * v[0] + a.m[1][i] * v[1] + a.m[2][i] * v[2],
+            TEST_ASSERT_DOUBLE_WITHIN(1e-13, a.m[0][i] * v[0] + a.m[1][i] * v[1] + a.m[2][i] * v[2],
                                       atv[i]);
         }
         for (size_t c = 0U; c < 3U; ++c) {
@@ -354,7 +352,7 @@ static void test_rot_log_is_accurate_near_pi(void)
 
 static void test_rot_log_at_exactly_pi_gives_either_sign(void)
 {
-    const double axes[][3] = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0},
+    const double axes[][3] = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0},  {0.0, 0.0, 1.0},
                               {0.6, 0.0, 0.8}, {0.0, -0.8, 0.6}, {0.48, 0.6, -0.64}};
     for (size_t i = 0U; i < sizeof axes / sizeof axes[0]; ++i) {
         dhc_mat3 r;
@@ -398,7 +396,8 @@ static void test_rpy_is_z_then_y_then_x_product(void)
 static void test_rpy_round_trips(void)
 {
     for (int trial = 0; trial < 200; ++trial) {
-        const double rpy[3] = {uniform(-TEST_PI, TEST_PI), uniform(-TEST_PI / 2.0 + 1e-3, TEST_PI / 2.0 - 1e-3),
+        const double rpy[3] = {uniform(-TEST_PI, TEST_PI),
+                               uniform(-TEST_PI / 2.0 + 1e-3, TEST_PI / 2.0 - 1e-3),
                                uniform(-TEST_PI, TEST_PI)};
         dhc_mat3 r;
         double back[3];
@@ -460,8 +459,8 @@ static void test_quat_round_trips_through_every_branch(void)
         double q[4];
         dhc_quat_from_rot(&r, q);
         TEST_ASSERT_TRUE(q[0] >= 0.0);
-        TEST_ASSERT_DOUBLE_WITHIN(1e-15,
-                                  1.0, sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]));
+        TEST_ASSERT_DOUBLE_WITHIN(1e-15, 1.0,
+                                  sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]));
         dhc_mat3 again;
         TEST_ASSERT_EQUAL(DHC_OK, dhc_rot_from_quat(q, &again));
         assert_rot(&r, &again, 1e-14);

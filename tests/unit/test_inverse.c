@@ -187,8 +187,7 @@ static void test_nominal_paper_arm_agrees_with_its_closed_form(void)
         TEST_ASSERT_EQUAL(DHC_OK, dhc_model_tool_point(&m, q_true, NULL, target));
         double closed[3];
         const double reach = 400.0 * cos(q_true[1]) + 345.0 * cos(q_true[1] + q_true[2]);
-        paper3_closed_form(&m.arm, target, reach > 0.0 ? 1 : -1, q_true[2] > 0.0 ? 1 : -1,
-                           closed);
+        paper3_closed_form(&m.arm, target, reach > 0.0 ? 1 : -1, q_true[2] > 0.0 ? 1 : -1, closed);
         dhc_sample s = sample_of(&m, q_true, DHC_MEAS_POSITION);
         dhc_vec3_copy(target, s.p_mm);
         for (size_t i = 0U; i < 3U; ++i) {

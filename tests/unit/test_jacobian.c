@@ -99,8 +99,8 @@ static void check_arm_against_fd(const dhc_arm *arm, const double *q)
     TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&jac, 6U, set.count, buf, 6U * DHC_MAX_PARAMS));
     double p[3];
     dhc_mat3 rot;
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_identification_jacobian(arm, &set, q, DHC_MAX_JOINTS, 1, &jac,
-                                                          p, &rot));
+    TEST_ASSERT_EQUAL(DHC_OK,
+                      dhc_identification_jacobian(arm, &set, q, DHC_MAX_JOINTS, 1, &jac, p, &rot));
     for (size_t k = 0U; k < set.count; ++k) {
         /* Steps sized to each unit: rad for angles, mm for lengths. */
         const double h = dhc_params_is_angle(&set, k) ? 1e-6 : 1e-4;
@@ -166,8 +166,10 @@ static void test_position_only_rows_equal_the_first_three_pose_rows(void)
     TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&j6, 6U, set.count, b6, 6U * DHC_MAX_PARAMS));
     TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&j3, 3U, set.count, b3, 3U * DHC_MAX_PARAMS));
     const double q[DHC_MAX_JOINTS] = {0.3, -1.2, 2.0, 0.7, -0.4};
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_identification_jacobian(&arm, &set, q, DHC_MAX_JOINTS, 1, &j6, NULL, NULL));
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_identification_jacobian(&arm, &set, q, DHC_MAX_JOINTS, 0, &j3, NULL, NULL));
+    TEST_ASSERT_EQUAL(
+        DHC_OK, dhc_identification_jacobian(&arm, &set, q, DHC_MAX_JOINTS, 1, &j6, NULL, NULL));
+    TEST_ASSERT_EQUAL(
+        DHC_OK, dhc_identification_jacobian(&arm, &set, q, DHC_MAX_JOINTS, 0, &j3, NULL, NULL));
     for (size_t r = 0U; r < 3U; ++r) {
         for (size_t c = 0U; c < set.count; ++c) {
             TEST_ASSERT_EQUAL_DOUBLE(DHC_MAT_AT(&j6, r, c), DHC_MAT_AT(&j3, r, c));
@@ -222,19 +224,19 @@ static void test_rejects_bad_shapes_and_non_finite_angles(void)
     dhc_mat jac;
     double q[DHC_MAX_JOINTS] = {0.1, 0.2, 0.3};
     TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&jac, 6U, set.count, buf, 6U * DHC_MAX_PARAMS));
-    TEST_ASSERT_EQUAL(DHC_ERR_DIMENSION,
-                      dhc_identification_jacobian(&arm, &set, q, DHC_MAX_JOINTS, 0, &jac, NULL, NULL));
+    TEST_ASSERT_EQUAL(DHC_ERR_DIMENSION, dhc_identification_jacobian(&arm, &set, q, DHC_MAX_JOINTS,
+                                                                     0, &jac, NULL, NULL));
     TEST_ASSERT_EQUAL(DHC_ERR_DIMENSION,
                       dhc_identification_jacobian(&arm, &set, q, 2U, 1, &jac, NULL, NULL));
     TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&jac, 6U, set.count - 1U, buf, 6U * DHC_MAX_PARAMS));
-    TEST_ASSERT_EQUAL(DHC_ERR_DIMENSION,
-                      dhc_identification_jacobian(&arm, &set, q, DHC_MAX_JOINTS, 1, &jac, NULL, NULL));
+    TEST_ASSERT_EQUAL(DHC_ERR_DIMENSION, dhc_identification_jacobian(&arm, &set, q, DHC_MAX_JOINTS,
+                                                                     1, &jac, NULL, NULL));
     TEST_ASSERT_EQUAL(DHC_OK, dhc_mat_init(&jac, 6U, set.count, buf, 6U * DHC_MAX_PARAMS));
     q[1] = (double)NAN;
-    TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE,
-                      dhc_identification_jacobian(&arm, &set, q, DHC_MAX_JOINTS, 1, &jac, NULL, NULL));
-    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
-                      dhc_identification_jacobian(&arm, NULL, q, DHC_MAX_JOINTS, 1, &jac, NULL, NULL));
+    TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, dhc_identification_jacobian(&arm, &set, q, DHC_MAX_JOINTS,
+                                                                     1, &jac, NULL, NULL));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_identification_jacobian(&arm, NULL, q, DHC_MAX_JOINTS,
+                                                                    1, &jac, NULL, NULL));
 }
 
 static void test_non_finite_geometry_is_reported_not_returned(void)
@@ -259,16 +261,16 @@ static void test_non_finite_geometry_is_reported_not_returned(void)
             broken.joint[1].a_mm = 1e308;
         }
         double tool[3] = {-1.0, -1.0, -1.0};
-        TEST_ASSERT_EQUAL(DHC_ERR_NONFINITE, dhc_identification_jacobian(&broken, &set, q,
-                                                                         DHC_MAX_JOINTS, 1, &jac,
-                                                                         tool, NULL));
+        TEST_ASSERT_EQUAL(
+            DHC_ERR_NONFINITE,
+            dhc_identification_jacobian(&broken, &set, q, DHC_MAX_JOINTS, 1, &jac, tool, NULL));
         for (size_t k = 0U; k < 6U * set.count; ++k) {
             TEST_ASSERT_TRUE(buf[k] >= 0.0 && buf[k] <= 0.0);
         }
         TEST_ASSERT_TRUE(tool[0] >= -1.0 && tool[0] <= -1.0);
     }
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_identification_jacobian(&arm, &set, q, DHC_MAX_JOINTS, 1, &jac,
-                                                          NULL, NULL));
+    TEST_ASSERT_EQUAL(
+        DHC_OK, dhc_identification_jacobian(&arm, &set, q, DHC_MAX_JOINTS, 1, &jac, NULL, NULL));
 }
 
 int main(void)

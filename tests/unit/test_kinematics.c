@@ -38,8 +38,8 @@ static void paper_link_matrix(double theta, double d, double a, double alpha, do
                       {0.0, sa, ca, d},
                       {0.0, 0.0, 0.0, 1.0}}};
     const double cb = cos(beta), sb = sin(beta);
-    const mat4 ry = {{{cb, 0.0, sb, 0.0}, {0.0, 1.0, 0.0, 0.0}, {-sb, 0.0, cb, 0.0},
-                      {0.0, 0.0, 0.0, 1.0}}};
+    const mat4 ry = {
+        {{cb, 0.0, sb, 0.0}, {0.0, 1.0, 0.0, 0.0}, {-sb, 0.0, cb, 0.0}, {0.0, 0.0, 0.0, 1.0}}};
     mat4_mul(&dh, &ry, out);
 }
 
@@ -135,8 +135,8 @@ static void test_forward_frames_trig_matches_paper_per_frame(void)
             const dhc_joint *j = &arm.joint[i];
             const double phi = q[i] + j->theta_offset_rad;
             const double u_local[3] = {cos(phi), sin(phi), 0.0};
-            const double v_local[3] = {-sin(phi) * cos(j->alpha_rad),
-                                       cos(phi) * cos(j->alpha_rad), sin(j->alpha_rad)};
+            const double v_local[3] = {-sin(phi) * cos(j->alpha_rad), cos(phi) * cos(j->alpha_rad),
+                                       sin(j->alpha_rad)};
             for (size_t r = 0U; r < 3U; ++r) {
                 double u = 0.0;
                 double v = 0.0;
@@ -149,8 +149,7 @@ static void test_forward_frames_trig_matches_paper_per_frame(void)
             }
             mat4 a;
             mat4 next;
-            paper_link_matrix(phi, scale * j->d_mm, scale * j->a_mm, j->alpha_rad, j->beta_rad,
-                              &a);
+            paper_link_matrix(phi, scale * j->d_mm, scale * j->a_mm, j->alpha_rad, j->beta_rad, &a);
             mat4_mul(&t, &a, &next);
             t = next;
             for (size_t r = 0U; r < 3U; ++r) {
@@ -161,9 +160,9 @@ static void test_forward_frames_trig_matches_paper_per_frame(void)
             }
         }
         for (size_t r = 0U; r < 3U; ++r) {
-            const double expect = scale * (t.m[r][0] * arm.tool_mm[0] +
-                                           t.m[r][1] * arm.tool_mm[1] +
-                                           t.m[r][2] * arm.tool_mm[2]) + t.m[r][3];
+            const double expect = scale * (t.m[r][0] * arm.tool_mm[0] + t.m[r][1] * arm.tool_mm[1] +
+                                           t.m[r][2] * arm.tool_mm[2]) +
+                                  t.m[r][3];
             TEST_ASSERT_DOUBLE_WITHIN(1e-9, expect, p[r]);
         }
     }
@@ -217,7 +216,8 @@ static void test_forward_frames_lists_every_link_frame(void)
     for (size_t r = 0U; r < 3U; ++r) {
         TEST_ASSERT_DOUBLE_WITHIN(1e-9, expect.pos[r], frames[4].pos[r]);
     }
-    TEST_ASSERT_EQUAL(DHC_ERR_DIMENSION, dhc_forward_frames(&arm, q, DHC_MAX_JOINTS, frames, 4U, p));
+    TEST_ASSERT_EQUAL(DHC_ERR_DIMENSION,
+                      dhc_forward_frames(&arm, q, DHC_MAX_JOINTS, frames, 4U, p));
     TEST_ASSERT_EQUAL(DHC_ERR_DIMENSION, dhc_forward_frames(&arm, q, 3U, frames, 5U, p));
 }
 
@@ -251,7 +251,8 @@ static void test_standard_dh_of_a_dh_arm_is_itself(void)
     dhc_arm out;
     TEST_ASSERT_EQUAL(DHC_OK, dhc_arm_to_standard_dh(&truth, &out));
     for (size_t i = 0U; i < 6U; ++i) {
-        TEST_ASSERT_DOUBLE_WITHIN(1e-9, truth.joint[i].theta_offset_rad, out.joint[i].theta_offset_rad);
+        TEST_ASSERT_DOUBLE_WITHIN(1e-9, truth.joint[i].theta_offset_rad,
+                                  out.joint[i].theta_offset_rad);
         TEST_ASSERT_DOUBLE_WITHIN(1e-7, truth.joint[i].d_mm, out.joint[i].d_mm);
         TEST_ASSERT_DOUBLE_WITHIN(1e-9, truth.joint[i].a_mm, out.joint[i].a_mm);
         TEST_ASSERT_DOUBLE_WITHIN(1e-12, truth.joint[i].alpha_rad, out.joint[i].alpha_rad);

@@ -20,7 +20,6 @@ void tearDown(void) {}
 
 /* ---------------------------------------------------------------- helpers */
 
-
 static void assert_exact_zero(double x)
 {
     TEST_ASSERT_TRUE_MESSAGE(same_bits(0.0, x), "expected an exact +0.0");
@@ -502,8 +501,8 @@ static void test_accumulation_matches_plain_sums(void)
         }
         for (size_t i = 0U; i < n; ++i) {
             for (size_t j = 0U; j < n; ++j) {
-                TEST_ASSERT_DOUBLE_WITHIN(1e-12 * (1.0 + fabs(plain[i * n + j])),
-                                          plain[i * n + j], ne.jtj[i * n + j]);
+                TEST_ASSERT_DOUBLE_WITHIN(1e-12 * (1.0 + fabs(plain[i * n + j])), plain[i * n + j],
+                                          ne.jtj[i * n + j]);
                 TEST_ASSERT_TRUE(same_bits(ne.jtj[i * n + j], ne.jtj[j * n + i]));
             }
             TEST_ASSERT_DOUBLE_WITHIN(1e-12 * (1.0 + fabs(g[i])), g[i], ne.jtr[i]);

@@ -146,7 +146,7 @@ static void test_dense_ops_reject_bad_shapes_without_writing(void)
         buf_b[i] = 1.0;
     }
     fill_sentinel(buf_c, 4U + GUARD);
-    TEST_ASSERT_EQUAL(DHC_ERR_DIMENSION, dhc_mat_mul(&a, &b, &c)); /* 2x3 * 2x3 */
+    TEST_ASSERT_EQUAL(DHC_ERR_DIMENSION, dhc_mat_mul(&a, &b, &c));  /* 2x3 * 2x3 */
     TEST_ASSERT_EQUAL(DHC_ERR_DIMENSION, dhc_mat_tmul(&a, &b, &c)); /* gives 3x3, not 2x2 */
     TEST_ASSERT_EQUAL(DHC_ERR_DIMENSION, dhc_mat_transpose(&a, &c));
     TEST_ASSERT_EQUAL(DHC_ERR_DIMENSION, dhc_mat_transpose(&a, &b));

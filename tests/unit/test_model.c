@@ -66,9 +66,9 @@ static void test_gravity_moments_of_the_paper_arm_match_the_closed_form(void)
  * UR10 (CB3) DH table; the cross-products are checked against a dot-product closed form. */
 static void test_a_weight_on_the_axis_has_no_moment_about_it(void)
 {
-    static const test_dh_row ur10[6] = {{90.0, 0.0, 127.3},     {0.0, -612.0, 0.0},
-                                        {0.0, -572.3, 0.0},     {90.0, 0.0, 163.941},
-                                        {-90.0, 0.0, 115.7},    {0.0, 0.0, 92.2}};
+    static const test_dh_row ur10[6] = {{90.0, 0.0, 127.3},  {0.0, -612.0, 0.0},
+                                        {0.0, -572.3, 0.0},  {90.0, 0.0, 163.941},
+                                        {-90.0, 0.0, 115.7}, {0.0, 0.0, 92.2}};
     dhc_arm arm;
     test_arm_from_table(&arm, ur10, 6U, 0.0);
     const dhc_model m = test_model_of(&arm);
@@ -85,8 +85,8 @@ static void test_a_weight_on_the_axis_has_no_moment_about_it(void)
         }
         /* joint 2 carries the upper arm: -(horizontal reach of o_3 from axis 2) along y */
         dhc_frame f[DHC_MAX_JOINTS + 1U];
-        TEST_ASSERT_EQUAL(DHC_OK, dhc_forward_frames(&m.arm, q, DHC_MAX_JOINTS, f,
-                                                     DHC_MAX_JOINTS + 1U, NULL));
+        TEST_ASSERT_EQUAL(
+            DHC_OK, dhc_forward_frames(&m.arm, q, DHC_MAX_JOINTS, f, DHC_MAX_JOINTS + 1U, NULL));
         double z[3];
         dhc_rot_column(&f[1].rot, 2U, z);
         const double lx = f[2].pos[0] - f[1].pos[0];
@@ -183,8 +183,8 @@ static void test_wire_lengths_are_scaled_distances_plus_offsets(void)
     dhc_prediction pred;
     TEST_ASSERT_EQUAL(DHC_OK, dhc_model_predict(&m, &s, &pred));
     /* T_Meas = x 1300, yaw 180 deg: anchor (0, y, z) sits at (1300, -y, z) in the world. */
-    const double world[3][3] = {{1300.0, 0.0, 1200.0}, {1300.0, -600.0, 300.0},
-                                {1300.0, 600.0, 300.0}};
+    const double world[3][3] = {
+        {1300.0, 0.0, 1200.0}, {1300.0, -600.0, 300.0}, {1300.0, 600.0, 300.0}};
     for (size_t k = 0U; k < 3U; ++k) {
         const double dx = pred.p_mm[0] - world[k][0];
         const double dy = pred.p_mm[1] - world[k][1];
@@ -229,8 +229,8 @@ static size_t check_columns(const dhc_model *m, const dhc_sample *s, int skip_ge
     size_t checked = 0U;
     static double delta[DHC_MAX_PARAMS];
     for (size_t k = 0U; k < set.count; ++k) {
-        const int length_like = set.id[k].kind <= (uint8_t)DHC_P_TOOL_Z ||
-                                set.id[k].kind == (uint8_t)DHC_P_THERMAL;
+        const int length_like =
+            set.id[k].kind <= (uint8_t)DHC_P_TOOL_Z || set.id[k].kind == (uint8_t)DHC_P_THERMAL;
         if (skip_geometric && length_like) {
             continue;
         }
@@ -239,7 +239,7 @@ static size_t check_columns(const dhc_model *m, const dhc_sample *s, int skip_ge
         const double h = set.id[k].kind == (uint8_t)DHC_P_COMPLIANCE ||
                                  set.id[k].kind == (uint8_t)DHC_P_DRIFT_SCALE
                              ? 1e-9
-                         : set.id[k].kind == (uint8_t)DHC_P_THERMAL   ? 1e-7
+                         : set.id[k].kind == (uint8_t)DHC_P_THERMAL ? 1e-7
                          : set.id[k].kind == (uint8_t)DHC_P_JOINT_SCALE ||
                                  set.id[k].kind == (uint8_t)DHC_P_MEAS_SCALE
                              ? 1e-7
@@ -383,14 +383,15 @@ static void test_pose_residual_slope_matches_differences_of_the_residual(void)
                     delta[c] = c == k ? (double)sign * h : 0.0;
                 }
                 TEST_ASSERT_EQUAL(DHC_OK, dhc_params_apply(&set, &moved, delta, set.count));
-                TEST_ASSERT_EQUAL(DHC_OK,
-                                  dhc_model_residual(&moved, &s, weight, sign > 0 ? rp : rm, &rows));
+                TEST_ASSERT_EQUAL(
+                    DHC_OK, dhc_model_residual(&moved, &s, weight, sign > 0 ? rp : rm, &rows));
             }
             for (size_t r = 3U; r < 6U; ++r) {
                 const double fd = -(rp[r] - rm[r]) / (2.0 * h); /* residual falls as pred rises */
                 const double tol = 1e-5 * (fabs(fd) + weight);
                 TEST_ASSERT_DOUBLE_WITHIN(tol, fd, DHC_MAT_AT(&jac, r, k));
-                worst_plain = fmax(worst_plain, fabs(fd - plain[r * set.count + k]) / (fabs(fd) + weight));
+                worst_plain =
+                    fmax(worst_plain, fabs(fd - plain[r * set.count + k]) / (fabs(fd) + weight));
             }
         }
     }
@@ -451,11 +452,13 @@ static void test_effect_names_parse_and_print(void)
     (void)dhc_params_name(&set, 2U + 5U, name, sizeof name);
     TEST_ASSERT_EQUAL_STRING("anchor2_z", name);
     /* all-or-nothing: a repeated effect adds nothing */
-    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_params_add_effect(&set, &m, DHC_EFFECT_JOINT_COMPLIANCE, 1U));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
+                      dhc_params_add_effect(&set, &m, DHC_EFFECT_JOINT_COMPLIANCE, 1U));
     TEST_ASSERT_EQUAL(11U, set.count);
     dhc_model bare = m;
     bare.measurer.present = 0;
-    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_params_add_effect(&set, &bare, DHC_EFFECT_MEASURER_SCALE, 0U));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
+                      dhc_params_add_effect(&set, &bare, DHC_EFFECT_MEASURER_SCALE, 0U));
 }
 
 static void test_bad_samples_are_refused(void)

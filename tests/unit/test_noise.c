@@ -53,7 +53,8 @@ static void fit_and_diagnose(const dhc_calib_options *opt, const dhc_diagnose_op
     TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, fitted));
     TEST_ASSERT_EQUAL(DHC_OK, dhc_calib_fit(fitted, &set, test_read_sample, &data, data.n,
                                             data.flags, opt, &cws, r));
-    size_t nc = dhc_diagnose_candidates(fitted, &set, &test_no_covariates, cands, DHC_MAX_CANDIDATES);
+    size_t nc =
+        dhc_diagnose_candidates(fitted, &set, &test_no_covariates, cands, DHC_MAX_CANDIDATES);
     if (first_catalogue_only) {
         size_t kept = 0U;
         for (size_t c = 0U; c < nc; ++c) {
@@ -63,9 +64,9 @@ static void fit_and_diagnose(const dhc_calib_options *opt, const dhc_diagnose_op
         }
         nc = kept;
     }
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_diagnose(fitted, &set, r->identifiable, r->sigma * r->sigma,
-                                           cands, nc, test_read_sample, &data, data.n,
-                                           data.flags, dopt, &dws, &diag));
+    TEST_ASSERT_EQUAL(DHC_OK,
+                      dhc_diagnose(fitted, &set, r->identifiable, r->sigma * r->sigma, cands, nc,
+                                   test_read_sample, &data, data.n, data.flags, dopt, &dws, &diag));
 }
 
 static void simulate_positions(uint64_t seed)
@@ -93,19 +94,19 @@ static uint64_t bits(double x)
  * standard errors, sigma, RMS, and the best candidate's log10 p and explained sum of
  * squares. */
 static const uint64_t GOLDEN_VALUE[12] = {
-    0x3f6c7a911e432261ULL, 0x407b16615e8423cbULL, 0x3f8478eae469f456ULL,
-    0x3ff921edd9290bfbULL, 0x3ef16ab2b4d953feULL, 0x3f4bcdf2f8a6099fULL,
-    0x4078fb27a0cb92f8ULL, 0xbee44d4361743d86ULL, 0xbef4dc47ca8cd0a8ULL,
-    0xbf6bcee4c596e760ULL, 0x407597f60144afa5ULL, 0x0000000000000000ULL,
+    0x3f6c7a911e432261ULL, 0x407b16615e8423cbULL, 0x3f8478eae469f456ULL, 0x3ff921edd9290bfbULL,
+    0x3ef16ab2b4d953feULL, 0x3f4bcdf2f8a6099fULL, 0x4078fb27a0cb92f8ULL, 0xbee44d4361743d86ULL,
+    0xbef4dc47ca8cd0a8ULL, 0xbf6bcee4c596e760ULL, 0x407597f60144afa5ULL, 0x0000000000000000ULL,
 };
 static const uint64_t GOLDEN_STD[12] = {
-    0x3ef089a0c7e57f94ULL, 0x3f7d4652c21ec121ULL, 0x3f7d4652c0e80141ULL,
-    0x3ef96b7bdec594ccULL, 0x3ef2b262ad739aafULL, 0x3f00b4c01d82eceaULL,
-    0x3f7d3111b51cb926ULL, 0x3ef7fbdc327f7c4eULL, 0x3efa594f66ec44a1ULL,
-    0x3f80e652b2edecc7ULL, 0x3f7788bd5bd73988ULL, 0x0000000000000000ULL,
+    0x3ef089a0c7e57f94ULL, 0x3f7d4652c21ec121ULL, 0x3f7d4652c0e80141ULL, 0x3ef96b7bdec594ccULL,
+    0x3ef2b262ad739aafULL, 0x3f00b4c01d82eceaULL, 0x3f7d3111b51cb926ULL, 0x3ef7fbdc327f7c4eULL,
+    0x3efa594f66ec44a1ULL, 0x3f80e652b2edecc7ULL, 0x3f7788bd5bd73988ULL, 0x0000000000000000ULL,
 };
 static const uint64_t GOLDEN_SCALARS[4] = {
-    0x3fa68266bbfde18aULL, 0x3fb2e37f8e2fe9e7ULL, 0xbfe41e0293f30375ULL,
+    0x3fa68266bbfde18aULL,
+    0x3fb2e37f8e2fe9e7ULL,
+    0xbfe41e0293f30375ULL,
     0x3f85faaf06fb469dULL,
 };
 
@@ -307,7 +308,8 @@ static double dense_gls_step(dhc_model *m, const uint8_t *use, double *step_norm
         nmat[c][q] = g;
     }
     /* solve with the right-hand side as an extra column (row stride GLS_MAXP + 1) */
-    TEST_ASSERT_TRUE(test_gauss_jordan(&nmat[0][0], q, GLS_MAXP + 1U, GLS_MAXP + 1U) != 0 || q == 0U);
+    TEST_ASSERT_TRUE(test_gauss_jordan(&nmat[0][0], q, GLS_MAXP + 1U, GLS_MAXP + 1U) != 0 ||
+                     q == 0U);
     double delta[GLS_MAXP] = {0.0};
     double norm = 0.0;
     for (size_t c = 0U; c < q; ++c) {
@@ -361,8 +363,7 @@ static void test_whitened_fit_equals_dense_gls(void)
     dhc_model nominal = test_paper3_model();
     TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &nominal));
     TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(&set, &nominal, DHC_EFFECT_JOINT_SCALE, 0U));
-    TEST_ASSERT_EQUAL(DHC_OK,
-                      dhc_params_add_effect(&set, &nominal, DHC_EFFECT_JOINT_HARMONIC, 1U));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(&set, &nominal, DHC_EFFECT_JOINT_HARMONIC, 1U));
     TEST_ASSERT_TRUE(set.count <= GLS_MAXP);
     dhc_calib_options opt;
     dhc_calib_default_options(&opt);
@@ -453,12 +454,13 @@ static void test_bad_noise_models_are_refused(void)
     dhc_diagnose_options dopt;
     dhc_diagnose_default_options(&dopt);
     dopt.noise.joint_rad[0] = 1e-5;
-    const size_t nc = dhc_diagnose_candidates(&m, &set, &test_no_covariates, cands, DHC_MAX_CANDIDATES);
+    const size_t nc =
+        dhc_diagnose_candidates(&m, &set, &test_no_covariates, cands, DHC_MAX_CANDIDATES);
     uint8_t ident[DHC_MAX_PARAMS];
     memset(ident, 1, sizeof ident);
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
-                      dhc_diagnose(&m, &set, ident, 1.0, cands, nc, test_read_sample, &data,
-                                   data.n, data.flags, &dopt, &dws, &diag));
+                      dhc_diagnose(&m, &set, ident, 1.0, cands, nc, test_read_sample, &data, data.n,
+                                   data.flags, &dopt, &dws, &diag));
 }
 
 /* ------------------------------------------------------------ (c) Monte Carlo */

@@ -22,8 +22,7 @@ static void test_base_model_follows_each_joints_convention(void)
     TEST_ASSERT_EQUAL_size_t(4U * m.arm.n_joints, set.count);
     for (size_t j = 0U; j < m.arm.n_joints; ++j) {
         const int hayati = m.arm.joint[j].convention == DHC_CONV_HAYATI;
-        const uint8_t want[4] = {(uint8_t)DHC_P_THETA,
-                                 (uint8_t)(hayati ? DHC_P_BETA : DHC_P_D),
+        const uint8_t want[4] = {(uint8_t)DHC_P_THETA, (uint8_t)(hayati ? DHC_P_BETA : DHC_P_D),
                                  (uint8_t)DHC_P_A, (uint8_t)DHC_P_ALPHA};
         for (size_t k = 0U; k < 4U; ++k) {
             TEST_ASSERT_EQUAL_UINT8(want[k], set.id[4U * j + k].kind);

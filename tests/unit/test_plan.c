@@ -130,8 +130,8 @@ static dhc_model paper_arm(dhc_param_set *set)
     for (size_t k = 0U; k < base.count; ++k) {
         const dhc_param_id *id = &base.id[k];
         if (!(id->kind == (uint8_t)DHC_P_ALPHA && id->joint == 2U)) {
-            TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add(set, &m, (dhc_param_kind)id->kind,
-                                                     id->joint, id->aux));
+            TEST_ASSERT_EQUAL(
+                DHC_OK, dhc_params_add(set, &m, (dhc_param_kind)id->kind, id->joint, id->aux));
         }
     }
     TEST_ASSERT_EQUAL_size_t(base.count - 1U, set->count);
@@ -151,8 +151,8 @@ static void test_observability_is_the_scaled_determinant(void)
     TEST_ASSERT_EQUAL_size_t(set.count, rank); /* the base model: every parameter */
     static double info[DHC_MAX_PARAMS * DHC_MAX_PARAMS];
     information(&m, &set, NULL, n, NULL, info);
-    const double expect = exp(0.5 * log_det(info, set.count) / (double)set.count) /
-                          sqrt(3.0 * (double)n);
+    const double expect =
+        exp(0.5 * log_det(info, set.count) / (double)set.count) / sqrt(3.0 * (double)n);
     TEST_ASSERT_DOUBLE_WITHIN(1e-9 * expect, expect, o1);
 }
 
@@ -206,8 +206,8 @@ static void small_pool_gets_the_best_plan(size_t k, size_t workspace)
     const size_t n = 4U;
     size_t chosen[4];
     dhc_plan_report rep;
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_select(&m, &set, pool_part(k, workspace), n, NULL, &ws,
-                                              chosen, &rep));
+    TEST_ASSERT_EQUAL(
+        DHC_OK, dhc_plan_select(&m, &set, pool_part(k, workspace), n, NULL, &ws, chosen, &rep));
     const size_t p = set.count;
     TEST_ASSERT_EQUAL_size_t(p, rep.identifiable);
     /* W: one candidate's average information (unscaled: the criterion does not depend on
@@ -348,27 +348,25 @@ static void test_what_the_workspace_cannot_weigh_is_refused(void)
     size_t chosen[4];
     dhc_plan_report rep;
     TEST_ASSERT_EQUAL(DHC_ERR_UNDERDETERMINED,
-                      dhc_plan_select(&m, &set, pool_part(12U, 1U), 4U, NULL, &ws, chosen,
-                                      &rep));
+                      dhc_plan_select(&m, &set, pool_part(12U, 1U), 4U, NULL, &ws, chosen, &rep));
     double weights[12];
     dhc_plan_weighting_report best;
-    TEST_ASSERT_EQUAL(DHC_ERR_UNDERDETERMINED,
-                      dhc_plan_weighting(&m, &set, pool_part(12U, 1U), 4U, NULL, weights, &ws,
-                                         &best));
+    TEST_ASSERT_EQUAL(DHC_ERR_UNDERDETERMINED, dhc_plan_weighting(&m, &set, pool_part(12U, 1U), 4U,
+                                                                  NULL, weights, &ws, &best));
     for (size_t i = 0U; i < 3U; ++i) {
         pool[i].q_rad[1] = HUGE_VAL * 0.0; /* NaN: not usable */
     }
-    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_plan_select(&m, &set, pool_part(12U, 3U), 4U, NULL,
-                                                        &ws, chosen, &rep));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
+                      dhc_plan_select(&m, &set, pool_part(12U, 3U), 4U, NULL, &ws, chosen, &rep));
     /* the three NaN candidates among ten where the arm works */
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_select(&m, &set, pool_part(10U, 10U), 4U, NULL, &ws,
-                                              chosen, &rep));
+    TEST_ASSERT_EQUAL(DHC_OK,
+                      dhc_plan_select(&m, &set, pool_part(10U, 10U), 4U, NULL, &ws, chosen, &rep));
     TEST_ASSERT_EQUAL_size_t(7U, rep.usable);
     for (size_t i = 0U; i < 4U; ++i) {
         TEST_ASSERT_TRUE(chosen[i] >= 3U);
     }
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_weighting(&m, &set, pool_part(10U, 10U), 4U, NULL,
-                                                 weights, &ws, &best));
+    TEST_ASSERT_EQUAL(
+        DHC_OK, dhc_plan_weighting(&m, &set, pool_part(10U, 10U), 4U, NULL, weights, &ws, &best));
     for (size_t i = 0U; i < 3U; ++i) {
         TEST_ASSERT_EQUAL_DOUBLE(0.0, weights[i]);
     }
@@ -389,11 +387,10 @@ static void test_plan_beats_random_plans(void)
     size_t again[15];
     dhc_plan_report rep;
     dhc_plan_report rep2;
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_select(&m, &set, pool_of(POOL), n, NULL, &ws,
-                                              chosen, &rep));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_select(&m, &set, pool_of(POOL), n, NULL, &ws, chosen, &rep));
     TEST_ASSERT_TRUE(set.count <= STORE_PARAMS);
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_select(&m, &set, pool_of(POOL), n, store, &ws,
-                                              again, &rep2));
+    TEST_ASSERT_EQUAL(DHC_OK,
+                      dhc_plan_select(&m, &set, pool_of(POOL), n, store, &ws, again, &rep2));
     TEST_ASSERT_EQUAL_MEMORY(chosen, again, sizeof chosen);
     TEST_ASSERT_EQUAL_DOUBLE(rep.o1, rep2.o1);
     TEST_ASSERT_EQUAL_size_t(POOL, rep.usable);
@@ -414,8 +411,8 @@ static void test_plan_beats_random_plans(void)
             } while (!fresh);
         }
         double o1 = 0.0;
-        TEST_ASSERT_EQUAL(DHC_OK,
-                          dhc_plan_observability(&m, &set, read_pool, NULL, idx, n, &ws, &o1, NULL));
+        TEST_ASSERT_EQUAL(
+            DHC_OK, dhc_plan_observability(&m, &set, read_pool, NULL, idx, n, &ws, &o1, NULL));
         best_random = fmax(best_random, o1);
         sum_random += o1;
     }
@@ -440,8 +437,8 @@ static void test_unidentifiable_parameters_are_left_out(void)
     fill_pool(&m, DHC_MEAS_WIRES, 1, 31U);
     size_t chosen[12];
     dhc_plan_report rep;
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_select(&m, &set, pool_of(100U), 12U, NULL, &ws,
-                                              chosen, &rep));
+    TEST_ASSERT_EQUAL(DHC_OK,
+                      dhc_plan_select(&m, &set, pool_of(100U), 12U, NULL, &ws, chosen, &rep));
     TEST_ASSERT_EQUAL_size_t(set.count - 1U, rep.identifiable);
     TEST_ASSERT_EQUAL_size_t(set.count - 1U, rep.rank);
     /* approached from both sides it is identifiable */
@@ -449,8 +446,8 @@ static void test_unidentifiable_parameters_are_left_out(void)
     for (size_t i = 0U; i < 100U; ++i) {
         pool[i].dir[1] = test_uniform(&rng) < 0.5 ? (int8_t)-1 : (int8_t)1;
     }
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_plan_select(&m, &set, pool_of(100U), 12U, NULL, &ws,
-                                              chosen, &rep));
+    TEST_ASSERT_EQUAL(DHC_OK,
+                      dhc_plan_select(&m, &set, pool_of(100U), 12U, NULL, &ws, chosen, &rep));
     TEST_ASSERT_EQUAL_size_t(set.count, rep.identifiable);
 }
 
@@ -461,17 +458,17 @@ static void test_bad_requests_are_refused(void)
     fill_pool(&m, DHC_MEAS_WIRES, 1, 41U);
     size_t chosen[POOL];
     dhc_plan_report rep;
-    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_plan_select(&m, &set, pool_of(10U), 11U,
-                                                        NULL, &ws, chosen, &rep));
-    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_plan_select(&m, &set, pool_of(10U), 0U,
-                                                        NULL, &ws, chosen, &rep));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
+                      dhc_plan_select(&m, &set, pool_of(10U), 11U, NULL, &ws, chosen, &rep));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
+                      dhc_plan_select(&m, &set, pool_of(10U), 0U, NULL, &ws, chosen, &rep));
     /* the reader's own error comes back */
-    TEST_ASSERT_EQUAL(DHC_ERR_NO_DATA, dhc_plan_select(&m, &set, pool_of(POOL + 1U), 5U,
-                                                       NULL, &ws, chosen, &rep));
+    TEST_ASSERT_EQUAL(DHC_ERR_NO_DATA,
+                      dhc_plan_select(&m, &set, pool_of(POOL + 1U), 5U, NULL, &ws, chosen, &rep));
     /* a candidate of another kind (a tool pose among wire samples) */
     dhc_model_sample_at(&m, pool[3].q_rad, pool[3].dir, DHC_MEAS_POSE, &pool[3]);
-    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_plan_select(&m, &set, pool_of(10U), 5U,
-                                                        NULL, &ws, chosen, &rep));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
+                      dhc_plan_select(&m, &set, pool_of(10U), 5U, NULL, &ws, chosen, &rep));
 }
 
 int main(void)

@@ -27,7 +27,6 @@
 #include "dhcal/dhc_params.h"
 #include "unity.h"
 
-
 #if defined(__arm__) && !defined(__linux__)
 #define ROBUST_SCALE 4U /* bare-metal Cortex-M4 under QEMU: a quarter of the cases */
 #else
@@ -119,11 +118,10 @@ static void ref_mul(const ref_frame *a, const ref_frame *b, ref_frame *out)
 {
     for (size_t i = 0U; i < 3U; ++i) {
         for (size_t j = 0U; j < 3U; ++j) {
-            out->r[i][j] = a->r[i][0] * b->r[0][j] + a->r[i][1] * b->r[1][j] +
-                           a->r[i][2] * b->r[2][j];
+            out->r[i][j] =
+                a->r[i][0] * b->r[0][j] + a->r[i][1] * b->r[1][j] + a->r[i][2] * b->r[2][j];
         }
-        out->p[i] = a->r[i][0] * b->p[0] + a->r[i][1] * b->p[1] + a->r[i][2] * b->p[2] +
-                    a->p[i];
+        out->p[i] = a->r[i][0] * b->p[0] + a->r[i][1] * b->p[1] + a->r[i][2] * b->p[2] + a->p[i];
     }
 }
 
@@ -205,8 +203,8 @@ static void ref_predict(const dhc_model *m, const dhc_sample *s, double out[3], 
             const double *g = m->gravity;
             const double c[3] = {l[1] * g[2] - l[2] * g[1], l[2] * g[0] - l[0] * g[2],
                                  l[0] * g[1] - l[1] * g[0]};
-            dq += fx->compliance[j] * (f[i].r[0][2] * c[0] + f[i].r[1][2] * c[1] +
-                                       f[i].r[2][2] * c[2]);
+            dq += fx->compliance[j] *
+                  (f[i].r[0][2] * c[0] + f[i].r[1][2] * c[1] + f[i].r[2][2] * c[2]);
         }
         q_eff[i] = q + dq;
     }
@@ -221,8 +219,8 @@ static void ref_predict(const dhc_model *m, const dhc_sample *s, double out[3], 
     const double dt = s->t_s - m->drift_ref_s;
     for (size_t k = 0U; k < 3U; ++k) {
         const double b = m->arm.base.pos[k];
-        tool->p[k] = b + (1.0 + m->drift_scale_per_s * dt) * (tool->p[k] - b) +
-                     m->drift_mm_per_s[k] * dt;
+        tool->p[k] =
+            b + (1.0 + m->drift_scale_per_s * dt) * (tool->p[k] - b) + m->drift_mm_per_s[k] * dt;
     }
     if (s->kind != (uint8_t)DHC_MEAS_WIRES) {
         memcpy(out, tool->p, sizeof tool->p);
@@ -383,7 +381,7 @@ static void all_kinds(dhc_param_set *s, const dhc_model *m, size_t first)
         TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(s, m, global[e], 0U));
     }
     /* the joint `first` gets every order of harmonic first, then the rest as they fit */
-    const dhc_effect per_joint[7] = {DHC_EFFECT_JOINT_HARMONIC2, DHC_EFFECT_JOINT_HARMONIC4,
+    const dhc_effect per_joint[7] = {DHC_EFFECT_JOINT_HARMONIC2,  DHC_EFFECT_JOINT_HARMONIC4,
                                      DHC_EFFECT_JOINT_COMPLIANCE, DHC_EFFECT_JOINT_SCALE,
                                      DHC_EFFECT_JOINT_HARMONIC,   DHC_EFFECT_JOINT_BACKLASH,
                                      DHC_EFFECT_JOINT_HARMONIC3};
@@ -586,8 +584,7 @@ static dhc_status fit(dhc_model *model, double L)
     }
     opt.orientation_weight_mm_per_rad = L;
     opt.outlier_floor_mm = 1e-6 * L;
-    return dhc_calib_fit(model, &set, test_read_sample, &data, data.n, data.flags, &opt, &ws,
-                         &rep);
+    return dhc_calib_fit(model, &set, test_read_sample, &data, data.n, data.flags, &opt, &ws, &rep);
 }
 
 /* What every fit must give, whatever the data: a documented status; finite numbers
@@ -691,8 +688,8 @@ static void test_fits_stopped_on_their_way_leave_unidentifiable_parameters_untou
         add_errors(&g, &arm, NULL, 1.0, &t);
         t.joint[i].alpha_rad = arm.joint[i].alpha_rad;
         const dhc_model truth = test_model_of(&t);
-        measure(&truth, 40U, c % 2U == 0U ? DHC_MEAS_POSE : DHC_MEAS_POSITION, &g,
-                DHC_MAX_JOINTS, 0.0, 0);
+        measure(&truth, 40U, c % 2U == 0U ? DHC_MEAS_POSE : DHC_MEAS_POSITION, &g, DHC_MAX_JOINTS,
+                0.0, 0);
         for (size_t limit = 1U; limit <= 4U; ++limit) {
             iteration_limit = limit;
             model = nominal;
@@ -802,8 +799,8 @@ static void test_scaling_a_deficient_problem_by_1e6_changes_only_the_units(void)
                 const int angle = dhc_params_is_angle(&set, k);
                 const double unit = angle ? 1.0 : L;
                 /* to the fit's convergence tolerance, not to rounding */
-                TEST_ASSERT_DOUBLE_WITHIN(1e-7 * (1.0 + fabs(unit_rep.value[k])),
-                                          unit_rep.value[k], rep.value[k] / unit);
+                TEST_ASSERT_DOUBLE_WITHIN(1e-7 * (1.0 + fabs(unit_rep.value[k])), unit_rep.value[k],
+                                          rep.value[k] / unit);
             }
         }
     }
@@ -957,8 +954,7 @@ static void test_a_joint_never_moved_confounds_its_offset_and_effects(void)
         const size_t lost = 3U + (j == 0U ? 0U : 4U);
         TEST_ASSERT_EQUAL(set.count - lost, rep.rank);
         const size_t group[4] = {index_of(DHC_P_THETA, j), index_of(DHC_P_JOINT_SCALE, j),
-                                 index_of(DHC_P_HARMONIC_SIN, j),
-                                 index_of(DHC_P_HARMONIC_COS, j)};
+                                 index_of(DHC_P_HARMONIC_SIN, j), index_of(DHC_P_HARMONIC_COS, j)};
         size_t known = 0U;
         for (size_t a = 0U; a < 4U; ++a) {
             known += rep.identifiable[group[a]] ? 1U : 0U;
@@ -1138,7 +1134,8 @@ static void test_columns_of_zeros_are_unidentifiable_without_partners(void)
         measure(&truth, 30U, DHC_MEAS_POSITION, &g, DHC_MAX_JOINTS, 0.0, 0);
         model = nominal;
         TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &model));
-        TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(&set, &model, DHC_EFFECT_THERMAL_SCALE, 0U));
+        TEST_ASSERT_EQUAL(DHC_OK,
+                          dhc_params_add_effect(&set, &model, DHC_EFFECT_THERMAL_SCALE, 0U));
         const dhc_status st = fit(&model, L);
         assert_report_sane(st);
         assert_unidentifiable_untouched(&nominal);
@@ -1184,7 +1181,8 @@ static void test_duplicated_columns_name_each_other(void)
         measure(&truth, 30U, DHC_MEAS_POSE, &g, DHC_MAX_JOINTS, 0.0, 1);
         model = nominal;
         TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &model));
-        TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(&set, &model, DHC_EFFECT_JOINT_BACKLASH, j));
+        TEST_ASSERT_EQUAL(DHC_OK,
+                          dhc_params_add_effect(&set, &model, DHC_EFFECT_JOINT_BACKLASH, j));
         dhc_status st = fit(&model, L);
         assert_report_sane(st);
         assert_unidentifiable_untouched(&nominal);
@@ -1233,8 +1231,8 @@ static void test_duplicated_columns_name_each_other(void)
 
 /* Random k x LSQ_N rows with columns spread over 1e-6 .. 1e6 and, depending on `pattern`,
  * a column of zeros, a scaled copy of another column, or a combination of two. */
-static void random_rows(test_rng *g, double *rows, size_t k, const double *colscale,
-                        int zero_col, int dup_col, int combo_col)
+static void random_rows(test_rng *g, double *rows, size_t k, const double *colscale, int zero_col,
+                        int dup_col, int combo_col)
 {
     for (size_t e = 0U; e < k; ++e) {
         double *row = rows + e * LSQ_N;
@@ -1437,8 +1435,7 @@ static void test_non_finite_samples_stop_the_fit_with_a_status(void)
             TEST_ASSERT_TRUE(dhc_is_finite(v));
             assert_report_sane(st);
             assert_unidentifiable_untouched(&nominal);
-            TEST_ASSERT_TRUE(dhc_sample_is_outlier(data.flags[victim]) ||
-                             rep.rms_mm <= 1e-9);
+            TEST_ASSERT_TRUE(dhc_sample_is_outlier(data.flags[victim]) || rep.rms_mm <= 1e-9);
         } else {
             TEST_ASSERT_TRUE_MESSAGE(st == DHC_ERR_NONFINITE || st == DHC_ERR_ARGUMENT,
                                      dhc_status_str(st));

@@ -9,9 +9,17 @@ void tearDown(void) {}
 
 /* All enumerators, in declaration order; the last one bounds the range. */
 static const dhc_status ALL_STATUSES[] = {
-    DHC_OK,           DHC_ERR_ARGUMENT,        DHC_ERR_DIMENSION,     DHC_ERR_CAPACITY,
-    DHC_ERR_NONFINITE, DHC_ERR_NOT_SPD,        DHC_ERR_SINGULAR,      DHC_ERR_INCONSISTENT,
-    DHC_ERR_UNDERDETERMINED, DHC_ERR_NOT_CONVERGED, DHC_ERR_NO_DATA,
+    DHC_OK,
+    DHC_ERR_ARGUMENT,
+    DHC_ERR_DIMENSION,
+    DHC_ERR_CAPACITY,
+    DHC_ERR_NONFINITE,
+    DHC_ERR_NOT_SPD,
+    DHC_ERR_SINGULAR,
+    DHC_ERR_INCONSISTENT,
+    DHC_ERR_UNDERDETERMINED,
+    DHC_ERR_NOT_CONVERGED,
+    DHC_ERR_NO_DATA,
 };
 #define N_STATUSES (sizeof ALL_STATUSES / sizeof ALL_STATUSES[0])
 
@@ -38,8 +46,8 @@ static void test_phrases_are_distinct(void)
 {
     for (size_t i = 0U; i < N_STATUSES; ++i) {
         for (size_t j = i + 1U; j < N_STATUSES; ++j) {
-            TEST_ASSERT_NOT_EQUAL(0, strcmp(dhc_status_str(ALL_STATUSES[i]),
-                                            dhc_status_str(ALL_STATUSES[j])));
+            TEST_ASSERT_NOT_EQUAL(
+                0, strcmp(dhc_status_str(ALL_STATUSES[i]), dhc_status_str(ALL_STATUSES[j])));
         }
     }
 }

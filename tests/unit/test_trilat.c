@@ -11,7 +11,6 @@
 void setUp(void) {}
 void tearDown(void) {}
 
-
 /* The paper's measurer (docs/formats.md, section 2): anchors (0,0,1200), (0,600,300), (0,-600,300)
  * and T_Meas = xyz (1300, 0, 0), rpy (0, 0, 180 deg). */
 #define PAPER_A 1200.0
@@ -111,8 +110,7 @@ static void hand_frame(double roll, double pitch, double yaw, const double pos[3
 static void hand_apply(const dhc_frame *f, const double p[3], double out[3])
 {
     for (size_t i = 0U; i < 3U; ++i) {
-        out[i] = f->rot.m[i][0] * p[0] + f->rot.m[i][1] * p[1] + f->rot.m[i][2] * p[2] +
-                 f->pos[i];
+        out[i] = f->rot.m[i][0] * p[0] + f->rot.m[i][1] * p[1] + f->rot.m[i][2] * p[2] + f->pos[i];
     }
 }
 
@@ -307,8 +305,8 @@ static void test_world_is_frame_applied_to_local(void)
         local_measurer(PAPER_A, PAPER_B, PAPER_C, 1.0, &m);
         const double pos[3] = {rng_range(&rng, -5000.0, 5000.0), rng_range(&rng, -5000.0, 5000.0),
                                rng_range(&rng, -5000.0, 5000.0)};
-        hand_frame(rng_range(&rng, -TEST_PI, TEST_PI), rng_range(&rng, -1.5, 1.5), rng_range(&rng, -TEST_PI, TEST_PI),
-                   pos, &m.frame);
+        hand_frame(rng_range(&rng, -TEST_PI, TEST_PI), rng_range(&rng, -1.5, 1.5),
+                   rng_range(&rng, -TEST_PI, TEST_PI), pos, &m.frame);
         const double q_local[3] = {rng_range(&rng, 100.0, 1500.0), rng_range(&rng, -900.0, 900.0),
                                    rng_range(&rng, -300.0, 1600.0)};
         double len[3];
@@ -539,10 +537,10 @@ static void test_degenerate_anchors_are_rejected(void)
 {
     const double len[3] = {945.0, 1335.0, 375.0};
     /* a, b, c; collinear anchors or P2 = P3, exactly or to within rounding of the scale. */
-    static const double bad[7][3] = {
-        {300.0, 600.0, 300.0},          {300.0 + 1e-10, 600.0, 300.0}, {1200.0, 0.0, 300.0},
-        {1200.0, -600.0, 300.0},        {1200.0, 1e-7, 300.0},         {0.0, 0.0, 0.0},
-        {1e6 + 1e-4, 600.0, 1e6}};
+    static const double bad[7][3] = {{300.0, 600.0, 300.0},   {300.0 + 1e-10, 600.0, 300.0},
+                                     {1200.0, 0.0, 300.0},    {1200.0, -600.0, 300.0},
+                                     {1200.0, 1e-7, 300.0},   {0.0, 0.0, 0.0},
+                                     {1e6 + 1e-4, 600.0, 1e6}};
     for (size_t i = 0U; i < 7U; ++i) {
         dhc_measurer m;
         paper_measurer(1.0, &m);
@@ -598,16 +596,15 @@ static void test_nonfinite_frame_fails_world_only(void)
     guard_fill(&world);
     TEST_ASSERT_EQUAL_INT(DHC_OK, dhc_trilat_local(&m, len, 0.0, guard_out(&local)));
     assert_guard_cells_intact(&local);
-    TEST_ASSERT_EQUAL_INT(DHC_ERR_NONFINITE,
-                          dhc_trilat_world(&m, len, 0.0, guard_out(&world)));
+    TEST_ASSERT_EQUAL_INT(DHC_ERR_NONFINITE, dhc_trilat_world(&m, len, 0.0, guard_out(&world)));
     assert_untouched(&world);
 }
 
 static void test_x_sign_must_be_exactly_plus_or_minus_one(void)
 {
     const double len[3] = {945.0, 1335.0, 375.0};
-    const double bad[8] = {0.0, 0.5, 2.0, -2.0, (double)NAN, HUGE_VAL, nextafter(1.0, 2.0),
-                           nextafter(-1.0, 0.0)};
+    const double bad[8] = {
+        0.0, 0.5, 2.0, -2.0, (double)NAN, HUGE_VAL, nextafter(1.0, 2.0), nextafter(-1.0, 0.0)};
     for (size_t i = 0U; i < 8U; ++i) {
         dhc_measurer m;
         paper_measurer(bad[i], &m);
@@ -705,8 +702,8 @@ static void test_a_model_measurer_reads_its_own_lengths_back(void)
     m.measurer.offset_mm[0] = 0.5;
     m.measurer.offset_mm[1] = -0.3;
     m.measurer.offset_mm[2] = 0.2;
-    const double anchor_world[3][3] = {{1300.0, 0.0, 1200.0}, {1300.0, -600.0, 300.0},
-                                       {1300.0, 600.0, 300.0}};
+    const double anchor_world[3][3] = {
+        {1300.0, 0.0, 1200.0}, {1300.0, -600.0, 300.0}, {1300.0, 600.0, 300.0}};
     test_rng g = {0x77ULL};
     for (size_t t = 0U; t < 50U; ++t) {
         /* points on the arm's side of the anchor plane (world x < 1300) */

@@ -59,19 +59,18 @@ static void test_one_link_closed_form(void)
         position_sample(&m, &q, &samples[i]);
     }
     const double sigma = 0.05;
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_uncertainty_from_samples(&unc, &m, &set, NULL, read_sample,
-                                                           NULL, n, NULL, 1000.0, sigma));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_uncertainty_from_samples(&unc, &m, &set, NULL, read_sample, NULL,
+                                                           n, NULL, 1000.0, sigma));
     for (double q = -3.0; q <= 3.0; q += 0.7) {
         double var = 0.0;
-        TEST_ASSERT_EQUAL(DHC_OK, dhc_uncertainty_tool_point(&unc, &m, &set, &q, NULL, NULL,
-                                                             &var));
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_uncertainty_tool_point(&unc, &m, &set, &q, NULL, NULL, &var));
         TEST_ASSERT_DOUBLE_WITHIN(1e-12 * 3.0 * sigma * sigma, 3.0 * sigma * sigma / (double)n,
                                   var);
         /* the joint's own noise adds |dp/dq|^2 sd^2 = a^2 sd^2 */
         const double sd = 2e-4;
         double var_q = 0.0;
-        TEST_ASSERT_EQUAL(DHC_OK, dhc_uncertainty_tool_point(&unc, &m, &set, &q, NULL, &sd,
-                                                             &var_q));
+        TEST_ASSERT_EQUAL(DHC_OK,
+                          dhc_uncertainty_tool_point(&unc, &m, &set, &q, NULL, &sd, &var_q));
         TEST_ASSERT_DOUBLE_WITHIN(1e-9 * var_q, var + 400.0 * 400.0 * sd * sd, var_q);
     }
 }
@@ -79,8 +78,8 @@ static void test_one_link_closed_form(void)
 /* ---------------------------------------------------------------- the independent way */
 
 /* The tool point with parameter k moved by h (k = SIZE_MAX: none) and joint jq by hq. */
-static void point_moved(const dhc_model *m, const dhc_param_set *set, size_t k, double h,
-                        size_t jq, double hq, const dhc_sample *s, double p[3])
+static void point_moved(const dhc_model *m, const dhc_param_set *set, size_t k, double h, size_t jq,
+                        double hq, const dhc_sample *s, double p[3])
 {
     static dhc_model moved;
     moved = *m;
@@ -99,8 +98,8 @@ static void point_moved(const dhc_model *m, const dhc_param_set *set, size_t k, 
 }
 
 /* 3 x p Jacobian of the tool point by central differences. */
-static void fd_param_jacobian(const dhc_model *m, const dhc_param_set *set,
-                              const dhc_sample *s, double jac[3][DHC_MAX_PARAMS])
+static void fd_param_jacobian(const dhc_model *m, const dhc_param_set *set, const dhc_sample *s,
+                              double jac[3][DHC_MAX_PARAMS])
 {
     for (size_t k = 0U; k < set->count; ++k) {
         const double h = dhc_params_is_angle(set, k) ? 1e-6 : 1e-4;
@@ -114,8 +113,8 @@ static void fd_param_jacobian(const dhc_model *m, const dhc_param_set *set,
     }
 }
 
-static void fd_joint_jacobian(const dhc_model *m, const dhc_param_set *set,
-                              const dhc_sample *s, double jq[3][DHC_MAX_JOINTS])
+static void fd_joint_jacobian(const dhc_model *m, const dhc_param_set *set, const dhc_sample *s,
+                              double jq[3][DHC_MAX_JOINTS])
 {
     for (size_t j = 0U; j < m->arm.n_joints; ++j) {
         double a[3];
@@ -195,10 +194,8 @@ static void test_table3_arm_against_finite_differences_and_gauss_jordan(void)
     const double *const joint_noise = noise.joint_rad;
     const double meas_noise = noise.meas_mm;
     const double sigma = 1.3; /* unit-free with the noise model on */
-    TEST_ASSERT_EQUAL(DHC_OK,
-                      dhc_uncertainty_from_samples(&unc, &m, &set, use, read_sample, NULL,
-                                                   N_SAMPLES, &noise, 1000.0,
-                                                   sigma));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_uncertainty_from_samples(&unc, &m, &set, use, read_sample, NULL,
+                                                           N_SAMPLES, &noise, 1000.0, sigma));
     /* N = sum_i J_i^T S_i^-1 J_i, S_i = meas^2 I + Jq_i diag(joint^2) Jq_i^T, over the
      * parameters in use */
     static double nmat[DHC_MAX_PARAMS][DHC_MAX_PARAMS];
@@ -256,8 +253,7 @@ static void test_table3_arm_against_finite_differences_and_gauss_jordan(void)
             }
         }
         double got = 0.0;
-        TEST_ASSERT_EQUAL(DHC_OK, dhc_uncertainty_tool_point(&unc, &m, &set, q, NULL, NULL,
-                                                             &got));
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_uncertainty_tool_point(&unc, &m, &set, q, NULL, NULL, &got));
         TEST_ASSERT_TRUE(want > 0.0);
         TEST_ASSERT_DOUBLE_WITHIN(1e-6 * want, want, got);
         const double sd[DHC_MAX_JOINTS] = {3e-5, 1e-5, 2e-5};
@@ -267,8 +263,7 @@ static void test_table3_arm_against_finite_differences_and_gauss_jordan(void)
                 want_q += jq[r][j] * jq[r][j] * sd[j] * sd[j];
             }
         }
-        TEST_ASSERT_EQUAL(DHC_OK, dhc_uncertainty_tool_point(&unc, &m, &set, q, NULL, sd,
-                                                             &got));
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_uncertainty_tool_point(&unc, &m, &set, q, NULL, sd, &got));
         TEST_ASSERT_DOUBLE_WITHIN(1e-6 * want_q, want_q, got);
     }
 }
@@ -278,17 +273,17 @@ static void test_bad_arguments_are_refused(void)
     const dhc_model m = test_paper3_model();
     dhc_param_set set;
     TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &m));
-    TEST_ASSERT_EQUAL(DHC_ERR_NO_DATA, dhc_uncertainty_from_samples(&unc, &m, &set, NULL,
-                                                                    read_sample, NULL, 0U,
-                                                                    NULL, 1000.0, 1.0));
-    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_uncertainty_from_samples(&unc, &m, &set, NULL,
-                                                                     read_sample, NULL, 3U,
-                                                                     NULL, 1000.0, -1.0));
+    TEST_ASSERT_EQUAL(DHC_ERR_NO_DATA,
+                      dhc_uncertainty_from_samples(&unc, &m, &set, NULL, read_sample, NULL, 0U,
+                                                   NULL, 1000.0, 1.0));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
+                      dhc_uncertainty_from_samples(&unc, &m, &set, NULL, read_sample, NULL, 3U,
+                                                   NULL, 1000.0, -1.0));
     const dhc_noise_model jn = {{1e-4, 1e-4, 1e-4}, 0.0};
     /* joint noise without wire or point noise: a singular weighting */
-    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT, dhc_uncertainty_from_samples(&unc, &m, &set, NULL,
-                                                                     read_sample, NULL, 3U,
-                                                                     &jn, 1000.0, 1.0));
+    TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,
+                      dhc_uncertainty_from_samples(&unc, &m, &set, NULL, read_sample, NULL, 3U, &jn,
+                                                   1000.0, 1.0));
     const double q[3] = {0.1, 0.2, 0.3};
     double v = 0.0;
     TEST_ASSERT_EQUAL(DHC_ERR_ARGUMENT,

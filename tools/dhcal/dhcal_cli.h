@@ -34,7 +34,6 @@ typedef struct {
     const char *repeatability; /* the arm's ISO 9283 repeatability, mm */
 } dhcal_cli_options;
 
-
 /* What --out names for a command. */
 typedef enum {
     DHCAL_OUT_NONE,  /* not taken */
@@ -64,12 +63,11 @@ extern const dhcal_measured_command dhcal_plot_command;
 int dhcal_cli_print_json(cJSON *obj);
 
 /* fit's printers and check, which refine's report shares (dhcal_fit_cmd.c). */
-void dhcal_cli_text_fit(const dhcal_fit *f, const dhcal_session *s,
-                        const dhcal_cli_options *o, const double *row_err);
-void dhcal_cli_text_extras(const dhcal_fit *f, const dhcal_session *s,
-                           const dhcal_fit_extras *x, int diagnosed_nothing);
-int dhcal_cli_refuse_implausible(const dhcal_session *s, const dhcal_fit *fit,
-                                 const char *out);
+void dhcal_cli_text_fit(const dhcal_fit *f, const dhcal_session *s, const dhcal_cli_options *o,
+                        const double *row_err);
+void dhcal_cli_text_extras(const dhcal_fit *f, const dhcal_session *s, const dhcal_fit_extras *x,
+                           int diagnosed_nothing);
+int dhcal_cli_refuse_implausible(const dhcal_session *s, const dhcal_fit *fit, const char *out);
 
 /* refine's loop on the session (max_steps 0: diagnose, its start and first judgement), the
  * error on standard error: 0, EXIT_USAGE or EXIT_COMPUTE (dhcal_refine_cmd.c; plot draws

@@ -93,8 +93,11 @@ static int run_compare(const dhcal_cli_options *o, dhcal_session *s)
 }
 
 const dhcal_measured_command dhcal_compare_command = {
-    "compare", run_compare,
+    "compare",
+    run_compare,
     "usage: dhcal compare --model M.json --data D.csv [--json]\n"
     "The model's prediction for every row against its measurement, without\n"
     "fitting: per-row error, RMS and maximum (mm; wire-length space for L1..L3).\n",
-    DHCAL_OUT_NONE, 0, 0};
+    DHCAL_OUT_NONE,
+    0,
+    0};

@@ -150,7 +150,7 @@ static int load_model(const char *path, dhc_model *m, dhcal_error *err)
 
 /* The sample a target asks for at start angles q: the controller's conditions. */
 static void target_sample(const dhc_model *m, const dhcal_dataset *t, const dhcal_row *row,
-                           const double *q, int pose, dhc_sample *s)
+                          const double *q, int pose, dhc_sample *s)
 {
     int8_t dir[DHC_MAX_JOINTS];
     for (size_t j = 0U; j < m->arm.n_joints; ++j) {
@@ -206,7 +206,8 @@ static void nominal_target(const dhc_model *nominal, const compensated_row *r, i
     dhc_model_sample_at(nominal, r->q_rad, NULL, DHC_MEAS_POSITION, &s);
     dhc_prediction pred;
     if (dhc_model_predict(nominal, &s, &pred) != DHC_OK) {
-        dhc_vec3_set(out->nominal_p_mm, (double)NAN, (double)NAN, (double)NAN); /* refused when written */
+        dhc_vec3_set(out->nominal_p_mm, (double)NAN, (double)NAN,
+                     (double)NAN); /* refused when written */
         return;
     }
     dhc_vec3_copy(pred.p_mm, out->nominal_p_mm);
@@ -215,13 +216,12 @@ static void nominal_target(const dhc_model *nominal, const compensated_row *r, i
     }
 }
 
-static int write_output(const compensate_options *o, const dhc_model *m,
-                        const dhcal_dataset *t, const compensated_row *rows, int quat_out)
+static int write_output(const compensate_options *o, const dhc_model *m, const dhcal_dataset *t,
+                        const compensated_row *rows, int quat_out)
 {
     dhcal_text text = {NULL, 0U, 0U, 0};
-    dhcal_text_printf(&text, "# dhcal compensate: model %s, targets %s%s%s\n", o->model,
-                      o->targets, o->nominal != NULL ? ", nominal " : "",
-                      o->nominal != NULL ? o->nominal : "");
+    dhcal_text_printf(&text, "# dhcal compensate: model %s, targets %s%s%s\n", o->model, o->targets,
+                      o->nominal != NULL ? ", nominal " : "", o->nominal != NULL ? o->nominal : "");
     const size_t n = m->arm.n_joints;
     for (size_t j = 0U; j < n; ++j) {
         dhcal_text_printf(&text, "q%zu,", j + 1U);
@@ -270,7 +270,7 @@ static int write_output(const compensate_options *o, const dhc_model *m,
 
 static const char *outcome_name(dhc_inverse_outcome outcome)
 {
-    return outcome == DHC_INVERSE_CONVERGED     ? "reached"
+    return outcome == DHC_INVERSE_CONVERGED      ? "reached"
            : outcome == DHC_INVERSE_OUT_OF_REACH ? "out_of_reach"
                                                  : "not_converged";
 }
@@ -290,9 +290,9 @@ static int report(const compensate_options *o, const dhc_model *m, const dhcal_d
         sum2 += rows[k].error_mm * rows[k].error_mm;
     }
     const double rms_mm = sqrt(sum2 / (double)t->n_rows);
-    const char *orientation = pose              ? "targets"
-                              : t->has_quat     ? "ignored (fewer than 6 joints)"
-                                                : "none";
+    const char *orientation = pose          ? "targets"
+                              : t->has_quat ? "ignored (fewer than 6 joints)"
+                                            : "none";
     if (o->json) {
         cJSON *obj = cJSON_CreateObject();
         cJSON_AddNumberToObject(obj, "rows", (double)t->n_rows);
@@ -303,7 +303,9 @@ static int report(const compensate_options *o, const dhc_model *m, const dhcal_d
         cJSON_AddNumberToObject(obj, "rms_error_mm", rms_mm);
         cJSON_AddNumberToObject(obj, "joints", (double)m->arm.n_joints);
         cJSON_AddStringToObject(obj, "orientation",
-                                pose ? "targets" : t->has_quat ? "ignored" : "none");
+                                pose          ? "targets"
+                                : t->has_quat ? "ignored"
+                                              : "none");
         cJSON_AddBoolToObject(obj, "nominal", o->nominal != NULL);
         cJSON *bad = cJSON_AddArrayToObject(obj, "failed");
         for (size_t k = 0U; k < t->n_rows; ++k) {
@@ -339,8 +341,9 @@ static int report(const compensate_options *o, const dhc_model *m, const dhcal_d
     }
     for (size_t k = 0U; k < t->n_rows; ++k) {
         if (rows[k].outcome != DHC_INVERSE_CONVERGED) {
-            fprintf(stderr, "dhcal: %s:%zu: row %zu %s (%.6g mm from the target); its input "
-                            "angles are kept\n",
+            fprintf(stderr,
+                    "dhcal: %s:%zu: row %zu %s (%.6g mm from the target); its input "
+                    "angles are kept\n",
                     o->targets, t->rows[k].line, k + 1U,
                     rows[k].outcome == DHC_INVERSE_OUT_OF_REACH ? "out of reach"
                                                                 : "not met in 100 iterations",
@@ -378,8 +381,7 @@ int dhcal_compensate_main(int argc, char **argv)
     }
     if (rc == DHCAL_IO_OK && !o.no_units_check) { /* targets against the model, not its frame */
         const dhcal_units_ask ask = {NULL, -1, "use --no-units-check if they are right", NULL};
-        rc = dhcal_units_check_files(&model, o.model, &t, o.targets, NULL, NULL, &ask, NULL,
-                                     &err);
+        rc = dhcal_units_check_files(&model, o.model, &t, o.targets, NULL, NULL, &ask, NULL, &err);
     }
     if (rc != DHCAL_IO_OK) {
         dhcal_dataset_free(&t); /* a refusal after the targets were read */

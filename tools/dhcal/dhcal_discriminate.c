@@ -104,8 +104,8 @@ static size_t rank_of(const double *m, size_t n, size_t ld)
 
 /* s (nk x nk, row stride DISC_N) = m_kk - m_ke m_ee^-1 m_ek over the index lists e and k
  * of m (row stride ld); 0 when m_ee is not positive definite. */
-static int schur(const double *m, size_t ld, const size_t *e, size_t ne, const size_t *k,
-                 size_t nk, double *s)
+static int schur(const double *m, size_t ld, const size_t *e, size_t ne, const size_t *k, size_t nk,
+                 double *s)
 {
     static double l[DISC_N * DISC_N];
     static double z[DISC_N * DISC_N]; /* column c: L^-1 m_e,k[c] */
@@ -154,22 +154,22 @@ static double quad(const double *theta, size_t k, size_t mcols, const double *s)
 /* ---------------------------------------------------------------- the problem */
 
 typedef struct {
-    size_t p, kg, ka, kb;       /* reduced columns: geometry, A, B in this order */
-    size_t col[DHC_MAX_PARAMS]; /* reduced -> index in the full set */
+    size_t p, kg, ka, kb;         /* reduced columns: geometry, A, B in this order */
+    size_t col[DHC_MAX_PARAMS];   /* reduced -> index in the full set */
     double scale[DHC_MAX_PARAMS]; /* full set: RMS over the workspace of one pose's column */
-    size_t rows;                /* per candidate */
+    size_t rows;                  /* per candidate */
     size_t count, workspace;
-    double *y;                  /* count x rows x p, scaled, reduced */
-    uint8_t *usable;            /* count */
+    double *y;       /* count x rows x p, scaled, reduced */
+    uint8_t *usable; /* count */
     double m_data[DISC_N * DISC_N];
     double theta_a[DISC_N * DISC_N]; /* ka x ma: A's directions */
     double theta_b[DISC_N * DISC_N];
     size_t ma, mb;
-    double ref_a, ref_b;        /* one workspace pose's signal along them, averaged */
+    double ref_a, ref_b; /* one workspace pose's signal along them, averaged */
     double corr_data;
     int data_directions;
     size_t data_rows;
-    int sep_a, sep_b;           /* the hypothesis counts in the criterion (DISC_SEPARABLE) */
+    int sep_a, sep_b; /* the hypothesis counts in the criterion (DISC_SEPARABLE) */
 } problem;
 
 /* m += y^T y for a candidate's rows (reduced). */
@@ -420,11 +420,10 @@ static void candidate_jacobians(const dhcal_disc_problem *pb, const dhc_param_se
         dhc_model_sample_at(pb->model, pb->q_rad + c * nj, NULL, pb->kind, &s);
         dhc_mat jac;
         double *dst = raw + c * cells;
-        pr->usable[c] =
-            dhc_mat_init(&jac, pr->rows, full->count, dst, cells) == DHC_OK &&
-            dhc_model_jacobian(pb->model, full, &s, DHC_ORIENTATION_WEIGHT_MM_PER_RAD, &jac,
-                               NULL) == DHC_OK &&
-            dhc_all_finite(dst, cells);
+        pr->usable[c] = dhc_mat_init(&jac, pr->rows, full->count, dst, cells) == DHC_OK &&
+                        dhc_model_jacobian(pb->model, full, &s, DHC_ORIENTATION_WEIGHT_MM_PER_RAD,
+                                           &jac, NULL) == DHC_OK &&
+                        dhc_all_finite(dst, cells);
     }
 }
 
@@ -488,8 +487,8 @@ static void data_info(const dhcal_disc_problem *pb, const dhc_param_set *full, p
         dhc_mat jac;
         if (dhc_mat_init(&jac, dhc_sample_rows(&s->samples[i]), full->count, jb,
                          sizeof jb / sizeof jb[0]) != DHC_OK ||
-            dhc_model_linearize(pb->model, full, &s->samples[i],
-                                DHC_ORIENTATION_WEIGHT_MM_PER_RAD, r, &rows, &jac) != DHC_OK ||
+            dhc_model_linearize(pb->model, full, &s->samples[i], DHC_ORIENTATION_WEIGHT_MM_PER_RAD,
+                                r, &rows, &jac) != DHC_OK ||
             !dhc_all_finite(jb, rows * full->count) || !dhc_all_finite(r, rows)) {
             continue;
         }
@@ -779,8 +778,8 @@ static size_t greedy(const problem *pr, size_t n, size_t rank_possible, size_t *
 /* Fedorov's exchange for the maximin: each chosen pose in turn is swapped for the unchosen
  * candidate that raises min(d_A, d_B) most, when it does by DISC_MIN_GAIN and the plan keeps
  * its rank, until a pass swaps nothing or DISC_MAX_PASSES passes. Returns the swaps. */
-static size_t exchange(const problem *pr, size_t n, size_t rank, size_t *chosen,
-                       uint8_t *taken, double *m)
+static size_t exchange(const problem *pr, size_t n, size_t rank, size_t *chosen, uint8_t *taken,
+                       double *m)
 {
     static fast_base fb;
     static double minus[DISC_N * DISC_N];
@@ -863,8 +862,8 @@ static void results(const problem *pr, size_t n, const double *m, const dhcal_di
 
 /* The problem from the candidates and the data: Jacobians, scales, the columns some plan
  * identifies, the reduced rows, the data's information and the effects' directions. */
-static int build(const dhcal_disc_problem *pb, const dhc_param_set *full, problem *pr,
-                 double *raw, dhcal_disc_result *res, dhcal_error *err)
+static int build(const dhcal_disc_problem *pb, const dhc_param_set *full, problem *pr, double *raw,
+                 dhcal_disc_result *res, dhcal_error *err)
 {
     static double mall[DISC_N * DISC_N];
     static double mdf[DISC_N * DISC_N];
@@ -872,8 +871,8 @@ static int build(const dhcal_disc_problem *pb, const dhc_param_set *full, proble
     double rr = 0.0;
     const size_t np = full->count;
     const size_t ng = pb->geometry->count;
-    const size_t na = dhc_effect_param_count(pb->pair->effect[0], pb->model->arm.n_joints,
-                                             pb->pair->joint[0]);
+    const size_t na =
+        dhc_effect_param_count(pb->pair->effect[0], pb->model->arm.n_joints, pb->pair->joint[0]);
     candidate_jacobians(pb, full, pr, raw);
     if (column_scales(pr, np, raw, pr->scale) == 0U) {
         snprintf(err->msg, sizeof err->msg, "no candidate where the arm works can be evaluated");
@@ -898,7 +897,8 @@ static int build(const dhcal_disc_problem *pb, const dhc_param_set *full, proble
     res->params_a = pr->ka;
     res->params_b = pr->kb;
     if (pr->ka == 0U || pr->kb == 0U) {
-        snprintf(err->msg, sizeof err->msg, "%s changes nothing at these candidate poses that "
+        snprintf(err->msg, sizeof err->msg,
+                 "%s changes nothing at these candidate poses that "
                  "the geometry cannot absorb: no plan can show it",
                  pb->pair->label[pr->ka == 0U ? 0 : 1]);
         return DHCAL_IO_FAILED;
@@ -943,9 +943,10 @@ int dhcal_disc_select(const dhcal_disc_problem *pb, size_t *chosen, dhcal_disc_r
     if (dhc_params_add_effect(&full, pb->model, pb->pair->effect[0], pb->pair->joint[0]) !=
             DHC_OK ||
         dhc_params_add_effect(&full, pb->model, pb->pair->effect[1], pb->pair->joint[1]) !=
-            DHC_OK || pb->count == 0U) {
-        snprintf(err->msg, sizeof err->msg, "the model cannot take %s and %s",
-                 pb->pair->label[0], pb->pair->label[1]);
+            DHC_OK ||
+        pb->count == 0U) {
+        snprintf(err->msg, sizeof err->msg, "the model cannot take %s and %s", pb->pair->label[0],
+                 pb->pair->label[1]);
         return DHCAL_IO_FAILED;
     }
     dhc_sample s0;

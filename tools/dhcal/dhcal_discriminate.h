@@ -21,8 +21,8 @@
  * signal, so that neither effect's units nor its size decide. A hypothesis that no plan of
  * the candidates can test (its signature lies within the other's at every candidate pose,
  * to 1 - correlation^2 < 1e-3: B as fitted to the data may be a special case of A) is left
- * out of the minimum and of the correlation reported, unless neither can be tested. theta: with --data whose
- * geometry fit converged, each effect's direction fitted to the data's residual (what
+ * out of the minimum and of the correlation reported, unless neither can be tested. theta: with
+ * --data whose geometry fit converged, each effect's direction fitted to the data's residual (what
  * diagnose's fields are made of); otherwise every direction of the effect's parameters
  * alike (averaged over theta isotropic in the metric of typical_A). A greedy start that
  * first completes the rank (the plan with the data must identify every parameter of the
@@ -60,10 +60,10 @@ typedef struct {
     int have;
     dhcal_dataset rows;
     dhcal_samples samples;
-    int fitted;      /* the geometry fit converged: its model is where the Jacobians are
-                        taken, its residual gives the effects' directions */
-    dhcal_fit *fit;  /* heap */
-    char why[300];   /* when not fitted: the fit's reason */
+    int fitted;     /* the geometry fit converged: its model is where the Jacobians are
+                       taken, its residual gives the effects' directions */
+    dhcal_fit *fit; /* heap */
+    char why[300];  /* when not fitted: the fit's reason */
 } dhcal_disc_data;
 
 /* Loads path for the model (units check unless no_units_check, as the other commands),
@@ -77,30 +77,30 @@ void dhcal_disc_data_free(dhcal_disc_data *d);
 
 /* What the selection is asked. */
 typedef struct {
-    const dhc_model *model;          /* where the Jacobians are taken */
-    const dhc_param_set *geometry;   /* the base model plus --effects */
+    const dhc_model *model;        /* where the Jacobians are taken */
+    const dhc_param_set *geometry; /* the base model plus --effects */
     const dhcal_disc_pair *pair;
-    const double *q_rad;             /* candidates, n_joints each */
-    size_t count;                    /* candidates */
-    size_t workspace;                /* the first ones: random where the arm works */
-    dhc_meas_kind kind;              /* how the candidates will be measured */
-    const dhcal_disc_data *data;     /* NULL or have 0: none */
-    size_t poses;                    /* to choose */
+    const double *q_rad;         /* candidates, n_joints each */
+    size_t count;                /* candidates */
+    size_t workspace;            /* the first ones: random where the arm works */
+    dhc_meas_kind kind;          /* how the candidates will be measured */
+    const dhcal_disc_data *data; /* NULL or have 0: none */
+    size_t poses;                /* to choose */
 } dhcal_disc_problem;
 
 typedef struct {
-    size_t full_count;                /* parameters of geometry, A and B */
-    uint8_t kept[DHC_MAX_PARAMS];     /* of those, the ones some plan identifies */
+    size_t full_count;                          /* parameters of geometry, A and B */
+    uint8_t kept[DHC_MAX_PARAMS];               /* of those, the ones some plan identifies */
     size_t params_geometry, params_a, params_b; /* kept, per part */
-    size_t rank, rank_possible;       /* of the plan with the data; what the candidates allow */
-    size_t data_rows;                 /* used rows of --data */
-    int data_directions;              /* 1: theta fitted to the data's residual */
+    size_t rank, rank_possible; /* of the plan with the data; what the candidates allow */
+    size_t data_rows;           /* used rows of --data */
+    int data_directions;        /* 1: theta fitted to the data's residual */
     /* correlation: the larger of correlation_A and correlation_B (see above); NAN where
      * not computed */
     double corr_before, corr_after, corr_random;
     double corr_data; /* diagnose's: the fitted fields over the data's own residual */
     double corr_after_a, corr_after_b;
-    double corr_pool;  /* over every candidate together (and the data) */
+    double corr_pool; /* over every candidate together (and the data) */
     /* the hypothesis (A, or B, the truth) counts: some plan of these candidates can leave
      * DISC_SEPARABLE of its signature beyond the other's (when neither can, both count) */
     int separable_a, separable_b;
@@ -120,9 +120,9 @@ int dhcal_disc_select(const dhcal_disc_problem *pb, size_t *chosen, dhcal_disc_r
 typedef struct {
     int json;
     const char *out;
-    const char *data_path;    /* NULL: none */
+    const char *data_path; /* NULL: none */
     size_t poses, candidates, end_candidates;
-    const char *measured;     /* "wires" | "position" | "pose" */
+    const char *measured; /* "wires" | "position" | "pose" */
 } dhcal_disc_report_info;
 
 /* The plan's report, text or one JSON object, on standard output. */

@@ -28,26 +28,29 @@ static int parse_one(const char *text, const char *p, size_t len, const dhc_mode
     if (len == 0U || dhc_effect_parse(p, len, model->arm.n_joints, e, joint) != DHC_OK) {
         char known[512];
         (void)dhcal_effect_catalogue(known, sizeof known);
-        snprintf(msg, sizeof msg, "'%.*s' is not an effect of this model (names: %s; 1 <= i "
-                                  "<= %zu)", (int)(len > 60U ? 60U : len), p, known,
-                 model->arm.n_joints);
+        snprintf(msg, sizeof msg,
+                 "'%.*s' is not an effect of this model (names: %s; 1 <= i "
+                 "<= %zu)",
+                 (int)(len > 60U ? 60U : len), p, known, model->arm.n_joints);
         return pair_error(err, text, msg);
     }
     const dhc_effect_info *fx = dhc_effect_info_of(*e);
-    if (fx != NULL && (fx->needs & (DHC_NEEDS_TEMPERATURE | DHC_NEEDS_TIME |
-                                    DHC_NEEDS_BOTH_DIRECTIONS)) != 0U) {
-        snprintf(msg, sizeof msg, "'%.*s' depends on the %s, not on the pose: a plan of poses "
-                                  "cannot show it", (int)len, p,
+    if (fx != NULL &&
+        (fx->needs & (DHC_NEEDS_TEMPERATURE | DHC_NEEDS_TIME | DHC_NEEDS_BOTH_DIRECTIONS)) != 0U) {
+        snprintf(msg, sizeof msg,
+                 "'%.*s' depends on the %s, not on the pose: a plan of poses "
+                 "cannot show it",
+                 (int)len, p,
                  (fx->needs & DHC_NEEDS_TEMPERATURE) != 0U ? "temperature"
-                 : (fx->needs & DHC_NEEDS_TIME) != 0U     ? "time"
-                                                          : "approach direction");
+                 : (fx->needs & DHC_NEEDS_TIME) != 0U      ? "time"
+                                                           : "approach direction");
         return pair_error(err, text, msg);
     }
     dhc_param_set trial = *set;
     const dhc_status st = dhc_params_add_effect(&trial, model, *e, *joint);
     if (st != DHC_OK) {
         snprintf(msg, sizeof msg, "the model cannot take '%.*s': %s", (int)len, p,
-                 st == DHC_ERR_CAPACITY                        ? "too many parameters"
+                 st == DHC_ERR_CAPACITY ? "too many parameters"
                  : fx != NULL && (fx->needs & DHC_NEEDS_WIRES) != 0U && !model->measurer.present
                      ? "it has no 'measurer'"
                      : "it is fitted already (--effects)");
@@ -62,19 +65,19 @@ int dhcal_disc_parse(const char *text, const dhc_model *model, const dhc_param_s
     memset(out, 0, sizeof *out);
     const char *comma = strchr(text, ',');
     if (comma == NULL || strchr(comma + 1, ',') != NULL) {
-        return pair_error(err, text, "give two effect labels A,B (e.g. "
-                                     "joint_scale:2,joint_harmonic:2)");
+        return pair_error(err, text,
+                          "give two effect labels A,B (e.g. "
+                          "joint_scale:2,joint_harmonic:2)");
     }
     const char *part[2] = {text, comma + 1};
     const size_t len[2] = {(size_t)(comma - text), strlen(comma + 1)};
     for (size_t k = 0U; k < 2U; ++k) {
-        const int rc = parse_one(text, part[k], len[k], model, set, &out->effect[k],
-                                 &out->joint[k], err);
+        const int rc =
+            parse_one(text, part[k], len[k], model, set, &out->effect[k], &out->joint[k], err);
         if (rc != DHCAL_IO_OK) {
             return rc;
         }
-        (void)dhc_effect_label(out->effect[k], out->joint[k], out->label[k],
-                               sizeof out->label[k]);
+        (void)dhc_effect_label(out->effect[k], out->joint[k], out->label[k], sizeof out->label[k]);
     }
     if (out->effect[0] == out->effect[1] &&
         (out->joint[0] == out->joint[1] || !dhc_effect_is_per_joint(out->effect[0]))) {
@@ -103,8 +106,8 @@ int dhcal_disc_load_data(const char *path, const dhc_model *model, const char *m
     if (rc == DHCAL_IO_OK && !no_units_check) { /* before any fit (dhcal_units.h) */
         const dhcal_units_ask ask = {effects, 1, "use --no-units-check if they are right",
                                      "--effects base_frame,..."};
-        rc = dhcal_units_check_files(model, model_path, &d->rows, path, NULL, NULL, &ask,
-                                     stderr, err);
+        rc = dhcal_units_check_files(model, model_path, &d->rows, path, NULL, NULL, &ask, stderr,
+                                     err);
     }
     if (rc != DHCAL_IO_OK) {
         return rc;
@@ -118,12 +121,11 @@ int dhcal_disc_load_data(const char *path, const dhc_model *model, const char *m
     memset(&noise, 0, sizeof noise);
     dhcal_error e2;
     memset(&e2, 0, sizeof e2);
-    rc = dhcal_run_fit(model, effects, DHCAL_GEOMETRY_FULL, &noise, &d->samples, NULL, d->fit,
-                       &e2);
+    rc = dhcal_run_fit(model, effects, DHCAL_GEOMETRY_FULL, &noise, &d->samples, NULL, d->fit, &e2);
     d->fitted = rc == DHCAL_IO_OK && d->fit->status == DHC_OK;
     if (!d->fitted) {
-        snprintf(d->why, sizeof d->why, "%.200s", rc != DHCAL_IO_OK ? e2.msg
-                                                                   : "the fit did not converge");
+        snprintf(d->why, sizeof d->why, "%.200s",
+                 rc != DHCAL_IO_OK ? e2.msg : "the fit did not converge");
         memset(d->samples.flags, 0, d->samples.n); /* every row counts, at the nominal model */
     }
     return DHCAL_IO_OK;
@@ -230,8 +232,8 @@ void dhcal_disc_report(const dhcal_disc_report_info *info, const dhcal_disc_prob
     const char *a = pb->pair->label[0];
     const char *b = pb->pair->label[1];
     printf("plan: %zu poses to tell %s from %s, of %zu candidates where the arm works and %zu "
-           "at the ends of the joint ranges (%s measured)", info->poses, a, b, info->candidates,
-           info->end_candidates, info->measured);
+           "at the ends of the joint ranges (%s measured)",
+           info->poses, a, b, info->candidates, info->end_candidates, info->measured);
     if (info->data_path != NULL) {
         printf(", added to the %zu rows of %s", res->data_rows, info->data_path);
     }
@@ -239,13 +241,14 @@ void dhcal_disc_report(const dhcal_disc_report_info *info, const dhcal_disc_prob
     char names[1024];
     left_out(pb, res, NULL, names, sizeof names);
     printf("parameters: %zu of the geometry's %zu, %zu of %s's and %zu of %s's; the plan%s "
-           "identifies %zu of the %zu the candidates allow%s%s\n", res->params_geometry,
-           pb->geometry->count, res->params_a, a, res->params_b, b,
+           "identifies %zu of the %zu the candidates allow%s%s\n",
+           res->params_geometry, pb->geometry->count, res->params_a, a, res->params_b, b,
            info->data_path != NULL ? " with the data" : "", res->rank, res->rank_possible,
            names[0] != '\0' ? "; left out: " : "", names);
     printf("correlation of the two signatures (the larger of: %s's tool-error field against "
            "%s's best fit to it, and the reverse; diagnose calls two effects look-alikes "
-           "above 0.9):\n", a, b);
+           "above 0.9):\n",
+           a, b);
     const char *with = info->data_path != NULL ? "with " : "";
     if (info->data_path != NULL) {
         printf("  the data alone          %.4f", res->corr_before);
@@ -263,7 +266,8 @@ void dhcal_disc_report(const dhcal_disc_report_info *info, const dhcal_disc_prob
            res->corr_after_a, b, res->corr_after_b);
     printf("distinguishability (what of each signature neither the geometry nor the other "
            "effect absorbs, in poses' worth of its own signal): %s %.4g, %s %.4g; the smaller "
-           "with %zu random poses %.4g", a, res->d_a, b, res->d_b, info->poses, res->d_random);
+           "with %zu random poses %.4g",
+           a, res->d_a, b, res->d_b, info->poses, res->d_random);
     if (info->data_path != NULL) {
         printf(", of the data alone %.4g", res->d_before);
     }
@@ -279,8 +283,8 @@ void dhcal_disc_report(const dhcal_disc_report_info *info, const dhcal_disc_prob
         if (!(h == 0U ? res->separable_a : res->separable_b)) {
             printf("if %s%s were the truth, %s would reproduce it at every candidate pose "
                    "(1 - correlation^2 below 0.001 even over all of them): no plan tells "
-                   "that apart, and the plan serves the other case\n", pb->pair->label[h],
-                   res->data_directions ? " as fitted to the data" : "",
+                   "that apart, and the plan serves the other case\n",
+                   pb->pair->label[h], res->data_directions ? " as fitted to the data" : "",
                    pb->pair->label[1U - h]);
         }
     }

@@ -88,8 +88,8 @@ static void text_where(const dhcal_fit *f, const dhcal_session *s)
     free(err);
 }
 
-void dhcal_cli_text_extras(const dhcal_fit *f, const dhcal_session *s,
-                           const dhcal_fit_extras *x, int diagnosed_nothing)
+void dhcal_cli_text_extras(const dhcal_fit *f, const dhcal_session *s, const dhcal_fit_extras *x,
+                           int diagnosed_nothing)
 {
     if (x->have_cv) {
         printf("cross-validated RMS %.4f mm (%zu folds)\n", x->cv.rms_mm, x->cv.folds);
@@ -117,7 +117,8 @@ void dhcal_cli_text_extras(const dhcal_fit *f, const dhcal_session *s,
     }
     if (!a->have_test) {
         printf("adequacy: noise %.4f mm per coordinate from %s; too few rows for a lack-of-fit "
-               "test\n", a->noise_mm, ref);
+               "test\n",
+               a->noise_mm, ref);
         return;
     }
     if (strcmp(a->verdict, "fits_noise") == 0) {
@@ -133,12 +134,12 @@ void dhcal_cli_text_extras(const dhcal_fit *f, const dhcal_session *s,
     text_where(f, s);
 }
 
-void dhcal_cli_text_fit(const dhcal_fit *f, const dhcal_session *s,
-                        const dhcal_cli_options *o, const double *row_err)
+void dhcal_cli_text_fit(const dhcal_fit *f, const dhcal_session *s, const dhcal_cli_options *o,
+                        const double *row_err)
 {
     const dhc_calib_report *rep = &f->rep;
-    printf("fit of '%s' to %s: %zu rows used, %zu outliers left out\n", s->file.name,
-           o->data, rep->samples_used, rep->outliers);
+    printf("fit of '%s' to %s: %zu rows used, %zu outliers left out\n", s->file.name, o->data,
+           rep->samples_used, rep->outliers);
     printf("%s after %zu iterations: RMS %.4f mm, max %.4f mm%s",
            rep->converged ? "converged" : "NOT converged", rep->iterations, rep->rms_mm,
            rep->max_mm, s->samples.wires ? " (wire lengths)" : "");
@@ -180,7 +181,8 @@ void dhcal_cli_text_fit(const dhcal_fit *f, const dhcal_session *s,
         (void)dhc_params_name(&f->set, k, name, sizeof name);
         if (rep->unsupported[k]) {
             printf("held at nominal: %s (these data determine it only to more than half its "
-                   "physical range)\n", name);
+                   "physical range)\n",
+                   name);
             continue;
         }
         printf("%s: %s (kept at nominal)",
@@ -207,8 +209,7 @@ void dhcal_cli_text_fit(const dhcal_fit *f, const dhcal_session *s,
 }
 
 /* Runs the fit; on success fills row_err (caller frees). */
-static int do_fit(const dhcal_cli_options *o, dhcal_session *s, dhcal_fit *fit,
-                  double **row_err)
+static int do_fit(const dhcal_cli_options *o, dhcal_session *s, dhcal_fit *fit, double **row_err)
 {
     dhcal_error err;
     memset(&err, 0, sizeof err);
@@ -229,8 +230,7 @@ static int do_fit(const dhcal_cli_options *o, dhcal_session *s, dhcal_fit *fit,
 }
 
 /* A fitted model outside its physical range is refused as a calibration (exit 1). */
-int dhcal_cli_refuse_implausible(const dhcal_session *s, const dhcal_fit *fit,
-                                 const char *out)
+int dhcal_cli_refuse_implausible(const dhcal_session *s, const dhcal_fit *fit, const char *out)
 {
     char why[200];
     if (!dhcal_implausible(&s->model, fit, why, sizeof why)) {
@@ -333,7 +333,8 @@ static int run_fit(const dhcal_cli_options *o, dhcal_session *s)
  * the pose, so an error that grows with it cannot be told from one that depends on the pose. */
 
 const dhcal_measured_command dhcal_fit_command = {
-    "fit", run_fit,
+    "fit",
+    run_fit,
     "usage: dhcal fit --model M.json --data D.csv [--effects LIST] [--heldout H.csv]\n"
     "                 [--geometry LEVEL] [--noise J,M] [--cv] [--out C.json] [--json]\n"
     "Fits joint offsets and link geometry (Hayati's beta where consecutive axes\n"
@@ -344,4 +345,6 @@ const dhcal_measured_command dhcal_fit_command = {
     "ranges and the uncertainty the calibration predicts there. --cv adds the\n"
     "cross-validated RMS. --out writes the calibrated model (same schema; it loads\n"
     "again as --model) only when the fit succeeds and is physically plausible.\n",
-    DHCAL_OUT_MODEL, 1, 1};
+    DHCAL_OUT_MODEL,
+    1,
+    1};

@@ -115,8 +115,8 @@ static size_t draw_candidates(const dhc_model *m, size_t k, uint64_t seed, int a
                               double min_z, double *q_rad)
 {
     const size_t nj = m->arm.n_joints;
-    uint64_t s = seed * 0x9E3779B97F4A7C15ULL + (at_ends ? 0x5851F42D4C957F2DULL
-                                                          : 0x2545F4914F6CDD1DULL);
+    uint64_t s =
+        seed * 0x9E3779B97F4A7C15ULL + (at_ends ? 0x5851F42D4C957F2DULL : 0x2545F4914F6CDD1DULL);
     size_t got = 0U;
     for (size_t tries = 0U; got < k && tries < 1000U * k; ++tries) {
         double *q = q_rad + got * nj;
@@ -178,9 +178,21 @@ typedef struct {
 /* 0, 2 (usage) or -1 (help printed). */
 static int parse_plan_args(int argc, char **argv, plan_options *o)
 {
-    enum { OPT_MODEL = 1, OPT_POSES, OPT_EFFECTS, OPT_CANDIDATES, OPT_END_CANDIDATES,
-           OPT_SEED, OPT_MIN_Z, OPT_OUT, OPT_JSON, OPT_HELP, OPT_NO_UNITS, OPT_DISCRIMINATE,
-           OPT_DATA };
+    enum {
+        OPT_MODEL = 1,
+        OPT_POSES,
+        OPT_EFFECTS,
+        OPT_CANDIDATES,
+        OPT_END_CANDIDATES,
+        OPT_SEED,
+        OPT_MIN_Z,
+        OPT_OUT,
+        OPT_JSON,
+        OPT_HELP,
+        OPT_NO_UNITS,
+        OPT_DISCRIMINATE,
+        OPT_DATA
+    };
     static const struct option long_options[] = {
         {"model", required_argument, NULL, OPT_MODEL},
         {"poses", required_argument, NULL, OPT_POSES},
@@ -226,15 +238,17 @@ static int parse_plan_args(int argc, char **argv, plan_options *o)
             break;
         case OPT_CANDIDATES:
             if (parse_count(optarg, 2UL, PLAN_MAX_CANDIDATES, &o->candidates) != 0) {
-                snprintf(msg, sizeof msg, "--candidates: '%.200s' is not a count in 2..%lu",
-                         optarg, PLAN_MAX_CANDIDATES);
+                snprintf(msg, sizeof msg, "--candidates: '%.200s' is not a count in 2..%lu", optarg,
+                         PLAN_MAX_CANDIDATES);
                 return plan_usage_error(msg);
             }
             break;
         case OPT_END_CANDIDATES:
             if (parse_count(optarg, 0UL, PLAN_MAX_CANDIDATES, &o->end_candidates) != 0) {
-                snprintf(msg, sizeof msg, "--end-candidates: '%.200s' is not a count in "
-                                          "0..%lu", optarg, PLAN_MAX_CANDIDATES);
+                snprintf(msg, sizeof msg,
+                         "--end-candidates: '%.200s' is not a count in "
+                         "0..%lu",
+                         optarg, PLAN_MAX_CANDIDATES);
                 return plan_usage_error(msg);
             }
             o->end_candidates_given = 1;
@@ -250,8 +264,10 @@ static int parse_plan_args(int argc, char **argv, plan_options *o)
             char *end = NULL;
             o->min_z = strtod(optarg, &end);
             if (end == optarg || *end != '\0' || !isfinite(o->min_z) || fabs(o->min_z) > 1e5) {
-                snprintf(msg, sizeof msg, "--min-z: '%.200s' is not a height in mm within "
-                                          "+-100000", optarg);
+                snprintf(msg, sizeof msg,
+                         "--min-z: '%.200s' is not a height in mm within "
+                         "+-100000",
+                         optarg);
                 return plan_usage_error(msg);
             }
             break;
@@ -330,9 +346,9 @@ static void report(const plan_options *o, size_t ends, const dhc_param_set *set,
         return;
     }
     printf("plan: %lu poses of %lu candidates where the arm works and %zu at the ends of the "
-           "joint ranges (%s measured), written to %s\n", o->poses, o->candidates,
-           ends, kind == DHC_MEAS_WIRES ? "wire lengths" : "tool positions",
-           o->out);
+           "joint ranges (%s measured), written to %s\n",
+           o->poses, o->candidates, ends,
+           kind == DHC_MEAS_WIRES ? "wire lengths" : "tool positions", o->out);
     printf("parameters: %zu of %zu identifiable from the candidates", rep->identifiable,
            set->count);
     const char *sep = "; left out: ";
@@ -345,14 +361,16 @@ static void report(const plan_options *o, size_t ends, const dhc_param_set *set,
         }
     }
     printf("\nobservability O1: planned %.4g (rank %zu), random plan of the same size %.4g "
-           "(rank %zu): %.2fx\n", rep->o1, rep->rank, o1_random, rank_random,
+           "(rank %zu): %.2fx\n",
+           rep->o1, rep->rank, o1_random, rank_random,
            o1_random > 0.0 ? rep->o1 / o1_random : HUGE_VAL);
     printf("prediction variance where the arm works, per unit measurement variance: "
-           "planned %.4g, random plan %.4g: %.2fx less\n", rep->variance, rep->variance_first,
+           "planned %.4g, random plan %.4g: %.2fx less\n",
+           rep->variance, rep->variance_first,
            rep->variance > 0.0 ? rep->variance_first / rep->variance : HUGE_VAL);
     printf("no plan of %lu poses from these candidates predicts below %.4g (their best "
-           "weighting %.4g): the plan is within %.1f %% of the best possible\n", o->poses,
-           best->floor, best->variance, 100.0 * (rep->variance / best->floor - 1.0));
+           "weighting %.4g): the plan is within %.1f %% of the best possible\n",
+           o->poses, best->floor, best->variance, 100.0 * (rep->variance / best->floor - 1.0));
 }
 
 static const char *kind_name(dhc_meas_kind kind)
@@ -372,8 +390,8 @@ static int discriminate_plan(const plan_options *o, const dhc_model *model,
     static dhcal_disc_data data;
     int rc = dhcal_disc_parse(o->discriminate, model, set, &pair, &err);
     if (rc == DHCAL_IO_OK && o->data != NULL) {
-        rc = dhcal_disc_load_data(o->data, model, o->model, o->effects, o->no_units_check,
-                                  &data, &err);
+        rc = dhcal_disc_load_data(o->data, model, o->model, o->effects, o->no_units_check, &data,
+                                  &err);
     }
     if (rc != DHCAL_IO_OK) {
         fprintf(stderr, "dhcal: plan: %s\n", err.msg);
@@ -391,18 +409,26 @@ static int discriminate_plan(const plan_options *o, const dhc_model *model,
     }
     const size_t got = draw_candidates(model, k, o->seed, 0, o->min_z, q);
     if (got < k) {
-        fprintf(stderr, "dhcal: plan: %s: only %zu of %zu random poses put the tool at or above "
-                        "--min-z %g mm\n", o->model, got, k, o->min_z);
+        fprintf(stderr,
+                "dhcal: plan: %s: only %zu of %zu random poses put the tool at or above "
+                "--min-z %g mm\n",
+                o->model, got, k, o->min_z);
         goto done;
     }
-    const size_t ends = draw_candidates(model, o->end_candidates, o->seed, 1, o->min_z,
-                                        q + k * nj);
+    const size_t ends = draw_candidates(model, o->end_candidates, o->seed, 1, o->min_z, q + k * nj);
     dhc_meas_kind kind = model->measurer.present ? DHC_MEAS_WIRES : DHC_MEAS_POSITION;
     if (data.have && data.samples.n > 0U) {
         kind = (dhc_meas_kind)data.samples.samples[0].kind;
     }
-    const dhcal_disc_problem pb = {data.fitted ? &data.fit->model : model, set, &pair, q,
-                                   k + ends, k, kind, data.have ? &data : NULL, o->poses};
+    const dhcal_disc_problem pb = {data.fitted ? &data.fit->model : model,
+                                   set,
+                                   &pair,
+                                   q,
+                                   k + ends,
+                                   k,
+                                   kind,
+                                   data.have ? &data : NULL,
+                                   o->poses};
     dhcal_disc_result res;
     if (dhcal_disc_select(&pb, chosen, &res, &err) != DHCAL_IO_OK) {
         fprintf(stderr, "dhcal: plan: no plan: %s\n", err.msg);
@@ -412,8 +438,8 @@ static int discriminate_plan(const plan_options *o, const dhc_model *model,
         fprintf(stderr, "dhcal: plan: %s\n", err.msg);
         goto done;
     }
-    const dhcal_disc_report_info info = {o->json, o->out, o->data, o->poses, k, ends,
-                                         kind_name(kind)};
+    const dhcal_disc_report_info info = {o->json, o->out, o->data,        o->poses,
+                                         k,       ends,   kind_name(kind)};
     dhcal_disc_report(&info, &pb, &res);
     rc = 0;
 done:
@@ -477,8 +503,10 @@ int dhcal_plan_command(int argc, char **argv)
     }
     const size_t got = draw_candidates(&model, k, o.seed, 0, o.min_z, q);
     if (got < k) {
-        fprintf(stderr, "dhcal: plan: %s: only %zu of %zu random poses put the tool at or above "
-                        "--min-z %g mm\n", o.model, got, k, o.min_z);
+        fprintf(stderr,
+                "dhcal: plan: %s: only %zu of %zu random poses put the tool at or above "
+                "--min-z %g mm\n",
+                o.model, got, k, o.min_z);
         goto done;
     }
     /* fewer end candidates than asked when the ends of the ranges put the tool below --min-z */
@@ -495,8 +523,8 @@ int dhcal_plan_command(int argc, char **argv)
     /* the random plan of the same size: the first candidates, drawn at random */
     double o1_random = 0.0;
     size_t rank_random = 0U;
-    st = dhc_plan_observability(&model, &set, read_candidate, &c, NULL, o.poses, &ws,
-                                &o1_random, &rank_random); /* leaves ws's kept set as it is */
+    st = dhc_plan_observability(&model, &set, read_candidate, &c, NULL, o.poses, &ws, &o1_random,
+                                &rank_random); /* leaves ws's kept set as it is */
     if (st != DHC_OK) {
         fprintf(stderr, "dhcal: plan: the random plan's O1: %s\n", dhc_status_str(st));
         goto done;

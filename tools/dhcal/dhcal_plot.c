@@ -86,8 +86,8 @@ static void residuals_svg(dhcal_text *b, const dhcal_plot_data *d)
         lx = dhcal_svg_legend_item(b, lx, 52.0, component_color[k], 0, names[k], SIZE_MAX);
     }
     char note[160];
-    (void)snprintf(note, sizeof note, "%zu rows; residual in mm (%s), the same in every panel",
-                   n, d->wires ? "wire lengths" : "position");
+    (void)snprintf(note, sizeof note, "%zu rows; residual in mm (%s), the same in every panel", n,
+                   d->wires ? "wire lengths" : "position");
     if (lx + dhcal_svg_text_width(strlen(note), 12.0) <= width - 10.0) {
         dhcal_svg_text(b, lx, 52.0, "font-size=\"12\" fill=\"" DHCAL_COLOR_MUTED "\"", note);
     }
@@ -107,8 +107,9 @@ static void residuals_svg(dhcal_text *b, const dhcal_plot_data *d)
             }
             dhcal_svg_pad_range(&xlo, &xhi, 0.03, 0.03);
         }
-        const dhcal_svg_frame f = {cx + left, cy + 30.0, plot_w, plot_h,
-                                   dhcal_svg_fit_axis(xlo, xhi, plot_w, 11.0, 1, 0), ay};
+        const dhcal_svg_frame f = {
+            cx + left, cy + 30.0, plot_w, plot_h, dhcal_svg_fit_axis(xlo, xhi, plot_w, 11.0, 1, 0),
+            ay};
         dhcal_text_printf(b, "<g class=\"panel\" id=\"joint%zu\">\n", j + 1U);
         dhcal_svg_draw_frame(b, &f, 1);
         dhcal_svg_zero_lines(b, &f, 0);
@@ -325,8 +326,12 @@ static void joints_svg(dhcal_text *b, const dhcal_plot_data *d)
                 dhcal_svg_pad_range(&xlo, &xhi, 0.03, 0.03);
             }
             const double cx = 10.0;
-            const dhcal_svg_frame f = {cx + left, cy + 30.0, plot_w, plot_h,
-                                       dhcal_svg_fit_axis(xlo, xhi, plot_w, 11.0, 1, 0), ay[j]};
+            const dhcal_svg_frame f = {cx + left,
+                                       cy + 30.0,
+                                       plot_w,
+                                       plot_h,
+                                       dhcal_svg_fit_axis(xlo, xhi, plot_w, 11.0, 1, 0),
+                                       ay[j]};
             dhcal_svg_draw_frame(b, &f, 1);
             dhcal_svg_zero_lines(b, &f, 0);
             const size_t clipped = joint_points(b, &f, d, j, d->q_deg, y_scale[j]);
@@ -397,13 +402,12 @@ static void fmt_mm(char *s, size_t cap, double v)
  * (-5) or below (+15) its line or stacked beside the other: the first arrangement that keeps
  * both baselines inside [y_min + 11, y_max] and 15 px apart; stacked at the top when none
  * does (a plot area too small to matter). */
-static void place_labels(double py_up, double py_low, double y_min, double y_max,
-                         double *ty_up, double *ty_low)
+static void place_labels(double py_up, double py_low, double y_min, double y_max, double *ty_up,
+                         double *ty_low)
 {
     const double cand[6][2] = {
-        {py_up - 5.0, py_low - 5.0},  {py_up - 5.0, py_low + 15.0},
-        {py_low - 20.0, py_low - 5.0}, {py_up + 15.0, py_up + 30.0},
-        {py_up + 15.0, py_low + 15.0}, {py_up - 20.0, py_up - 5.0},
+        {py_up - 5.0, py_low - 5.0},  {py_up - 5.0, py_low + 15.0},  {py_low - 20.0, py_low - 5.0},
+        {py_up + 15.0, py_up + 30.0}, {py_up + 15.0, py_low + 15.0}, {py_up - 20.0, py_up - 5.0},
     };
     for (size_t c = 0U; c < 6U; ++c) {
         const double a = cand[c][0];
@@ -458,8 +462,8 @@ static void errors_svg(dhcal_text *b, const dhcal_plot_data *d)
     const double left = 24.0 + dhcal_svg_text_width(dhcal_svg_tick_label_chars(&ay), 11.0) + 12.0;
     const double xhi = n > 1U ? (double)(n - 1U) : 1.0;
     const double plot_w = width - left - 24.0;
-    const dhcal_svg_frame f = {left, 72.0, plot_w, plot_h,
-                               dhcal_svg_fit_axis(0.0, xhi, plot_w, 11.0, 1, 1), ay};
+    const dhcal_svg_frame f = {
+        left, 72.0, plot_w, plot_h, dhcal_svg_fit_axis(0.0, xhi, plot_w, 11.0, 1, 1), ay};
     const double height = f.y + f.h + 48.0;
 
     begin_titled(b, width, height, "Error per row, before and after: ", d);
@@ -489,8 +493,8 @@ static void errors_svg(dhcal_text *b, const dhcal_plot_data *d)
     const char *const after_rms_label = after_rms.failed ? "after" : after_rms.p;
 
     /* Legend: round swatches, like the points they stand for. */
-    const double lx = dhcal_svg_legend_item(b, 20.0, 52.0, DHCAL_COLOR_BEFORE, 1,
-                                            "before (base fit)", SIZE_MAX);
+    const double lx =
+        dhcal_svg_legend_item(b, 20.0, 52.0, DHCAL_COLOR_BEFORE, 1, "before (base fit)", SIZE_MAX);
     (void)dhcal_svg_legend_item(b, lx, 52.0, DHCAL_COLOR_AFTER, 1, after_label,
                                 dhcal_svg_chars_fit(width - lx - 40.0, 12.0));
 
@@ -559,14 +563,18 @@ static void candidates_svg(dhcal_text *b, const dhcal_plot_data *d)
     const double row_h = 24.0;
     dhcal_svg_axis categories = dhcal_svg_make_axis(0.0, 1.0, 1.0, 0);
     categories.n_ticks = 0U; /* the y axis holds names, not numbers: no ticks */
-    const dhcal_svg_frame f = {20.0 + label_w, 72.0, 480.0, row_h * (double)(nc > 0U ? nc : 1U),
-                               dhcal_svg_make_axis(0.0, 100.0, 5.0, 0), categories};
+    const dhcal_svg_frame f = {20.0 + label_w,
+                               72.0,
+                               480.0,
+                               row_h * (double)(nc > 0U ? nc : 1U),
+                               dhcal_svg_make_axis(0.0, 100.0, 5.0, 0),
+                               categories};
     const double width = f.x + f.w + 170.0;
     const double height = f.y + f.h + 48.0;
 
     begin_titled(b, width, height, "Candidate effects: ", d);
-    const double lx = dhcal_svg_legend_item(b, 20.0, 52.0, DHCAL_COLOR_SIGNIFICANT, 0,
-                                            "significant", SIZE_MAX);
+    const double lx =
+        dhcal_svg_legend_item(b, 20.0, 52.0, DHCAL_COLOR_SIGNIFICANT, 0, "significant", SIZE_MAX);
     (void)dhcal_svg_legend_item(b, lx, 52.0, DHCAL_COLOR_OTHER, 0, "not significant", SIZE_MAX);
 
     dhcal_svg_draw_frame(b, &f, 1);
@@ -605,8 +613,8 @@ static void candidates_svg(dhcal_text *b, const dhcal_plot_data *d)
 
 /* Checks n values; on the first non-finite or implausibly large one writes the message.
  * cols > 0: a matrix (row, column in the message); cols == 0: a vector. */
-static int check_values(const double *v, size_t n, size_t cols, const char *name,
-                        const char *unit, dhcal_error *err)
+static int check_values(const double *v, size_t n, size_t cols, const char *name, const char *unit,
+                        dhcal_error *err)
 {
     for (size_t i = 0U; i < n; ++i) {
         if (isfinite(v[i]) && fabs(v[i]) <= PLOT_MAX_ABS) {
@@ -649,17 +657,20 @@ static int check_data(const dhcal_plot_data *d, dhcal_error *err)
     int rc = DHCAL_IO_OK;
     if (n > 0U) {
         rc = check_values(d->q_deg, n * d->n_joints, d->n_joints, "q_deg", "deg", err);
-        rc = rc != DHCAL_IO_OK ? rc : check_values(d->resid_before, 3U * n, 3U, "resid_before", "mm", err);
-        rc = rc != DHCAL_IO_OK ? rc : check_values(d->resid_after, 3U * n, 3U, "resid_after", "mm", err);
+        rc = rc != DHCAL_IO_OK
+                 ? rc
+                 : check_values(d->resid_before, 3U * n, 3U, "resid_before", "mm", err);
+        rc = rc != DHCAL_IO_OK ? rc
+                               : check_values(d->resid_after, 3U * n, 3U, "resid_after", "mm", err);
         rc = rc != DHCAL_IO_OK ? rc : check_values(d->err_before, n, 0U, "err_before", "mm", err);
         rc = rc != DHCAL_IO_OK ? rc : check_values(d->err_after, n, 0U, "err_after", "mm", err);
         const size_t nq = n * d->n_joints;
-        rc = rc != DHCAL_IO_OK ? rc
-                               : check_values(d->joint_err_deg, nq, d->n_joints, "joint_err_deg",
-                                              "deg", err);
-        rc = rc != DHCAL_IO_OK ? rc
-                               : check_values(d->moment_mm, nq, d->n_joints, "moment_mm", "mm",
-                                              err);
+        rc = rc != DHCAL_IO_OK
+                 ? rc
+                 : check_values(d->joint_err_deg, nq, d->n_joints, "joint_err_deg", "deg", err);
+        rc = rc != DHCAL_IO_OK
+                 ? rc
+                 : check_values(d->moment_mm, nq, d->n_joints, "moment_mm", "mm", err);
         for (size_t i = 0U; rc == DHCAL_IO_OK && i < nq; ++i) {
             if (d->dir[i] < -1 || d->dir[i] > 1) {
                 rc = dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
@@ -668,7 +679,8 @@ static int check_data(const dhcal_plot_data *d, dhcal_error *err)
             }
         }
     }
-    rc = rc != DHCAL_IO_OK ? rc : check_values(&d->rms_before_mm, 1U, 0U, "rms_before_mm", "mm", err);
+    rc = rc != DHCAL_IO_OK ? rc
+                           : check_values(&d->rms_before_mm, 1U, 0U, "rms_before_mm", "mm", err);
     rc = rc != DHCAL_IO_OK ? rc : check_values(&d->rms_after_mm, 1U, 0U, "rms_after_mm", "mm", err);
     for (size_t i = 0U; rc == DHCAL_IO_OK && i < d->n_candidates; ++i) {
         if (!isfinite(d->candidates[i].explained)) {
@@ -750,9 +762,9 @@ int dhcal_plot_write(const char *dir, const dhcal_plot_data *d, dhcal_error *err
         return rc;
     }
     static const char *const names[PLOT_DOCS] = {"residuals.svg", "joints.svg", "errors.svg",
-                                              "candidates.svg"};
-    dhcal_text doc[PLOT_DOCS] = {{NULL, 0U, 0U, 0}, {NULL, 0U, 0U, 0}, {NULL, 0U, 0U, 0},
-                          {NULL, 0U, 0U, 0}};
+                                                 "candidates.svg"};
+    dhcal_text doc[PLOT_DOCS] = {
+        {NULL, 0U, 0U, 0}, {NULL, 0U, 0U, 0}, {NULL, 0U, 0U, 0}, {NULL, 0U, 0U, 0}};
     residuals_svg(&doc[0], d);
     joints_svg(&doc[1], d);
     errors_svg(&doc[2], d);

@@ -13,7 +13,7 @@ typedef struct {
 } dhcal_plot_candidate;
 
 typedef struct {
-    const char *title;          /* model name */
+    const char *title; /* model name */
     size_t n_rows;
     size_t n_joints;
     const double *q_deg;        /* n_rows x n_joints, row-major */
@@ -23,8 +23,8 @@ typedef struct {
     const double *err_after;    /* n_rows */
     double rms_before_mm;
     double rms_after_mm;
-    int wires;                  /* components are wire lengths L1..L3 */
-    const char *effect;         /* effect added for "after"; "" when none was named */
+    int wires;                              /* components are wire lengths L1..L3 */
+    const char *effect;                     /* effect added for "after"; "" when none was named */
     const dhcal_plot_candidate *candidates; /* best first */
     size_t n_candidates;
     /* Apparent joint errors: dq = pinv(J_q) r per row, the joint error that would explain

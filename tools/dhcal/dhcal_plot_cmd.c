@@ -48,8 +48,8 @@ static int run_plot(const dhcal_cli_options *o, dhcal_session *s)
 
     /* "after": the effect the diagnosis names, added to whatever --effects gave */
     if (rc == 0 && trials->named < diag->count) {
-        (void)dhc_effect_label(diag->c[trials->named].effect, diag->c[trials->named].joint,
-                               label, sizeof label);
+        (void)dhc_effect_label(diag->c[trials->named].effect, diag->c[trials->named].joint, label,
+                               sizeof label);
         char list[600];
         snprintf(list, sizeof list, "%s%s%s", o->effects != NULL ? o->effects : "",
                  o->effects != NULL ? "," : "", label);
@@ -57,8 +57,7 @@ static int run_plot(const dhcal_cli_options *o, dhcal_session *s)
             s->samples.flags[i] = (uint8_t)DHC_SAMPLE_USED;
         }
         rc = dhcal_run_fit(&s->model, list, s->geometry, &s->noise, &s->samples, NULL, &after,
-                           &err) ==
-                     DHCAL_IO_OK
+                           &err) == DHCAL_IO_OK
                  ? 0
                  : EXIT_COMPUTE;
     } else if (rc == 0) {
@@ -92,9 +91,11 @@ static int run_plot(const dhcal_cli_options *o, dhcal_session *s)
         nc++;
     }
     if (rc == 0) {
-        const dhcal_plot_data d = {s->file.name, n, nj, q_deg, res_before, res_after,
-                                   err_before, err_after, es_b.rms_mm, es_a.rms_mm,
-                                   s->samples.wires, label, cands, nc, joint_err, moment, dir};
+        const dhcal_plot_data d = {
+            s->file.name,     n,          nj,        q_deg,       res_before,
+            res_after,        err_before, err_after, es_b.rms_mm, es_a.rms_mm,
+            s->samples.wires, label,      cands,     nc,          joint_err,
+            moment,           dir};
         rc = dhcal_plot_write(o->out, &d, &err) == DHCAL_IO_OK ? 0 : EXIT_COMPUTE;
         if (rc != 0) {
             fprintf(stderr, "dhcal: %s\n", err.msg);
@@ -132,9 +133,12 @@ static int run_plot(const dhcal_cli_options *o, dhcal_session *s)
 }
 
 const dhcal_measured_command dhcal_plot_command = {
-    "plot", run_plot,
+    "plot",
+    run_plot,
     "usage: dhcal plot --model M.json --data D.csv --out DIR [--effects LIST]\n"
     "Writes SVG files into DIR: residual components against each joint angle\n"
     "(where a missing effect shows its shape), per-row error before and after\n"
     "adding the effect the diagnosis names, and the candidate ranking.\n",
-    DHCAL_OUT_DIR, 0, 1};
+    DHCAL_OUT_DIR,
+    0,
+    1};

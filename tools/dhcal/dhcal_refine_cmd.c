@@ -32,10 +32,9 @@ int dhcal_cli_run_refine(const dhcal_cli_options *o, dhcal_session *s, size_t ma
 {
     dhcal_error err;
     memset(&err, 0, sizeof err);
-    const int rc = dhcal_run_refine(&s->model, o->effects,
-                                    o->geometry != NULL ? &s->geometry : NULL, &s->noise,
-                                    s->repeatability_mm, max_steps, &s->samples,
-                                    s->have_held ? &s->held : NULL, res, &err);
+    const int rc = dhcal_run_refine(
+        &s->model, o->effects, o->geometry != NULL ? &s->geometry : NULL, &s->noise,
+        s->repeatability_mm, max_steps, &s->samples, s->have_held ? &s->held : NULL, res, &err);
     if (rc != DHCAL_IO_OK) {
         fprintf(stderr, "dhcal: %s\n", err.msg);
         return rc == DHCAL_IO_BAD_INPUT ? EXIT_USAGE : EXIT_COMPUTE;
@@ -146,12 +145,12 @@ static int run_refine(const dhcal_cli_options *o, dhcal_session *s)
         const int prc = dhcal_cli_print_json(obj);
         rc = rc != 0 ? rc : prc;
     } else {
-        printf("refine of '%s' to %s: base model (%s geometry)%s%s\n", s->file.name,
-               o->data, dhcal_geometry_name(fit->geometry), o->effects != NULL ? " + " : "",
+        printf("refine of '%s' to %s: base model (%s geometry)%s%s\n", s->file.name, o->data,
+               dhcal_geometry_name(fit->geometry), o->effects != NULL ? " + " : "",
                o->effects != NULL ? o->effects : "");
         text_start(&res);
-        printf("%-5s %-24s %10s %12s %8s %s\n", "step", "added", "RMS mm", "CV RMS mm",
-               "CV rows", s->have_held ? "held-out RMS / mean mm" : "");
+        printf("%-5s %-24s %10s %12s %8s %s\n", "step", "added", "RMS mm", "CV RMS mm", "CV rows",
+               s->have_held ? "held-out RMS / mean mm" : "");
         for (size_t k = 0U; k < res.n_steps; ++k) {
             const dhcal_refine_step *st = &res.step[k];
             printf("%-5zu %-24s %10.4f %12.4f %8zu", k,
@@ -182,7 +181,8 @@ static int run_refine(const dhcal_cli_options *o, dhcal_session *s)
 /* ---------------------------------------------------------------- plot */
 
 const dhcal_measured_command dhcal_diagnose_command = {
-    "diagnose", run_diagnose,
+    "diagnose",
+    run_diagnose,
     "usage: dhcal diagnose --model M.json --data D.csv [--effects LIST] [--cv] [--json]\n"
     "Fits as refine starts, screens every effect the model does not have yet with\n"
     "the score test, refits the six best on the same rows and cross-validates them\n"
@@ -192,10 +192,13 @@ const dhcal_measured_command dhcal_diagnose_command = {
     "why it fell short (docs/effects.md 6). refine's first step is the one named.\n"
     "Drift (thermal) candidates are scored only when the time (temperature) varies\n"
     "apart from the pose. --cv is accepted (it always cross-validates).\n",
-    DHCAL_OUT_NONE, 1, 1};
+    DHCAL_OUT_NONE,
+    1,
+    1};
 
 const dhcal_measured_command dhcal_refine_command = {
-    "refine", run_refine,
+    "refine",
+    run_refine,
     "usage: dhcal refine --model M.json --data D.csv [--effects START] [--heldout H.csv]\n"
     "                    [--noise J,M] [--geometry LEVEL] [--out C.json] [--json]\n"
     "From the base model plus START (e.g. base_frame,tool_offset), adds the effect\n"
@@ -205,4 +208,6 @@ const dhcal_measured_command dhcal_refine_command = {
     "rows and no --geometry, cross-validation also picks how much geometry to fit.\n"
     "--heldout rows are evaluated at every step, never used to choose. --out writes\n"
     "the final model.\n",
-    DHCAL_OUT_MODEL, 0, 1};
+    DHCAL_OUT_MODEL,
+    0,
+    1};

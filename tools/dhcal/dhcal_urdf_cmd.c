@@ -70,12 +70,10 @@ static int parse(int argc, char **argv, urdf_options *o)
     const char *command = argv[1];
     const int import = strcmp(command, "import-urdf") == 0;
     enum { OPT_HELP = 1, OPT_BASE, OPT_TIP, OPT_TOOL, OPT_OUT };
-    static const struct option long_options[] = {{"help", no_argument, NULL, OPT_HELP},
-                                                 {"base", required_argument, NULL, OPT_BASE},
-                                                 {"tip", required_argument, NULL, OPT_TIP},
-                                                 {"tool-mm", required_argument, NULL, OPT_TOOL},
-                                                 {"out", required_argument, NULL, OPT_OUT},
-                                                 {NULL, 0, NULL, 0}};
+    static const struct option long_options[] = {
+        {"help", no_argument, NULL, OPT_HELP},     {"base", required_argument, NULL, OPT_BASE},
+        {"tip", required_argument, NULL, OPT_TIP}, {"tool-mm", required_argument, NULL, OPT_TOOL},
+        {"out", required_argument, NULL, OPT_OUT}, {NULL, 0, NULL, 0}};
     dhcal_options opts;
     dhcal_options_begin(&opts, argc, argv);
     char **args = opts.argv;
@@ -159,8 +157,8 @@ static void print_import_report(const urdf_options *o, const dhcal_model *m,
                                 const dhcal_urdf_import_report *r)
 {
     const dhc_arm *arm = &m->arm;
-    printf("robot '%s': link '%s' -> link '%s', %zu revolute joints, %zu fixed\n",
-           r->robot_name, o->base, o->tip, arm->n_joints, r->n_fixed);
+    printf("robot '%s': link '%s' -> link '%s', %zu revolute joints, %zu fixed\n", r->robot_name,
+           o->base, o->tip, arm->n_joints, r->n_fixed);
     for (size_t i = 0U; i < arm->n_joints; ++i) {
         const dhc_joint *j = &arm->joint[i];
         const int hayati = j->convention == DHC_CONV_HAYATI;
@@ -181,8 +179,8 @@ static void print_import_report(const urdf_options *o, const dhcal_model *m,
            "%.9g]\n",
            o->base, shown(arm->base.pos[0]), shown(arm->base.pos[1]), shown(arm->base.pos[2]),
            shown(deg(rpy[0])), shown(deg(rpy[1])), shown(deg(rpy[2])));
-    printf("tool_mm (in frame %zu): [%.9g, %.9g, %.9g]\n", arm->n_joints,
-           shown(arm->tool_mm[0]), shown(arm->tool_mm[1]), shown(arm->tool_mm[2]));
+    printf("tool_mm (in frame %zu): [%.9g, %.9g, %.9g]\n", arm->n_joints, shown(arm->tool_mm[0]),
+           shown(arm->tool_mm[1]), shown(arm->tool_mm[2]));
     double w[3];
     dhc_rot_log(&r->tip_in_frame_n, w);
     const double angle = dhc_vec3_norm(w);
@@ -285,7 +283,8 @@ static int run_export(const urdf_options *o)
         printf("the effects left out move the model's tool point by %.3g mm RMS, %.3g mm at most, "
                "over its joint ranges: a controller that loads this URDF misses that much "
                "(dhcal compensate includes them; for a URDF alone, calibrate the rigid geometry, "
-               "e.g. dhcal fit --effects base_frame,tool_offset)\n", rms, max);
+               "e.g. dhcal fit --effects base_frame,tool_offset)\n",
+               rms, max);
     }
     return 0;
 }

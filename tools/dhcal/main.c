@@ -48,8 +48,7 @@ static const dhcal_command commands[] = {
     {"plan", NULL, dhcal_plan_command, "the poses to measure: an optimal plan (dhcal plan --help)"},
     {"import-urdf", NULL, dhcal_urdf_command,
      "a URDF's serial chain as a model file (dhcal import-urdf --help)"},
-    {"export-urdf", NULL, dhcal_urdf_command,
-     "a model file as a URDF (dhcal export-urdf --help)"},
+    {"export-urdf", NULL, dhcal_urdf_command, "a model file as a URDF (dhcal export-urdf --help)"},
 };
 #define N_COMMANDS (sizeof commands / sizeof commands[0])
 
@@ -157,8 +156,20 @@ static int parse_args(int argc, char **argv, const dhcal_measured_command *cmd,
 {
     memset(o, 0, sizeof *o);
     o->command = cmd->name;
-    enum { OPT_JSON = 1, OPT_CV, OPT_HELP, OPT_MODEL, OPT_DATA, OPT_HELDOUT, OPT_OUT,
-           OPT_EFFECTS, OPT_NOISE, OPT_GEOMETRY, OPT_NO_UNITS, OPT_REPEATABILITY };
+    enum {
+        OPT_JSON = 1,
+        OPT_CV,
+        OPT_HELP,
+        OPT_MODEL,
+        OPT_DATA,
+        OPT_HELDOUT,
+        OPT_OUT,
+        OPT_EFFECTS,
+        OPT_NOISE,
+        OPT_GEOMETRY,
+        OPT_NO_UNITS,
+        OPT_REPEATABILITY
+    };
     static const struct option long_options[] = {
         {"json", no_argument, NULL, OPT_JSON},
         {"cv", no_argument, NULL, OPT_CV},
@@ -234,8 +245,7 @@ static int load_session(const dhcal_cli_options *o, dhcal_session *s)
     static dhcal_model file;
     int rc = dhcal_model_load(o->model, &file, &err);
     if (rc == DHCAL_IO_OK) {
-        rc = dhcal_session_begin(s, &file, o->model, o->noise, o->geometry, o->repeatability,
-                                 &err);
+        rc = dhcal_session_begin(s, &file, o->model, o->noise, o->geometry, o->repeatability, &err);
     }
     if (rc == DHCAL_IO_OK) {
         rc = dhcal_csv_load(o->data, s->model.arm.n_joints, &s->data, &err);
@@ -252,8 +262,8 @@ static int load_session(const dhcal_cli_options *o, dhcal_session *s)
                                      "use --no-units-check if they are right",
                                      "--effects base_frame,..."};
         rc = dhcal_units_check_files(&s->model, o->model, &s->data, o->data,
-                                     s->have_held ? &s->held_data : NULL, o->heldout, &ask,
-                                     stderr, &err);
+                                     s->have_held ? &s->held_data : NULL, o->heldout, &ask, stderr,
+                                     &err);
     }
     if (rc != DHCAL_IO_OK) {
         fprintf(stderr, "dhcal: %s\n", err.msg);

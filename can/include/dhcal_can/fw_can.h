@@ -34,22 +34,22 @@
 
 #include "dhcal_can/fw_can_transport.h"
 
-#define FW_CAN_MAX_DRIVES 3U     /* the DBC defines three drives */
+#define FW_CAN_MAX_DRIVES 3U /* the DBC defines three drives */
 #define FW_CAN_N_WIRES 3U
 
 #define FW_CAN_ID_SYNC 0x080U
 #define FW_CAN_ID_DRIVE_CMD_BASE 0x100U /* + drive index */
 #define FW_CAN_ID_DRIVE_FB_BASE 0x180U  /* + drive index */
 #define FW_CAN_ID_WIRES 0x200U
-#define FW_CAN_ID_MAX 0x7FFU            /* 11-bit identifiers */
+#define FW_CAN_ID_MAX 0x7FFU /* 11-bit identifiers */
 
 #define FW_CAN_DLC_SYNC 2U
 #define FW_CAN_DLC_DRIVE_CMD 4U
 #define FW_CAN_DLC_DRIVE_FB 6U
 #define FW_CAN_DLC_WIRES 8U
 
-#define FW_CAN_CODE_MAX 4095U    /* 12-bit DAC and ADC codes */
-#define FW_CAN_CODE_ZERO 2048U   /* offset binary: mid-scale = 0 V */
+#define FW_CAN_CODE_MAX 4095U  /* 12-bit DAC and ADC codes */
+#define FW_CAN_CODE_ZERO 2048U /* offset binary: mid-scale = 0 V */
 
 typedef enum {
     FW_CAN_MSG_OK = 0,

@@ -15,15 +15,15 @@
 /* 11-bit identifiers only: the protocol (can/dhcal.dbc) uses no extended frames. */
 typedef struct {
     uint32_t id;
-    uint8_t len;                  /* 0..8 */
+    uint8_t len; /* 0..8 */
     uint8_t data[FW_CAN_MAX_DLC];
 } fw_can_frame;
 
 typedef enum {
-    FW_CAN_OK = 0,      /* a frame was sent / received */
-    FW_CAN_TIMEOUT,     /* nothing arrived within the timeout */
-    FW_CAN_OVERRUN,     /* the receiver lost frames (kernel drop counter rose) */
-    FW_CAN_ERR_IO       /* the interface failed */
+    FW_CAN_OK = 0,  /* a frame was sent / received */
+    FW_CAN_TIMEOUT, /* nothing arrived within the timeout */
+    FW_CAN_OVERRUN, /* the receiver lost frames (kernel drop counter rose) */
+    FW_CAN_ERR_IO   /* the interface failed */
 } fw_can_status;
 
 typedef struct {

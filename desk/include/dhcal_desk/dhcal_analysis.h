@@ -38,9 +38,9 @@ int dhcal_geometry_set(const dhc_model *model, dhcal_geometry g, dhc_param_set *
 typedef struct {
     dhcal_error_stats train;   /* over the rows fitted (filled by the caller's evaluation) */
     dhcal_error_stats heldout; /* the model without the session's drift */
-    dhc_noise_model noise;    /* what the fit weighted with (the diagnosis uses the same) */
-    dhc_param_set set;    /* base model + effects */
-    dhc_model model;      /* calibrated (nominal when the fit failed) */
+    dhc_noise_model noise;     /* what the fit weighted with (the diagnosis uses the same) */
+    dhc_param_set set;         /* base model + effects */
+    dhc_model model;           /* calibrated (nominal when the fit failed) */
     dhc_calib_report rep;
     dhcal_geometry geometry;
     dhc_status status;
@@ -70,15 +70,13 @@ void dhcal_calib_options_for(const dhc_model *model, const dhc_noise_model *nois
  * out->status), DHCAL_IO_FAILED with a plain-words message otherwise (under-determined
  * data included). */
 int dhcal_fit_from(const dhc_model *start, const dhc_param_set *set, const dhc_noise_model *noise,
-                   dhcal_samples *s, const dhcal_samples *held, dhcal_fit *out,
-                   dhcal_error *err);
+                   dhcal_samples *s, const dhcal_samples *held, dhcal_fit *out, dhcal_error *err);
 
 /* dhcal_fit_from on the rows as they are: no row is screened or let back in (the screens
  * are off), so that fits compared with each other (the candidates of a diagnosis, the
  * steps of refine, the folds of a cross-validation) are made on one fixed set of rows. */
 int dhcal_fit_kept(const dhc_model *start, const dhc_param_set *set, const dhc_noise_model *noise,
-                   dhcal_samples *s, const dhcal_samples *held, dhcal_fit *out,
-                   dhcal_error *err);
+                   dhcal_samples *s, const dhcal_samples *held, dhcal_fit *out, dhcal_error *err);
 
 /* fit's parameter set less the link parameters its fit held at their input values for want
  * of support (dhc_calib_report.unsupported): what a fit that builds on this one (a
@@ -94,16 +92,16 @@ int dhcal_run_fit(const dhc_model *nominal, const char *effects, dhcal_geometry 
 /* Whether the session's covariates vary apart from the pose (dhc_covariate_pose_r2 over the
  * fitted rows): drift and thermal candidates are tried only when they do. */
 typedef struct {
-    double time_r2;        /* of t_s, or of the row number when the data have no t_s */
-    int time_from_rows;    /* no t_s column: t is the row number */
+    double time_r2;     /* of t_s, or of the row number when the data have no t_s */
+    int time_from_rows; /* no t_s column: t is the row number */
     int temperature_varies;
     double temperature_r2; /* when it varies */
     dhc_candidate_scope scope;
 } dhcal_covariates;
 
 /* The covariates of the fit's used rows (flags of s). DHCAL_IO_FAILED with the reason. */
-int dhcal_session_covariates(const dhcal_fit *fit, const dhcal_samples *s,
-                             dhcal_covariates *cov, dhcal_error *err);
+int dhcal_session_covariates(const dhcal_fit *fit, const dhcal_samples *s, dhcal_covariates *cov,
+                             dhcal_error *err);
 
 /* Ranks every candidate effect the fit's model can take against its residuals; cov (may be
  * NULL) receives what decided the drift and thermal candidates. */
@@ -148,14 +146,14 @@ size_t dhcal_implausible_param(const dhc_model *nominal, const dhcal_fit *fit, d
  * the same joint angles: their scatter is the noise, the robot's repeatability included;
  * the lack-of-fit F test). Without a reference the verdict is "unknown". */
 typedef struct {
-    const char *source;          /* "given" | "repeats" | "none" */
+    const char *source; /* "given" | "repeats" | "none" */
     int have_noise;
-    double noise_mm;             /* per coordinate */
+    double noise_mm; /* per coordinate */
     int have_test;
     double lack_of_fit_log10_p;
     int have_systematic;
-    double systematic_mm;        /* RMS (3-D) of the error beyond the noise */
-    const char *verdict;         /* "fits_noise" | "systematic_error" | "unknown" */
+    double systematic_mm; /* RMS (3-D) of the error beyond the noise */
+    const char *verdict;  /* "fits_noise" | "systematic_error" | "unknown" */
     size_t repeat_groups;
     size_t repeat_rows;
 } dhcal_adequacy;

@@ -18,9 +18,9 @@ typedef struct {
     size_t rows;
     double fold_ss[DHCAL_CV_MAX_FOLDS]; /* each fold's rows' sum of squared errors (mm^2) */
     size_t fold_rows[DHCAL_CV_MAX_FOLDS];
-    size_t refit_folds; /* folds whose estimate was refitted: every fold for
-                           dhcal_cross_validate_refit; for dhcal_cross_validate those its step
-                           could not serve (see there) */
+    size_t refit_folds;    /* folds whose estimate was refitted: every fold for
+                              dhcal_cross_validate_refit; for dhcal_cross_validate those its step
+                              could not serve (see there) */
     size_t iterated_folds; /* folds whose estimate took iterated steps (see there) */
 } dhcal_cv;
 
@@ -69,11 +69,10 @@ int dhcal_cross_validate(const dhc_model *start, const dhc_param_set *set,
  * linearised refit of set from start, confirmed as a fold's step is (*have_estimate 1), or
  * not to be trusted (0: the caller refits). One pass more. */
 int dhcal_cross_validate_step(const dhc_model *start, const dhc_param_set *set,
-                              const dhc_noise_model *noise, const dhcal_samples *s,
-                              dhcal_cv *out, dhc_model *estimate, int *have_estimate,
-                              dhcal_error *err);
+                              const dhc_noise_model *noise, const dhcal_samples *s, dhcal_cv *out,
+                              dhc_model *estimate, int *have_estimate, dhcal_error *err);
 int dhcal_cross_validate_refit(const dhc_model *start, const dhc_param_set *set,
-                               const dhc_noise_model *noise, const dhcal_samples *s,
-                               dhcal_cv *out, dhcal_error *err);
+                               const dhc_noise_model *noise, const dhcal_samples *s, dhcal_cv *out,
+                               dhcal_error *err);
 
 #endif /* DHCAL_CV_H */

@@ -94,29 +94,29 @@ dhcal_size_reference dhcal_size_reference_of(const dhcal_fit *fit, const dhcal_s
 
 typedef struct {
     dhcal_verdict verdict;
-    int tried;                /* refitted and cross-validated */
-    dhcal_cv cv;              /* when tried */
-    double cv_gain;           /* 1 - cv / cv of the model without it */
-    double gain_t;            /* fold gains' mean over its standard error */
-    double gain_log10_p;      /* one-sided t test of that (F - 1 dof) */
-    double gain_sure_mm2;     /* the summed fold gains' lower one-sided bound at
-                                 DHCAL_EVIDENCE_ALPHA (mm^2): how much the folds agree it
-                                 gains at least; the one named has the largest */
-    double tool_rms_mm;       /* what adding it changes at the tool over the data's poses */
+    int tried;            /* refitted and cross-validated */
+    dhcal_cv cv;          /* when tried */
+    double cv_gain;       /* 1 - cv / cv of the model without it */
+    double gain_t;        /* fold gains' mean over its standard error */
+    double gain_log10_p;  /* one-sided t test of that (F - 1 dof) */
+    double gain_sure_mm2; /* the summed fold gains' lower one-sided bound at
+                             DHCAL_EVIDENCE_ALPHA (mm^2): how much the folds agree it
+                             gains at least; the one named has the largest */
+    double tool_rms_mm;   /* what adding it changes at the tool over the data's poses */
     double tool_max_mm;
-    double range_rms_mm;      /* ... and over poses spread across the joint ranges */
+    double range_rms_mm; /* ... and over poses spread across the joint ranges */
     double range_max_mm;
-    double workspace_std_mm;  /* positioning uncertainty over the joint ranges with it */
-    double magnitude;         /* the fitted effect's size: |s| for a scale; the amplitude
-                                 (deg) for a harmonic; half the play (deg) for backlash; for
-                                 compliance the largest deflection (deg) over the data's
-                                 poses and the joint ranges */
-    double plausible_max;     /* what real arms show at most, same unit (0: no bound) */
-    double excitation;        /* compliance: gravity moment RMS over the data / reach */
+    double workspace_std_mm; /* positioning uncertainty over the joint ranges with it */
+    double magnitude;        /* the fitted effect's size: |s| for a scale; the amplitude
+                                (deg) for a harmonic; half the play (deg) for backlash; for
+                                compliance the largest deflection (deg) over the data's
+                                poses and the joint ranges */
+    double plausible_max;    /* what real arms show at most, same unit (0: no bound) */
+    double excitation;       /* compliance: gravity moment RMS over the data / reach */
     size_t n_look_alikes;
     size_t look_alike[DHCAL_MAX_LOOKALIKES]; /* indices into the diagnosis' list */
     double look_alike_r[DHCAL_MAX_LOOKALIKES];
-    char geometry_why[160];   /* DHCAL_VERDICT_GEOMETRY: the parameter out of range */
+    char geometry_why[160]; /* DHCAL_VERDICT_GEOMETRY: the parameter out of range */
 } dhcal_trial;
 
 typedef struct {
@@ -142,10 +142,9 @@ typedef struct {
  * refit.
  * s->flags end as they started. DHCAL_IO_FAILED when memory runs out. */
 int dhcal_judge_candidates(const dhc_model *nominal, const dhcal_fit *fit, const dhcal_cv *cv,
-                           const dhc_diagnosis *diag,
-                           const dhcal_size_reference *reference, dhcal_samples *s,
-                           const dhcal_samples *held, dhcal_trials *out, dhcal_fit *best_fit,
-                           dhcal_error *err);
+                           const dhc_diagnosis *diag, const dhcal_size_reference *reference,
+                           dhcal_samples *s, const dhcal_samples *held, dhcal_trials *out,
+                           dhcal_fit *best_fit, dhcal_error *err);
 
 /* dhcal_trial.magnitude's bound for effect e (0: none). */
 double dhcal_plausible_magnitude(dhc_effect e);

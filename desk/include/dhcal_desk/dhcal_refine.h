@@ -15,35 +15,35 @@
 #define DHCAL_EFFECTS_CAP 600U
 
 typedef struct {
-    char added[64];                    /* the effect added; "" for the start */
-    char effects[DHCAL_EFFECTS_CAP];   /* the effect list after the step */
-    double rms_mm;                     /* training RMS */
+    char added[64];                  /* the effect added; "" for the start */
+    char effects[DHCAL_EFFECTS_CAP]; /* the effect list after the step */
+    double rms_mm;                   /* training RMS */
     double cv_rms_mm;
-    size_t cv_rows;                    /* the rows its cross-validation used: the same at
-                                          every step (the rows are decided once) */
+    size_t cv_rows; /* the rows its cross-validation used: the same at
+                       every step (the rows are decided once) */
     int have_heldout;
     double heldout_rms_mm;
     double heldout_mean_mm;
 } dhcal_refine_step;
 
 typedef struct {
-    dhcal_fit fit;                     /* the final model's fit (training rows, held-out) */
-    dhcal_cv cv;                       /* its cross-validation */
-    char effects[DHCAL_EFFECTS_CAP];   /* the final list, start set included */
+    dhcal_fit fit;                   /* the final model's fit (training rows, held-out) */
+    dhcal_cv cv;                     /* its cross-validation */
+    char effects[DHCAL_EFFECTS_CAP]; /* the final list, start set included */
     size_t n_steps;
     dhcal_refine_step step[DHCAL_REFINE_MAX_STEPS + 1U];
-    int geometry_chosen;               /* 1: cross-validation chose the level (few rows) */
-    double geometry_cv_mm[3];          /* per level when chosen; negative: not fittable */
+    int geometry_chosen;      /* 1: cross-validation chose the level (few rows) */
+    double geometry_cv_mm[3]; /* per level when chosen; negative: not fittable */
     char geometry_why[720];
-    char held_why[480];                /* link parameters held at nominal because the start's
-                                          fit moved them beyond their physical range */
+    char held_why[480]; /* link parameters held at nominal because the start's
+                           fit moved them beyond their physical range */
     char stopped_why[720];
     /* the last judgement: of the final model's candidates when the loop stopped because
      * none was named (then trials.best_rejected is the closest one and why it fell short) */
     dhc_diagnosis diag;
     dhcal_covariates cov;
     dhcal_trials trials;
-    int judged;                        /* diag and trials hold a judgement */
+    int judged; /* diag and trials hold a judgement */
 } dhcal_refine_result;
 
 /* Rows are few for a parameter set when the equations number fewer than this many times

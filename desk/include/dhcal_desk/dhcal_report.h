@@ -26,13 +26,13 @@ typedef struct {
 } dhcal_fit_extras;
 
 /* Adequacy of the fit on s and, with held (may be NULL), the extrapolation to it; no CV. */
-void dhcal_fit_extras_compute(const dhcal_fit *f, const dhcal_samples *s,
-                              const dhcal_samples *held, dhcal_fit_extras *x);
+void dhcal_fit_extras_compute(const dhcal_fit *f, const dhcal_samples *s, const dhcal_samples *held,
+                              dhcal_fit_extras *x);
 
 /* The fit's keys: rms_mm .. outliers. input is the model the fit started from (base_r*
  * report the rotation composed into its base); row_err holds every row's error norm. */
-void dhcal_json_fit(cJSON *obj, const dhcal_fit *f, const dhc_model *input,
-                    const dhcal_samples *s, const double *row_err);
+void dhcal_json_fit(cJSON *obj, const dhcal_fit *f, const dhc_model *input, const dhcal_samples *s,
+                    const double *row_err);
 
 /* geometry, cv_rms_mm, heldout_outside_range, predicted_std_mm, adequacy. */
 void dhcal_json_extras(cJSON *obj, const dhcal_fit *f, const dhcal_fit_extras *x);

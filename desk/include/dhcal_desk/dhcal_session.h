@@ -11,8 +11,8 @@
 #include "dhcal_io/dhcal_model_file.h"
 
 typedef struct {
-    dhcal_model file;        /* the model file's content (names, limits, repeatability) */
-    dhc_model model;         /* ... as the library takes it */
+    dhcal_model file; /* the model file's content (names, limits, repeatability) */
+    dhc_model model;  /* ... as the library takes it */
     dhc_noise_model noise;
     dhcal_geometry geometry;
     double repeatability_mm; /* the arm's ISO 9283 repeatability; 0: not known */

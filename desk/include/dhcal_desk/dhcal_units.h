@@ -61,11 +61,11 @@
  * quaternion (Umeyama's scale). mirror: a's x coordinate is negated first (the best
  * improper alignment: the mirror image). */
 typedef struct {
-    double spread_a;       /* RMS distance of a's points from their centroid */
+    double spread_a; /* RMS distance of a's points from their centroid */
     double spread_b;
-    double corr;           /* Procrustes correlation in [0, 1]: 1 when a is b up to a similarity */
-    double scale;          /* corr spread_b / spread_a */
-    double rot[3][3];      /* applied to a (after the mirror) */
+    double corr;      /* Procrustes correlation in [0, 1]: 1 when a is b up to a similarity */
+    double scale;     /* corr spread_b / spread_a */
+    double rot[3][3]; /* applied to a (after the mirror) */
     double shift[3];
     double turn_deg;       /* rot's angle */
     double rms_similarity; /* RMS of b - (scale rot a + shift) = spread_b sqrt(1 - corr^2) */
@@ -78,24 +78,24 @@ int dhcal_similarity_fit(const double *a, const double *b, size_t n, int mirror,
 
 /* What the caller asks, and how a refusal tells the user to go on. */
 typedef struct {
-    const char *effects;     /* the effects asked for: base_frame allows another frame */
-    int frame_refuses;       /* 1: a frame finding refuses (commands that fit); 0: it is a
-                                note; -1: the frame is not judged (compensation targets) */
-    const char *override;    /* appended to a refusal: e.g. "use --no-units-check if they
-                                are right" */
-    const char *frame_how;   /* how to fit the frame: e.g. "--effects base_frame,..." */
+    const char *effects;   /* the effects asked for: base_frame allows another frame */
+    int frame_refuses;     /* 1: a frame finding refuses (commands that fit); 0: it is a
+                              note; -1: the frame is not judged (compensation targets) */
+    const char *override;  /* appended to a refusal: e.g. "use --no-units-check if they
+                              are right" */
+    const char *frame_how; /* how to fit the frame: e.g. "--effects base_frame,..." */
 } dhcal_units_ask;
 
 /* The numbers the check found (for messages, tests and docs); NAN where not computed. */
 typedef struct {
     double reach_mm;
-    size_t rows;            /* rows compared */
-    int wires;              /* compared in wire-length space */
-    double max_abs_q;       /* largest |angle| as the file wrote it (deg) */
-    double e_deg, e_rad;    /* aligned residual / predicted spread, angles as degrees, as
-                               radians (NAN when the radian reading was not tried) */
-    int radians;            /* the radian reading was taken */
-    double scale;           /* measured -> model, in the reading taken */
+    size_t rows;         /* rows compared */
+    int wires;           /* compared in wire-length space */
+    double max_abs_q;    /* largest |angle| as the file wrote it (deg) */
+    double e_deg, e_rad; /* aligned residual / predicted spread, angles as degrees, as
+                            radians (NAN when the radian reading was not tried) */
+    int radians;         /* the radian reading was taken */
+    double scale;        /* measured -> model, in the reading taken */
     double spread_meas, spread_model;
     double best_swap_ratio; /* e as read / e of the best exchange of two joint columns */
     int swap_a, swap_b;     /* those columns (1-based), 0 when none tried */
@@ -103,7 +103,7 @@ typedef struct {
     double direct_rms_mm, rigid_rms_mm;
     int refused;
     int has_note;
-    char note[600];         /* a frame finding that did not refuse */
+    char note[600]; /* a frame finding that did not refuse */
 } dhcal_units_report;
 
 /* The model alone: DHCAL_IO_BAD_INPUT naming path when its reach is below

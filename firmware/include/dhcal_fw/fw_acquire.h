@@ -53,9 +53,9 @@
 
 /* What the holds of one acquisition run showed. */
 typedef struct {
-    uint32_t retakes;          /* holds retaken: the arm moved during a sample's hold */
-    double wire_sem_ss;        /* sum over holds and wires of the squared standard error
-                                  of the mean wire length */
+    uint32_t retakes;   /* holds retaken: the arm moved during a sample's hold */
+    double wire_sem_ss; /* sum over holds and wires of the squared standard error
+                           of the mean wire length */
     uint32_t wire_sem_count;
     double angle_dither_ss[DHC_MAX_JOINTS]; /* per joint: sum over holds of (last reading -
                                   mean reading over the hold)^2 */
@@ -83,11 +83,10 @@ double fw_acq_angle_dither_rad(const fw_acq_stats *st, size_t joint);
 /* Runs the plan; samples[0 .. *n_done) are kept whatever happens, and a sample that fails
  * a check is never added. The holds are counted in st. */
 fw_fault fw_acquire(fw_ctrl *c, const dhc_model *model, const fw_pose *poses, size_t n,
-                    uint32_t hold_ticks, fw_acq_stats *st, dhc_sample *samples,
-                    size_t *n_done);
+                    uint32_t hold_ticks, fw_acq_stats *st, dhc_sample *samples, size_t *n_done);
 
 /* One sample at the current (settled) pose; its holds counted in st. */
-fw_fault fw_acquire_one(fw_ctrl *c, const dhc_model *model, uint32_t hold_ticks,
-                        fw_acq_stats *st, dhc_sample *out);
+fw_fault fw_acquire_one(fw_ctrl *c, const dhc_model *model, uint32_t hold_ticks, fw_acq_stats *st,
+                        dhc_sample *out);
 
 #endif /* FW_ACQUIRE_H */

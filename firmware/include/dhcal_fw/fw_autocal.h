@@ -42,12 +42,12 @@
 extern const dhc_candidate_scope fw_autocal_scope;
 
 typedef struct {
-    dhc_calib_report geo;    /* base model fit */
-    dhc_status diagnosis;    /* DHC_OK when the diagnosis ran (or is off); its error when it
-                                failed: then nothing is named, and no effect was ruled out */
-    int found;               /* the diagnosis named a significant effect */
+    dhc_calib_report geo; /* base model fit */
+    dhc_status diagnosis; /* DHC_OK when the diagnosis ran (or is off); its error when it
+                             failed: then nothing is named, and no effect was ruled out */
+    int found;            /* the diagnosis named a significant effect */
     dhc_effect effect;
-    size_t effect_joint;     /* 0-based */
+    size_t effect_joint; /* 0-based */
     double effect_log10_p;
     int effect_fitted;       /* the refit with it succeeded: the model carries the effect */
     dhc_calib_report eff;    /* refit with the effect (valid when effect_fitted) */
@@ -127,9 +127,8 @@ fw_fault fw_autocal_configured(const fw_autocal_config *cfg, dhc_model *model,
  * storage); geo_out (may be NULL) receives the geometry-only fit. Returns FW_FAULT_STORAGE
  * when the store fails (the model is still returned); other faults as
  * fw_autocal_configured. */
-fw_fault fw_autocal(dhc_model *model, const dhc_sample *samples, size_t n,
-                    const fw_nvstore *nv, fw_autocal_workspace *ws, dhc_model *geo_out,
-                    fw_autocal_result *res);
+fw_fault fw_autocal(dhc_model *model, const dhc_sample *samples, size_t n, const fw_nvstore *nv,
+                    fw_autocal_workspace *ws, dhc_model *geo_out, fw_autocal_result *res);
 
 #if DHC_WITH_NAMES
 /* The effect the diagnosis added, as the effect table names it (docs/effects.md):

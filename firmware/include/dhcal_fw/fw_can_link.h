@@ -56,7 +56,7 @@
 /* Optional time source. Both NULL: no pacing, recv timeouts only (simulation, tests). */
 typedef struct {
     void *ctx;
-    uint64_t (*now_us)(void *ctx);                  /* monotonic microseconds */
+    uint64_t (*now_us)(void *ctx);                    /* monotonic microseconds */
     void (*sleep_until_us)(void *ctx, uint64_t t_us); /* may be NULL: SYNC sent at once */
 } fw_can_clock;
 
@@ -70,30 +70,30 @@ typedef struct {
 } fw_can_link_config;
 
 typedef struct {
-    uint64_t ticks;      /* SYNCs sent (start's included) */
-    uint64_t complete;   /* ticks whose feedback all arrived in time */
-    uint32_t timeouts;   /* ticks that ended in FW_PORT_ERR_TIMEOUT */
-    uint32_t lost;       /* frames missing at those timeouts */
-    uint32_t late;       /* frames echoing an older tick (discarded) */
-    uint32_t future;     /* frames echoing a tick not sent yet (discarded) */
-    uint32_t duplicate;  /* second frame of an id for the current tick (discarded) */
-    uint32_t malformed;  /* our ids with a bad length or reserved bits (discarded) */
-    uint32_t foreign;    /* ids the link does not consume (ignored) */
-    uint32_t overruns;   /* the transport reported lost frames */
-    uint32_t io_errors;  /* transport send/recv failures */
+    uint64_t ticks;        /* SYNCs sent (start's included) */
+    uint64_t complete;     /* ticks whose feedback all arrived in time */
+    uint32_t timeouts;     /* ticks that ended in FW_PORT_ERR_TIMEOUT */
+    uint32_t lost;         /* frames missing at those timeouts */
+    uint32_t late;         /* frames echoing an older tick (discarded) */
+    uint32_t future;       /* frames echoing a tick not sent yet (discarded) */
+    uint32_t duplicate;    /* second frame of an id for the current tick (discarded) */
+    uint32_t malformed;    /* our ids with a bad length or reserved bits (discarded) */
+    uint32_t foreign;      /* ids the link does not consume (ignored) */
+    uint32_t overruns;     /* the transport reported lost frames */
+    uint32_t io_errors;    /* transport send/recv failures */
     uint32_t drive_faults; /* feedback frames with the Fault bit */
 } fw_can_link_counters;
 
 typedef struct {
     fw_can_transport transport;
     fw_can_link_config cfg;
-    uint64_t tick;          /* current tick n (SYNCs sent - 1) */
-    uint64_t t0_us;         /* clock at start (with a clock) */
+    uint64_t tick;  /* current tick n (SYNCs sent - 1) */
+    uint64_t t0_us; /* clock at start (with a clock) */
     int started;
-    int fresh;              /* every frame of tick n arrived: reads succeed */
+    int fresh;                 /* every frame of tick n arrived: reads succeed */
     fw_port_status last_error; /* what reads return while !fresh */
-    uint8_t drive_enable;   /* Enable bit of the commands (1 after init) */
-    uint32_t received_mask; /* bit j: DRIVE_FB_j of tick n; bit FW_CAN_MAX_DRIVES: wires */
+    uint8_t drive_enable;      /* Enable bit of the commands (1 after init) */
+    uint32_t received_mask;    /* bit j: DRIVE_FB_j of tick n; bit FW_CAN_MAX_DRIVES: wires */
     fw_can_drive_fb fb[FW_CAN_MAX_DRIVES]; /* tick n's feedback (status bits for logs) */
     fw_can_wires wires;
     fw_can_link_counters counters;

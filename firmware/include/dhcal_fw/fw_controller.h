@@ -32,21 +32,21 @@
 
 typedef enum {
     FW_FAULT_NONE = 0,
-    FW_FAULT_ENCODER_JUMP,      /* a counter step above the plausible maximum */
-    FW_FAULT_TACHO_MISMATCH,    /* tacho and encoder velocity disagree for too long */
-    FW_FAULT_DRIVE_SATURATED,   /* a drive at its limit for too long */
-    FW_FAULT_WIRES_INCONSISTENT,/* wire lengths that cannot meet at one point */
-    FW_FAULT_PORT_TIMEOUT,      /* the port had no fresh data */
-    FW_FAULT_PORT_IO,           /* the port failed */
-    FW_FAULT_STORAGE,           /* the calibration store failed */
-    FW_FAULT_SETTLE_TIMEOUT,    /* a move did not settle in time */
-    FW_FAULT_JOINT_LIMIT,       /* a target outside the joint range */
-    FW_FAULT_ARGUMENT,          /* invalid call */
-    FW_FAULT_NOT_CONVERGED,     /* a calibration fit did not converge */
-    FW_FAULT_UNDERDETERMINED,   /* too few or too poor samples for the parameters */
-    FW_FAULT_NUMERIC,           /* samples or model that break the arithmetic (non-finite,
-                                   singular) */
-    FW_FAULT_STOPPED,           /* stopped on request (an operator, a signal) */
+    FW_FAULT_ENCODER_JUMP,       /* a counter step above the plausible maximum */
+    FW_FAULT_TACHO_MISMATCH,     /* tacho and encoder velocity disagree for too long */
+    FW_FAULT_DRIVE_SATURATED,    /* a drive at its limit for too long */
+    FW_FAULT_WIRES_INCONSISTENT, /* wire lengths that cannot meet at one point */
+    FW_FAULT_PORT_TIMEOUT,       /* the port had no fresh data */
+    FW_FAULT_PORT_IO,            /* the port failed */
+    FW_FAULT_STORAGE,            /* the calibration store failed */
+    FW_FAULT_SETTLE_TIMEOUT,     /* a move did not settle in time */
+    FW_FAULT_JOINT_LIMIT,        /* a target outside the joint range */
+    FW_FAULT_ARGUMENT,           /* invalid call */
+    FW_FAULT_NOT_CONVERGED,      /* a calibration fit did not converge */
+    FW_FAULT_UNDERDETERMINED,    /* too few or too poor samples for the parameters */
+    FW_FAULT_NUMERIC,            /* samples or model that break the arithmetic (non-finite,
+                                    singular) */
+    FW_FAULT_STOPPED,            /* stopped on request (an operator, a signal) */
     FW_FAULT_COUNT
 } fw_fault;
 
@@ -57,9 +57,9 @@ typedef struct {
     fw_pid_gains gains[DHC_MAX_JOINTS];
     double q_min_rad[DHC_MAX_JOINTS]; /* joint range (targets outside: FW_FAULT_JOINT_LIMIT) */
     double q_max_rad[DHC_MAX_JOINTS];
-    double v_max_rad_s;            /* trajectory limits */
+    double v_max_rad_s; /* trajectory limits */
     double a_max_rad_s2;
-    double approach_rad;           /* overshoot before the final approach */
+    double approach_rad; /* overshoot before the final approach */
     double settle_pos_tol_rad;
     double settle_vel_tol_rad_s;
     uint32_t settle_ticks;         /* consecutive ticks inside the tolerances */
@@ -75,7 +75,7 @@ typedef struct {
      * second differences of sigma sqrt(6) s. A larger change is a wheel that slipped (or
      * jumped) within the tick: FW_FAULT_WIRES_INCONSISTENT, the wire in fault_index. */
     int32_t wire_max_step_change;
-    double tick_s;                 /* control period (0.001) */
+    double tick_s; /* control period (0.001) */
 } fw_ctrl_config;
 
 typedef struct {
@@ -87,21 +87,21 @@ typedef struct {
     int64_t enc_home[DHC_MAX_JOINTS]; /* absolute count of the reading at init */
     fw_counter wire[3];
     int64_t wire_home[3];
-    int64_t wire_step[3];                /* last tick's counter step, counts */
-    int64_t wire_step_change_max;        /* largest |step change| seen (diagnostics) */
+    int64_t wire_step[3];         /* last tick's counter step, counts */
+    int64_t wire_step_change_max; /* largest |step change| seen (diagnostics) */
     fw_pid_state pid[DHC_MAX_JOINTS];
     double q_rad[DHC_MAX_JOINTS];        /* encoder angles, latest tick */
     double qd_enc_rad_s[DHC_MAX_JOINTS]; /* low-passed encoder differences */
     double qd_tacho_rad_s[DHC_MAX_JOINTS];
-    double q_ref_rad[DHC_MAX_JOINTS];    /* the reference the servo holds */
-    double u_v[DHC_MAX_JOINTS];          /* last drive command, volts */
-    int8_t dir[DHC_MAX_JOINTS];          /* sign of each joint's last approach */
+    double q_ref_rad[DHC_MAX_JOINTS]; /* the reference the servo holds */
+    double u_v[DHC_MAX_JOINTS];       /* last drive command, volts */
+    int8_t dir[DHC_MAX_JOINTS];       /* sign of each joint's last approach */
     uint32_t tacho_bad[DHC_MAX_JOINTS];
     uint32_t sat_count[DHC_MAX_JOINTS];
     uint64_t t_us;
     uint64_t ticks;
     fw_fault fault;
-    size_t fault_index;                  /* joint or wire the fault concerns */
+    size_t fault_index; /* joint or wire the fault concerns */
 } fw_ctrl;
 
 /* Gains and limits for the paper's drive (docs/formats.md, 6.5: 100:1 gear, ~10 Hz position

@@ -3,9 +3,9 @@
  * The controller commands the arm through the model it currently believes in (nominal at
  * first, then calibrated, effects included), so the inverse kinematics runs on the full
  * dhc_model: the library's dhc_model_inverse (dhc_inverse.h), the same code as the host's
- * dhcal compensate, on the predicted tool point from a seed. For arms shaped like the paper's 3-DOF robot (vertical base axis, then two
- * parallel axes) fw_ik_seed_3dof gives a closed-form seed from the nominal geometry.
- * No heap, no I/O; cost O(iterations * N^2).
+ * dhcal compensate, on the predicted tool point from a seed. For arms shaped like the paper's 3-DOF
+ * robot (vertical base axis, then two parallel axes) fw_ik_seed_3dof gives a closed-form seed from
+ * the nominal geometry. No heap, no I/O; cost O(iterations * N^2).
  */
 #ifndef FW_IK_H
 #define FW_IK_H

@@ -4,12 +4,12 @@
  * The same sequence runs on every controller: the simulation (dhcal-demo), the Linux port
  * (dhcal-fw) and a bare-metal build. The caller owns all of the job's state in one fw_job
  * (static storage: it holds the samples and the calibration's workspaces, about 290 KiB with
- * the default DHC_MAX_PARAMS of 64; the normal matrices grow with its square) and hands it a port, the machine's conversions (fw_io_config),
- * its nominal model and a configuration; nothing is kept between jobs elsewhere, so a
- * second calibration does not depend on the first. The steps may run one by one (the demo
- * positions the arm with the nominal model between boot and plan) or all at once
- * (fw_job_run). Every step returns the controller's fault; a step after a fault returns
- * that fault without moving. Portable C11: no heap, no I/O. See docs/architecture.md.
+ * the default DHC_MAX_PARAMS of 64; the normal matrices grow with its square) and hands it a port,
+ * the machine's conversions (fw_io_config), its nominal model and a configuration; nothing is kept
+ * between jobs elsewhere, so a second calibration does not depend on the first. The steps may run
+ * one by one (the demo positions the arm with the nominal model between boot and plan) or all at
+ * once (fw_job_run). Every step returns the controller's fault; a step after a fault returns that
+ * fault without moving. Portable C11: no heap, no I/O. See docs/architecture.md.
  */
 #ifndef FW_JOB_H
 #define FW_JOB_H
@@ -29,30 +29,30 @@
 typedef struct {
     double q_start_rad[DHC_MAX_JOINTS]; /* where the arm stands at boot: the counters are
                                            homed there (the joints' n_joints first) */
-    size_t n_samples;      /* poses in the plan, 1..FW_ACQ_MAX_SAMPLES */
+    size_t n_samples;                   /* poses in the plan, 1..FW_ACQ_MAX_SAMPLES */
     uint32_t plan_seed;
-    size_t plan_candidates; /* 0: the plan is n_samples random poses; else the n_samples
-                               of this many random candidates (at most
-                               FW_PLAN_MAX_CANDIDATES) that observe the base model and the
-                               configured effects best (fw_plan_select), and with the
-                               diagnosis on the effects it may add as well: a plan for the
-                               base model alone gathers its poses where look-alikes cannot
-                               be told apart (measured: docs/numbers.md, 5) */
-    const fw_pose *poses;  /* NULL: the job plans its poses (plan_candidates, plan_seed,
-                              mixed_dirs); else the n_samples poses to measure, in this
-                              order, as given: a plan made at the desk (`dhcal plan`, e.g.
-                              --discriminate A,B: poses that tell two look-alike effects
-                              apart), read by the port. Each must have finite angles within
-                              the model's joint ranges and directions of -1 or +1, else
-                              fw_job_plan faults FW_FAULT_ARGUMENT. Not copied before
-                              fw_job_plan: it must live until then. */
-    int mixed_dirs;        /* approach directions drawn +-1 (fw_plan.h) */
-    uint32_t hold_ticks;   /* ticks averaged per sample */
-    int noise_model;       /* 1: the fits weight by the encoders' quantisation and the
-                              wire noise measured over the holds (fw_autocal_config) */
+    size_t plan_candidates;    /* 0: the plan is n_samples random poses; else the n_samples
+                                  of this many random candidates (at most
+                                  FW_PLAN_MAX_CANDIDATES) that observe the base model and the
+                                  configured effects best (fw_plan_select), and with the
+                                  diagnosis on the effects it may add as well: a plan for the
+                                  base model alone gathers its poses where look-alikes cannot
+                                  be told apart (measured: docs/numbers.md, 5) */
+    const fw_pose *poses;      /* NULL: the job plans its poses (plan_candidates, plan_seed,
+                                  mixed_dirs); else the n_samples poses to measure, in this
+                                  order, as given: a plan made at the desk (`dhcal plan`, e.g.
+                                  --discriminate A,B: poses that tell two look-alike effects
+                                  apart), read by the port. Each must have finite angles within
+                                  the model's joint ranges and directions of -1 or +1, else
+                                  fw_job_plan faults FW_FAULT_ARGUMENT. Not copied before
+                                  fw_job_plan: it must live until then. */
+    int mixed_dirs;            /* approach directions drawn +-1 (fw_plan.h) */
+    uint32_t hold_ticks;       /* ticks averaged per sample */
+    int noise_model;           /* 1: the fits weight by the encoders' quantisation and the
+                                  wire noise measured over the holds (fw_autocal_config) */
     fw_autocal_config autocal; /* configured effects, diagnosis, wire noise; the job sets
                                   its io and acq */
-    fw_ctrl_config ctrl;   /* the servo and its limits */
+    fw_ctrl_config ctrl;       /* the servo and its limits */
 } fw_job_config;
 
 typedef struct {
@@ -63,16 +63,16 @@ typedef struct {
     fw_ctrl ctrl;
     fw_pose plan[FW_ACQ_MAX_SAMPLES];
     size_t n_plan;
-    double o1;              /* observability of the plan for the base model (fw_plan.h) */
-    size_t o1_rank;         /* parameters the plan observes ... */
-    size_t o1_params;       /* ... of the base model's */
+    double o1;        /* observability of the plan for the base model (fw_plan.h) */
+    size_t o1_rank;   /* parameters the plan observes ... */
+    size_t o1_params; /* ... of the base model's */
     fw_acq_stats acq;
     dhc_sample samples[FW_ACQ_MAX_SAMPLES];
-    size_t n_samples;       /* taken; on an acquisition fault the ones before it */
-    dhc_model geometric;    /* the base fit (geometry and the configured effects) */
-    dhc_model calibrated;   /* the final model (with the diagnosed effect, if any) */
+    size_t n_samples;     /* taken; on an acquisition fault the ones before it */
+    dhc_model geometric;  /* the base fit (geometry and the configured effects) */
+    dhc_model calibrated; /* the final model (with the diagnosed effect, if any) */
     fw_autocal_result result;
-    int calibrated_ok;      /* result, geometric and calibrated are valid */
+    int calibrated_ok; /* result, geometric and calibrated are valid */
     fw_plan_workspace plan_ws;
     fw_autocal_workspace autocal_ws;
 } fw_job;

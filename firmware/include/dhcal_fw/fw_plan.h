@@ -4,10 +4,11 @@
  * a margin, kept when the model puts the tool at least 250 mm from axis 1, above z = 100 mm
  * and at least 300 mm in front of the measurer's anchor plane. A planned plan
  * (fw_plan_select) draws more candidates that way and keeps the n from which a fit predicts
- * the tool best over them (dhc_plan_select). Approach directions: with mixed_dirs each joint's is drawn +-1 (backlash-like effects become observable), else +1
- * for all: direction-dependent offsets (backlash, the link bearing's friction holding a
- * compliant joint's spring) are then the same in every sample and are absorbed by the
- * joint offsets, which is exact as long as positioning approaches the same way.
+ * the tool best over them (dhc_plan_select). Approach directions: with mixed_dirs each joint's is
+ * drawn +-1 (backlash-like effects become observable), else +1 for all: direction-dependent offsets
+ * (backlash, the link bearing's friction holding a compliant joint's spring) are then the same in
+ * every sample and are absorbed by the joint offsets, which is exact as long as positioning
+ * approaches the same way.
  *
  * Observability index of a plan (Borm & Menq's O1), documented choice:
  *     O1 = (prod_k sigma_k)^(1/p) / sqrt(m),
@@ -60,16 +61,15 @@ size_t fw_plan_poses(const dhc_model *model, size_t n, uint32_t seed, int mixed_
  * how many (0 when fewer than n candidates pass the workspace limits, candidates is above
  * FW_PLAN_MAX_CANDIDATES or n above FW_PLAN_MAX_POSES, or the selection fails). */
 #if DHC_WITH_PLAN /* dhc_config.h */
-size_t fw_plan_select(const dhc_model *model, const dhc_param_set *set, size_t n,
-                      size_t candidates, uint32_t seed, int mixed_dirs, fw_plan_workspace *ws,
-                      fw_pose *poses);
+size_t fw_plan_select(const dhc_model *model, const dhc_param_set *set, size_t n, size_t candidates,
+                      uint32_t seed, int mixed_dirs, fw_plan_workspace *ws, fw_pose *poses);
 #endif
 
 /* O1 of the plan for the parameter set (see above); *rank may be NULL. Errors of lib's
  * Jacobian and analysis; DHC_ERR_ARGUMENT for an empty plan or set, or NULL. */
 dhc_status fw_plan_observability(const dhc_model *model, const dhc_param_set *set,
-                                 const fw_pose *poses, size_t n, fw_plan_workspace *ws,
-                                 double *o1, size_t *rank);
+                                 const fw_pose *poses, size_t n, fw_plan_workspace *ws, double *o1,
+                                 size_t *rank);
 
 /* The wire lengths the model predicts at a pose (at its thermal reference). */
 dhc_status fw_pose_wires(const dhc_model *model, const fw_pose *pose, double wire_mm[3]);

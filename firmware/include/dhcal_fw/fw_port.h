@@ -41,12 +41,12 @@ typedef struct {
 
 /* Conversions between raw codes and physical units for one machine. */
 typedef struct {
-    double counts_per_rad[DHC_MAX_JOINTS]; /* encoder counts per JOINT radian (gear included) */
+    double counts_per_rad[DHC_MAX_JOINTS];    /* encoder counts per JOINT radian (gear included) */
     double tacho_v_per_rad_s[DHC_MAX_JOINTS]; /* at the joint */
-    double adc_v_full_scale;   /* ADC code 0..4095 spans -fs..+fs volts */
-    double dac_v_full_scale;   /* DAC code 0..4095 spans -fs..+fs volts */
-    double wire_mm_per_count;  /* friction wheel: 2 pi r / (lines x 4) */
-    double wire_ref_mm[3];     /* wire length when its counter read zero */
+    double adc_v_full_scale;                  /* ADC code 0..4095 spans -fs..+fs volts */
+    double dac_v_full_scale;                  /* DAC code 0..4095 spans -fs..+fs volts */
+    double wire_mm_per_count;                 /* friction wheel: 2 pi r / (lines x 4) */
+    double wire_ref_mm[3];                    /* wire length when its counter read zero */
 } fw_io_config;
 
 /* A joint's conversions from its drive's data: encoder counts per MOTOR turn (after x4

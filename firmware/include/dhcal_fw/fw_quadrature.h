@@ -27,10 +27,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-typedef enum {
-    FW_QUAD_LINE_A = 0,
-    FW_QUAD_LINE_B = 1
-} fw_quad_line;
+typedef enum { FW_QUAD_LINE_A = 0, FW_QUAD_LINE_B = 1 } fw_quad_line;
 
 typedef enum {
     FW_QUAD_FALLING = 0, /* new level 0 */
@@ -38,9 +35,9 @@ typedef enum {
 } fw_quad_edge;
 
 typedef struct {
-    uint8_t line;   /* fw_quad_line */
-    uint8_t edge;   /* fw_quad_edge */
-    uint64_t t_ns;  /* event timestamp (any monotonic origin) */
+    uint8_t line;  /* fw_quad_line */
+    uint8_t edge;  /* fw_quad_edge */
+    uint64_t t_ns; /* event timestamp (any monotonic origin) */
 } fw_quad_event;
 
 typedef enum {
@@ -53,13 +50,13 @@ typedef enum {
 typedef struct {
     uint8_t level_a;
     uint8_t level_b;
-    int64_t count;          /* x4 counts since init (plus the initial value) */
+    int64_t count; /* x4 counts since init (plus the initial value) */
     uint64_t last_t_ns;
-    int has_time;           /* an event was fed since init */
-    uint32_t edges;         /* events decoded */
-    uint32_t missed;        /* FW_QUAD_FAULT_MISSED_EDGE events */
-    uint32_t time_faults;   /* FW_QUAD_FAULT_TIME_BACKWARDS events */
-    fw_quad_status fault;   /* first fault since init / clear, latched (FW_QUAD_OK: none) */
+    int has_time;         /* an event was fed since init */
+    uint32_t edges;       /* events decoded */
+    uint32_t missed;      /* FW_QUAD_FAULT_MISSED_EDGE events */
+    uint32_t time_faults; /* FW_QUAD_FAULT_TIME_BACKWARDS events */
+    fw_quad_status fault; /* first fault since init / clear, latched (FW_QUAD_OK: none) */
 } fw_quadrature;
 
 /* Starts at the lines' current levels (non-zero = high) with count count0. */

@@ -21,10 +21,10 @@
 
 typedef struct {
     size_t n;
-    dhc_frame base;                       /* frame 0 in the world, metres */
-    dhc_frame link[DHC_MAX_JOINTS];       /* C_i, metres */
+    dhc_frame base;                 /* frame 0 in the world, metres */
+    dhc_frame link[DHC_MAX_JOINTS]; /* C_i, metres */
     double theta_offset_rad[DHC_MAX_JOINTS];
-    double tool_m[3];                     /* tool point in frame n */
+    double tool_m[3]; /* tool point in frame n */
     double mass_kg[DHC_MAX_JOINTS];
     double com_m[DHC_MAX_JOINTS][3];      /* in frame i */
     dhc_mat3 inertia[DHC_MAX_JOINTS];     /* about the COM, frame i axes, kg m^2 */
@@ -63,7 +63,6 @@ void dhs_arm_mass_matrix(const dhs_arm *arm, const dhs_arm_pose *pose, double *m
 /* Bias torques h(q, dq) = C(q, dq) dq + g(q): recursive Newton-Euler with zero joint
  * accelerations (gravity enters as an upward acceleration of the base), so that
  * M ddq + h = tau. dq: link velocities (rad/s). O(N). */
-void dhs_arm_bias(const dhs_arm *arm, const dhs_arm_pose *pose, const double *dq,
-                  double *h_nm);
+void dhs_arm_bias(const dhs_arm *arm, const dhs_arm_pose *pose, const double *dq, double *h_nm);
 
 #endif /* DHS_ARM_H */

@@ -45,7 +45,7 @@
 #define DHS_BUS_CMD_WATCHDOG_TICKS 10U
 /* frames the nodes emit: DRIVE_FB_0..FW_CAN_MAX_DRIVES-1, then MEAS_WIRES */
 #define DHS_BUS_N_TX_IDS (FW_CAN_MAX_DRIVES + 1U)
-#define DHS_BUS_MAX_DELAYED 8U  /* two ticks of held-back frames */
+#define DHS_BUS_MAX_DELAYED 8U /* two ticks of held-back frames */
 
 typedef enum {
     DHS_BUS_OK = 0,       /* a frame of ours, acted on */
@@ -60,16 +60,16 @@ typedef enum {
 typedef void (*dhs_bus_emit)(void *ctx, const fw_can_frame *frame);
 
 typedef struct {
-    dhs_plant *plant;           /* caller's, not owned */
-    size_t n;                   /* drives = plant joints (<= FW_CAN_MAX_DRIVES) */
-    int started;                /* a SYNC was seen */
-    uint16_t tick;              /* of the last SYNC */
+    dhs_plant *plant;                     /* caller's, not owned */
+    size_t n;                             /* drives = plant joints (<= FW_CAN_MAX_DRIVES) */
+    int started;                          /* a SYNC was seen */
+    uint16_t tick;                        /* of the last SYNC */
     uint16_t dac_code[FW_CAN_MAX_DRIVES]; /* applied command */
     uint8_t enabled[FW_CAN_MAX_DRIVES];
     uint8_t brake_released[FW_CAN_MAX_DRIVES];
     uint32_t cmd_missing[FW_CAN_MAX_DRIVES]; /* consecutive periods without a command */
     uint8_t cmd_fresh[FW_CAN_MAX_DRIVES];    /* a command arrived in this period */
-    dhc_status plant_status;    /* DHC_OK until the plant fails */
+    dhc_status plant_status;                 /* DHC_OK until the plant fails */
     /* fault injection */
     uint32_t drop_next[DHS_BUS_N_TX_IDS];
     uint32_t delay_next[DHS_BUS_N_TX_IDS];

@@ -35,15 +35,15 @@
 
 typedef struct {
     /* what the controller records */
-    double q_rad[DHC_MAX_JOINTS];      /* encoder angles, nominal conversion */
-    int8_t dir[DHC_MAX_JOINTS];        /* approach directions */
-    double xyz_mm[3];                  /* measured tool point (noise_xyz) */
-    double wire_mm[3];                 /* reported wire lengths (measurer only) */
+    double q_rad[DHC_MAX_JOINTS]; /* encoder angles, nominal conversion */
+    int8_t dir[DHC_MAX_JOINTS];   /* approach directions */
+    double xyz_mm[3];             /* measured tool point (noise_xyz) */
+    double wire_mm[3];            /* reported wire lengths (measurer only) */
     /* truth */
     int64_t encoder_counts[DHC_MAX_JOINTS];
     double motor_rad[DHC_MAX_JOINTS];
     double link_rad[DHC_MAX_JOINTS];
-    double hold_nm[DHC_MAX_JOINTS];    /* gravity torque each joint carries */
+    double hold_nm[DHC_MAX_JOINTS]; /* gravity torque each joint carries */
     double tool_mm[3];
     double wire_true_mm[3];
 } dhs_sample_row;

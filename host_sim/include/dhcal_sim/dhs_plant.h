@@ -57,9 +57,9 @@
 #include "dhs_scenario.h"
 #include "dhs_wires.h"
 
-#define DHS_DAC_CODES 4096U  /* 12-bit DAC: 0 = -range, 2048 = 0 V, 4095 = +range - 1 LSB */
+#define DHS_DAC_CODES 4096U /* 12-bit DAC: 0 = -range, 2048 = 0 V, 4095 = +range - 1 LSB */
 #define DHS_DAC_ZERO 2048U
-#define DHS_ADC_CODES 4096U  /* 12-bit ADC, offset binary like the DAC, clamped 0..4095 */
+#define DHS_ADC_CODES 4096U /* 12-bit ADC, offset binary like the DAC, clamped 0..4095 */
 
 /* Largest number of mechanical coordinates: a link and a motor per joint. */
 #define DHS_MAX_DOF (DHC_MAX_JOINTS + DHC_MAX_JOINTS)
@@ -74,11 +74,11 @@ typedef struct {
 } dhs_cs;
 
 typedef struct {
-    dhs_scenario sc;      /* private copy: the caller's scenario may go away */
+    dhs_scenario sc; /* private copy: the caller's scenario may go away */
     dhs_arm arm;
     size_t n;
-    uint64_t steps;       /* physics steps since init */
-    double h_s;           /* step, s */
+    uint64_t steps; /* physics steps since init */
+    double h_s;     /* step, s */
     /* state */
     double current_a[DHC_MAX_JOINTS];
     double motor_rad[DHC_MAX_JOINTS];
@@ -87,13 +87,13 @@ typedef struct {
     double link_rad_s[DHC_MAX_JOINTS];
     uint16_t dac[DHC_MAX_JOINTS];
     int brake[DHC_MAX_JOINTS];
-    double friction_impulse[DHS_MAX_DOF]; /* last step's, warm start */
-    dhs_cs link_cs[DHC_MAX_JOINTS];                    /* of q_i + theta_offset_i */
-    dhs_cs te_cs[DHC_MAX_JOINTS][DHS_MAX_HARMONICS];  /* of k x gear output angle */
-    int wires_stale;      /* the tool moved since the wheels last followed it */
+    double friction_impulse[DHS_MAX_DOF];            /* last step's, warm start */
+    dhs_cs link_cs[DHC_MAX_JOINTS];                  /* of q_i + theta_offset_i */
+    dhs_cs te_cs[DHC_MAX_JOINTS][DHS_MAX_HARMONICS]; /* of k x gear output angle */
+    int wires_stale; /* the tool moved since the wheels last followed it */
     /* precomputed */
     uint32_t steps_per_ms;
-    uint32_t ms_phase;    /* steps since the last whole millisecond */
+    uint32_t ms_phase;                 /* steps since the last whole millisecond */
     double elec_decay[DHC_MAX_JOINTS]; /* exp(-h R / L) */
     double inv_r[DHC_MAX_JOINTS];      /* 1 / R */
     double inv_ratio[DHC_MAX_JOINTS];  /* 1 / N */
@@ -102,7 +102,7 @@ typedef struct {
     /* outputs of the last step (truth, for tests and diagnostics) */
     double voltage_v[DHC_MAX_JOINTS];
     double spring_nm[DHC_MAX_JOINTS];
-    dhs_arm_pose pose;    /* at the current link angles */
+    dhs_arm_pose pose; /* at the current link angles */
     double tool_mm[3];
     int has_wires;
     dhs_wires wires;
@@ -117,10 +117,10 @@ typedef struct {
     double motor_rad[DHC_MAX_JOINTS];
     double motor_rad_s[DHC_MAX_JOINTS];
     double current_a[DHC_MAX_JOINTS];
-    double voltage_v[DHC_MAX_JOINTS];   /* at the armature, after gain and saturation */
-    double spring_nm[DHC_MAX_JOINTS];   /* transmitted torque (rigid joints: 0) */
-    double tool_mm[3];                  /* true tool point, world */
-    double wire_mm[3];                  /* true wire lengths (0 without a measurer) */
+    double voltage_v[DHC_MAX_JOINTS]; /* at the armature, after gain and saturation */
+    double spring_nm[DHC_MAX_JOINTS]; /* transmitted torque (rigid joints: 0) */
+    double tool_mm[3];                /* true tool point, world */
+    double wire_mm[3];                /* true wire lengths (0 without a measurer) */
 } dhs_plant_truth;
 
 /* Sets up the plant of scenario sc at rest: gear outputs at q_start_rad (motor = N q,

@@ -38,45 +38,45 @@
 #define DHS_RIGID 0.0
 
 typedef struct {
-    unsigned order;  /* k >= 1: cycles per revolution of the gear output */
-    double sin_rad;  /* TE(theta) = sum_k sin_rad sin(k theta) + cos_rad cos(k theta) */
+    unsigned order; /* k >= 1: cycles per revolution of the gear output */
+    double sin_rad; /* TE(theta) = sum_k sin_rad sin(k theta) + cos_rad cos(k theta) */
     double cos_rad;
 } dhs_harmonic;
 
 typedef struct {
     /* DC motor, armature circuit and shaft */
-    double r_ohm;            /* armature resistance R > 0 */
-    double l_h;              /* armature inductance L > 0 */
-    double ke_v_s_per_rad;   /* back-EMF constant Ke > 0 */
-    double kt_nm_per_a;      /* torque constant Kt > 0 */
-    double jm_kgm2;          /* rotor (+ first gear stage) inertia > 0 */
-    double bm_nms_per_rad;   /* viscous friction on the motor shaft >= 0 */
-    double coulomb_nm;       /* Coulomb friction on the motor shaft >= 0 */
-    double brake_nm;         /* holding brake on the motor shaft (when engaged) >= 0 */
+    double r_ohm;          /* armature resistance R > 0 */
+    double l_h;            /* armature inductance L > 0 */
+    double ke_v_s_per_rad; /* back-EMF constant Ke > 0 */
+    double kt_nm_per_a;    /* torque constant Kt > 0 */
+    double jm_kgm2;        /* rotor (+ first gear stage) inertia > 0 */
+    double bm_nms_per_rad; /* viscous friction on the motor shaft >= 0 */
+    double coulomb_nm;     /* Coulomb friction on the motor shaft >= 0 */
+    double brake_nm;       /* holding brake on the motor shaft (when engaged) >= 0 */
     /* amplifier (voltage mode) behind the DAC */
     double amp_gain_v_per_v; /* armature volts per DAC volt */
     double supply_v;         /* |armature voltage| <= supply_v */
     double current_limit_a;  /* |i| <= current_limit_a */
     /* gearbox and joint */
-    double gear_ratio;       /* true N > 0: motor angle = N x gear output angle */
-    double backlash_rad;     /* full play b >= 0 of the dead zone (needs a finite stiffness) */
+    double gear_ratio;   /* true N > 0: motor angle = N x gear output angle */
+    double backlash_rad; /* full play b >= 0 of the dead zone (needs a finite stiffness) */
     size_t n_harmonics;
     dhs_harmonic te[DHS_MAX_HARMONICS]; /* transmission error (needs a finite stiffness) */
-    double stiffness_nm_per_rad; /* k > 0, or DHS_RIGID */
-    double damping_nms_per_rad;  /* structural damping of the joint while in contact >= 0 */
+    double stiffness_nm_per_rad;        /* k > 0, or DHS_RIGID */
+    double damping_nms_per_rad;         /* structural damping of the joint while in contact >= 0 */
     /* link (the moving body after this joint), in the joint's DH frame i (the frame that
      * moves with it); its weight loads this joint and all before it */
-    double mass_kg;              /* >= 0 */
-    double com_m[3];             /* centre of mass in frame i */
-    double inertia_kgm2[3];      /* principal moments about the COM, frame i axes, >= 0 */
-    double link_coulomb_nm;      /* bearing friction on the link side >= 0 */
+    double mass_kg;                  /* >= 0 */
+    double com_m[3];                 /* centre of mass in frame i */
+    double inertia_kgm2[3];          /* principal moments about the COM, frame i axes, >= 0 */
+    double link_coulomb_nm;          /* bearing friction on the link side >= 0 */
     double link_viscous_nms_per_rad; /* >= 0 */
     /* sensors */
-    uint32_t encoder_lines;      /* true lines per motor revolution (x4 counts) */
-    double tacho_v_s_per_rad;    /* tacho constant */
-    double tacho_ripple;         /* relative ripple amplitude (0.02 = 2 %) >= 0 */
-    unsigned tacho_ripple_cycles;/* ripple periods per motor revolution */
-    double tacho_noise_v;        /* Gaussian noise per ADC read >= 0 */
+    uint32_t encoder_lines;       /* true lines per motor revolution (x4 counts) */
+    double tacho_v_s_per_rad;     /* tacho constant */
+    double tacho_ripple;          /* relative ripple amplitude (0.02 = 2 %) >= 0 */
+    unsigned tacho_ripple_cycles; /* ripple periods per motor revolution */
+    double tacho_noise_v;         /* Gaussian noise per ADC read >= 0 */
     /* what the controller believes (converts counts to joint angles with these) */
     double nominal_gear_ratio;
     uint32_t nominal_encoder_lines;
@@ -84,17 +84,17 @@ typedef struct {
 
 typedef struct {
     int present;
-    double anchor_true_mm[3][3];    /* anchors in the measurer frame, as built */
-    dhc_frame frame_true;           /* T_Meas as placed */
-    double wheel_radius_mm;         /* nominal friction-wheel radius (controller's) */
-    double wheel_radius_true_mm;    /* actual */
-    uint32_t lines;                 /* lines per wheel revolution (x4 counts) */
-    double zero_length_true_mm[3];  /* wire length at which the counter reads 0 */
+    double anchor_true_mm[3][3];      /* anchors in the measurer frame, as built */
+    dhc_frame frame_true;             /* T_Meas as placed */
+    double wheel_radius_mm;           /* nominal friction-wheel radius (controller's) */
+    double wheel_radius_true_mm;      /* actual */
+    uint32_t lines;                   /* lines per wheel revolution (x4 counts) */
+    double zero_length_true_mm[3];    /* wire length at which the counter reads 0 */
     double zero_length_nominal_mm[3]; /* what the controller believes it is */
-    double slip_sd_mm_per_sqrt_mm;  /* slip random walk: sd of lost length per sqrt(mm)
-                                       of wire travel >= 0 */
-    double noise_mm;                /* wire length noise per reading (sag, stretch) >= 0 */
-    unsigned counter_bits;          /* 16: hardware counter wraps at 2^16; 1..32 */
+    double slip_sd_mm_per_sqrt_mm;    /* slip random walk: sd of lost length per sqrt(mm)
+                                         of wire travel >= 0 */
+    double noise_mm;                  /* wire length noise per reading (sag, stretch) >= 0 */
+    unsigned counter_bits;            /* 16: hardware counter wraps at 2^16; 1..32 */
 } dhs_measurer_params;
 
 typedef struct {
@@ -109,13 +109,13 @@ typedef struct {
     uint32_t step_ns;       /* physics step, divides 1 ms; <= 100000 (10 kHz or finer) */
     size_t n_joints;
     dhs_joint_params joint[DHC_MAX_JOINTS];
-    double payload_kg;      /* a point-like payload on the last link ... */
+    double payload_kg;              /* a point-like payload on the last link ... */
     double payload_com_m[3];        /* ... at this point of the last frame ... */
     double payload_inertia_kgm2[3]; /* ... with these principal moments (last frame axes) */
-    double dac_range_v;     /* 12-bit offset-binary DAC: code 0 = -range, 4096 = +range */
-    double adc_range_v;     /* 12-bit offset-binary tacho ADC over +-range */
+    double dac_range_v;             /* 12-bit offset-binary DAC: code 0 = -range, 4096 = +range */
+    double adc_range_v;             /* 12-bit offset-binary tacho ADC over +-range */
     dhs_measurer_params measurer;
-    double noise_xyz_mm;    /* dataset mode, x,y,z columns: Gaussian per coordinate */
+    double noise_xyz_mm;         /* dataset mode, x,y,z columns: Gaussian per coordinate */
     double min_axis_distance_mm; /* dataset targets: tool at least this far from axis 1 */
     double min_anchor_plane_mm;  /* ... and this far in front of the measurer's anchor plane */
 } dhs_scenario;

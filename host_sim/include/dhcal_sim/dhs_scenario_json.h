@@ -60,8 +60,8 @@
 
 typedef struct {
     dhs_scenario sc;
-    dhcal_model model;      /* the nominal model file as loaded */
-    char model_path[4096];  /* as resolved (relative to the scenario's directory) */
+    dhcal_model model;     /* the nominal model file as loaded */
+    char model_path[4096]; /* as resolved (relative to the scenario's directory) */
 } dhs_scenario_file;
 
 /* Loads and validates a scenario and its model file. Returns DHCAL_IO_OK, or

@@ -27,11 +27,11 @@
 
 typedef struct {
     double anchor_world_mm[3][3];
-    double length_mm[3];       /* true length now */
-    double wheel_mm[3];        /* travel rolled since zero, with slip */
-    double pending_mm[3];      /* travel not yet given its slip draw */
-    double counts_per_mm;      /* true wheel: 4 lines / (2 pi r_true) */
-    double mm_per_count;       /* nominal wheel: 2 pi r_nominal / (4 lines) */
+    double length_mm[3];  /* true length now */
+    double wheel_mm[3];   /* travel rolled since zero, with slip */
+    double pending_mm[3]; /* travel not yet given its slip draw */
+    double counts_per_mm; /* true wheel: 4 lines / (2 pi r_true) */
+    double mm_per_count;  /* nominal wheel: 2 pi r_nominal / (4 lines) */
     double zero_nominal_mm[3];
     double slip_sd;
     double noise_mm;

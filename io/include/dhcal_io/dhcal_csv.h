@@ -20,21 +20,21 @@
 
 /* One data line of a measurement CSV. */
 typedef struct {
-    size_t line;                  /* 1-based line number in the file (for messages) */
+    size_t line; /* 1-based line number in the file (for messages) */
     double q_rad[DHC_MAX_JOINTS];
-    double xyz_mm[3];             /* has_xyz */
-    double wires_mm[3];           /* has_wires: raw L1, L2, L3 */
-    double quat[4];               /* has_quat: w, x, y, z (normalised on load) */
-    int dir[DHC_MAX_JOINTS];      /* has_dir: -1 or +1 */
-    double temp_c;                /* has_temp */
-    double t_s;                   /* has_time: time of the measurement, s (drift) */
+    double xyz_mm[3];        /* has_xyz */
+    double wires_mm[3];      /* has_wires: raw L1, L2, L3 */
+    double quat[4];          /* has_quat: w, x, y, z (normalised on load) */
+    int dir[DHC_MAX_JOINTS]; /* has_dir: -1 or +1 */
+    double temp_c;           /* has_temp */
+    double t_s;              /* has_time: time of the measurement, s (drift) */
 } dhcal_row;
 
 typedef struct {
     size_t n_rows;
     size_t n_joints;
     int has_xyz, has_wires, has_quat, has_dir, has_temp, has_time;
-    int has_q; /* always 1 but for compensation targets (dhcal_csv_load_targets) */
+    int has_q;       /* always 1 but for compensation targets (dhcal_csv_load_targets) */
     dhcal_row *rows; /* heap, n_rows entries */
 } dhcal_dataset;
 

@@ -60,9 +60,8 @@ int dhcal_samples_errors(const dhc_model *model, const dhcal_samples *s, double 
 /* dhcal_samples_errors where the residuals of the samples flagged DHC_SAMPLE_USED are known
  * already (known: 3 per sample, as a fit leaves them: dhc_calib_options.sample_residual):
  * only the others are evaluated. */
-int dhcal_samples_errors_known(const dhc_model *model, const dhcal_samples *s,
-                               const double *known, double *resid, double *err_mm,
-                               dhcal_error_stats *stats);
+int dhcal_samples_errors_known(const dhc_model *model, const dhcal_samples *s, const double *known,
+                               double *resid, double *err_mm, dhcal_error_stats *stats);
 
 /* The statistics of dhcal_samples_errors from the errors err_mm (n entries). */
 void dhcal_error_stats_of(const dhcal_samples *s, const double *err_mm, dhcal_error_stats *stats);

@@ -12,7 +12,7 @@
  * with *effect and *joint (0-based) and *cursor moved past the item and its comma; 0 at the
  * end; -1 when the item is no effect of such an arm. *item and *len name the item read
  * (for messages) whenever one was. */
-int dhcal_effect_list_next(const char **cursor, size_t n_joints, dhc_effect *effect,
-                           size_t *joint, const char **item, size_t *len);
+int dhcal_effect_list_next(const char **cursor, size_t n_joints, dhc_effect *effect, size_t *joint,
+                           const char **item, size_t *len);
 
 #endif /* DHCAL_EFFECT_LIST_H */

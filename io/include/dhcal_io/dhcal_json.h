@@ -99,8 +99,8 @@ int dhcal_jfile_beside(const dhcal_jctx *c, const char *jpath, const char *rel, 
 
 /* A model object (the model file's schema) read from obj, which sits at jpath in file ("":
  * the file is the model). As dhcal_model_load otherwise. */
-int dhcal_model_from_json(const char *file, const char *jpath, const cJSON *obj,
-                          dhcal_model *model, dhcal_error *err);
+int dhcal_model_from_json(const char *file, const char *jpath, const cJSON *obj, dhcal_model *model,
+                          dhcal_error *err);
 
 /* A program's JSON result: obj printed on standard output as one line (cJSON's unformatted
  * print) and deleted (obj may be NULL: out of memory). 0, or -1 with "PROGRAM: out of

@@ -33,39 +33,39 @@
 typedef struct {
     char name[64];
     char model_path[DHCAL_MACHINE_PATH_CAP]; /* the model file, resolved ("" when inline) */
-    dhc_model model;                 /* the nominal model, with its measurer */
+    dhc_model model;                         /* the nominal model, with its measurer */
     size_t n_joints;
-    double start_pose_rad[DHC_MAX_JOINTS]; /* where the arm stands at boot */
+    double start_pose_rad[DHC_MAX_JOINTS];         /* where the arm stands at boot */
     double encoder_counts_per_rev[DHC_MAX_JOINTS]; /* counts per MOTOR turn (x4 decoded) */
-    double gear_ratio[DHC_MAX_JOINTS];   /* motor turns per joint turn */
-    double tacho_v_s_per_rad[DHC_MAX_JOINTS]; /* volts per motor rad/s */
-    double dac_range_v;                  /* DAC codes 0..4095 span -range..+range */
+    double gear_ratio[DHC_MAX_JOINTS];             /* motor turns per joint turn */
+    double tacho_v_s_per_rad[DHC_MAX_JOINTS];      /* volts per motor rad/s */
+    double dac_range_v;                            /* DAC codes 0..4095 span -range..+range */
     double adc_range_v;
     int has_speed_limit;
-    double max_speed_rad_s;              /* joint trajectory limits (when given) */
+    double max_speed_rad_s; /* joint trajectory limits (when given) */
     int has_accel_limit;
     double max_accel_rad_s2;
-    double wire_wheel_radius_mm;         /* the measurer's friction wheels */
-    double wire_counts_per_rev;          /* counts per wheel turn (x4 decoded) */
-    double wire_zero_mm[3];              /* wire length at counter zero */
-    char can_interface[32];              /* "" when not given */
+    double wire_wheel_radius_mm; /* the measurer's friction wheels */
+    double wire_counts_per_rev;  /* counts per wheel turn (x4 decoded) */
+    double wire_zero_mm[3];      /* wire length at counter zero */
+    char can_interface[32];      /* "" when not given */
     int has_can_id_offset;
     unsigned can_id_offset;
-    unsigned can_reply_timeout_us;       /* 0 when not given */
+    unsigned can_reply_timeout_us; /* 0 when not given */
     int has_can_start_timeout;
     unsigned can_start_timeout_ms;
-    char gpio_chip[64];                  /* "" when not given */
+    char gpio_chip[64]; /* "" when not given */
     unsigned gpio_lines[2];
-    char store_path[DHCAL_MACHINE_PATH_CAP]; /* resolved; "" when not given */
+    char store_path[DHCAL_MACHINE_PATH_CAP];      /* resolved; "" when not given */
     char params_out_path[DHCAL_MACHINE_PATH_CAP]; /* resolved; "" when not given */
     /* acquisition: at most one of samples/plan_candidates and plan_path is given */
-    unsigned samples;                    /* 0 when not given */
+    unsigned samples; /* 0 when not given */
     int has_plan_seed;
     unsigned plan_seed;
     int has_plan_candidates;
     unsigned plan_candidates;
     char plan_path[DHCAL_MACHINE_PATH_CAP]; /* resolved; "" when not given */
-    unsigned hold_ticks;                 /* 0 when not given */
+    unsigned hold_ticks;                    /* 0 when not given */
 } dhcal_machine;
 
 /* Loads and checks a machine file. Relative paths in it ("model", "store", "params_out",

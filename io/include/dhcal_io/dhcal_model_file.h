@@ -33,13 +33,13 @@ typedef struct {
 
 typedef struct {
     char name[128];
-    dhc_arm arm;            /* joints (incl. beta_deg when given), base, tool_mm */
+    dhc_arm arm;                  /* joints (incl. beta_deg when given), base, tool_mm */
     int has_beta[DHC_MAX_JOINTS]; /* the file gave beta_deg for that joint */
-    double gravity[3];      /* unit vector, world frame; default {0, 0, -1} */
-    double repeatability_mm; /* the arm's ISO 9283 pose repeatability RP; 0: not given */
+    double gravity[3];            /* unit vector, world frame; default {0, 0, -1} */
+    double repeatability_mm;      /* the arm's ISO 9283 pose repeatability RP; 0: not given */
     int has_measurer;
-    double anchors_mm[3][3];   /* measurer anchors in the measurer frame */
-    dhc_frame measurer_frame;  /* T_Meas: measurer frame in the world */
+    double anchors_mm[3][3];  /* measurer anchors in the measurer frame */
+    dhc_frame measurer_frame; /* T_Meas: measurer frame in the world */
     size_t n_effects;
     dhcal_effect_value effects[DHCAL_MAX_EFFECTS];
 } dhcal_model;

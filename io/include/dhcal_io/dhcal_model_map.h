@@ -16,12 +16,10 @@
 
 /* DHCAL_IO_BAD_INPUT with "<path>: effects.<name>: ..." for a wrong value count or an
  * entry that belongs elsewhere. */
-int dhcal_model_to_lib(const dhcal_model *file, const char *path, dhc_model *out,
-                       dhcal_error *err);
+int dhcal_model_to_lib(const dhcal_model *file, const char *path, dhc_model *out, dhcal_error *err);
 
 /* The file representation of a fitted model: geometry, base, tool, measurer anchors and
  * every non-zero effect; name, gravity and beta flags taken from template. */
-void dhcal_model_from_lib(const dhc_model *m, const dhcal_model *template_model,
-                          dhcal_model *out);
+void dhcal_model_from_lib(const dhc_model *m, const dhcal_model *template_model, dhcal_model *out);
 
 #endif /* DHCAL_MODEL_MAP_H */

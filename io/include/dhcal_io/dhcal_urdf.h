@@ -23,11 +23,11 @@
 /* What an import found besides the model. */
 typedef struct {
     char robot_name[128];
-    size_t n_fixed;                        /* fixed joints in the chain */
-    char joint_names[DHC_MAX_JOINTS][64];  /* the movable joints, chain order (truncated) */
-    int continuous[DHC_MAX_JOINTS];        /* 1: a continuous joint (range +-720 deg) */
-    long joint_lines[DHC_MAX_JOINTS];      /* their lines in the file */
-    dhc_mat3 tip_in_frame_n;               /* tip link's rotation in frame N (not in the model) */
+    size_t n_fixed;                       /* fixed joints in the chain */
+    char joint_names[DHC_MAX_JOINTS][64]; /* the movable joints, chain order (truncated) */
+    int continuous[DHC_MAX_JOINTS];       /* 1: a continuous joint (range +-720 deg) */
+    long joint_lines[DHC_MAX_JOINTS];     /* their lines in the file */
+    dhc_mat3 tip_in_frame_n;              /* tip link's rotation in frame N (not in the model) */
 } dhcal_urdf_import_report;
 
 /* Reads the URDF at path and converts the chain from link base_link to link tip_link into

@@ -46,18 +46,18 @@ typedef enum {
 /* One joint of the chain from the base link to the tip link, in chain order. */
 typedef struct {
     dhcal_urdf_joint_type type;
-    dhc_frame origin;   /* parent link -> joint frame at q = 0, mm */
-    double axis[3];     /* unit vector in the joint frame (movable joints) */
-    double lower_rad;   /* revolute: the URDF's limits; continuous: ignored */
+    dhc_frame origin; /* parent link -> joint frame at q = 0, mm */
+    double axis[3];   /* unit vector in the joint frame (movable joints) */
+    double lower_rad; /* revolute: the URDF's limits; continuous: ignored */
     double upper_rad;
 } dhcal_urdf_joint;
 
 typedef enum {
     DHCAL_URDF_CHAIN_OK = 0,
-    DHCAL_URDF_CHAIN_NO_JOINT,      /* no revolute or continuous joint between the links */
-    DHCAL_URDF_CHAIN_TOO_MANY,      /* more movable joints than DHC_MAX_JOINTS */
-    DHCAL_URDF_CHAIN_BAD_AXIS,      /* an axis of (near) zero length or not finite */
-    DHCAL_URDF_CHAIN_NONFINITE      /* a number of the chain is not finite */
+    DHCAL_URDF_CHAIN_NO_JOINT, /* no revolute or continuous joint between the links */
+    DHCAL_URDF_CHAIN_TOO_MANY, /* more movable joints than DHC_MAX_JOINTS */
+    DHCAL_URDF_CHAIN_BAD_AXIS, /* an axis of (near) zero length or not finite */
+    DHCAL_URDF_CHAIN_NONFINITE /* a number of the chain is not finite */
 } dhcal_urdf_chain_status;
 
 /* The chain joints[0..n) (base link to tip link) as a DH arm (conventions chosen as the model

@@ -54,41 +54,40 @@ enum {
 /* 1 for the flags the fit sets (every kind of outlier), 0 for used and excluded samples. */
 int dhc_sample_is_outlier(uint8_t flag);
 
-
 typedef struct {
-    size_t max_iterations;       /* LM iterations per fit round (default 100) */
-    double rank_rel_tol;         /* pivot tolerance on the scaled normal matrix (1e-10) */
-    double ssr_rel_tol;          /* stop when SSR falls by less than this share (1e-10) */
-    double step_rel_tol;         /* ... or the scaled step is below this (1e-12) */
-    double noise_rel_tol;        /* ... or the fit is this close to its minimum relative to
-                                    the noise it estimates (1e-2): what a Gauss-Newton step
-                                    still promises is below (tol sigma)^2, or an accepted
-                                    step moved no parameter by more than tol of its standard
-                                    error and lowered the SSR by under 2 tol sigma^2. The
-                                    test real data meet; 0 turns it off */
+    size_t max_iterations;             /* LM iterations per fit round (default 100) */
+    double rank_rel_tol;               /* pivot tolerance on the scaled normal matrix (1e-10) */
+    double ssr_rel_tol;                /* stop when SSR falls by less than this share (1e-10) */
+    double step_rel_tol;               /* ... or the scaled step is below this (1e-12) */
+    double noise_rel_tol;              /* ... or the fit is this close to its minimum relative to
+                                          the noise it estimates (1e-2): what a Gauss-Newton step
+                                          still promises is below (tol sigma)^2, or an accepted
+                                          step moved no parameter by more than tol of its standard
+                                          error and lowered the SSR by under 2 tol sigma^2. The
+                                          test real data meet; 0 turns it off */
     size_t max_identifiability_checks; /* re-analyses at a converged estimate that free
                                     parameters found unidentifiable at the start, at most
                                     (3); 0 also keeps them out between LM's steps */
-    double max_std_angle_rad;    /* a joint offset or twist whose standard error exceeds this
-                                    is held at its input value (0: no bound, the default) */
-    double max_std_length_mm;    /* ... a length (a, d) likewise (0: no bound) */
+    double max_std_angle_rad;          /* a joint offset or twist whose standard error exceeds this
+                                          is held at its input value (0: no bound, the default) */
+    double max_std_length_mm;          /* ... a length (a, d) likewise (0: no bound) */
     /* rad residuals count as this many mm (DHC_ORIENTATION_WEIGHT_MM_PER_RAD) */
     double orientation_weight_mm_per_rad;
-    double outlier_threshold;    /* |error| / robust sigma above this is an outlier (6); 0 off */
-    double outlier_floor_mm;     /* robust sigma is at least this (1e-6 mm: noise-free data);
-                                    with the noise model on, errors and this floor are in
-                                    whitened (unit-free) units */
-    double joint_margin_rad;     /* a joint angle beyond its range by more is an outlier (0.1) */
-    double reach_margin;         /* a point farther from the base origin than (1 + this) times
-                                    the arm's reach is an outlier (0.1); screened only while
-                                    most samples are within reach (else the base, not the
-                                    rows, is off); 0 off */
-    int robust_start;            /* 1: when some sample's error at the input model exceeds the
-                                    median's ROBUST_TRIGGER times, a trimmed fit (the 3/4 of the
-                                    samples closest to it, twice) starts the fit and samples far
-                                    from it are left out first (1) */
-    size_t max_outlier_rounds;   /* refits after removing outliers (3) */
-    uint32_t structural_seed;    /* seed of the random poses used for the structural rank */
+    double outlier_threshold;  /* |error| / robust sigma above this is an outlier (6); 0 off */
+    double outlier_floor_mm;   /* robust sigma is at least this (1e-6 mm: noise-free data);
+                                  with the noise model on, errors and this floor are in
+                                  whitened (unit-free) units */
+    double joint_margin_rad;   /* a joint angle beyond its range by more is an outlier (0.1) */
+    double reach_margin;       /* a point farther from the base origin than (1 + this) times
+                                  the arm's reach is an outlier (0.1); screened only while
+                                  most samples are within reach (else the base, not the
+                                  rows, is off); 0 off */
+    int robust_start;          /* 1: when some sample's error at the input model exceeds the
+                                  median's ROBUST_TRIGGER times, a trimmed fit (the 3/4 of the
+                                  samples closest to it, twice) starts the fit and samples far
+                                  from it are left out first (1) */
+    size_t max_outlier_rounds; /* refits after removing outliers (3) */
+    uint32_t structural_seed;  /* seed of the random poses used for the structural rank */
     /* Noise model (all 0 by default = off, unweighted least squares): see dhc_noise_model.
      * When on, the fit is generalized least squares and the report's sigma is unit-free
      * (see below). */
@@ -113,37 +112,37 @@ typedef struct {
 } dhc_calib_options;
 
 typedef struct {
-    size_t iterations;      /* LM iterations, all rounds */
-    int converged;          /* 1 when the last round met its tolerance */
-    int residuals_kept;     /* 1: opt->sample_residual holds the fitted model's residuals
-                               of the samples used */
+    size_t iterations;  /* LM iterations, all rounds */
+    int converged;      /* 1 when the last round met its tolerance */
+    int residuals_kept; /* 1: opt->sample_residual holds the fitted model's residuals
+                           of the samples used */
     size_t samples_used;
-    size_t rows;            /* equations in the final fit */
+    size_t rows; /* equations in the final fit */
     size_t n_params;
-    size_t rank;            /* parameters identified from the data */
-    size_t structural_rank; /* parameters the model could identify from rich data; more
-                               than rank: some parameter is identifiable in principle but
-                               not from these data (structurally_identifiable and not
-                               identifiable), kept at its input value */
-    size_t freed;           /* parameters unidentifiable at the input values that the
-                               analysis at the estimate found identifiable and fitted */
+    size_t rank;                         /* parameters identified from the data */
+    size_t structural_rank;              /* parameters the model could identify from rich data; more
+                                            than rank: some parameter is identifiable in principle but
+                                            not from these data (structurally_identifiable and not
+                                            identifiable), kept at its input value */
+    size_t freed;                        /* parameters unidentifiable at the input values that the
+                                            analysis at the estimate found identifiable and fitted */
     uint8_t unsupported[DHC_MAX_PARAMS]; /* 1: held at its input value because the data
                                determine it only to more than max_std_* */
-    size_t outliers;        /* samples flagged as any kind of outlier */
-    double rms_mm;          /* sqrt(mean |position error|^2) over used samples; for wire
-                               samples the error is the vector of 3 wire residuals */
-    double max_mm;          /* largest such error over used samples */
-    double rms_rad;         /* same for orientation (0 without pose samples) */
-    double sigma;           /* residual standard deviation per row, sqrt(SSR / (rows - rank));
-                               with the noise model on, SSR is the whitened sum of squares
-                               and sigma is unit-free: the ratio of the actual scatter to
-                               the noise model's (about 1 when the model is right; std_err
-                               are still in parameter units, from sigma^2 (J^T W J)^-1).
-                               rms_mm, max_mm and rms_rad stay physical (unweighted). */
-    double condition;       /* condition estimate of the scaled identifiable block (0 in a
-                               build without DHC_WITH_REPORT_EXTRAS) */
-    double value[DHC_MAX_PARAMS];    /* parameter values after the fit (dhc_params_value) */
-    double std_err[DHC_MAX_PARAMS];  /* standard errors (0 for unidentifiable) */
+    size_t outliers;                     /* samples flagged as any kind of outlier */
+    double rms_mm;                /* sqrt(mean |position error|^2) over used samples; for wire
+                                     samples the error is the vector of 3 wire residuals */
+    double max_mm;                /* largest such error over used samples */
+    double rms_rad;               /* same for orientation (0 without pose samples) */
+    double sigma;                 /* residual standard deviation per row, sqrt(SSR / (rows - rank));
+                                     with the noise model on, SSR is the whitened sum of squares
+                                     and sigma is unit-free: the ratio of the actual scatter to
+                                     the noise model's (about 1 when the model is right; std_err
+                                     are still in parameter units, from sigma^2 (J^T W J)^-1).
+                                     rms_mm, max_mm and rms_rad stay physical (unweighted). */
+    double condition;             /* condition estimate of the scaled identifiable block (0 in a
+                                     build without DHC_WITH_REPORT_EXTRAS) */
+    double value[DHC_MAX_PARAMS]; /* parameter values after the fit (dhc_params_value) */
+    double std_err[DHC_MAX_PARAMS]; /* standard errors (0 for unidentifiable) */
     uint8_t identifiable[DHC_MAX_PARAMS];
     uint8_t structurally_identifiable[DHC_MAX_PARAMS];
     /* confounded[j][k] = 1: unidentifiable parameter j moves with parameter k (none in a
@@ -158,9 +157,9 @@ typedef struct {
     dhc_model current;
     dhc_model trial;
     dhc_sample sample;
-    dhc_arm_trig trig; /* of the model the current pass evaluates */
+    dhc_arm_trig trig;         /* of the model the current pass evaluates */
     dhc_arm_trig weights_trig; /* of the model whose covariance whitens the pass */
-    dhc_model_eval eval; /* one evaluation's scratch: off the stack */
+    dhc_model_eval eval;       /* one evaluation's scratch: off the stack */
     double delta[DHC_MAX_PARAMS];
     double scratch[DHC_MAX_PARAMS];
     double weights_residual[DHC_MAX_ROWS_PER_SAMPLE];
@@ -169,7 +168,6 @@ typedef struct {
 } dhc_calib_workspace;
 
 void dhc_calib_default_options(dhc_calib_options *opt);
-
 
 /* Fits the parameters of set to the samples. flags (n bytes) marks samples the caller
  * excludes; the fit adds outlier marks (DHC_SAMPLE_OUTLIER and the kinds after it, each

@@ -48,82 +48,86 @@ DHC_STATIC_ASSERT(DHC_MAX_PARAMS <= 256U, "DHC_MAX_PARAMS too large for the inde
  * without the conversions and base_frame) are not declared: a caller fails to compile.
  * A feature built on another that is left out fails to compile too (#error below).
  * scripts/target-report --features lists each one's bytes on the Cortex-M4. */
-#ifndef DHC_WITH_DIAGNOSE        /* dhc_diagnose.h: the score test of missing effects */
+/* dhc_diagnose.h: the score test of missing effects */
+#ifndef DHC_WITH_DIAGNOSE
 #define DHC_WITH_DIAGNOSE 1
 #endif
-#ifndef DHC_WITH_SESSION_TESTS   /* dhc_f_log10_sf (lack of fit against replicates),
-                                    dhc_covariate_pose_r2 (time, temperature vs the pose) */
+/* dhc_f_log10_sf (lack of fit against replicates), dhc_covariate_pose_r2 (time, temperature vs
+ * the pose) */
+#ifndef DHC_WITH_SESSION_TESTS
 #define DHC_WITH_SESSION_TESTS 1
 #endif
-#ifndef DHC_WITH_UNCERTAINTY     /* dhc_uncertainty.h, dhc_lsq_prediction_variance */
+/* dhc_uncertainty.h, dhc_lsq_prediction_variance */
+#ifndef DHC_WITH_UNCERTAINTY
 #define DHC_WITH_UNCERTAINTY 1
 #endif
-#ifndef DHC_WITH_EIV             /* the noise model: errors in variables, dhc_sample_whiten */
+/* the noise model: errors in variables, dhc_sample_whiten */
+#ifndef DHC_WITH_EIV
 #define DHC_WITH_EIV 1
 #endif
-#ifndef DHC_WITH_POSE_SAMPLES    /* DHC_MEAS_POSE samples (orientation rows) */
+/* DHC_MEAS_POSE samples (orientation rows) */
+#ifndef DHC_WITH_POSE_SAMPLES
 #define DHC_WITH_POSE_SAMPLES 1
 #endif
-#ifndef DHC_WITH_ROBUST_START    /* dhc_calib_options.robust_start, and the fit's guards for
-                                    data no plan chose (a link angle's runaway step damped,
-                                    early freeing undone when LM wanders off): a controller
-                                    fits poses its plan chose for what they identify */
+/* dhc_calib_options.robust_start, and the fit's guards for data no plan chose (a link angle's
+ * runaway step damped, early freeing undone when LM wanders off): a controller fits poses its
+ * plan chose for what they identify */
+#ifndef DHC_WITH_ROBUST_START
 #define DHC_WITH_ROBUST_START 1
 #endif
-#ifndef DHC_WITH_EFFECT_SUMMARIES /* dhc_effect_info.summary text ("" when 0) */
+/* dhc_effect_info.summary text ("" when 0) */
+#ifndef DHC_WITH_EFFECT_SUMMARIES
 #define DHC_WITH_EFFECT_SUMMARIES 1
 #endif
-#ifndef DHC_WITH_CONVERSIONS     /* dhc_arm_to_standard_dh, quaternions, roll-pitch-yaw */
+/* dhc_arm_to_standard_dh, quaternions, roll-pitch-yaw */
+#ifndef DHC_WITH_CONVERSIONS
 #define DHC_WITH_CONVERSIONS 1
 #endif
-#ifndef DHC_WITH_PLAN            /* dhc_plan_select: optimal pose plans */
+/* dhc_plan_select: optimal pose plans */
+#ifndef DHC_WITH_PLAN
 #define DHC_WITH_PLAN 1
 #endif
-#ifndef DHC_WITH_REPORT_EXTRAS   /* what a fit's report explains for people: the condition
-                                    estimate (dhc_chol_condition_estimate, dhc_lsq_factor
-                                    .condition, dhc_calib_report.condition: 0 when left out)
-                                    and the parameters each unidentifiable one trades off
-                                    with (dhc_lsq_confounded, .confounded: none) */
+/* what a fit's report explains for people: the condition estimate (dhc_chol_condition_estimate,
+ * dhc_lsq_factor .condition, dhc_calib_report.condition: 0 when left out) and the parameters
+ * each unidentifiable one trades off with (dhc_lsq_confounded, .confounded: none) */
+#ifndef DHC_WITH_REPORT_EXTRAS
 #define DHC_WITH_REPORT_EXTRAS 1
 #endif
-#ifndef DHC_WITH_NAMES           /* what front ends show people and read from files: the
-                                    names dhc_status_str, dhc_params_name, dhc_effect_label,
-                                    dhc_effect_parse, and the units dhc_params_is_angle,
-                                    dhc_params_in_degrees (a controller reports numbers; the
-                                    catalogue keeps its entries' names) */
+/* what front ends show people and read from files: the names dhc_status_str, dhc_params_name,
+ * dhc_effect_label, dhc_effect_parse, and the units dhc_params_is_angle, dhc_params_in_degrees
+ * (a controller reports numbers; the catalogue keeps its entries' names) */
+#ifndef DHC_WITH_NAMES
 #define DHC_WITH_NAMES 1
 #endif
-#ifndef DHC_WITH_MATRIX_OPS      /* the checked dense algebra offered to callers: dhc_mat_mul,
-                                    _tmul, _transpose, _vec, dhc_chol_solve, dhc_tri_lower_solve,
-                                    _t_solve (the fit runs on its own kernels; the diagnosis
-                                    needs the solves) */
+/* the checked dense algebra offered to callers: dhc_mat_mul, _tmul, _transpose, _vec,
+ * dhc_chol_solve, dhc_tri_lower_solve, _t_solve (the fit runs on its own kernels; the diagnosis
+ * needs the solves) */
+#ifndef DHC_WITH_MATRIX_OPS
 #define DHC_WITH_MATRIX_OPS 1
 #endif
 #if DHC_WITH_DIAGNOSE && !DHC_WITH_MATRIX_OPS
 #error "DHC_WITH_DIAGNOSE needs DHC_WITH_MATRIX_OPS: the score test solves with dhc_chol_solve"
 #endif
-#ifndef DHC_WITH_DESK_KINEMATICS /* what the desk's tools call one pose at a time (URDF import
-                                    and export, the simulation, analyses): the bare arm's
-                                    frames and Jacobians (dhc_forward, dhc_forward_frames,
-                                    _scaled, dhc_joint_transform, dhc_identification_jacobian,
-                                    dhc_joint_jacobian), the model's in one call
-                                    (dhc_model_jacobian, dhc_model_linearize,
-                                    dhc_model_gravity_moments) and the frame algebra
-                                    (dhc_frame_mul, dhc_rot_tmul, dhc_rot_mul_t, dhc_vec3_axpy).
-                                    A controller's loops prepare the arm once: dhc_arm_prepare,
-                                    dhc_forward_frames_trig and the *_prepared forms stay */
+/* what the desk's tools call one pose at a time (URDF import and export, the simulation,
+ * analyses): the bare arm's frames and Jacobians (dhc_forward, dhc_forward_frames, _scaled,
+ * dhc_joint_transform, dhc_identification_jacobian, dhc_joint_jacobian), the model's in one
+ * call (dhc_model_jacobian, dhc_model_linearize, dhc_model_gravity_moments) and the frame
+ * algebra (dhc_frame_mul, dhc_rot_tmul, dhc_rot_mul_t, dhc_vec3_axpy). A controller's loops
+ * prepare the arm once: dhc_arm_prepare, dhc_forward_frames_trig and the *_prepared forms stay */
+#ifndef DHC_WITH_DESK_KINEMATICS
 #define DHC_WITH_DESK_KINEMATICS 1
 #endif
 #if (DHC_WITH_UNCERTAINTY || DHC_WITH_CONVERSIONS) && !DHC_WITH_DESK_KINEMATICS
 #error "DHC_WITH_UNCERTAINTY and DHC_WITH_CONVERSIONS need DHC_WITH_DESK_KINEMATICS"
 #endif
-#ifndef DHC_WITH_TRILATERATION   /* dhc_trilat.h: the point three wire lengths meet at (the
-                                    desk's view of samples; a controller checks the wires
-                                    against the model's predicted lengths instead) */
+/* dhc_trilat.h: the point three wire lengths meet at (the desk's view of samples; a controller
+ * checks the wires against the model's predicted lengths instead) */
+#ifndef DHC_WITH_TRILATERATION
 #define DHC_WITH_TRILATERATION 1
 #endif
-#ifndef DHC_WITH_INVERSE         /* dhc_inverse.h: commanded angles for a target on the full
-                                    model (the controller's IK, dhcal compensate) */
+/* dhc_inverse.h: commanded angles for a target on the full model (the controller's IK, dhcal
+ * compensate) */
+#ifndef DHC_WITH_INVERSE
 #define DHC_WITH_INVERSE 1
 #endif
 
@@ -137,36 +141,44 @@ DHC_STATIC_ASSERT(DHC_MAX_PARAMS <= 256U, "DHC_MAX_PARAMS too large for the inde
  * (DHC_ERR_ARGUMENT) and the diagnosis never offers it; a model that carries a value of one
  * is refused where it is evaluated (dhc_model_evaluate and everything built on it:
  * DHC_ERR_ARGUMENT), never predicted without it. */
-#ifndef DHC_WITH_EFFECT_BASE_FRAME       /* base_frame (its parameters, not the base) */
+/* base_frame (its parameters, not the base) */
+#ifndef DHC_WITH_EFFECT_BASE_FRAME
 #define DHC_WITH_EFFECT_BASE_FRAME 1
 #endif
-#ifndef DHC_WITH_EFFECT_JOINT_SCALE      /* joint_scale */
+/* joint_scale */
+#ifndef DHC_WITH_EFFECT_JOINT_SCALE
 #define DHC_WITH_EFFECT_JOINT_SCALE 1
 #endif
-#ifndef DHC_WITH_EFFECT_JOINT_HARMONIC   /* joint_harmonic, joint_harmonic2 .. 4 */
+/* joint_harmonic, joint_harmonic2 .. 4 */
+#ifndef DHC_WITH_EFFECT_JOINT_HARMONIC
 #define DHC_WITH_EFFECT_JOINT_HARMONIC 1
 #endif
-#ifndef DHC_WITH_EFFECT_JOINT_BACKLASH   /* joint_backlash */
+/* joint_backlash */
+#ifndef DHC_WITH_EFFECT_JOINT_BACKLASH
 #define DHC_WITH_EFFECT_JOINT_BACKLASH 1
 #endif
-#ifndef DHC_WITH_EFFECT_JOINT_COMPLIANCE /* joint_compliance */
+/* joint_compliance */
+#ifndef DHC_WITH_EFFECT_JOINT_COMPLIANCE
 #define DHC_WITH_EFFECT_JOINT_COMPLIANCE 1
 #endif
-#ifndef DHC_WITH_EFFECT_MEASURER         /* measurer_scale, measurer_offset, measurer_anchors
-                                            (the measurer itself, its wire lengths, stay) */
+/* measurer_scale, measurer_offset, measurer_anchors (the measurer itself, its wire lengths,
+ * stay) */
+#ifndef DHC_WITH_EFFECT_MEASURER
 #define DHC_WITH_EFFECT_MEASURER 1
 #endif
-#ifndef DHC_WITH_EFFECT_THERMAL          /* thermal_scale */
+/* thermal_scale */
+#ifndef DHC_WITH_EFFECT_THERMAL
 #define DHC_WITH_EFFECT_THERMAL 1
 #endif
-#ifndef DHC_WITH_EFFECT_DRIFT            /* drift_scale, drift_offset */
+/* drift_scale, drift_offset */
+#ifndef DHC_WITH_EFFECT_DRIFT
 #define DHC_WITH_EFFECT_DRIFT 1
 #endif
-#define DHC_WITH_ALL_EFFECTS                                                                 \
-    (DHC_WITH_EFFECT_BASE_FRAME && DHC_WITH_EFFECT_JOINT_SCALE &&                            \
-     DHC_WITH_EFFECT_JOINT_HARMONIC &&                                                       \
-     DHC_WITH_EFFECT_JOINT_BACKLASH && DHC_WITH_EFFECT_JOINT_COMPLIANCE &&                   \
-     DHC_WITH_EFFECT_MEASURER && DHC_WITH_EFFECT_THERMAL && DHC_WITH_EFFECT_DRIFT)
+#define DHC_WITH_ALL_EFFECTS                                                                    \
+    (DHC_WITH_EFFECT_BASE_FRAME && DHC_WITH_EFFECT_JOINT_SCALE &&                               \
+     DHC_WITH_EFFECT_JOINT_HARMONIC && DHC_WITH_EFFECT_JOINT_BACKLASH &&                        \
+     DHC_WITH_EFFECT_JOINT_COMPLIANCE && DHC_WITH_EFFECT_MEASURER && DHC_WITH_EFFECT_THERMAL && \
+     DHC_WITH_EFFECT_DRIFT)
 
 /* DHC_SMALL_CODE: 1 chooses the compact form of a few loops that faster builds unroll
  * (the same arithmetic in the same order: the same results). Default: on where the

@@ -46,16 +46,16 @@ typedef struct {
 typedef struct {
     dhc_effect effect;
     size_t joint;
-    size_t n_params;       /* parameters the effect adds */
-    size_t rank;           /* of them, directions the base model does not have (dof) */
-    double explained_ss;   /* residual sum of squares the candidate would remove */
-    double explained;      /* explained_ss / SSR of the fit, 0..1 */
-    double score;          /* explained_ss / sigma^2 */
-    double log10_p;        /* log10 of the chi^2(rank) upper tail of score; 0 when rank 0 */
-    int significant;       /* Holm step-down at alpha over all candidates */
+    size_t n_params;     /* parameters the effect adds */
+    size_t rank;         /* of them, directions the base model does not have (dof) */
+    double explained_ss; /* residual sum of squares the candidate would remove */
+    double explained;    /* explained_ss / SSR of the fit, 0..1 */
+    double score;        /* explained_ss / sigma^2 */
+    double log10_p;      /* log10 of the chi^2(rank) upper tail of score; 0 when rank 0 */
+    int significant;     /* Holm step-down at alpha over all candidates */
     double value[DHC_MAX_CANDIDATE_PARAMS]; /* one-step estimate of its parameters */
-    size_t lookalike;      /* index (in the result list) of a candidate it cannot be told
-                              apart from, or DHC_MAX_CANDIDATES */
+    size_t lookalike; /* index (in the result list) of a candidate it cannot be told
+                         apart from, or DHC_MAX_CANDIDATES */
 } dhc_candidate_result;
 
 typedef struct {
@@ -67,12 +67,12 @@ typedef struct {
 } dhc_diagnosis;
 
 typedef struct {
-    double alpha;          /* family-wise false alarm level (default 1e-3) */
-    double separable_tol;  /* a candidate direction whose share outside the base model's
-                              span is below this is not separable (default 1e-6) */
-    double lookalike_ratio;/* two candidates are look-alikes when their union explains less
-                              than this factor more than the better one (default 1.02) and
-                              the better one adds nothing significant (at alpha) to the other */
+    double alpha;           /* family-wise false alarm level (default 1e-3) */
+    double separable_tol;   /* a candidate direction whose share outside the base model's
+                               span is below this is not separable (default 1e-6) */
+    double lookalike_ratio; /* two candidates are look-alikes when their union explains less
+                               than this factor more than the better one (default 1.02) and
+                               the better one adds nothing significant (at alpha) to the other */
     double orientation_weight_mm_per_rad; /* as in the fit (DHC_ORIENTATION_WEIGHT_MM_PER_RAD) */
     /* Noise model, as dhc_calib_options (all 0 = off): use the fit's. When on, residuals
      * and Jacobian rows (candidates' too) are whitened sample by sample (dhc_sample_whiten),
@@ -86,8 +86,8 @@ typedef struct {
  * lives here so the call stays within a small embedded stack. */
 typedef struct {
     dhc_normal_eq ne;
-    dhc_param_set set;    /* base + the batch's candidate columns */
-    double factor[DHC_MAX_PARAMS * DHC_MAX_PARAMS];   /* base block, pivoted Cholesky */
+    dhc_param_set set;                              /* base + the batch's candidate columns */
+    double factor[DHC_MAX_PARAMS * DHC_MAX_PARAMS]; /* base block, pivoted Cholesky */
     double work[DHC_MAX_PARAMS * 2U * DHC_MAX_CANDIDATE_PARAMS]; /* A^-1 B_c */
     double schur[4U * DHC_MAX_CANDIDATE_PARAMS * DHC_MAX_CANDIDATE_PARAMS];
     double rhs[DHC_MAX_PARAMS];
@@ -100,8 +100,8 @@ typedef struct {
     size_t range_count[DHC_MAX_CANDIDATES];
     size_t rival[DHC_MAX_CANDIDATES];
     dhc_sample sample;
-    dhc_arm_trig trig;    /* of the model diagnosed */
-    dhc_model_eval eval;  /* one evaluation's scratch */
+    dhc_arm_trig trig;   /* of the model diagnosed */
+    dhc_model_eval eval; /* one evaluation's scratch */
     double jac_buf[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS];
 } dhc_diagnose_workspace;
 
@@ -141,8 +141,7 @@ dhc_status dhc_covariate_pose_r2(size_t n_joints, dhc_covariate which, dhc_sampl
  * cap). */
 #if DHC_WITH_DIAGNOSE /* not defined without the diagnosis: "none" would mean "none found" */
 size_t dhc_diagnose_candidates(const dhc_model *model, const dhc_param_set *base,
-                               const dhc_candidate_scope *scope, dhc_candidate *out,
-                               size_t cap);
+                               const dhc_candidate_scope *scope, dhc_candidate *out, size_t cap);
 #endif
 
 /* Scores the candidates against the fitted model (DHC_ERR_ARGUMENT in a build without the
@@ -154,11 +153,10 @@ size_t dhc_diagnose_candidates(const dhc_model *model, const dhc_param_set *base
  * candidate the model cannot take; errors of the
  * reader and of dhc_model_jacobian. O(passes * n * P^2 + candidates * P^2 k). */
 dhc_status dhc_diagnose(const dhc_model *model, const dhc_param_set *base,
-                        const uint8_t *identifiable, double sigma2,
-                        const dhc_candidate *candidates, size_t n_candidates,
-                        dhc_sample_reader read, const void *ctx, size_t n, const uint8_t *flags,
-                        const dhc_diagnose_options *opt, dhc_diagnose_workspace *ws,
-                        dhc_diagnosis *out);
+                        const uint8_t *identifiable, double sigma2, const dhc_candidate *candidates,
+                        size_t n_candidates, dhc_sample_reader read, const void *ctx, size_t n,
+                        const uint8_t *flags, const dhc_diagnose_options *opt,
+                        dhc_diagnose_workspace *ws, dhc_diagnosis *out);
 
 /* log10 of the upper tail P(X > chi2) of chi-square with dof degrees of freedom, accurate
  * far into the tail (no underflow to -inf before ~1e300). dof >= 1, chi2 >= 0. */

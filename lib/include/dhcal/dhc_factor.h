@@ -49,8 +49,7 @@ dhc_status dhc_chol_pivoted(dhc_mat *a, size_t *perm, size_t perm_len, double re
 dhc_status dhc_chol_solve(const dhc_mat *l, size_t k, const double *b, double *x, size_t len);
 
 /* Forward substitution L y = b on the leading k x k block; y may alias b. O(k^2). */
-dhc_status dhc_tri_lower_solve(const dhc_mat *l, size_t k, const double *b, double *y,
-                               size_t len);
+dhc_status dhc_tri_lower_solve(const dhc_mat *l, size_t k, const double *b, double *y, size_t len);
 /* Back substitution L^T x = y on the leading k x k block; x may alias y. O(k^2). */
 dhc_status dhc_tri_lower_t_solve(const dhc_mat *l, size_t k, const double *y, double *x,
                                  size_t len);

@@ -47,21 +47,21 @@ extern "C" {
 
 typedef enum {
     DHC_INVERSE_CONVERGED = 0,
-    DHC_INVERSE_OUT_OF_REACH,  /* at rest short of the target: workspace edge or a range */
-    DHC_INVERSE_NOT_CONVERGED  /* iterations used up while still approaching */
+    DHC_INVERSE_OUT_OF_REACH, /* at rest short of the target: workspace edge or a range */
+    DHC_INVERSE_NOT_CONVERGED /* iterations used up while still approaching */
 } dhc_inverse_outcome;
 
 typedef struct {
-    double tol_mm;             /* > 0: stop when |r| (mm, orientation weighted) is below */
-    double weight_mm_per_rad;  /* > 0: orientation rows of pose targets */
-    size_t max_iterations;     /* >= 1 */
+    double tol_mm;            /* > 0: stop when |r| (mm, orientation weighted) is below */
+    double weight_mm_per_rad; /* > 0: orientation rows of pose targets */
+    size_t max_iterations;    /* >= 1 */
 } dhc_inverse_options;
 
 typedef struct {
     dhc_inverse_outcome outcome;
-    double error_mm;    /* tool point's distance from the target at the returned q */
-    double error_rad;   /* orientation angle left (pose targets; 0 for points) */
-    size_t iterations;  /* steps taken, accepted or not */
+    double error_mm;   /* tool point's distance from the target at the returned q */
+    double error_rad;  /* orientation angle left (pose targets; 0 for points) */
+    size_t iterations; /* steps taken, accepted or not */
 } dhc_inverse_result;
 
 /* Scratch of one solve: the arm's trigonometry and a model evaluation. */

@@ -41,8 +41,7 @@ extern "C" {
  * parameter. */
 dhc_status dhc_identification_jacobian(const dhc_arm *arm, const dhc_param_set *set,
                                        const double *q_rad, size_t q_len, int with_orientation,
-                                       dhc_mat *jac, double tool_world_mm[3],
-                                       dhc_mat3 *tool_rot);
+                                       dhc_mat *jac, double tool_world_mm[3], dhc_mat3 *tool_rot);
 
 /* Jacobian of dhc_model_residual's prediction for sample s: jac is dhc_sample_rows(s) x
  * set->count; orientation rows are multiplied by weight_mm_per_rad like the residual's.
@@ -50,9 +49,8 @@ dhc_status dhc_identification_jacobian(const dhc_arm *arm, const dhc_param_set *
  * DHC_ERR_DIMENSION for a wrong jac shape; DHC_ERR_NONFINITE when the prediction or an
  * entry of jac is not finite (a thermal factor 1 + k (T - T0) of 0, an overflowing weight
  * or geometry): jac is then all zero. */
-dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set,
-                              const dhc_sample *s, double weight_mm_per_rad, dhc_mat *jac,
-                              dhc_prediction *pred);
+dhc_status dhc_model_jacobian(const dhc_model *model, const dhc_param_set *set, const dhc_sample *s,
+                              double weight_mm_per_rad, dhc_mat *jac, dhc_prediction *pred);
 
 /* d(tool point)/d(q_i) and d(rotation)/d(q_i) for every joint: the ordinary manipulator
  * Jacobian, (3 or 6) x n_joints: dhc_identification_jacobian's columns of the joint
@@ -72,10 +70,10 @@ dhc_status dhc_model_linearize(const dhc_model *model, const dhc_param_set *set,
  * dhc_model_evaluate_prepared's; ev is the evaluation's scratch (about 1.5 KiB: a
  * workspace's, so that the pass stays within a small stack). */
 dhc_status dhc_model_linearize_prepared(const dhc_model *model, const dhc_arm_trig *trig,
-                                       const dhc_param_set *set, const dhc_sample *s,
-                                       const double *sincos_q, double weight_mm_per_rad,
-                                       double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows,
-                                       dhc_mat *jac, dhc_model_eval *ev);
+                                        const dhc_param_set *set, const dhc_sample *s,
+                                        const double *sincos_q, double weight_mm_per_rad,
+                                        double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows,
+                                        dhc_mat *jac, dhc_model_eval *ev);
 
 /* dhc_model_jacobian at the prepared trigonometry, with the scratch ev, as
  * dhc_model_linearize_prepared's; pred receives the prediction (not NULL). */

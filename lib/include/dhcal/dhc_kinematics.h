@@ -43,7 +43,7 @@ typedef struct {
 typedef struct {
     size_t n_joints;
     dhc_joint joint[DHC_MAX_JOINTS];
-    dhc_frame base; /* robot base frame in the world */
+    dhc_frame base;    /* robot base frame in the world */
     double tool_mm[3]; /* tool point in the last link frame */
 } dhc_arm;
 
@@ -91,9 +91,9 @@ dhc_status dhc_forward_frames(const dhc_arm *arm, const double *q_rad, size_t q_
 
 /* The same with every link length (a, d, tool) multiplied by length_scale: thermal
  * expansion without copying the arm. */
-dhc_status dhc_forward_frames_scaled(const dhc_arm *arm, double length_scale,
-                                     const double *q_rad, size_t q_len, dhc_frame *frames,
-                                     size_t frames_len, double tool_world_mm[3]);
+dhc_status dhc_forward_frames_scaled(const dhc_arm *arm, double length_scale, const double *q_rad,
+                                     size_t q_len, dhc_frame *frames, size_t frames_len,
+                                     double tool_world_mm[3]);
 
 /* dhc_forward_frames_scaled with the arm's trigonometry from dhc_arm_prepare (trig must
  * be the arm's) and the joint angles given by their sines and cosines (n_joints each, the

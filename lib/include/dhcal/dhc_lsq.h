@@ -35,9 +35,9 @@ extern "C" {
 #define DHC_LSQ_ZERO_DIAG (DBL_MIN / DBL_EPSILON)
 
 typedef struct {
-    size_t n;      /* parameters (columns) */
-    size_t rows;   /* equations accumulated */
-    double ssr;    /* sum of w * r^2 */
+    size_t n;                                    /* parameters (columns) */
+    size_t rows;                                 /* equations accumulated */
+    double ssr;                                  /* sum of w * r^2 */
     double jtj[DHC_MAX_PARAMS * DHC_MAX_PARAMS]; /* J^T W J, row-major n x n, full */
     double jtr[DHC_MAX_PARAMS];                  /* J^T W r */
 } dhc_normal_eq;
@@ -45,14 +45,14 @@ typedef struct {
 typedef struct {
     size_t n;
     size_t rank;
-    size_t perm[DHC_MAX_PARAMS];       /* pivot order: perm[k] = parameter index */
-    double scale[DHC_MAX_PARAMS];      /* column scale: 1 / sqrt(diag(J^T W J)); 1 for a
-                                          diagonal <= DHC_LSQ_ZERO_DIAG, a column that counts
-                                          as zero (never identifiable) */
+    size_t perm[DHC_MAX_PARAMS];  /* pivot order: perm[k] = parameter index */
+    double scale[DHC_MAX_PARAMS]; /* column scale: 1 / sqrt(diag(J^T W J)); 1 for a
+                                     diagonal <= DHC_LSQ_ZERO_DIAG, a column that counts
+                                     as zero (never identifiable) */
     double factor[DHC_MAX_PARAMS * DHC_MAX_PARAMS]; /* L of the scaled, pivoted matrix */
     uint8_t identifiable[DHC_MAX_PARAMS];
-    double condition;                  /* estimate for the identifiable block (scaled; 0
-                                          without DHC_WITH_REPORT_EXTRAS) */
+    double condition; /* estimate for the identifiable block (scaled; 0
+                         without DHC_WITH_REPORT_EXTRAS) */
 } dhc_lsq_factor;
 
 /* Starts an empty accumulator for n parameters. DHC_ERR_CAPACITY when n is 0 or above
@@ -97,8 +97,8 @@ double dhc_lsq_predicted_decrease(const dhc_normal_eq *ne, const double *delta);
  * to factor (cannot happen for lambda > 0 on finite data analysed with a rel_tol above the
  * rounding level that dhc_lsq_analyse names: its pivots then stay far above the
  * DBL_EPSILON-relative floor used here): delta is then all zero. O(r^3). */
-dhc_status dhc_lsq_step(const dhc_normal_eq *ne, dhc_lsq_factor *fac, double lambda,
-                        double *delta, size_t len);
+dhc_status dhc_lsq_step(const dhc_normal_eq *ne, dhc_lsq_factor *fac, double lambda, double *delta,
+                        size_t len);
 
 /* The decrease of the SSR that a full Gauss-Newton step on the identifiable parameters
  * predicts: g1^T N11^-1 g1 (g = J^T W r), the Newton decrement squared. Equal to the step's
@@ -106,8 +106,7 @@ dhc_status dhc_lsq_step(const dhc_normal_eq *ne, dhc_lsq_factor *fac, double lam
  * left is at most sqrt(t) standard errors long (Mahalanobis): a convergence test relative
  * to the noise, in the units of the SSR. ne must be the accumulator fac was analysed from.
  * DHC_ERR_ARGUMENT (NULL, fac not analysed), DHC_ERR_DIMENSION (fac->n != ne->n). O(r^2). */
-dhc_status dhc_lsq_decrement(const dhc_normal_eq *ne, const dhc_lsq_factor *fac,
-                             double *decrement);
+dhc_status dhc_lsq_decrement(const dhc_normal_eq *ne, const dhc_lsq_factor *fac, double *decrement);
 
 /* Covariance of the identifiable parameters at noise variance sigma2 (per unit weight):
  * std[k] = sqrt(sigma2 * (N11^-1)_kk) for identifiable k, 0 otherwise; std has len >= n
@@ -115,8 +114,7 @@ dhc_status dhc_lsq_decrement(const dhc_normal_eq *ne, const dhc_lsq_factor *fac,
  * DHC_ERR_DIMENSION (len < n), DHC_ERR_NONFINITE (sigma2 not finite: nothing written; or a
  * standard error that overflows, as a pivot just above rel_tol can give: std is then all
  * zero). O(r^3), uses the factor only, one n-double stack array. */
-dhc_status dhc_lsq_std_errors(const dhc_lsq_factor *fac, double sigma2, double *std,
-                              size_t len);
+dhc_status dhc_lsq_std_errors(const dhc_lsq_factor *fac, double sigma2, double *std, size_t len);
 
 /* Variance that the identifiable parameters' covariance sigma2 N11^-1 gives a linear
  * function of them: sigma2 j1^T N11^-1 j1 for the row j (n entries, one per parameter;
@@ -124,8 +122,8 @@ dhc_status dhc_lsq_std_errors(const dhc_lsq_factor *fac, double sigma2, double *
  * positioning uncertainty of a predicted point is the sum over its three rows.
  * DHC_ERR_ARGUMENT (NULL, sigma2 < 0, fac not analysed), DHC_ERR_DIMENSION (len < n),
  * DHC_ERR_NONFINITE (non-finite row or sigma2). O(r^2), one n-double stack array. */
-dhc_status dhc_lsq_prediction_variance(const dhc_lsq_factor *fac, double sigma2,
-                                       const double *row, size_t len, double *variance);
+dhc_status dhc_lsq_prediction_variance(const dhc_lsq_factor *fac, double sigma2, const double *row,
+                                       size_t len, double *variance);
 
 /* For an unidentifiable parameter j: the parameters it is confounded with, i.e. those with
  * a non-negligible coefficient in the null-space combination v (v_j = 1,

@@ -38,27 +38,27 @@ extern "C" {
 #define DHC_HARMONIC_MAX_ORDER 4U
 
 typedef struct {
-    double scale;               /* s_i */
-    double harmonic_sin_rad;    /* A_i */
-    double harmonic_cos_rad;    /* B_i */
+    double scale;                                            /* s_i */
+    double harmonic_sin_rad;                                 /* A_i */
+    double harmonic_cos_rad;                                 /* B_i */
     double harmonic_hi_sin_rad[DHC_HARMONIC_MAX_ORDER - 1U]; /* A_ik, k = 2.. (index k-2) */
     double harmonic_hi_cos_rad[DHC_HARMONIC_MAX_ORDER - 1U]; /* B_ik */
-    double backlash_rad;        /* b_i: full play; each direction sees half */
+    double backlash_rad;               /* b_i: full play; each direction sees half */
     double compliance[DHC_MAX_JOINTS]; /* c_ij for j = index >= i, rad/mm */
 } dhc_joint_effects;
 
 typedef struct {
     int present;
-    double anchor_mm[3][3];  /* anchors in the measurer frame (paper: P1, P2, P3) */
-    dhc_frame frame;         /* T_Meas: measurer frame in the world */
-    double scale;            /* s_m: wheel radius error, one for all wires */
-    double offset_mm[3];     /* o_k: zero reference of each wire */
+    double anchor_mm[3][3]; /* anchors in the measurer frame (paper: P1, P2, P3) */
+    dhc_frame frame;        /* T_Meas: measurer frame in the world */
+    double scale;           /* s_m: wheel radius error, one for all wires */
+    double offset_mm[3];    /* o_k: zero reference of each wire */
 } dhc_measurer_model;
 
 typedef struct {
     dhc_arm arm;
     dhc_joint_effects effect[DHC_MAX_JOINTS];
-    double gravity[3];        /* unit vector, world frame */
+    double gravity[3]; /* unit vector, world frame */
     dhc_measurer_model measurer;
     double thermal_per_k;     /* k */
     double thermal_ref_c;     /* T0 */
@@ -152,8 +152,7 @@ dhc_status dhc_model_evaluate(const dhc_model *model, const dhc_sample *s, int n
  * samples again and again. */
 dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_trig *trig,
                                        const dhc_sample *s, const double *sincos_q,
-                                       int need_moments, dhc_model_eval *ev,
-                                       dhc_prediction *out);
+                                       int need_moments, dhc_model_eval *ev, dhc_prediction *out);
 
 /* World position of anchor k (0..2). */
 void dhc_measurer_anchor_world(const dhc_measurer_model *m, size_t k, double out[3]);
@@ -184,17 +183,16 @@ dhc_status dhc_model_tool_point(const dhc_model *model, const double *q_rad, con
  * weighted into mm-equivalents with weight_mm_per_rad. Errors of dhc_model_predict, and
  * DHC_ERR_NONFINITE when a residual is not finite (a non-finite or overflowing weight, a
  * difference that overflows); r and rows are written only on success. */
-dhc_status dhc_model_residual(const dhc_model *model, const dhc_sample *s,
-                              double weight_mm_per_rad, double r[DHC_MAX_ROWS_PER_SAMPLE],
-                              size_t *rows);
+dhc_status dhc_model_residual(const dhc_model *model, const dhc_sample *s, double weight_mm_per_rad,
+                              double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows);
 
 /* dhc_model_residual at the arm's trigonometry from dhc_arm_prepare (model->arm's,
  * unchanged since): for passes over many samples at one model. sincos_q as
  * dhc_model_evaluate_prepared's. */
 dhc_status dhc_model_residual_prepared(const dhc_model *model, const dhc_arm_trig *trig,
                                        const dhc_sample *s, const double *sincos_q,
-                                       double weight_mm_per_rad,
-                                       double r[DHC_MAX_ROWS_PER_SAMPLE], size_t *rows);
+                                       double weight_mm_per_rad, double r[DHC_MAX_ROWS_PER_SAMPLE],
+                                       size_t *rows);
 
 /* The residual of a sample from a prediction already made (dhc_model_predict, or the one
  * dhc_model_jacobian returns): as dhc_model_residual without evaluating the model again. */

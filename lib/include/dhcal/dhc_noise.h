@@ -50,10 +50,10 @@ dhc_status dhc_noise_model_check(const dhc_noise_model *noise, size_t n_joints, 
  * a positive meas_noise_mm (a pose sample's 6 x 6 covariance from 3 joints is singular);
  * errors of dhc_model_jacobian; DHC_ERR_DIMENSION for a jac of the wrong row count. With the
  * noise model off, nothing is changed. O(rows^2 (n_joints + cols)). */
-dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_arm_trig *trig,
-                             dhc_model_eval *ev, const dhc_sample *s,
-                             const dhc_noise_model *noise, double weight_mm_per_rad,
-                             const double *r_model, double *r, dhc_mat *jac);
+dhc_status dhc_sample_whiten(const dhc_model *model, const dhc_arm_trig *trig, dhc_model_eval *ev,
+                             const dhc_sample *s, const dhc_noise_model *noise,
+                             double weight_mm_per_rad, const double *r_model, double *r,
+                             dhc_mat *jac);
 
 #ifdef __cplusplus
 }

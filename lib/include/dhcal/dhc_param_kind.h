@@ -23,17 +23,17 @@ typedef enum {
     DHC_P_TOOL_X, /* tool point in the last link frame, mm */
     DHC_P_TOOL_Y,
     DHC_P_TOOL_Z,
-    DHC_P_JOINT_SCALE,   /* s_i (joint) */
-    DHC_P_HARMONIC_SIN,  /* A_ik, rad (joint i, aux k - 1: order k = 1..4) */
-    DHC_P_HARMONIC_COS,  /* B_ik, rad (joint i, aux k - 1) */
-    DHC_P_BACKLASH,      /* b_i, rad (joint) */
-    DHC_P_COMPLIANCE,    /* c_ij, rad/mm (joint i, aux j >= i) */
-    DHC_P_MEAS_SCALE,    /* s_m */
-    DHC_P_MEAS_OFFSET,   /* o_k, mm (aux k = 0..2) */
-    DHC_P_MEAS_ANCHOR,   /* anchor coordinate, mm (aux = 3 k + axis) */
-    DHC_P_THERMAL,       /* k, 1/K */
-    DHC_P_DRIFT_SCALE,   /* k_d, 1/s */
-    DHC_P_DRIFT_OFFSET,  /* v, mm/s (aux = world axis 0..2) */
+    DHC_P_JOINT_SCALE,  /* s_i (joint) */
+    DHC_P_HARMONIC_SIN, /* A_ik, rad (joint i, aux k - 1: order k = 1..4) */
+    DHC_P_HARMONIC_COS, /* B_ik, rad (joint i, aux k - 1) */
+    DHC_P_BACKLASH,     /* b_i, rad (joint) */
+    DHC_P_COMPLIANCE,   /* c_ij, rad/mm (joint i, aux j >= i) */
+    DHC_P_MEAS_SCALE,   /* s_m */
+    DHC_P_MEAS_OFFSET,  /* o_k, mm (aux k = 0..2) */
+    DHC_P_MEAS_ANCHOR,  /* anchor coordinate, mm (aux = 3 k + axis) */
+    DHC_P_THERMAL,      /* k, 1/K */
+    DHC_P_DRIFT_SCALE,  /* k_d, 1/s */
+    DHC_P_DRIFT_OFFSET, /* v, mm/s (aux = world axis 0..2) */
     DHC_P_KIND_COUNT
 } dhc_param_kind;
 

@@ -61,8 +61,7 @@ double dhc_params_value(const dhc_param_set *set, const dhc_model *model, size_t
 /* Sets parameter k to value. DHC_ERR_ARGUMENT for a base-frame rotation (a perturbation,
  * not a quantity of the model) or k outside the set; DHC_ERR_NONFINITE for a non-finite
  * value (model untouched then). */
-dhc_status dhc_params_set_value(const dhc_param_set *set, dhc_model *model, size_t k,
-                                double value);
+dhc_status dhc_params_set_value(const dhc_param_set *set, dhc_model *model, size_t k, double value);
 
 /* Adds delta[k] to every parameter of the set in the model. Base-frame rotations compose
  * exactly (Rodrigues) about the base origin. DHC_ERR_DIMENSION when len != set->count,

@@ -10,14 +10,14 @@
  * information where the arm works, i.e. the variance of the predicted tool point (summed
  * over a sample's rows, per unit measurement variance) averaged over the workspace
  * candidates' poses (I-optimality; a random plan of n poses has about r / n for r
- * parameters). That is what a held-out error measures; the determinant of M (D-optimality) shrinks the parameters'
- * confidence volume instead and measured worse there (tests/acceptance/test_plan_poses.py).
- * First every workspace candidate's Jacobian is accumulated: the parameters that no plan
- * drawn from these candidates can identify (a pivot of their joint information below
- * 1e-10, dhc_lsq_analyse) are left out, the columns are scaled so that one pose contributes about
- * 1 to each diagonal entry, and W is factored (W = C C^T; rows transformed by C^-1 turn the
- * criterion into trace(M^-1)). Then a greedy start adds, n times, the candidate that lowers
- * the criterion most (a small ridge, 1e-6 of one pose, keeps the first steps defined), and
+ * parameters). That is what a held-out error measures; the determinant of M (D-optimality) shrinks
+ * the parameters' confidence volume instead and measured worse there
+ * (tests/acceptance/test_plan_poses.py). First every workspace candidate's Jacobian is accumulated:
+ * the parameters that no plan drawn from these candidates can identify (a pivot of their joint
+ * information below 1e-10, dhc_lsq_analyse) are left out, the columns are scaled so that one pose
+ * contributes about 1 to each diagonal entry, and W is factored (W = C C^T; rows transformed by
+ * C^-1 turn the criterion into trace(M^-1)). Then a greedy start adds, n times, the candidate that
+ * lowers the criterion most (a small ridge, 1e-6 of one pose, keeps the first steps defined), and
  * Fedorov's exchange swaps a chosen pose for an unchosen one while that lowers it, until no
  * swap does or DHC_PLAN_MAX_EXCHANGE_PASSES passes over the plan. Ties go to the lower
  * candidate index: the same candidates give the same plan.
@@ -37,9 +37,9 @@
  * as sqrt(det) of the scaled normal matrix from its pivoted Cholesky factor.
  *
  * Both read each candidate through the model's analytic Jacobian
- * (dhc_model_jacobian_prepared): nothing is measured, a plan is scored before it runs. No heap; the scratch is the
- * workspace's (about 40 DHC_MAX_PARAMS^2 bytes: static storage, not a stack). Optional
- * storage of the caller's for the candidates' Jacobian rows spares evaluating the model
+ * (dhc_model_jacobian_prepared): nothing is measured, a plan is scored before it runs. No heap; the
+ * scratch is the workspace's (about 40 DHC_MAX_PARAMS^2 bytes: static storage, not a stack).
+ * Optional storage of the caller's for the candidates' Jacobian rows spares evaluating the model
  * again on every pass (the same plan either way). A build with DHC_WITH_PLAN 0 leaves the
  * selection and the weighting out (dhc_plan_select and dhc_plan_weighting answer
  * DHC_ERR_ARGUMENT); the score stays.
@@ -72,9 +72,9 @@ extern "C" {
 typedef struct {
     dhc_normal_eq ne;   /* the candidates' (or the plan's) information, unscaled */
     dhc_lsq_factor fac; /* its analysis */
-    double info[DHC_MAX_PARAMS * DHC_MAX_PARAMS];   /* the plan's: kept, scaled, by C^-1 */
-    double chol[DHC_MAX_PARAMS * DHC_MAX_PARAMS];   /* its Cholesky factor (lower) */
-    double wchol[DHC_MAX_PARAMS * DHC_MAX_PARAMS];  /* C: W = C C^T (lower) */
+    double info[DHC_MAX_PARAMS * DHC_MAX_PARAMS];  /* the plan's: kept, scaled, by C^-1 */
+    double chol[DHC_MAX_PARAMS * DHC_MAX_PARAMS];  /* its Cholesky factor (lower) */
+    double wchol[DHC_MAX_PARAMS * DHC_MAX_PARAMS]; /* C: W = C C^T (lower) */
     double jac[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS];
     double rows[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS]; /* a candidate's scaled rows */
     double solved[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS];
@@ -84,22 +84,22 @@ typedef struct {
     size_t n_kept;
     size_t rows_per_pose;
     dhc_sample sample;
-    dhc_arm_trig trig;    /* the model's, prepared once a call */
-    dhc_model_eval ev;    /* an evaluation's scratch: off the stack */
+    dhc_arm_trig trig; /* the model's, prepared once a call */
+    dhc_model_eval ev; /* an evaluation's scratch: off the stack */
     dhc_prediction pred;
 } dhc_plan_workspace;
 
 typedef struct {
-    size_t usable;       /* candidates whose Jacobian could be evaluated */
-    size_t identifiable; /* parameters some plan from the candidates identifies (as its
-                            fit will): the criterion's; the set's others are left out */
-    double variance;     /* the criterion at the plan: trace(M^-1 W) (about r / n for a
-                            random plan of n poses) */
+    size_t usable;         /* candidates whose Jacobian could be evaluated */
+    size_t identifiable;   /* parameters some plan from the candidates identifies (as its
+                              fit will): the criterion's; the set's others are left out */
+    double variance;       /* the criterion at the plan: trace(M^-1 W) (about r / n for a
+                              random plan of n poses) */
     double variance_first; /* the criterion for candidates 0 .. n-1: the random plan of the
                               same size when the candidates are random */
-    size_t exchanges;    /* swaps the exchange made after the greedy start */
-    double o1;           /* the plan's observability index (dhc_plan_observability) */
-    size_t rank;         /* parameters the plan identifies */
+    size_t exchanges;      /* swaps the exchange made after the greedy start */
+    double o1;             /* the plan's observability index (dhc_plan_observability) */
+    size_t rank;           /* parameters the plan identifies */
 } dhc_plan_report;
 
 /* The candidates a plan is chosen from: read(ctx, 0 .. count-1) (samples of one kind:

@@ -23,10 +23,10 @@ extern "C" {
 #endif
 
 typedef struct {
-    double a_mm; /* height of P1 */
-    double b_mm; /* half spacing of P2, P3 */
-    double c_mm; /* height of P2, P3 */
-    double x_sign; /* +1 or -1: the side of the anchor plane the work space is on */
+    double a_mm;     /* height of P1 */
+    double b_mm;     /* half spacing of P2, P3 */
+    double c_mm;     /* height of P2, P3 */
+    double x_sign;   /* +1 or -1: the side of the anchor plane the work space is on */
     dhc_frame frame; /* T_Meas: measurer frame in the world */
 } dhc_measurer;
 

@@ -42,8 +42,8 @@ typedef struct {
     double jac[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS];
     double r[DHC_MAX_ROWS_PER_SAMPLE];
     dhc_param_set thetas;
-    dhc_arm_trig trig;     /* of the model */
-    dhc_model_eval eval;   /* one evaluation's scratch */
+    dhc_arm_trig trig;   /* of the model */
+    dhc_model_eval eval; /* one evaluation's scratch */
     dhc_prediction pred;
 } dhc_uncertainty;
 

@@ -11,7 +11,7 @@
 #define DHCAL_VERSION_STRING "0.4.0"
 
 /* One number for preprocessor comparisons: 10000 * major + 100 * minor + patch. */
-#define DHCAL_VERSION                                                                        \
+#define DHCAL_VERSION \
     (DHCAL_VERSION_MAJOR * 10000 + DHCAL_VERSION_MINOR * 100 + DHCAL_VERSION_PATCH)
 
 #endif /* DHC_VERSION_H */

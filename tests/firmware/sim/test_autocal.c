@@ -60,7 +60,8 @@ static void acquire(double joint2_stiffness)
     TEST_ASSERT_EQUAL_size_t(N_TRAIN, fw_plan_poses(&nominal, N_TRAIN, 31U, 0, plan));
     TEST_ASSERT_EQUAL_size_t(N_HELD, fw_plan_poses(&nominal, N_HELD, 32U, 0, plan_held));
     size_t n = 0U;
-    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_acquire(&ctrl, &nominal, plan, N_TRAIN, HOLD, &acq, train, &n));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE,
+                      fw_acquire(&ctrl, &nominal, plan, N_TRAIN, HOLD, &acq, train, &n));
     TEST_ASSERT_EQUAL_size_t(N_TRAIN, n);
     n = 0U;
     TEST_ASSERT_EQUAL(FW_FAULT_NONE,
@@ -96,8 +97,8 @@ static void test_configured_compliance_of_a_rigid_arm_fits_to_zero(void)
     fw_autocal_config cfg;
     config_with_compliance_2(&cfg, 0);
     dhc_model model = nominal;
-    TEST_ASSERT_EQUAL(FW_FAULT_NONE,
-                      fw_autocal_configured(&cfg, &model, train, N_TRAIN, NULL, &cal_ws, NULL, &res));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_autocal_configured(&cfg, &model, train, N_TRAIN, NULL,
+                                                           &cal_ws, NULL, &res));
     TEST_ASSERT_EQUAL_INT(0, res.found); /* diagnosis off */
     dhc_param_set base;
     TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&base, &nominal));
@@ -126,15 +127,16 @@ static void test_configured_compliance_predicts_a_compliant_arm_better(void)
     fw_autocal_default_config(&geometry_only);
     geometry_only.diagnose = 0;
     dhc_model geo = nominal;
-    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_autocal_configured(&geometry_only, &geo, train, N_TRAIN, NULL, &cal_ws, NULL, &res));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_autocal_configured(&geometry_only, &geo, train, N_TRAIN,
+                                                           NULL, &cal_ws, NULL, &res));
     TEST_ASSERT_EQUAL_INT(0, res.found);
     const double geo_held = fw_wire_rms(&geo, held, N_HELD);
 
     fw_autocal_config cfg;
     config_with_compliance_2(&cfg, 0);
     dhc_model with = nominal;
-    TEST_ASSERT_EQUAL(FW_FAULT_NONE,
-                      fw_autocal_configured(&cfg, &with, train, N_TRAIN, NULL, &cal_ws, NULL, &res));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_autocal_configured(&cfg, &with, train, N_TRAIN, NULL,
+                                                           &cal_ws, NULL, &res));
     const double with_held = fw_wire_rms(&with, held, N_HELD);
     TEST_ASSERT_TRUE(fabs(with.effect[1].compliance[1]) > 0.0);
     printf("held-out wire RMS: geometry %.4f mm, with joint_compliance:2 %.4f mm\n", geo_held,

@@ -35,7 +35,7 @@ typedef struct {
     fw_can_frame rx[QUEUE_CAP];
     size_t head;
     size_t count;
-    size_t cap;            /* QUEUE_CAP unless a test shrinks it */
+    size_t cap; /* QUEUE_CAP unless a test shrinks it */
     int overflowed;
     fw_can_frame inject[4];
     size_t n_inject;
@@ -184,13 +184,13 @@ static fw_io_config io;
 static fw_ctrl_config cfg;
 static double wire_start_mm[3];
 
-static fw_sim sim;               /* reference: the sim port */
+static fw_sim sim; /* reference: the sim port */
 static fw_port sim_port;
 static recorder sim_rec;
 static fw_port sim_rec_port;
 static fw_ctrl sim_ctrl;
 
-static dhs_plant can_plant;      /* the same world behind the bus */
+static dhs_plant can_plant; /* the same world behind the bus */
 static dhs_bus bus;
 static mem_bus mem;
 static fw_can_link link;
@@ -366,8 +366,8 @@ static void test_a_late_frame_is_counted_and_not_used(void)
     run_ticks(20U);
     /* Before the nodes answer SYNC 30, an answer to SYNC 29 arrives with an encoder value
      * 5000 counts off: used, it would be an encoder jump fault. */
-    const fw_can_drive_fb stale = {(uint16_t)(link.fb[1].encoder_counts + 5000U), 2048U, 1U,
-                                   0U, 0U, 29U};
+    const fw_can_drive_fb stale = {
+        (uint16_t)(link.fb[1].encoder_counts + 5000U), 2048U, 1U, 0U, 0U, 29U};
     TEST_ASSERT_EQUAL(FW_CAN_MSG_OK, fw_can_encode_drive_fb(1U, &stale, &mem.inject[0]));
     mem.n_inject = 1U;
     mem.inject_at_sync = 31U; /* SYNC 0 (start) is the first one sent */
@@ -433,14 +433,14 @@ static void test_malformed_and_foreign_frames_are_ignored(void)
     fw_can_frame *in = mem.inject;
     const fw_can_drive_fb fb = {0U, 2048U, 1U, 0U, 0U, 6U};
     TEST_ASSERT_EQUAL(FW_CAN_MSG_OK, fw_can_encode_drive_fb(0U, &fb, &in[0]));
-    in[0].len = 5U;                     /* a wrong length */
+    in[0].len = 5U; /* a wrong length */
     in[1] = in[0];
     in[1].len = 6U;
-    in[1].data[3] |= 0x80U;             /* a reserved bit */
+    in[1].data[3] |= 0x80U; /* a reserved bit */
     memset(&in[2], 0, sizeof in[2]);
-    in[2].id = 0x7E5U;                  /* somebody else's frame */
+    in[2].id = 0x7E5U; /* somebody else's frame */
     in[2].len = 1U;
-    const fw_can_sync other = {6U};     /* a SYNC from another master */
+    const fw_can_sync other = {6U}; /* a SYNC from another master */
     TEST_ASSERT_EQUAL(FW_CAN_MSG_OK, fw_can_encode_sync(&other, &in[3]));
     mem.n_inject = 4U;
     mem.inject_at_sync = 7U;

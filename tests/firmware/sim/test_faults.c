@@ -107,8 +107,8 @@ static void ensure_clean_run(void)
     io_nominal = io;
     size_t n = 0U;
     for (size_t k = 0U; k < N_SNAP; ++k) {
-        TEST_ASSERT_EQUAL(FW_FAULT_NONE,
-                          fw_acquire(&ctrl, &model, plan + n, snap_at[k] - n, HOLD, &acq, clean, &n));
+        TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_acquire(&ctrl, &model, plan + n, snap_at[k] - n, HOLD,
+                                                    &acq, clean, &n));
         snap_sim[k] = sim;
         snap_ctrl[k] = ctrl;
     }
@@ -116,7 +116,8 @@ static void ensure_clean_run(void)
                       fw_acquire(&ctrl, &model, plan + n, N_TRAIN - n, HOLD, &acq, clean, &n));
     TEST_ASSERT_EQUAL_size_t(N_TRAIN, n);
     n = 0U;
-    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_acquire(&ctrl, &model, plan_held, N_HELD, HOLD, &acq, held, &n));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE,
+                      fw_acquire(&ctrl, &model, plan_held, N_HELD, HOLD, &acq, held, &n));
     TEST_ASSERT_EQUAL_size_t(N_HELD, n);
     clean_model = model;
     TEST_ASSERT_EQUAL(FW_FAULT_NONE,
@@ -127,8 +128,8 @@ static void ensure_clean_run(void)
     TEST_ASSERT_TRUE(clean_held_rms < 0.05);
     printf("faults: clean run: %u + %u samples, held-out wire RMS nominal %.4f mm, "
            "calibrated %.4f mm, largest wire step change %lld counts\n",
-           (unsigned)N_TRAIN, (unsigned)N_HELD, fw_wire_rms(&model, held, N_HELD),
-           clean_held_rms, (long long)ctrl.wire_step_change_max);
+           (unsigned)N_TRAIN, (unsigned)N_HELD, fw_wire_rms(&model, held, N_HELD), clean_held_rms,
+           (long long)ctrl.wire_step_change_max);
     clean_done = 1;
 }
 
@@ -167,7 +168,8 @@ static void ensure_slipped_run(void)
     TEST_ASSERT_EQUAL_size_t(N_TRAIN, n);
     slipped_model = model;
     static fw_autocal_result r;
-    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_autocal(&slipped_model, slipped, n, NULL, &cal_ws, NULL, &r));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE,
+                      fw_autocal(&slipped_model, slipped, n, NULL, &cal_ws, NULL, &r));
     slipped_held_rms = fw_wire_rms(&slipped_model, held, N_HELD);
     slipped_done = 1;
 }
@@ -289,7 +291,7 @@ static void test_encoder_spike_below_the_plausible_step_bounds_the_sample_error(
 
 /* What the hook checks every tick (the plant as the controller last read it). */
 typedef struct {
-    int record;                 /* dry run: record the peak-speed tick's wire counts */
+    int record; /* dry run: record the peak-speed tick's wire counts */
     double peak_speed;
     int64_t peak_counts[3];
     uint64_t peak_tick;
@@ -321,8 +323,8 @@ static void wrap_hook(void *user, fw_sim *s)
         return;
     }
     for (size_t j = 0U; j < 3U; ++j) {
-        const int64_t plant_count = (int64_t)floor(
-            t.motor_rad[j] * dhs_motor_counts_per_rad(&s->plant.sc.joint[j]) + 0.5);
+        const int64_t plant_count =
+            (int64_t)floor(t.motor_rad[j] * dhs_motor_counts_per_rad(&s->plant.sc.joint[j]) + 0.5);
         const int64_t fw_count = ctrl.enc_home[j] + ctrl.enc[j].position;
         const int64_t d = fw_count > plant_count ? fw_count - plant_count : plant_count - fw_count;
         p->enc_count_err_max = d > p->enc_count_err_max ? d : p->enc_count_err_max;
@@ -420,8 +422,7 @@ static void test_counter_wraps_at_top_speed_and_in_the_hold_are_exact(void)
            (unsigned)sim.enc_wraps[0], (unsigned)sim.enc_wraps[1], (unsigned)sim.enc_wraps[2],
            (unsigned)sim.wire_wraps[0], (unsigned)sim.wire_wraps[1], (unsigned)sim.wire_wraps[2],
            (unsigned)(sim.wire_wraps[2] - wire3_before_hold), probe.enc_wrap_speed_min,
-           probe.wire_wrap_speed_min, (long long)probe.enc_count_err_max,
-           probe.wire_err_max_mm);
+           probe.wire_wrap_speed_min, (long long)probe.enc_count_err_max, probe.wire_err_max_mm);
     /* the wraps happened where intended */
     TEST_ASSERT_TRUE(enc_wraps_move[0] >= 1U && enc_wraps_move[2] >= 1U);
     TEST_ASSERT_TRUE(wire_wraps_move[0] >= 1U && wire_wraps_move[1] >= 1U);
@@ -489,7 +490,8 @@ static void test_stuck_wire_counter_is_detected_and_the_set_stays_clean(void)
         for (size_t k = 0U; k < 3U; ++k) {
             const double dm = clean[i].wire_mm[k] - clean[i - 1U].wire_mm[k];
             const double dp = b.wire_mm[k] - a.wire_mm[k];
-            worst = fmax(worst, fabs(dm - dp) / (FW_ACQ_PAIR_TOL_MM + FW_ACQ_PAIR_TOL_REL * fabs(dp)));
+            worst =
+                fmax(worst, fabs(dm - dp) / (FW_ACQ_PAIR_TOL_MM + FW_ACQ_PAIR_TOL_REL * fabs(dp)));
         }
     }
     size_t n = fork_at(SNAP_10);
@@ -579,7 +581,8 @@ static void test_power_cut_while_calibrating_or_storing_keeps_the_previous_calib
      * writes */
     dhc_model next = model;
     const size_t w0 = sim.nv_bytes_written;
-    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_autocal(&next, clean, N_TRAIN, &port.nv, &cal_ws, NULL, &res));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE,
+                      fw_autocal(&next, clean, N_TRAIN, &port.nv, &cal_ws, NULL, &res));
     TEST_ASSERT_TRUE(res.saved);
     const size_t write_len = sim.nv_bytes_written - w0;
     reboot_and_expect(&next, 2U);
@@ -592,7 +595,8 @@ static void test_power_cut_while_calibrating_or_storing_keeps_the_previous_calib
     sim.powered_off = 0;
     dhc_model m = model;
     ++n_faults_injected;
-    TEST_ASSERT_EQUAL(FW_FAULT_STORAGE, fw_autocal(&m, clean, N_TRAIN, &port.nv, &cal_ws, NULL, &res));
+    TEST_ASSERT_EQUAL(FW_FAULT_STORAGE,
+                      fw_autocal(&m, clean, N_TRAIN, &port.nv, &cal_ws, NULL, &res));
     TEST_ASSERT_EQUAL_MEMORY(nv_before, sim.nv, sizeof nv_before);
     reboot_and_expect(&prev, 1U);
 
@@ -604,7 +608,8 @@ static void test_power_cut_while_calibrating_or_storing_keeps_the_previous_calib
         sim.nv_cut_after = cut;
         sim.powered_off = 0;
         m = model;
-        TEST_ASSERT_EQUAL(FW_FAULT_STORAGE, fw_autocal(&m, clean, N_TRAIN, &port.nv, &cal_ws, NULL, &res));
+        TEST_ASSERT_EQUAL(FW_FAULT_STORAGE,
+                          fw_autocal(&m, clean, N_TRAIN, &port.nv, &cal_ws, NULL, &res));
         TEST_ASSERT_TRUE(sim.powered_off);
         reboot_and_expect(&prev, 1U);
         ++cuts;
@@ -615,7 +620,8 @@ static void test_power_cut_while_calibrating_or_storing_keeps_the_previous_calib
     sim.nv_cut_after = write_len - 1U;
     sim.powered_off = 0;
     m = model;
-    TEST_ASSERT_EQUAL(FW_FAULT_STORAGE, fw_autocal(&m, clean, N_TRAIN, &port.nv, &cal_ws, NULL, &res));
+    TEST_ASSERT_EQUAL(FW_FAULT_STORAGE,
+                      fw_autocal(&m, clean, N_TRAIN, &port.nv, &cal_ws, NULL, &res));
     reboot_and_expect(&prev, 1U);
     ++cuts;
     n_faults_injected += cuts;
@@ -653,7 +659,8 @@ static void test_a_worse_calibration_does_not_replace_the_stored_one(void)
     TEST_ASSERT_EQUAL(FW_CAL_OK, fw_cal_save(&port.nv, &model, &seq1));
     TEST_ASSERT_EQUAL_UINT32(1U, seq1);
     dhc_model good = model;
-    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_autocal(&good, clean, N_TRAIN, &port.nv, &cal_ws, NULL, &res));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE,
+                      fw_autocal(&good, clean, N_TRAIN, &port.nv, &cal_ws, NULL, &res));
     printf("faults: better calibration (24 samples): FPE %.4f mm vs stored (drawing) %.4f mm "
            "-> %s\n",
            res.new_fpe_mm, res.stored_rms_mm, res.saved ? "stored" : "kept");
@@ -684,7 +691,8 @@ static void test_a_worse_calibration_does_not_replace_the_stored_one(void)
      * wire 2, scored on those same samples */
     dhc_model bad = model;
     ++n_faults_injected;
-    TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_autocal(&bad, slipped, N_TRAIN, &port.nv, &cal_ws, NULL, &res));
+    TEST_ASSERT_EQUAL(FW_FAULT_NONE,
+                      fw_autocal(&bad, slipped, N_TRAIN, &port.nv, &cal_ws, NULL, &res));
     printf("faults: worse calibration (slipped data): RMS %.4f / FPE %.4f mm vs stored %.4f mm, "
            "median %.4f vs stored %.4f mm -> %s; held-out %.4f mm\n",
            res.new_rms_mm, res.new_fpe_mm, res.stored_rms_mm, res.new_median_mm,

@@ -107,8 +107,8 @@ static void test_planned_poses_come_from_the_candidates_and_observe_better(void)
     static fw_pose candidates[120];
     TEST_ASSERT_EQUAL_size_t(120U, fw_plan_poses(&model, 120U, 9U, 0, candidates));
     fw_pose planned[20];
-    TEST_ASSERT_EQUAL_size_t(20U, fw_plan_select(&model, &set, 20U, 120U, 9U, 0, &plan_ws,
-                                                 planned));
+    TEST_ASSERT_EQUAL_size_t(20U,
+                             fw_plan_select(&model, &set, 20U, 120U, 9U, 0, &plan_ws, planned));
     for (size_t i = 0U; i < 20U; ++i) {
         size_t found = 0U;
         for (size_t c = 0U; c < 120U; ++c) {
@@ -121,15 +121,15 @@ static void test_planned_poses_come_from_the_candidates_and_observe_better(void)
     }
     double o1_planned = 0.0;
     double o1_random = 0.0;
-    TEST_ASSERT_EQUAL(DHC_OK, fw_plan_observability(&model, &set, planned, 20U, &plan_ws,
-                                                    &o1_planned, NULL));
-    TEST_ASSERT_EQUAL(DHC_OK, fw_plan_observability(&model, &set, candidates, 20U, &plan_ws,
-                                                    &o1_random, NULL));
+    TEST_ASSERT_EQUAL(
+        DHC_OK, fw_plan_observability(&model, &set, planned, 20U, &plan_ws, &o1_planned, NULL));
+    TEST_ASSERT_EQUAL(
+        DHC_OK, fw_plan_observability(&model, &set, candidates, 20U, &plan_ws, &o1_random, NULL));
     TEST_ASSERT_TRUE(o1_planned > 1.1 * o1_random);
     /* more poses than candidates pass the limits, or than the workspace holds: none */
     TEST_ASSERT_EQUAL_size_t(0U, fw_plan_select(&model, &set, 20U, 15U, 9U, 0, &plan_ws, planned));
-    TEST_ASSERT_EQUAL_size_t(0U, fw_plan_select(&model, &set, 20U, FW_PLAN_MAX_CANDIDATES + 1U,
-                                                9U, 0, &plan_ws, planned));
+    TEST_ASSERT_EQUAL_size_t(0U, fw_plan_select(&model, &set, 20U, FW_PLAN_MAX_CANDIDATES + 1U, 9U,
+                                                0, &plan_ws, planned));
 }
 
 static void test_encoder_jump_stops_the_drives(void)

@@ -93,8 +93,7 @@ static void test_a_job_does_not_depend_on_the_one_before(void)
     cfg.hold_ticks = 17U;
     cfg.plan_seed = 99U;
     TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_job_run(&job, &cfg, &nominal, &port, &io, NULL));
-    TEST_ASSERT_TRUE(fabs(job.result.noise.joint_rad[1] - first.result.noise.joint_rad[1]) >
-                     0.0);
+    TEST_ASSERT_TRUE(fabs(job.result.noise.joint_rad[1] - first.result.noise.joint_rad[1]) > 0.0);
     /* the first job again, in the struct the other one used */
     fresh_arm();
     TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_job_run(&job, &cfg, &nominal, &port, &io, NULL));
@@ -162,12 +161,10 @@ static void test_a_recorded_acquisition_calibrates_like_the_live_one(void)
     TEST_ASSERT_EQUAL(FW_FAULT_ARGUMENT,
                       fw_job_acquire_recorded(&job, bad, FW_ACQ_MAX_SAMPLES + 1U, NULL));
     bad[3].kind = (uint8_t)DHC_MEAS_POSITION;
-    TEST_ASSERT_EQUAL(FW_FAULT_ARGUMENT,
-                      fw_job_acquire_recorded(&job, bad, live.n_samples, NULL));
+    TEST_ASSERT_EQUAL(FW_FAULT_ARGUMENT, fw_job_acquire_recorded(&job, bad, live.n_samples, NULL));
     bad[3] = live.samples[3];
     bad[5].wire_mm[1] = (double)NAN;
-    TEST_ASSERT_EQUAL(FW_FAULT_ARGUMENT,
-                      fw_job_acquire_recorded(&job, bad, live.n_samples, NULL));
+    TEST_ASSERT_EQUAL(FW_FAULT_ARGUMENT, fw_job_acquire_recorded(&job, bad, live.n_samples, NULL));
     TEST_ASSERT_EQUAL_size_t(0U, job.n_samples);
 }
 

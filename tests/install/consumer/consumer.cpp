@@ -12,7 +12,8 @@
 
 #include <dhcal/dhcal.h>
 
-namespace {
+namespace
+{
 
 constexpr double kA1 = 300.0;
 constexpr double kA2 = 200.0;
@@ -42,7 +43,10 @@ void planar_arm(dhc_arm *arm, double a1, double a2, double off2)
 }
 
 // Angles from a fixed sequence: reproducible, spread over the circle.
-double angle(unsigned k, unsigned j) { return std::fmod(0.7 * k + 1.9 * j + 0.37 * k * j, 6.2) - 3.1; }
+double angle(unsigned k, unsigned j)
+{
+    return std::fmod(0.7 * k + 1.9 * j + 0.37 * k * j, 6.2) - 3.1;
+}
 
 constexpr unsigned kSamples = 24U;
 dhc_sample samples[kSamples];
@@ -97,8 +101,8 @@ int main()
     dhc_calib_options opt;
     dhc_calib_default_options(&opt);
     unsigned char flags[kSamples] = {};
-    const dhc_status st = dhc_calib_fit(&model, &set, read_sample, nullptr, kSamples, flags,
-                                        &opt, &workspace, &report);
+    const dhc_status st = dhc_calib_fit(&model, &set, read_sample, nullptr, kSamples, flags, &opt,
+                                        &workspace, &report);
     check(st == DHC_OK, "dhc_calib_fit status", st, DHC_OK);
     std::printf("fit: %s, %zu iterations, residual RMS %.3g mm\n", dhc_status_str(st),
                 report.iterations, report.rms_mm);
@@ -108,8 +112,8 @@ int main()
         check(dhc_model_tool_point(&model, q, nullptr, got) == DHC_OK, "tool point", 0, 0);
         double want[2];
         closed_form(true_a1, kA2, true_off2, q[0], q[1], want);
-        check(std::hypot(got[0] - want[0], got[1] - want[1]) < 1e-6, "calibrated x",
-              got[0], want[0]);
+        check(std::hypot(got[0] - want[0], got[1] - want[1]) < 1e-6, "calibrated x", got[0],
+              want[0]);
     }
     std::printf("%s\n", failures == 0 ? "consumer: all checks passed" : "consumer: FAILED");
     return failures == 0 ? 0 : 1;

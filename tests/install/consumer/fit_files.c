@@ -38,8 +38,8 @@ int main(int argc, char **argv)
         st = dhc_calib_fit(&model, &set, dhcal_samples_read, &samples, samples.n, samples.flags,
                            &opt, &ws, &rep);
     }
-    printf("%s: %zu rows, %zu parameters (%zu identifiable): RMS %.4f mm, %s\n", argv[2],
-           samples.n, set.count, rep.rank, rep.rms_mm, dhc_status_str(st));
+    printf("%s: %zu rows, %zu parameters (%zu identifiable): RMS %.4f mm, %s\n", argv[2], samples.n,
+           set.count, rep.rank, rep.rms_mm, dhc_status_str(st));
     dhcal_samples_free(&samples);
     dhcal_dataset_free(&data);
     return st == DHC_OK ? 0 : 1;

@@ -246,7 +246,7 @@ int twin_main(int argc, char **argv)
         key[2] = (char)('0' + (int)k);
         twin_puts(key);
         twin_puts(fw_ik_solve(&stored, at, target, 1e-6, 50U, q) == FW_IK_OK ? " ok\n"
-                                                                            : " failed\n");
+                                                                             : " failed\n");
         for (size_t j = 0U; j < 3U; ++j) {
             char qkey[16] = "ik0.q0";
             qkey[2] = (char)('0' + (int)k);

@@ -68,8 +68,7 @@ int twin_main(int argc, char **argv)
     dhc_calib_default_options(&opt);
     const uint64_t t0 = twin_instructions();
     twin_measure_begin();
-    const dhc_status st =
-        dhc_calib_fit(&model, &set, read_sample, NULL, n, flags, &opt, &ws, &rep);
+    const dhc_status st = dhc_calib_fit(&model, &set, read_sample, NULL, n, flags, &opt, &ws, &rep);
     twin_measure_end();
     const uint64_t took = twin_instructions() - t0;
     twin_puts("status ");

@@ -47,7 +47,6 @@ void twin_put_u64(uint64_t v);
 void twin_put_double(const char *key, double v);
 
 /* Reads a sample file (see above) into s[0..*n). 0 on success, -1 with a message printed. */
-int twin_load_samples(const char *path, dhc_sample *s, size_t cap, size_t *n,
-                      size_t *n_joints);
+int twin_load_samples(const char *path, dhc_sample *s, size_t cap, size_t *n, size_t *n_joints);
 
 #endif /* DHC_TWIN_H */

@@ -63,8 +63,7 @@ static int count_of(double v, size_t max, size_t *out)
     return 0;
 }
 
-int twin_load_samples(const char *path, dhc_sample *s, size_t cap, size_t *n,
-                      size_t *n_joints)
+int twin_load_samples(const char *path, dhc_sample *s, size_t cap, size_t *n, size_t *n_joints)
 {
     size_t len = 0U;
     if (twin_read_file(path, file_buf, sizeof file_buf, &len) != 0) {
