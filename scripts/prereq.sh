@@ -161,7 +161,9 @@ probe_python() {
 
 probe_static() {
   clang-tidy --version >/dev/null 2>&1 || prereq_fail "clang-tidy does not run" || return 1
-  cppcheck --version >/dev/null 2>&1 || prereq_fail "cppcheck does not run"
+  cppcheck --version >/dev/null 2>&1 || prereq_fail "cppcheck does not run" || return 1
+  printf 'int main(void){return 0;}\n' >fmt.c
+  clang-format --style=LLVM fmt.c >/dev/null 2>&1 || prereq_fail "clang-format does not run"
 }
 
 probe_valgrind() {
