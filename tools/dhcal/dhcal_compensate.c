@@ -25,6 +25,7 @@
 #include "dhcal_io/dhcal_io.h"
 #include "dhcal_options.h"
 #include "dhcal_io/dhcal_text.h"
+#include "dhcal_io/dhcal_json.h"
 #include "dhcal_desk/dhcal_units.h"
 
 #define EXIT_COMPUTE 1
@@ -318,14 +319,9 @@ static int report(const compensate_options *o, const dhc_model *m, const dhcal_d
                 cJSON_AddItemToArray(bad, r);
             }
         }
-        char *text = cJSON_PrintUnformatted(obj);
-        cJSON_Delete(obj);
-        if (text == NULL) {
-            fprintf(stderr, "dhcal: out of memory\n");
+        if (dhcal_json_print(obj, "dhcal") != 0) {
             return EXIT_COMPUTE;
         }
-        puts(text);
-        free(text);
     } else {
         printf("%zu targets: %zu reached, %zu out of reach, %zu not converged\n", t->n_rows,
                t->n_rows - failed, out_of_reach, failed - out_of_reach);

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "dhcal_io/dhcal_model_file.h"
+#include "dhcal_io/dhcal_json.h"
 #include "dhcal_desk/dhcal_units.h"
 
 /* ---------------------------------------------------------------- the labels */
@@ -214,12 +215,7 @@ static void report_json(const dhcal_disc_report_info *info, const dhcal_disc_pro
     add_number(c, "before", res->d_before);
     add_number(c, "random", res->d_random);
     cJSON_AddStringToObject(obj, "out", info->out);
-    char *text = cJSON_PrintUnformatted(obj);
-    cJSON_Delete(obj);
-    if (text != NULL) {
-        puts(text);
-        free(text);
-    }
+    (void)dhcal_json_print(obj, "dhcal");
 }
 
 void dhcal_disc_report(const dhcal_disc_report_info *info, const dhcal_disc_problem *pb,

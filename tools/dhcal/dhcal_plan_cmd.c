@@ -25,6 +25,7 @@
 #include "dhcal_io/dhcal_file.h"
 #include "dhcal_io/dhcal_model_file.h"
 #include "dhcal_io/dhcal_model_map.h"
+#include "dhcal_io/dhcal_json.h"
 #include "dhcal_options.h"
 #include "dhcal_desk/dhcal_units.h"
 
@@ -337,12 +338,7 @@ static void report(const plan_options *o, size_t ends, const dhc_param_set *set,
         cJSON_AddNumberToObject(obj, "rank_random", (double)rank_random);
         cJSON_AddNumberToObject(obj, "exchanges", (double)rep->exchanges);
         cJSON_AddStringToObject(obj, "out", o->out);
-        char *text = cJSON_PrintUnformatted(obj);
-        cJSON_Delete(obj);
-        if (text != NULL) {
-            puts(text);
-            free(text);
-        }
+        (void)dhcal_json_print(obj, "dhcal");
         return;
     }
     printf("plan: %lu poses of %lu candidates where the arm works and %zu at the ends of the "
