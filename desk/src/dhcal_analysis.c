@@ -10,11 +10,26 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* One least-squares system and its analysis: a call's scratch (about 66 KiB), on the heap. */
+/* Rows gathered before they go to the accumulator (dhc_normal_eq_add's batch). */
+#define BATCH_ROWS 24U
+
+/* One least-squares system and its analysis: a call's scratch (about 80 KiB), on the heap. */
 typedef struct {
     dhc_normal_eq ne;
     dhc_lsq_factor fac;
+    double batch_jac[BATCH_ROWS * DHC_MAX_PARAMS];
+    double batch_r[BATCH_ROWS];
 } lsq_scratch;
+
+/* The first `rows` rows of w's batch (p columns) accumulated. */
+static int add_batch(lsq_scratch *w, size_t rows, size_t p)
+{
+    dhc_mat jac;
+    return dhc_mat_init(&jac, rows, p, w->batch_jac, BATCH_ROWS * DHC_MAX_PARAMS) == DHC_OK &&
+                   dhc_normal_eq_add(&w->ne, &jac, w->batch_r, NULL, rows) == DHC_OK
+               ? DHCAL_IO_OK
+               : DHCAL_IO_FAILED;
+}
 
 int dhcal_parse_effects(const char *list, const dhc_model *model, dhc_param_set *set,
                         dhcal_error *err)
@@ -767,20 +782,28 @@ static int extrapolate_in(const dhcal_fit *fit, const dhcal_samples *s, const dh
     }
     dhc_calib_options opt;
     dhcal_calib_options_for(&fit->model, &fit->noise, &opt);
-    double buf[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS];
     dhc_arm_trig trig;
     dhc_model_eval ev;
     dhc_arm_prepare(&fit->model.arm, &trig);
+    const size_t p = id_set.count;
+    size_t batch = 0U; /* rows waiting in w's batch: several samples' rows are added at once */
     for (size_t i = 0U; i < s->n; ++i) {
         if (s->flags[i] != (uint8_t)DHC_SAMPLE_USED) {
             continue;
         }
         const dhc_sample *smp = &s->samples[i];
         const size_t rows = dhc_sample_rows(smp);
+        if (batch + rows > BATCH_ROWS) {
+            if (add_batch(w, batch, p) != DHCAL_IO_OK) {
+                return DHCAL_IO_FAILED;
+            }
+            batch = 0U;
+        }
         dhc_mat jac;
-        double r[DHC_MAX_ROWS_PER_SAMPLE];
+        double *const r = w->batch_r + batch;
         size_t got;
-        if (dhc_mat_init(&jac, rows, id_set.count, buf, sizeof buf / sizeof buf[0]) != DHC_OK ||
+        if (dhc_mat_init(&jac, rows, p, w->batch_jac + batch * p, (BATCH_ROWS - batch) * p) !=
+                DHC_OK ||
             dhc_model_linearize(&fit->model, &id_set, smp, opt.orientation_weight_mm_per_rad, r,
                                 &got, &jac) != DHC_OK) {
             return DHCAL_IO_FAILED;
@@ -790,9 +813,10 @@ static int extrapolate_in(const dhcal_fit *fit, const dhcal_samples *s, const dh
                               opt.orientation_weight_mm_per_rad, r, r, &jac) != DHC_OK) {
             return DHCAL_IO_FAILED;
         }
-        if (dhc_normal_eq_add(&w->ne, &jac, r, NULL, rows) != DHC_OK) {
-            return DHCAL_IO_FAILED;
-        }
+        batch += rows;
+    }
+    if (batch > 0U && add_batch(w, batch, p) != DHCAL_IO_OK) {
+        return DHCAL_IO_FAILED;
     }
     if (dhc_lsq_analyse(&w->ne, opt.rank_rel_tol, &w->fac) != DHC_OK) {
         return DHCAL_IO_FAILED;
@@ -803,8 +827,8 @@ static int extrapolate_in(const dhcal_fit *fit, const dhcal_samples *s, const dh
     for (size_t i = 0U; i < held->n; ++i) {
         const dhc_sample *smp = &held->samples[i];
         dhc_mat jac;
-        if (dhc_mat_init(&jac, dhc_sample_rows(smp), id_set.count, buf,
-                         sizeof buf / sizeof buf[0]) != DHC_OK ||
+        if (dhc_mat_init(&jac, dhc_sample_rows(smp), id_set.count, w->batch_jac,
+                         BATCH_ROWS * DHC_MAX_PARAMS) != DHC_OK ||
             dhc_model_jacobian(&steady, &id_set, smp, opt.orientation_weight_mm_per_rad, &jac,
                                NULL) != DHC_OK) {
             return DHCAL_IO_FAILED;

@@ -441,26 +441,45 @@ static dhc_status score_columns(const batch_state *b, const size_t *cols, size_t
     return DHC_OK;
 }
 
-/* One pass over the used samples into ws->ne for the columns of ws->set. */
+/* The batch's rows (the first `rows` of jac_buf, ws->set.count columns) accumulated. */
+static dhc_status add_rows(dhc_diagnose_workspace *ws, size_t rows)
+{
+    dhc_mat jac;
+    dhc_status st = dhc_mat_init(&jac, rows, ws->set.count, ws->jac_buf,
+                                 sizeof ws->jac_buf / sizeof ws->jac_buf[0]);
+    if (st == DHC_OK) {
+        st = dhc_normal_eq_add(&ws->ne, &jac, ws->batch_r, NULL, rows);
+    }
+    return st;
+}
+
+/* One pass over the used samples into ws->ne for the columns of ws->set, several samples'
+ * rows at a time: the same sums as one sample at a time, fewer sweeps of the matrix. */
 static dhc_status accumulate(const dhc_model *model, dhc_sample_reader read, const void *ctx,
                              size_t n, const uint8_t *flags, const dhc_diagnose_options *opt,
                              dhc_diagnose_workspace *ws, double *ssr, size_t *rows)
 {
     const size_t p = ws->set.count;
+    const size_t jac_len = sizeof ws->jac_buf / sizeof ws->jac_buf[0];
     dhc_status st = dhc_normal_eq_init(&ws->ne, p);
     *ssr = 0.0;
     *rows = 0U;
     dhc_arm_prepare(&model->arm, &ws->trig);
+    size_t batch = 0U;
     for (size_t i = 0U; st == DHC_OK && i < n; ++i) {
         if (flags[i] != (uint8_t)DHC_SAMPLE_USED) {
             continue;
         }
         st = read(ctx, i, &ws->sample);
-        double r[DHC_MAX_ROWS_PER_SAMPLE];
         size_t k = dhc_sample_rows(&ws->sample);
+        if (st == DHC_OK && (batch + k > DHC_DIAGNOSE_BATCH_ROWS || (batch + k) * p > jac_len)) {
+            st = add_rows(ws, batch);
+            batch = 0U;
+        }
+        double *const r = ws->batch_r + batch;
         dhc_mat jac;
         if (st == DHC_OK) {
-            st = dhc_mat_init(&jac, k, p, ws->jac_buf, sizeof ws->jac_buf / sizeof ws->jac_buf[0]);
+            st = dhc_mat_init(&jac, k, p, ws->jac_buf + batch * p, jac_len - batch * p);
         }
         if (st == DHC_OK) {
             /* residual and slope from one evaluation, as the fit linearises them */
@@ -473,13 +492,14 @@ static dhc_status accumulate(const dhc_model *model, dhc_sample_reader read, con
             st = dhc_sample_whiten(model, &ws->trig, &ws->eval, &ws->sample, &opt->noise,
                                    opt->orientation_weight_mm_per_rad, r, r, &jac);
         }
-        if (st == DHC_OK) {
-            st = dhc_normal_eq_add(&ws->ne, &jac, r, NULL, k);
-        }
         for (size_t m = 0U; st == DHC_OK && m < k; ++m) {
             *ssr += r[m] * r[m];
         }
+        batch += k;
         *rows += k;
+    }
+    if (st == DHC_OK && batch > 0U) {
+        st = add_rows(ws, batch);
     }
     return st;
 }

@@ -82,7 +82,15 @@ typedef struct {
     dhc_noise_model noise;
 } dhc_diagnose_options;
 
-/* Scratch of dhc_diagnose (about 10 * DHC_MAX_PARAMS^2 bytes; keep it static). Every array
+/* Rows of equations dhc_diagnose gathers before they go to the accumulator (a build without
+ * the diagnosis keeps the workspace small). */
+#if DHC_WITH_DIAGNOSE
+#define DHC_DIAGNOSE_BATCH_ROWS 24U
+#else
+#define DHC_DIAGNOSE_BATCH_ROWS DHC_MAX_ROWS_PER_SAMPLE
+#endif
+
+/* Scratch of dhc_diagnose (about 13 * DHC_MAX_PARAMS^2 bytes; keep it static). Every array
  * lives here so the call stays within a small embedded stack. */
 typedef struct {
     dhc_normal_eq ne;
@@ -102,7 +110,9 @@ typedef struct {
     dhc_sample sample;
     dhc_arm_trig trig;   /* of the model diagnosed */
     dhc_model_eval eval; /* one evaluation's scratch */
-    double jac_buf[DHC_MAX_ROWS_PER_SAMPLE * DHC_MAX_PARAMS];
+    /* several samples' rows go to the accumulator at once (dhc_normal_eq_add's batch) */
+    double jac_buf[DHC_DIAGNOSE_BATCH_ROWS * DHC_MAX_PARAMS];
+    double batch_r[DHC_DIAGNOSE_BATCH_ROWS];
 } dhc_diagnose_workspace;
 
 void dhc_diagnose_default_options(dhc_diagnose_options *opt);
