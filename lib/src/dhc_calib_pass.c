@@ -176,15 +176,43 @@ static double next_uniform(uint32_t *state)
     return (double)(x >> 8) / 16777216.0;
 }
 
-/* The measurement kind most samples have. */
+/* The absolute measurement kind most samples have. */
 static uint8_t main_kind(const data_traits *t)
 {
     uint8_t best = 0U;
-    for (uint8_t k = 1U; k < 3U; ++k) {
+    for (uint8_t k = 1U; k <= (uint8_t)DHC_MEAS_WIRES; ++k) {
         best = t->kind_count[k] > t->kind_count[best] ? k : best;
     }
     return best;
 }
+
+/* The kind and target of structural pose k: the data's absolute kind (when they have absolute
+ * samples), then each plane and each point of the model in turn (when they have such
+ * samples). Data without contact samples: always the absolute kind. */
+#if DHC_WITH_CONTACT
+static void structural_slot(const dhc_model *model, const data_traits *t, size_t k, dhc_sample *s)
+{
+    const size_t absolute = t->kind_count[DHC_MEAS_POSITION] + t->kind_count[DHC_MEAS_POSE] +
+                                        t->kind_count[DHC_MEAS_WIRES] >
+                                    0U
+                                ? 1U
+                                : 0U;
+    const size_t planes = t->kind_count[DHC_MEAS_PLANE] > 0U ? model->contact.n_planes : 0U;
+    const size_t points = t->kind_count[DHC_MEAS_POINT] > 0U ? model->contact.n_points : 0U;
+    const size_t slots = absolute + planes + points;
+    const size_t slot = slots > 0U ? k % slots : 0U;
+    s->target = 0U;
+    if (slot < absolute || slots == 0U) {
+        s->kind = main_kind(t);
+    } else if (slot < absolute + planes) {
+        s->kind = (uint8_t)DHC_MEAS_PLANE;
+        s->target = (uint8_t)(slot - absolute);
+    } else {
+        s->kind = (uint8_t)DHC_MEAS_POINT;
+        s->target = (uint8_t)(slot - absolute - planes);
+    }
+}
+#endif
 
 /* Rank the model itself allows: the same parameters at random poses spread over the joint
  * ranges, with the data's measurement kind, temperature span and direction information.
@@ -197,8 +225,15 @@ dhc_status dhc_fit_structural_rank(const fit_context *fc, const dhc_model *model
     dhc_sample *const s = &ws->sample;
     memset(s, 0, sizeof *s);
     s->kind = main_kind(traits);
-    const size_t rows = dhc_sample_rows(s);
-    const size_t poses = (p + rows - 1U) / rows + STRUCTURAL_EXTRA_POSES;
+    /* contact data: every target gets its share of poses (a plane's rows are one each) */
+    const int contact =
+        DHC_WITH_CONTACT &&
+        traits->kind_count[DHC_MEAS_PLANE] + traits->kind_count[DHC_MEAS_POINT] > 0U;
+    const size_t rows = contact ? 1U : dhc_sample_rows(s);
+    const size_t poses =
+        (p + rows - 1U) / rows +
+        STRUCTURAL_EXTRA_POSES *
+            (contact ? 1U + model->contact.n_planes + model->contact.n_points : 1U);
     const double w = fc->opt->orientation_weight_mm_per_rad;
     uint32_t state = fc->opt->structural_seed != 0U ? fc->opt->structural_seed : 1U;
     dhc_status st = dhc_normal_eq_init(&ws->ne, p);
@@ -214,8 +249,15 @@ dhc_status dhc_fit_structural_rank(const fit_context *fc, const dhc_model *model
         }
         s->temp_c =
             traits->temp_min_c + (traits->temp_max_c - traits->temp_min_c) * next_uniform(&state);
+#if DHC_WITH_CONTACT
+        structural_slot(model, traits, k, s);
+        const size_t pose_rows = dhc_sample_rows(s);
+#else
+        const size_t pose_rows = rows;
+#endif
         dhc_mat jac;
-        st = dhc_mat_init(&jac, rows, p, ws->jac_buf, sizeof ws->jac_buf / sizeof ws->jac_buf[0]);
+        st = dhc_mat_init(&jac, pose_rows, p, ws->jac_buf,
+                          sizeof ws->jac_buf / sizeof ws->jac_buf[0]);
         dhc_prediction pred;
         if (st == DHC_OK) {
             st = dhc_model_jacobian_prepared(model, &ws->trig, fc->set, s, NULL, w, &jac, &pred,
@@ -225,7 +267,7 @@ dhc_status dhc_fit_structural_rank(const fit_context *fc, const dhc_model *model
             return st;
         }
         const double zero_r[DHC_MAX_ROWS_PER_SAMPLE] = {0.0};
-        st = dhc_normal_eq_add(&ws->ne, &jac, zero_r, NULL, rows);
+        st = dhc_normal_eq_add(&ws->ne, &jac, zero_r, NULL, pose_rows);
         if (st != DHC_OK) {
             return st;
         }
@@ -246,6 +288,9 @@ dhc_status dhc_fit_structural_rank(const fit_context *fc, const dhc_model *model
 static int beyond_reach(const dhc_model *model, const dhc_sample *s, double limit)
 {
     const double *b = model->arm.base.pos;
+    if (DHC_WITH_CONTACT && s->kind >= (uint8_t)DHC_MEAS_PLANE) {
+        return 0; /* a touch: nothing measured */
+    }
     if (s->kind != (uint8_t)DHC_MEAS_WIRES) {
         const double d[3] = {s->p_mm[0] - b[0], s->p_mm[1] - b[1], s->p_mm[2] - b[2]};
         return dhc_vec3_norm(d) > limit;

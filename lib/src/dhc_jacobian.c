@@ -11,6 +11,8 @@
 #include <math.h>
 #include <string.h>
 
+#include "dhcal/dhc_contact.h"
+
 static void rotation_column(const double axis[3], const double through[3], const double p[3],
                             double dp[3])
 {
@@ -238,6 +240,14 @@ static dhc_status jacobian_prepared(const dhc_model *model, const dhc_arm_trig *
             for (size_t r = 0U; r < 3U; ++r) {
                 DHC_MAT_AT(jac, r, k) = col[r];
             }
+#if DHC_WITH_CONTACT
+        } else if (s->kind >= (uint8_t)DHC_MEAS_PLANE) {
+            double col[3];
+            dhc_contact_column(&model->contact, s, id, pr->p_mm, dp, col);
+            for (size_t r = 0U; r < jac->rows; ++r) {
+                DHC_MAT_AT(jac, r, k) = col[r];
+            }
+#endif
         } else {
             put_column(jac, k, dp, dw, with_orientation, weight_mm_per_rad);
         }

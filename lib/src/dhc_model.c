@@ -24,7 +24,26 @@ dhc_status dhc_model_init(dhc_model *model, size_t n_joints)
 
 size_t dhc_sample_rows(const dhc_sample *s)
 {
+    if (DHC_WITH_CONTACT && s->kind == (uint8_t)DHC_MEAS_PLANE) {
+        return 1U;
+    }
     return s->kind == (uint8_t)DHC_MEAS_POSE ? 6U : 3U;
+}
+
+/* The kinds this build takes, and a contact sample's target one the model has. */
+static int kind_known(const dhc_model *model, const dhc_sample *s)
+{
+#if DHC_WITH_CONTACT
+    if (s->kind == (uint8_t)DHC_MEAS_PLANE) {
+        return s->target < model->contact.n_planes;
+    }
+    if (s->kind == (uint8_t)DHC_MEAS_POINT) {
+        return s->target < model->contact.n_points;
+    }
+#else
+    (void)model;
+#endif
+    return s->kind <= (uint8_t)DHC_MEAS_WIRES;
 }
 
 dhc_status dhc_sample_check(const dhc_model *model, const dhc_sample *s)
@@ -32,8 +51,7 @@ dhc_status dhc_sample_check(const dhc_model *model, const dhc_sample *s)
     if (model == NULL || s == NULL) {
         return DHC_ERR_ARGUMENT;
     }
-    if (s->kind > (uint8_t)DHC_MEAS_WIRES ||
-        (!DHC_WITH_POSE_SAMPLES && s->kind == (uint8_t)DHC_MEAS_POSE) ||
+    if (!kind_known(model, s) || (!DHC_WITH_POSE_SAMPLES && s->kind == (uint8_t)DHC_MEAS_POSE) ||
         (s->kind == (uint8_t)DHC_MEAS_WIRES && !model->measurer.present)) {
         return DHC_ERR_ARGUMENT;
     }
@@ -319,6 +337,18 @@ dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_tri
                                   : dhc_vec3_norm(d);
         }
     }
+#if DHC_WITH_CONTACT
+    dhc_vec3_set(out->contact_mm, 0.0, 0.0, 0.0);
+    if (s->kind >= (uint8_t)DHC_MEAS_PLANE &&
+        dhc_contact_predict(&model->contact, s, out->p_mm, out->contact_mm) != DHC_OK) {
+        return DHC_ERR_ARGUMENT;
+    }
+    for (size_t r = 0U; r < 3U; ++r) {
+        if (!dhc_is_finite(out->contact_mm[r])) {
+            return DHC_ERR_NONFINITE;
+        }
+    }
+#endif
     for (size_t r = 0U; r < 3U; ++r) {
         if (!dhc_is_finite(out->p_mm[r]) || !dhc_is_finite(out->wire_mm[r])) {
             return DHC_ERR_NONFINITE;
@@ -407,6 +437,11 @@ dhc_status dhc_model_residual_of(const dhc_sample *s, const dhc_prediction *pred
     double out[DHC_MAX_ROWS_PER_SAMPLE];
     if (s->kind == (uint8_t)DHC_MEAS_WIRES) {
         dhc_vec3_sub(s->wire_mm, pred->wire_mm, out);
+#if DHC_WITH_CONTACT
+    } else if (s->kind >= (uint8_t)DHC_MEAS_PLANE) {
+        /* a touch measures 0: on the plane, at the point (a plane's rows 2 and 3 stay 0) */
+        dhc_vec3_scale(pred->contact_mm, -1.0, out);
+#endif
     } else {
         dhc_vec3_sub(s->p_mm, pred->p_mm, out);
     }
@@ -432,6 +467,11 @@ dhc_status dhc_model_residual_of(const dhc_sample *s, const dhc_prediction *pred
     for (size_t k = 0U; k < n; ++k) {
         r[k] = out[k];
     }
+#if DHC_WITH_CONTACT
+    for (size_t k = n; k < 3U; ++k) {
+        r[k] = 0.0; /* a plane's one row: sums over a point's three see 0 */
+    }
+#endif
     *rows = n;
     return DHC_OK;
 }

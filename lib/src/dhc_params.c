@@ -3,6 +3,9 @@
 
 #include <string.h>
 
+#include "dhcal/dhc_contact.h"
+#include "dhcal/dhc_geometry.h"
+
 typedef enum {
     SCOPE_NONE,
     SCOPE_JOINT,
@@ -10,7 +13,9 @@ typedef enum {
     SCOPE_JOINT_PAIR,
     SCOPE_WIRE,
     SCOPE_ANCHOR,
-    SCOPE_AXIS
+    SCOPE_AXIS,
+    SCOPE_PLANE, /* joint = plane, aux = tilt 0, 1 (0 for the offset) */
+    SCOPE_POINT  /* joint = point, aux = axis */
 } scope;
 
 static scope kind_scope(unsigned kind)
@@ -29,6 +34,11 @@ static scope kind_scope(unsigned kind)
     case DHC_P_COMPLIANCE: return SCOPE_JOINT_PAIR;
     case DHC_P_MEAS_OFFSET: return SCOPE_WIRE;
     case DHC_P_MEAS_ANCHOR: return SCOPE_ANCHOR;
+#if DHC_WITH_CONTACT
+    case DHC_P_PLANE_TILT:
+    case DHC_P_PLANE_OFFSET: return SCOPE_PLANE;
+    case DHC_P_POINT: return SCOPE_POINT;
+#endif
     default: return SCOPE_NONE;
     }
 }
@@ -55,6 +65,12 @@ static int indices_fit(const dhc_model *model, unsigned kind, size_t joint, size
     case SCOPE_JOINT_PAIR: return joint < n && aux >= joint && aux < n;
     case SCOPE_WIRE: return joint == 0U && aux < 3U;
     case SCOPE_ANCHOR: return joint == 0U && aux < 9U;
+#if DHC_WITH_CONTACT
+    case SCOPE_PLANE:
+        return joint < model->contact.n_planes &&
+               aux < (kind == (unsigned)DHC_P_PLANE_TILT ? 2U : 1U);
+    case SCOPE_POINT: return joint < model->contact.n_points && aux < 3U;
+#endif
     case SCOPE_NONE:
     default: return joint == 0U && aux == 0U;
     }
@@ -68,10 +84,11 @@ dhc_status dhc_params_add(dhc_param_set *set, const dhc_model *model, dhc_param_
         (needs_measurer((unsigned)kind) && !model->measurer.present)) {
         return DHC_ERR_ARGUMENT;
     }
-    /* beyond the base model, a parameter of an effect in the build's catalogue: those of an
-     * effect the build leaves out (dhc_config.h) are refused */
+    /* beyond the base model and the contact targets, a parameter of an effect in the build's
+     * catalogue: those of an effect the build leaves out (dhc_config.h) are refused */
     const dhc_param_id id_new = {(uint8_t)kind, (uint8_t)joint, (uint8_t)aux};
-    if (kind > DHC_P_BETA && dhc_params_effect_of(&id_new) == DHC_EFFECT_COUNT) {
+    if (kind > DHC_P_BETA && (!DHC_WITH_CONTACT || kind < DHC_P_PLANE_TILT) &&
+        dhc_params_effect_of(&id_new) == DHC_EFFECT_COUNT) {
         return DHC_ERR_ARGUMENT;
     }
     for (size_t k = 0U; k < set->count; ++k) {
@@ -148,8 +165,8 @@ dhc_effect dhc_params_effect_of(const dhc_param_id *id)
     return DHC_EFFECT_COUNT;
 }
 
-/* The model quantity a parameter stands for; NULL for the base rotations, which are
- * perturbations composed by dhc_params_apply. */
+/* The model quantity a parameter stands for; NULL for the base rotations and the planes'
+ * tilts, which are perturbations composed by dhc_params_apply. */
 static double *param_slot(dhc_model *model, const dhc_param_id *id)
 {
     dhc_joint *const j = &model->arm.joint[id->joint];
@@ -180,6 +197,11 @@ static double *param_slot(dhc_model *model, const dhc_param_id *id)
     case DHC_P_THERMAL: return &model->thermal_per_k;
     case DHC_P_DRIFT_SCALE: return &model->drift_scale_per_s;
     case DHC_P_DRIFT_OFFSET: return &model->drift_mm_per_s[id->aux];
+#if DHC_WITH_CONTACT
+    case DHC_P_PLANE_OFFSET: return &model->contact.plane[id->joint].offset_mm;
+    case DHC_P_POINT: return &model->contact.point_mm[id->joint][id->aux];
+#endif
+    case DHC_P_PLANE_TILT:
     case DHC_P_BASE_RX:
     case DHC_P_BASE_RY:
     case DHC_P_BASE_RZ:
@@ -233,15 +255,36 @@ dhc_status dhc_params_apply(const dhc_param_set *set, dhc_model *model, const do
         }
     }
     double base_rot[3] = {0.0, 0.0, 0.0};
+#if DHC_WITH_CONTACT
+    double tilt[DHC_MAX_PLANES][2];
+    memset(tilt, 0, sizeof tilt);
+#endif
     for (size_t k = 0U; k < len; ++k) {
         const dhc_param_id *id = &set->id[k];
         double *slot = param_slot(model, id);
         if (slot != NULL) {
             *slot += delta[k];
+#if DHC_WITH_CONTACT
+        } else if (id->kind == (uint8_t)DHC_P_PLANE_TILT) {
+            tilt[id->joint % DHC_MAX_PLANES][id->aux & 1U] = delta[k];
+#endif
         } else {
             base_rot[id->kind - (uint8_t)DHC_P_BASE_RX] = delta[k];
         }
     }
+#if DHC_WITH_CONTACT
+    /* each plane's normal turned toward its tangents, and made a unit vector again */
+    for (size_t j = 0U; j < model->contact.n_planes; ++j) {
+        double *const n = model->contact.plane[j].normal;
+        double u[3];
+        double v[3];
+        dhc_plane_tangents(n, u, v);
+        for (size_t k = 0U; k < 3U; ++k) {
+            n[k] += tilt[j][0] * u[k] + tilt[j][1] * v[k];
+        }
+        dhc_vec3_scale(n, 1.0 / dhc_vec3_norm(n), n);
+    }
+#endif
     /* The Jacobian treats the three base rotations as one small rotation vector about the
      * base origin in world axes; composing it exactly keeps the rotation orthonormal. (A
      * build without base_frame has no such parameter: nothing to compose.) */
@@ -314,7 +357,10 @@ size_t dhc_params_name(const dhc_param_set *set, size_t k, char *buf, size_t cap
                                                         "anchor",
                                                         "thermal_scale",
                                                         "drift_scale",
-                                                        "drift_offset"};
+                                                        "drift_offset",
+                                                        "plane",
+                                                        "plane",
+                                                        "point"};
     static const char axes[3] = {'x', 'y', 'z'};
     if (set == NULL || buf == NULL || cap == 0U || k >= set->count ||
         set->id[k].kind >= (uint8_t)DHC_P_KIND_COUNT) {
@@ -353,6 +399,19 @@ size_t dhc_params_name(const dhc_param_set *set, size_t k, char *buf, size_t cap
         pos = put_str(buf, cap, pos, axis);
         break;
     }
+    case SCOPE_PLANE: /* "plane2_tilt1", "plane2_offset" */
+        pos = put_uint(buf, cap, pos, (unsigned)id.joint + 1U);
+        pos = put_str(buf, cap, pos, id.kind == (uint8_t)DHC_P_PLANE_OFFSET ? "_offset" : "_tilt");
+        if (id.kind == (uint8_t)DHC_P_PLANE_TILT) {
+            pos = put_uint(buf, cap, pos, (unsigned)id.aux + 1U);
+        }
+        break;
+    case SCOPE_POINT: { /* "point1_x" */
+        const char axis[3] = {'_', axes[id.aux % 3U], '\0'};
+        pos = put_uint(buf, cap, pos, (unsigned)id.joint + 1U);
+        pos = put_str(buf, cap, pos, axis);
+        break;
+    }
     case SCOPE_NONE:
     default: break;
     }
@@ -372,6 +431,7 @@ int dhc_params_is_angle(const dhc_param_set *set, size_t k)
     case DHC_P_BASE_RZ:
     case DHC_P_HARMONIC_SIN:
     case DHC_P_HARMONIC_COS:
+    case DHC_P_PLANE_TILT:
     case DHC_P_BACKLASH: return 1;
     default: return 0;
     }

@@ -22,6 +22,7 @@
 #include "dhc_test_arms.h"
 #include "dhc_test_samples.h"
 #include "dhcal/dhc_calib.h"
+#include "dhcal/dhc_contact.h"
 #include "dhcal/dhc_jacobian.h"
 #include "dhcal/dhc_lsq.h"
 #include "dhcal/dhc_params.h"
@@ -222,6 +223,20 @@ static void ref_predict(const dhc_model *m, const dhc_sample *s, double out[3], 
         tool->p[k] =
             b + (1.0 + m->drift_scale_per_s * dt) * (tool->p[k] - b) + m->drift_mm_per_s[k] * dt;
     }
+    if (s->kind == (uint8_t)DHC_MEAS_PLANE) { /* the signed distance n . p - h */
+        const dhc_plane *pl = &m->contact.plane[s->target];
+        out[0] = pl->normal[0] * tool->p[0] + pl->normal[1] * tool->p[1] +
+                 pl->normal[2] * tool->p[2] - pl->offset_mm;
+        out[1] = 0.0;
+        out[2] = 0.0;
+        return;
+    }
+    if (s->kind == (uint8_t)DHC_MEAS_POINT) { /* p - c */
+        for (size_t k = 0U; k < 3U; ++k) {
+            out[k] = tool->p[k] - m->contact.point_mm[s->target][k];
+        }
+        return;
+    }
     if (s->kind != (uint8_t)DHC_MEAS_WIRES) {
         memcpy(out, tool->p, sizeof tool->p);
         return;
@@ -237,6 +252,15 @@ static void ref_predict(const dhc_model *m, const dhc_sample *s, double out[3], 
         }
         out[k] = (1.0 + me->scale) * sqrt(d2) + me->offset_mm[k];
     }
+}
+
+static double norm_n(const double *v, size_t n)
+{
+    double s = 0.0;
+    for (size_t i = 0U; i < n; ++i) {
+        s += v[i] * v[i];
+    }
+    return sqrt(s);
 }
 
 /* Moves one parameter of the model by h, editing the field the parameter names (not
@@ -288,6 +312,36 @@ static void ref_perturb(dhc_model *m, const dhc_param_id *id, double h)
     case DHC_P_MEAS_OFFSET: m->measurer.offset_mm[id->aux] += h; break;
     case DHC_P_MEAS_ANCHOR: m->measurer.anchor_mm[id->aux / 3U][id->aux % 3U] += h; break;
     case DHC_P_THERMAL: m->thermal_per_k += h; break;
+    case DHC_P_PLANE_OFFSET: m->contact.plane[id->joint].offset_mm += h; break;
+    case DHC_P_POINT: m->contact.point_mm[id->joint][id->aux] += h; break;
+    case DHC_P_PLANE_TILT: {
+        /* the normal turned by h toward its tangent u (aux 0) or v = n x u (aux 1), u
+         * perpendicular to the world axis the normal leans on least (dhc_contact.h) */
+        double *n = m->contact.plane[id->joint].normal;
+        size_t least = 0U;
+        for (size_t k = 1U; k < 3U; ++k) {
+            least = fabs(n[k]) < fabs(n[least]) ? k : least;
+        }
+        const double e[3] = {least == 0U ? 1.0 : 0.0, least == 1U ? 1.0 : 0.0,
+                             least == 2U ? 1.0 : 0.0};
+        double u[3] = {e[1] * n[2] - e[2] * n[1], e[2] * n[0] - e[0] * n[2],
+                       e[0] * n[1] - e[1] * n[0]};
+        const double nu = norm_n(u, 3U);
+        for (size_t k = 0U; k < 3U; ++k) {
+            u[k] /= nu;
+        }
+        const double v[3] = {n[1] * u[2] - n[2] * u[1], n[2] * u[0] - n[0] * u[2],
+                             n[0] * u[1] - n[1] * u[0]};
+        const double *t = id->aux == 0U ? u : v;
+        for (size_t k = 0U; k < 3U; ++k) {
+            n[k] += h * t[k];
+        }
+        const double len = norm_n(n, 3U);
+        for (size_t k = 0U; k < 3U; ++k) {
+            n[k] /= len;
+        }
+        break;
+    }
     case DHC_P_KIND_COUNT:
     default: TEST_FAIL_MESSAGE("unknown parameter kind");
     }
@@ -310,15 +364,6 @@ static void ref_rot_diff(const ref_frame *a, const ref_frame *b, double w[3])
     for (size_t i = 0U; i < 3U; ++i) {
         w[i] *= k;
     }
-}
-
-static double norm_n(const double *v, size_t n)
-{
-    double s = 0.0;
-    for (size_t i = 0U; i < n; ++i) {
-        s += v[i] * v[i];
-    }
-    return sqrt(s);
 }
 
 /* ------------------------------------------------------------------ Jacobian property */
@@ -359,6 +404,19 @@ static void random_effects(test_rng *g, dhc_model *m, double L, int with_complia
     for (size_t k = 0U; k < 3U; ++k) {
         m->drift_mm_per_s[k] = L * test_range(g, -1e-6, 1e-6);
     }
+    /* a plane through a point near the arm, any direction, and a fixed point */
+    m->contact.n_planes = 1U;
+    m->contact.n_points = 1U;
+    double *nrm = m->contact.plane[0].normal;
+    for (size_t k = 0U; k < 3U; ++k) {
+        nrm[k] = test_range(g, -1.0, 1.0);
+        m->contact.point_mm[0][k] = L * test_range(g, -1.0, 1.0);
+    }
+    const double len = norm_n(nrm, 3U);
+    for (size_t k = 0U; k < 3U; ++k) {
+        nrm[k] /= len;
+    }
+    m->contact.plane[0].offset_mm = L * test_range(g, -1.0, 1.0);
 }
 
 /* Every parameter kind: theta, d, a, alpha, beta on every joint (whatever its convention),
@@ -380,6 +438,8 @@ static void all_kinds(dhc_param_set *s, const dhc_model *m, size_t first)
     for (size_t e = 0U; e < 8U; ++e) {
         TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(s, m, global[e], 0U));
     }
+    const dhc_status targets = dhc_params_add_targets(s, m); /* a long arm leaves no room */
+    TEST_ASSERT_TRUE(targets == DHC_OK || targets == DHC_ERR_CAPACITY);
     /* the joint `first` gets every order of harmonic first, then the rest as they fit */
     const dhc_effect per_joint[7] = {DHC_EFFECT_JOINT_HARMONIC2,  DHC_EFFECT_JOINT_HARMONIC4,
                                      DHC_EFFECT_JOINT_COMPLIANCE, DHC_EFFECT_JOINT_SCALE,
@@ -436,9 +496,12 @@ static void check_jacobian(const dhc_model *m, const dhc_sample *s, double L, in
     double base_out[3];
     ref_frame base_tool;
     ref_predict(m, s, base_out, &base_tool);
-    const double mag = norm_n(base_out, 3U);
+    /* the differences round at the tool point's size (a plane's distance may be far smaller) */
+    const double mag = fmax(norm_n(base_out, 3U), norm_n(base_tool.p, 3U));
     /* The two models agree on the prediction itself first (rounding of ~30 products). */
-    const double *lib_out = s->kind == (uint8_t)DHC_MEAS_WIRES ? pred.wire_mm : pred.p_mm;
+    const double *lib_out = s->kind == (uint8_t)DHC_MEAS_WIRES ? pred.wire_mm
+                            : dhc_sample_is_contact(s)         ? pred.contact_mm
+                                                               : pred.p_mm;
     for (size_t r = 0U; r < 3U; ++r) {
         TEST_ASSERT_DOUBLE_WITHIN(1e-12 * mag, base_out[r], lib_out[r]);
         for (size_t c = 0U; c < 3U; ++c) {
@@ -462,7 +525,7 @@ static void check_jacobian(const dhc_model *m, const dhc_sample *s, double L, in
         ref_perturb(&moved, &set.id[k], -h);
         ref_predict(&moved, s, out_m, &tool_m);
         double fd[6];
-        double diff[6];
+        double diff[6] = {0.0}; /* a plane's one row: the others compare as 0 */
         for (size_t r = 0U; r < 3U; ++r) {
             fd[r] = (out_p[r] - out_m[r]) / (2.0 * h);
         }
@@ -477,7 +540,14 @@ static void check_jacobian(const dhc_model *m, const dhc_sample *s, double L, in
          * (100 eps of the output over the step), which matters for columns that are ~0. */
         char name[32];
         (void)dhc_params_name(&set, k, name, sizeof name);
-        const double tol_p = 1e-6 * norm_n(fd, 3U) + 100.0 * DBL_EPSILON * mag / h;
+        /* a plane's row projects the tool point's move onto the normal: its error is the
+         * move's, however small the projection */
+        double fd_point[3];
+        for (size_t r = 0U; r < 3U; ++r) {
+            fd_point[r] = (tool_p.p[r] - tool_m.p[r]) / (2.0 * h);
+        }
+        const double tol_p =
+            1e-6 * fmax(norm_n(fd, 3U), norm_n(fd_point, 3U)) + 100.0 * DBL_EPSILON * mag / h;
         TEST_ASSERT_TRUE_MESSAGE(norm_n(diff, 3U) <= tol_p, name);
         if (rows == 6U) {
             const double tol_r = 1e-6 * norm_n(fd + 3, 3U) + 100.0 * DBL_EPSILON / h;
@@ -492,7 +562,8 @@ static void test_model_jacobian_matches_independent_differences_on_random_arms(v
 {
     test_rng g = {0x0DDC0FFEE1234567ULL};
     const double scales[5] = {1e-6, 1e-3, 1.0, 1e3, 1e6};
-    const dhc_meas_kind kinds[3] = {DHC_MEAS_POSITION, DHC_MEAS_POSE, DHC_MEAS_WIRES};
+    const dhc_meas_kind kinds[5] = {DHC_MEAS_POSITION, DHC_MEAS_POSE, DHC_MEAS_WIRES,
+                                    DHC_MEAS_PLANE, DHC_MEAS_POINT};
     static dhc_model m;
     jac_columns_checked = 0U;
     memset(jac_kind_checked, 0, sizeof jac_kind_checked);
@@ -526,7 +597,7 @@ static void test_model_jacobian_matches_independent_differences_on_random_arms(v
             }
             s.temp_c = m.thermal_ref_c + test_range(&g, -10.0, 10.0);
             s.t_s = m.drift_ref_s + test_range(&g, -500.0, 500.0);
-            s.kind = (uint8_t)kinds[(c + pose) % 3U];
+            s.kind = (uint8_t)kinds[(c + pose) % 5U];
             check_jacobian(&m, &s, L, compliant);
         }
     }

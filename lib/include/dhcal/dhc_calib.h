@@ -36,20 +36,8 @@
 extern "C" {
 #endif
 
-/* Fills *out with measurement `index` (0-based, < n). Any status other than DHC_OK aborts
- * the fit with that status. */
-typedef dhc_status (*dhc_sample_reader)(const void *ctx, size_t index, dhc_sample *out);
-
-/* Sample flags (the caller's array of n bytes). */
-enum {
-    DHC_SAMPLE_USED = 0,
-    DHC_SAMPLE_EXCLUDED = 1,     /* set by the caller: not used */
-    DHC_SAMPLE_OUTLIER = 2,      /* set by the fit: far from the fit (many robust sigmas) */
-    DHC_SAMPLE_JOINT_RANGE = 3,  /* ... a joint angle beyond its range: not this arm's pose */
-    DHC_SAMPLE_BEYOND_REACH = 4, /* ... measured farther from the base than the arm reaches */
-    DHC_SAMPLE_ROBUST = 5        /* ... far from the robust start (gross, before it could drag
-                                    the fit) */
-};
+/* The sample reader (dhc_sample_reader) and the sample flags (DHC_SAMPLE_USED, ...) are
+ * dhc_model.h's, with the samples. */
 
 /* 1 for the flags the fit sets (every kind of outlier), 0 for used and excluded samples. */
 int dhc_sample_is_outlier(uint8_t flag);

@@ -125,6 +125,19 @@ DHC_STATIC_ASSERT(DHC_MAX_PARAMS <= 256U, "DHC_MAX_PARAMS too large for the inde
 #ifndef DHC_WITH_TRILATERATION
 #define DHC_WITH_TRILATERATION 1
 #endif
+/* dhc_contact.h: contact rows, touches of unknown planes and fixed points (DHC_MEAS_PLANE,
+ * DHC_MEAS_POINT) whose poses are fitted with the model; without it such samples are refused
+ * and the model keeps room for one plane and one point */
+#ifndef DHC_WITH_CONTACT
+#define DHC_WITH_CONTACT 1
+#endif
+/* Planes and fixed points one model holds (dhc_contact_targets). */
+#ifndef DHC_MAX_PLANES
+#define DHC_MAX_PLANES (DHC_WITH_CONTACT ? 8U : 1U)
+#endif
+#ifndef DHC_MAX_POINTS
+#define DHC_MAX_POINTS (DHC_WITH_CONTACT ? 8U : 1U)
+#endif
 /* dhc_inverse.h: commanded angles for a target on the full model (the controller's IK, dhcal
  * compensate) */
 #ifndef DHC_WITH_INVERSE

@@ -17,6 +17,10 @@
  *   p = b + (1 + k_d (t - t0)) (p_arm - b) + v (t - t0),   b the base origin.
  * A wire-length sample sees
  *   L_k = (1 + s_m) |p - P_k| + o_k,   P_k = T_meas * anchor_k.
+ * A contact sample touches a target whose pose is fitted with the arm (dhc_contact.h):
+ *   plane j (unit normal n_j, offset h_j):  one row, the signed distance n_j . p - h_j = 0,
+ *   fixed point j (c_j):                    three rows, p - c_j = 0,
+ * p the arm's tool point (after the session's drift, as a measured point).
  * Units: mm, rad; c_ij in rad per mm of gravity moment arm.
  */
 #ifndef DHC_MODEL_H
@@ -55,6 +59,21 @@ typedef struct {
     double offset_mm[3];    /* o_k: zero reference of each wire */
 } dhc_measurer_model;
 
+/* A plane the tool touches: the points x with normal . x = offset_mm (normal a unit vector,
+ * world frame). */
+typedef struct {
+    double normal[3];
+    double offset_mm;
+} dhc_plane;
+
+/* The targets contact samples touch (dhc_contact.h), indexed by dhc_sample.target. */
+typedef struct {
+    size_t n_planes;
+    size_t n_points;
+    dhc_plane plane[DHC_MAX_PLANES];
+    double point_mm[DHC_MAX_POINTS][3]; /* fixed points (a sphere's or a cone's centre), world */
+} dhc_contact_targets;
+
 typedef struct {
     dhc_arm arm;
     dhc_joint_effects effect[DHC_MAX_JOINTS];
@@ -65,12 +84,15 @@ typedef struct {
     double drift_scale_per_s; /* k_d */
     double drift_mm_per_s[3]; /* v, world frame */
     double drift_ref_s;       /* t0 */
+    dhc_contact_targets contact;
 } dhc_model;
 
 typedef enum {
     DHC_MEAS_POSITION = 0, /* tool point, 3 rows (mm) */
     DHC_MEAS_POSE = 1,     /* tool point and last-link orientation, 6 rows */
-    DHC_MEAS_WIRES = 2     /* raw draw-wire lengths L1..L3, 3 rows (mm) */
+    DHC_MEAS_WIRES = 2,    /* raw draw-wire lengths L1..L3, 3 rows (mm) */
+    DHC_MEAS_PLANE = 3,    /* the tool point touches plane `target`: 1 row (mm) */
+    DHC_MEAS_POINT = 4     /* the tool point sits at fixed point `target`: 3 rows (mm) */
 } dhc_meas_kind;
 
 typedef struct {
@@ -82,7 +104,23 @@ typedef struct {
     double wire_mm[3];            /* measured wire lengths (WIRES) */
     int8_t dir[DHC_MAX_JOINTS];   /* last approach direction, -1 or +1 (0: unknown) */
     uint8_t kind;                 /* dhc_meas_kind */
+    uint8_t target;               /* PLANE, POINT: the plane's or the point's index */
 } dhc_sample;
+
+/* Fills *out with measurement `index` (0-based, < n). Any status other than DHC_OK aborts
+ * the fit (or the pass) that reads with that status. */
+typedef dhc_status (*dhc_sample_reader)(const void *ctx, size_t index, dhc_sample *out);
+
+/* Sample flags (the caller's array of n bytes). */
+enum {
+    DHC_SAMPLE_USED = 0,
+    DHC_SAMPLE_EXCLUDED = 1,     /* set by the caller: not used */
+    DHC_SAMPLE_OUTLIER = 2,      /* set by the fit: far from the fit (many robust sigmas) */
+    DHC_SAMPLE_JOINT_RANGE = 3,  /* ... a joint angle beyond its range: not this arm's pose */
+    DHC_SAMPLE_BEYOND_REACH = 4, /* ... measured farther from the base than the arm reaches */
+    DHC_SAMPLE_ROBUST = 5        /* ... far from the robust start (gross, before it could drag
+                                    the fit) */
+};
 
 /* What the model predicts for a sample. */
 typedef struct {
@@ -90,19 +128,31 @@ typedef struct {
     double p_arm_mm[3]; /* the arm's tool point, before the session's drift */
     double p_mm[3];
     dhc_mat3 rot;
-    double wire_mm[3]; /* WIRES samples only */
+    double wire_mm[3];    /* WIRES samples only */
+    double contact_mm[3]; /* PLANE: the signed distance n . p - h (then 0, 0); POINT: p - c */
 } dhc_prediction;
 
 /* A model around an arm of n_joints joints: no effects, gravity -z, no measurer,
  * thermal reference 20 C. DHC_ERR_CAPACITY for a bad joint count. */
 dhc_status dhc_model_init(dhc_model *model, size_t n_joints);
 
-/* Rows a sample contributes: 3 or 6. */
+/* Rows a sample contributes: 1 (PLANE), 3 or 6 (POSE). */
 size_t dhc_sample_rows(const dhc_sample *s);
+
+#if DHC_WITH_CONTACT
+/* 1 for the contact kinds (PLANE, POINT). */
+int dhc_sample_is_contact(const dhc_sample *s);
+
+/* What the model predicts for a contact sample whose tool point is p (world, mm): PLANE the
+ * signed distance n . p - h in out[0] (out[1], out[2] 0), POINT p - c. DHC_ERR_ARGUMENT for a
+ * sample of another kind or a target the model does not have. */
+dhc_status dhc_contact_predict(const dhc_contact_targets *t, const dhc_sample *s, const double p[3],
+                               double out[3]);
+#endif
 
 /* Checks a sample for non-finite values, kinds and directions against the model.
  * DHC_ERR_NONFINITE, DHC_ERR_ARGUMENT (unknown kind, dir not in {-1,0,1}, wires without a
- * measurer in the model). */
+ * measurer in the model, a contact target the model does not have). */
 dhc_status dhc_sample_check(const dhc_model *model, const dhc_sample *s);
 
 /* Factor 1 + k (T - T0) by which thermal expansion scales every link length. */

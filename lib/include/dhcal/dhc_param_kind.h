@@ -34,6 +34,10 @@ typedef enum {
     DHC_P_THERMAL,      /* k, 1/K */
     DHC_P_DRIFT_SCALE,  /* k_d, 1/s */
     DHC_P_DRIFT_OFFSET, /* v, mm/s (aux = world axis 0..2) */
+    DHC_P_PLANE_TILT,   /* small turn of plane `joint`'s normal toward its tangent aux (0, 1:
+                           dhc_plane_tangents), rad */
+    DHC_P_PLANE_OFFSET, /* plane `joint`'s offset h, mm */
+    DHC_P_POINT,        /* fixed point `joint`'s coordinate aux (world axis 0..2), mm */
     DHC_P_KIND_COUNT
 } dhc_param_kind;
 

@@ -8,6 +8,7 @@
 
 #include "dhc_calib.h"
 #include "dhc_config.h"
+#include "dhc_contact.h"
 #include "dhc_diagnose.h"
 #include "dhc_effects.h"
 #include "dhc_factor.h"
