@@ -60,7 +60,7 @@ static dhc_status analyse_keeping_set(const fit_context *fc, dhc_calib_report *r
     const int first = rep->iterations == 0U;
     for (size_t j = 0U; j < n; ++j) {
         ws->scratch[j] = ne->jtj[j * n + j];
-        if (!first && !rep->identifiable[j]) {
+        if ((!first && !rep->identifiable[j]) || (DHC_WITH_CONTACT && rep->blind[j])) {
             ne->jtj[j * n + j] = 0.0;
         }
     }
@@ -307,7 +307,8 @@ static int may_free(const fit_context *fc, const dhc_calib_report *rep, const ui
     const uint8_t kind = fc->set->id[k].kind;
     const int rotation = kind == (uint8_t)DHC_P_BASE_RX || kind == (uint8_t)DHC_P_BASE_RY ||
                          kind == (uint8_t)DHC_P_BASE_RZ;
-    return !rep->identifiable[k] && !rep->unsupported[k] && (mark == NULL || !rotation);
+    return !rep->identifiable[k] && !rep->unsupported[k] && !(DHC_WITH_CONTACT && rep->blind[k]) &&
+           (mark == NULL || !rotation);
 }
 
 static dhc_status free_identifiable(const fit_context *fc, dhc_calib_report *rep, uint8_t *mark,
@@ -395,6 +396,24 @@ static dhc_status hold_unsupported(const fit_context *fc, const pass_totals *tot
     return st;
 }
 
+/* Parameter k of the estimate back at its input value. A plane's tilt is a turn of its
+ * normal, not a quantity of the model: the normal goes back whole. */
+static dhc_status back_to_input(const fit_context *fc, size_t k)
+{
+    const dhc_param_id *const id = &fc->set->id[k];
+#if DHC_WITH_CONTACT
+    if (id->kind == (uint8_t)DHC_P_PLANE_TILT) {
+        memcpy(fc->ws->current.contact.plane[id->joint].normal,
+               fc->input->contact.plane[id->joint].normal, sizeof(double[3]));
+        return DHC_OK;
+    }
+#else
+    (void)id;
+#endif
+    return dhc_params_set_value(fc->set, &fc->ws->current, k,
+                                dhc_params_value(fc->set, fc->input, k));
+}
+
 /* Parameters freed between LM's steps join on the evidence of an estimate on its way: where
  * the truth itself is degenerate (exactly parallel axes), an iterate off it identifies what
  * the converged estimate cannot, and a parameter would end reported unidentifiable, off its
@@ -420,8 +439,7 @@ static dhc_status roll_back_early(const fit_context *fc, dhc_calib_report *rep, 
     dhc_status st = DHC_OK;
     for (size_t k = 0U; k < p && st == DHC_OK; ++k) {
         if (ws->freed_early[k]) {
-            st = dhc_params_set_value(fc->set, &ws->current, k,
-                                      dhc_params_value(fc->set, fc->input, k));
+            st = back_to_input(fc, k);
             rep->identifiable[k] = 0U;
             rep->freed--;
             ws->freed_early[k] = 0U;

@@ -14,6 +14,7 @@
 
 /* Medians of chi-square with 3 and 6 degrees of freedom: they turn the median squared
  * sample error into a noise variance estimate that a few outliers cannot inflate. */
+#define CHI2_MEDIAN_1DOF 0.454936423119573
 #define CHI2_MEDIAN_3DOF 2.365973884375338
 #define CHI2_MEDIAN_6DOF 5.348120627447122
 #define LAMBDA_START 1e-3
@@ -106,6 +107,7 @@ dhc_status dhc_fit_structural_rank(const fit_context *fc, const dhc_model *model
 typedef struct {
     size_t used;
     size_t pose;    /* pose samples among them (not counted from kept errors) */
+    size_t one_row; /* plane touches among them: one row each */
     size_t at_most; /* samples with e2 <= the scan's limit */
     double max_e2;
 } error_scan;

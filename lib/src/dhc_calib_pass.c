@@ -7,6 +7,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "dhcal/dhc_contact.h"
 #include "dhcal/dhc_jacobian.h"
 
 static void note_traits(data_traits *t, const dhc_sample *s, size_t n_joints, int first)
@@ -214,21 +215,18 @@ static void structural_slot(const dhc_model *model, const data_traits *t, size_t
 }
 #endif
 
-/* Rank the model itself allows: the same parameters at random poses spread over the joint
- * ranges, with the data's measurement kind, temperature span and direction information.
- * A data rank below it means the data, not the model, are short. */
-dhc_status dhc_fit_structural_rank(const fit_context *fc, const dhc_model *model,
-                                   const data_traits *traits, dhc_calib_report *rep)
+/* The analysis (in ws->fac) of the parameters at random poses spread over the joint ranges,
+ * with the data's temperature span and direction information, measured as the data's main
+ * absolute kind, or (contact) as touches of the data's targets. */
+static dhc_status structural_analysis(const fit_context *fc, const dhc_model *model,
+                                      const data_traits *traits, int contact)
 {
     dhc_calib_workspace *const ws = fc->ws;
     const size_t p = fc->set->count;
     dhc_sample *const s = &ws->sample;
     memset(s, 0, sizeof *s);
     s->kind = main_kind(traits);
-    /* contact data: every target gets its share of poses (a plane's rows are one each) */
-    const int contact =
-        DHC_WITH_CONTACT &&
-        traits->kind_count[DHC_MEAS_PLANE] + traits->kind_count[DHC_MEAS_POINT] > 0U;
+    /* contact: every target gets its share of poses (a plane's rows are one each) */
     const size_t rows = contact ? 1U : dhc_sample_rows(s);
     const size_t poses =
         (p + rows - 1U) / rows +
@@ -241,7 +239,7 @@ dhc_status dhc_fit_structural_rank(const fit_context *fc, const dhc_model *model
         return st;
     }
     dhc_arm_prepare(&model->arm, &ws->trig);
-    for (size_t k = 0U; k < poses; ++k) {
+    for (size_t k = 0U, drawn = 0U; k < poses && drawn < 8U * poses; ++drawn) {
         for (size_t i = 0U; i < model->arm.n_joints; ++i) {
             const dhc_joint *const j = &model->arm.joint[i];
             s->q_rad[i] = j->min_rad + (j->max_rad - j->min_rad) * next_uniform(&state);
@@ -250,7 +248,15 @@ dhc_status dhc_fit_structural_rank(const fit_context *fc, const dhc_model *model
         s->temp_c =
             traits->temp_min_c + (traits->temp_max_c - traits->temp_min_c) * next_uniform(&state);
 #if DHC_WITH_CONTACT
-        structural_slot(model, traits, k, s);
+        if (contact) {
+            structural_slot(model, traits, k, s);
+        }
+        /* a touch: the pose moved onto its target (off it, a plane's offset would not take a
+         * common scale of the lengths); a pose that cannot be is drawn again */
+        if (s->kind >= (uint8_t)DHC_MEAS_PLANE &&
+            dhc_contact_touch(model, &ws->trig, &ws->eval, s, 1e-6) != DHC_OK) {
+            continue;
+        }
         const size_t pose_rows = dhc_sample_rows(s);
 #else
         const size_t pose_rows = rows;
@@ -271,14 +277,44 @@ dhc_status dhc_fit_structural_rank(const fit_context *fc, const dhc_model *model
         if (st != DHC_OK) {
             return st;
         }
+        ++k;
     }
-    st = dhc_lsq_analyse(&ws->ne, fc->opt->rank_rel_tol, &ws->fac);
+    return dhc_lsq_analyse(&ws->ne, fc->opt->rank_rel_tol, &ws->fac);
+}
+
+/* Rank the model itself allows: the structural analysis with the data's kind. A data rank
+ * below it means the data, not the model, are short. Contact data: what absolute points
+ * would identify and touches cannot is blind (a rigid motion, a common scale), held. */
+dhc_status dhc_fit_structural_rank(const fit_context *fc, const dhc_model *model,
+                                   const data_traits *traits, dhc_calib_report *rep)
+{
+    const size_t p = fc->set->count;
+    dhc_status st = DHC_OK;
+#if DHC_WITH_CONTACT
+    const int contact =
+        traits->kind_count[DHC_MEAS_PLANE] + traits->kind_count[DHC_MEAS_POINT] > 0U;
+    memset(rep->blind, 0, sizeof rep->blind);
+    if (contact) {
+        st = structural_analysis(fc, model, traits, 0);
+        for (size_t k = 0U; k < p && st == DHC_OK; ++k) {
+            rep->blind[k] = fc->ws->fac.identifiable[k];
+        }
+    }
+#else
+    const int contact = 0;
+#endif
+    if (st == DHC_OK) {
+        st = structural_analysis(fc, model, traits, contact);
+    }
     if (st != DHC_OK) {
         return st;
     }
-    rep->structural_rank = ws->fac.rank;
+    rep->structural_rank = fc->ws->fac.rank;
     for (size_t k = 0U; k < p; ++k) {
-        rep->structurally_identifiable[k] = ws->fac.identifiable[k];
+        rep->structurally_identifiable[k] = fc->ws->fac.identifiable[k];
+#if DHC_WITH_CONTACT
+        rep->blind[k] = (uint8_t)(rep->blind[k] && !fc->ws->fac.identifiable[k]);
+#endif
     }
     return DHC_OK;
 }

@@ -73,6 +73,9 @@ dhc_status dhc_fit_scan_errors(const fit_context *fc, const dhc_model *model, co
     for (size_t i = 0U; next_used_error2(fc, model, at, &i, &e2, &rows, &st); ++i) {
         out->used++;
         out->pose += rows == 6U ? 1U : 0U;
+#if DHC_WITH_CONTACT
+        out->one_row += rows == 1U ? 1U : 0U;
+#endif
         out->max_e2 = fmax(out->max_e2, e2);
         if (e2 <= limit2) {
             out->at_most++;
@@ -167,6 +170,9 @@ dhc_status dhc_fit_scan_all(const fit_context *fc, const dhc_model *model, const
     }
     out->used = tot->samples;
     out->pose = tot->pose_samples;
+#if DHC_WITH_CONTACT
+    out->one_row = tot->traits.kind_count[DHC_MEAS_PLANE];
+#endif
     out->at_most = tot->samples;
     out->max_e2 = tot->max_e2;
     return DHC_OK;
@@ -184,7 +190,10 @@ dhc_status dhc_fit_robust_sigma(const fit_context *fc, const dhc_model *model,
     if (st == DHC_OK && all.used > 0U) {
         st = dhc_fit_quantile_error2(fc, model, tot, &all, 0.5, &median);
     }
-    const double chi2_median = 2U * all.pose > all.used ? CHI2_MEDIAN_6DOF : CHI2_MEDIAN_3DOF;
+    /* the median of a sample's squared error over sigma^2: chi-square with its rows */
+    const double chi2_median = 2U * all.pose > all.used                          ? CHI2_MEDIAN_6DOF
+                               : DHC_WITH_CONTACT && 2U * all.one_row > all.used ? CHI2_MEDIAN_1DOF
+                                                                                 : CHI2_MEDIAN_3DOF;
     *sigma = fmax(sqrt(median / chi2_median), fc->opt->outlier_floor_mm);
     *used = all.used;
     return st;

@@ -94,6 +94,103 @@ dhc_status dhc_params_add_targets(dhc_param_set *set, const dhc_model *model)
     return st;
 }
 
+/* The contact prediction (1 or 3 rows) at the sample's angles. */
+static dhc_status touch_error(const dhc_model *model, const dhc_arm_trig *trig, dhc_model_eval *ev,
+                              const dhc_sample *s, double e[3])
+{
+    dhc_prediction pred;
+    dhc_status st = dhc_sample_check(model, s);
+    if (st == DHC_OK) {
+        st = dhc_model_evaluate_prepared(model, trig, s, NULL, 0, ev, &pred);
+    }
+    if (st == DHC_OK) {
+        dhc_vec3_copy(pred.contact_mm, e);
+    }
+    return st;
+}
+
+dhc_status dhc_contact_touch(const dhc_model *model, const dhc_arm_trig *trig, dhc_model_eval *ev,
+                             dhc_sample *s, double tol_mm)
+{
+    if (model == NULL || trig == NULL || ev == NULL || s == NULL || !dhc_sample_is_contact(s) ||
+        !(tol_mm > 0.0)) {
+        return DHC_ERR_ARGUMENT;
+    }
+    const size_t n = model->arm.n_joints;
+    const size_t rows = dhc_sample_rows(s);
+    for (size_t it = 0U; it < 20U; ++it) {
+        double e[3];
+        dhc_status st = touch_error(model, trig, ev, s, e);
+        if (st != DHC_OK) {
+            return st;
+        }
+        if (dhc_vec3_norm(e) <= tol_mm) {
+            return DHC_OK;
+        }
+        /* the least-norm Gauss-Newton step over the joints: dq = J^T (J J^T + mu I)^-1 e,
+         * J by forward differences */
+        double jac[3][DHC_MAX_JOINTS];
+        for (size_t j = 0U; j < n; ++j) {
+            const double q = s->q_rad[j];
+            const double h = 1e-7 * (1.0 + fabs(q));
+            double e2[3];
+            s->q_rad[j] = q + h;
+            st = touch_error(model, trig, ev, s, e2);
+            s->q_rad[j] = q;
+            if (st != DHC_OK) {
+                return st;
+            }
+            for (size_t r = 0U; r < 3U; ++r) {
+                jac[r][j] = (e2[r] - e[r]) / h;
+            }
+        }
+        double a[3][3] = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
+        double trace = 0.0;
+        for (size_t r = 0U; r < rows; ++r) {
+            for (size_t c = 0U; c < rows; ++c) {
+                double sum = 0.0;
+                for (size_t j = 0U; j < n; ++j) {
+                    sum += jac[r][j] * jac[c][j];
+                }
+                a[r][c] = sum;
+            }
+            trace += a[r][r];
+        }
+        if (!(trace > 0.0)) {
+            return DHC_ERR_SINGULAR;
+        }
+        for (size_t r = 0U; r < rows; ++r) {
+            a[r][r] += 1e-9 * trace;
+        }
+        /* (rows x rows) solve by Gaussian elimination without pivoting: a is positive
+         * definite */
+        double y[3] = {e[0], e[1], e[2]};
+        for (size_t k = 0U; k < rows; ++k) {
+            for (size_t r = k + 1U; r < rows; ++r) {
+                const double f = a[r][k] / a[k][k];
+                for (size_t c = k; c < rows; ++c) {
+                    a[r][c] -= f * a[k][c];
+                }
+                y[r] -= f * y[k];
+            }
+        }
+        for (size_t k = rows; k-- > 0U;) {
+            for (size_t c = k + 1U; c < rows; ++c) {
+                y[k] -= a[k][c] * y[c];
+            }
+            y[k] /= a[k][k];
+        }
+        for (size_t j = 0U; j < n; ++j) {
+            double step = 0.0;
+            for (size_t r = 0U; r < rows; ++r) {
+                step += jac[r][j] * y[r];
+            }
+            s->q_rad[j] -= step;
+        }
+    }
+    return DHC_ERR_NOT_CONVERGED;
+}
+
 /* The eigenvector of the symmetric 3x3 matrix a with the smallest eigenvalue, by cyclic
  * Jacobi rotations (a is overwritten), and the middle eigenvalue over the largest. */
 static void smallest_eigenvector(double a[3][3], double out[3], double *ratio)

@@ -133,6 +133,10 @@ typedef struct {
     double std_err[DHC_MAX_PARAMS]; /* standard errors (0 for unidentifiable) */
     uint8_t identifiable[DHC_MAX_PARAMS];
     uint8_t structurally_identifiable[DHC_MAX_PARAMS];
+    /* 1: held at its input value because data of this kind cannot see it at all (contact
+     * data: not structurally identifiable at exact touches, dhc_contact.h; a rigid motion of
+     * the arm or a common scale is such a direction, and noise would otherwise fit it) */
+    uint8_t blind[DHC_MAX_PARAMS];
     /* confounded[j][k] = 1: unidentifiable parameter j moves with parameter k (none in a
      * build without DHC_WITH_REPORT_EXTRAS) */
     uint8_t confounded[DHC_MAX_PARAMS][DHC_MAX_PARAMS];

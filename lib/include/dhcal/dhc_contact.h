@@ -41,6 +41,15 @@ void dhc_plane_tangents(const double normal[3], double u[3], double v[3]);
 void dhc_contact_column(const dhc_contact_targets *t, const dhc_sample *s, const dhc_param_id *id,
                         const double p[3], const double dp[3], double col[3]);
 
+/* Turns the sample's joint angles until its tool point touches its target to tol_mm (the
+ * least-norm Gauss-Newton steps of a redundant inverse kinematics, at most 20): what a pose
+ * of contact data looks like, for the structural rank. Joint ranges are not kept. trig: the
+ * model arm's (dhc_arm_prepare); ev: scratch. DHC_ERR_NOT_CONVERGED, DHC_ERR_SINGULAR (no
+ * joint moves the point), errors of dhc_sample_check and the prediction; DHC_ERR_ARGUMENT for
+ * a sample of another kind. */
+dhc_status dhc_contact_touch(const dhc_model *model, const dhc_arm_trig *trig, dhc_model_eval *ev,
+                             dhc_sample *s, double tol_mm);
+
 /* Appends the parameters of every target of the model: two tilts and the offset of each
  * plane, three coordinates of each point. Errors of dhc_params_add (the set unchanged). */
 dhc_status dhc_params_add_targets(dhc_param_set *set, const dhc_model *model);
