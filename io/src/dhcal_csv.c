@@ -13,13 +13,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "dhcal_csv_columns.h"
 #include "dhcal_io_common.h"
-
-/* Value ranges of the CSV (docs/formats.md). */
-#define CSV_Q_MAX_DEG 720.0
-#define TEMP_MIN_C (-60.0)
-#define TEMP_MAX_C 150.0
-#define TIME_MAX_S 1e9
 
 /* ------------------------------------------------------------------ CSV: lines */
 
@@ -186,108 +181,6 @@ static size_t split_fields(char *line, size_t len, span **spans, size_t *cap)
 
 /* ------------------------------------------------------------------ CSV: columns */
 
-typedef enum {
-    COL_Q,
-    COL_XYZ,
-    COL_WIRE,
-    COL_QUAT,
-    COL_DIR,
-    COL_TEMP,
-    COL_TIME,
-    COL_KIND_COUNT
-} col_kind;
-
-typedef struct {
-    col_kind kind;
-    size_t idx; /* joint (0-based), axis, wire or quaternion component */
-} csv_col;
-
-/* Each column can appear once, so a valid header has at most this many: q and dir per joint,
- * x,y,z, L1..L3, qw..qz, temp_c and t_s. */
-#define CSV_MAX_COLS (2U * DHC_MAX_JOINTS + 3U + 3U + 4U + 2U)
-#define SEEN_WIDTH (DHC_MAX_JOINTS > 4U ? DHC_MAX_JOINTS : 4U)
-
-static const char *const XYZ_NAMES[3] = {"x", "y", "z"};
-static const char *const WIRE_NAMES[3] = {"L1", "L2", "L3"};
-static const char *const QUAT_NAMES[4] = {"qw", "qx", "qy", "qz"};
-
-static const char *col_name(csv_col c, char buf[16])
-{
-    switch (c.kind) {
-    case COL_Q: (void)snprintf(buf, 16U, "q%zu", c.idx + 1U); return buf;
-    case COL_XYZ: return XYZ_NAMES[c.idx];
-    case COL_WIRE: return WIRE_NAMES[c.idx];
-    case COL_QUAT: return QUAT_NAMES[c.idx];
-    case COL_DIR: (void)snprintf(buf, 16U, "dir%zu", c.idx + 1U); return buf;
-    case COL_TIME: return "t_s";
-    case COL_TEMP:
-    case COL_KIND_COUNT:
-    default: return "temp_c";
-    }
-}
-
-/* A 1-based index written "1", "2", ... (no sign, no leading zero). Returns 0 when s is not
- * one; values above 1e6 read as 1e6 (beyond any joint count). */
-static size_t parse_index(const char *s)
-{
-    if (*s < '1' || *s > '9') {
-        return 0U;
-    }
-    size_t v = 0U;
-    for (; *s != '\0'; ++s) {
-        if (*s < '0' || *s > '9') {
-            return 0U;
-        }
-        if (v < 1000000U) {
-            v = v * 10U + (size_t)(*s - '0');
-        }
-    }
-    return v;
-}
-
-/* Column of a header name; 0 when the name is unknown, -1 for a joint index beyond
- * n_joints (with *beyond set to the index). */
-static int classify(const char *name, size_t n_joints, csv_col *col, size_t *beyond)
-{
-    size_t k = 0U;
-    if (dhcal_find_name(name, XYZ_NAMES, 3U, &k)) {
-        *col = (csv_col){COL_XYZ, k};
-        return 1;
-    }
-    if (dhcal_find_name(name, WIRE_NAMES, 3U, &k)) {
-        *col = (csv_col){COL_WIRE, k};
-        return 1;
-    }
-    if (dhcal_find_name(name, QUAT_NAMES, 4U, &k)) {
-        *col = (csv_col){COL_QUAT, k};
-        return 1;
-    }
-    if (strcmp(name, "temp_c") == 0) {
-        *col = (csv_col){COL_TEMP, 0U};
-        return 1;
-    }
-    if (strcmp(name, "t_s") == 0) {
-        *col = (csv_col){COL_TIME, 0U};
-        return 1;
-    }
-    col_kind kind = COL_Q;
-    if (name[0] == 'q') {
-        k = parse_index(name + 1);
-    } else if (strncmp(name, "dir", 3U) == 0) {
-        kind = COL_DIR;
-        k = parse_index(name + 3);
-    }
-    if (k == 0U) {
-        return 0;
-    }
-    if (k > n_joints) {
-        *beyond = k;
-        return -1;
-    }
-    *col = (csv_col){kind, k - 1U};
-    return 1;
-}
-
 typedef struct {
     csv_reader rd;
     size_t n_joints;
@@ -323,9 +216,9 @@ static int check_group(csv_ctx *c, const size_t *seen, size_t n, col_kind kind, 
                         : kind == COL_WIRE ? "L1,L2,L3"
                         : kind == COL_QUAT ? "qw,qx,qy,qz"
                                            : "dir1..dirN";
-    return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
-                           "%s:%zu: column group %s is incomplete: missing '%s'", c->rd.path,
-                           c->header_line, group, col_name((csv_col){kind, first_missing}, nb));
+    return dhcal_error_set(
+        c->rd.err, DHCAL_IO_BAD_INPUT, "%s:%zu: column group %s is incomplete: missing '%s'",
+        c->rd.path, c->header_line, group, dhcal_csv_col_name((csv_col){kind, first_missing}, nb));
 }
 
 static int parse_header(csv_ctx *c, dhcal_dataset *data)
@@ -347,7 +240,7 @@ static int parse_header(csv_ctx *c, dhcal_dataset *data)
         }
         csv_col col = {COL_Q, 0U};
         size_t beyond = 0U;
-        const int cls = classify(f.s, c->n_joints, &col, &beyond);
+        const int cls = dhcal_csv_classify(f.s, c->n_joints, &col, &beyond);
         if (cls == 0 && memchr(f.s, ';', f.n) != NULL) {
             /* "q1;q2;q3;x;y;z": a spreadsheet's export in a locale that writes a decimal comma */
             return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
@@ -525,7 +418,7 @@ static int parse_value(csv_ctx *c, csv_col col, span f, double *out)
     }
     char nb[16];
     char sb[DHCAL_QUOTE_CAP];
-    const char *const name = col_name(col, nb);
+    const char *const name = dhcal_csv_col_name(col, nb);
     if (f.n == 0U) {
         return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT, "%s:%zu: column '%s': empty field",
                                c->rd.path, c->rd.line_no, name);
@@ -548,49 +441,13 @@ static int parse_value(csv_ctx *c, csv_col col, span f, double *out)
     return DHCAL_IO_OK;
 }
 
-/* The CSV's range rule for one value of a column kind (docs/formats.md, 4.2): NULL when v
- * keeps it, else the allowed range in words. One rule for the file reader and for rows handed
- * in as arrays (dhcal_dataset_from_arrays), so both accept exactly the same values. */
-static const char *value_rule(col_kind kind, double v)
-{
-    switch (kind) {
-    case COL_Q: return v < -CSV_Q_MAX_DEG || v > CSV_Q_MAX_DEG ? "[-720, 720] deg" : NULL;
-    case COL_XYZ: return v < -LEN_MAX_MM || v > LEN_MAX_MM ? "[-1e5, 1e5] mm" : NULL;
-    case COL_WIRE: return !(v > 0.0) || v > LEN_MAX_MM ? "(0, 1e5] mm" : NULL;
-    case COL_QUAT: return NULL;
-    case COL_DIR:
-        /* Exactly -1 or +1; written as two comparisons because of -Wfloat-equal. */
-        return (v >= 1.0 && v <= 1.0) || (v >= -1.0 && v <= -1.0) ? NULL : "-1 or +1";
-    case COL_TIME: return v < -TIME_MAX_S || v > TIME_MAX_S ? "[-1e9, 1e9] s" : NULL;
-    case COL_TEMP:
-    case COL_KIND_COUNT:
-    default: return v < TEMP_MIN_C || v > TEMP_MAX_C ? "[-60, 150] degC" : NULL;
-    }
-}
-
 static int out_of_range(csv_ctx *c, csv_col col, span f, const char *range)
 {
     char nb[16];
     char sb[DHCAL_QUOTE_CAP];
     return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT, "%s:%zu: column '%s': %s is outside %s",
-                           c->rd.path, c->rd.line_no, col_name(col, nb), dhcal_quote(f.s, f.n, sb),
-                           range);
-}
-
-/* A value that kept its column's rule, into the row (angles to radians). */
-static void store_value(dhcal_row *row, csv_col col, double v)
-{
-    switch (col.kind) {
-    case COL_Q: row->q_rad[col.idx] = v * DHC_DEG; break;
-    case COL_XYZ: row->xyz_mm[col.idx] = v; break;
-    case COL_WIRE: row->wires_mm[col.idx] = v; break;
-    case COL_QUAT: row->quat[col.idx] = v; break;
-    case COL_DIR: row->dir[col.idx] = v > 0.0 ? 1 : -1; break;
-    case COL_TIME: row->t_s = v; break;
-    case COL_TEMP:
-    case COL_KIND_COUNT:
-    default: row->temp_c = v; break;
-    }
+                           c->rd.path, c->rd.line_no, dhcal_csv_col_name(col, nb),
+                           dhcal_quote(f.s, f.n, sb), range);
 }
 
 static int parse_row(csv_ctx *c, dhcal_row *row)
@@ -615,18 +472,18 @@ static int parse_row(csv_ctx *c, dhcal_row *row)
         if (rc != DHCAL_IO_OK) {
             return rc;
         }
-        const char *const rule = value_rule(col.kind, v);
+        const char *const rule = dhcal_csv_value_rule(col.kind, v);
         if (rule != NULL && col.kind == COL_DIR) {
             char nb[16];
             char sb[DHCAL_QUOTE_CAP];
-            return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
-                                   "%s:%zu: column '%s': %s is not -1 or +1", c->rd.path,
-                                   c->rd.line_no, col_name(col, nb), dhcal_quote(f.s, f.n, sb));
+            return dhcal_error_set(
+                c->rd.err, DHCAL_IO_BAD_INPUT, "%s:%zu: column '%s': %s is not -1 or +1",
+                c->rd.path, c->rd.line_no, dhcal_csv_col_name(col, nb), dhcal_quote(f.s, f.n, sb));
         }
         if (rule != NULL) {
             return out_of_range(c, col, f, rule);
         }
-        store_value(row, col, v);
+        dhcal_csv_store_value(row, col, v);
     }
     if (c->has_quat) {
         /* Each component is finite, but their squares may overflow: the norm then is inf
@@ -782,125 +639,4 @@ void dhcal_dataset_free(dhcal_dataset *data)
     }
     free(data->rows);
     memset(data, 0, sizeof *data);
-}
-
-/* ------------------------------------------------------------------ rows as arrays */
-
-int dhcal_dataset_from_arrays(const dhcal_arrays *a, dhcal_dataset *data, dhcal_error *err)
-{
-    memset(data, 0, sizeof *data);
-    const char *const name = a->name != NULL ? a->name : "data";
-    if (a->n_joints == 0U || a->n_joints > DHC_MAX_JOINTS) {
-        return dhcal_error_set(err, DHCAL_IO_FAILED, "%s: joint count %zu outside 1..%u", name,
-                               a->n_joints, DHC_MAX_JOINTS);
-    }
-    if (a->n_rows == 0U) {
-        return dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s: no rows", name);
-    }
-    if (a->q_deg == NULL || (a->xyz_mm == NULL && a->wires_mm == NULL)) {
-        return dhcal_error_set(err, DHCAL_IO_FAILED,
-                               "%s: joint angles and tool points or wire lengths required", name);
-    }
-    if (a->n_rows > SIZE_MAX / sizeof *data->rows) {
-        return dhcal_error_set(err, DHCAL_IO_FAILED, "%s: out of memory for %zu rows", name,
-                               a->n_rows);
-    }
-    data->rows = calloc(a->n_rows, sizeof *data->rows);
-    if (data->rows == NULL) {
-        return dhcal_error_set(err, DHCAL_IO_FAILED, "%s: out of memory for %zu rows", name,
-                               a->n_rows);
-    }
-    data->n_rows = a->n_rows;
-    data->n_joints = a->n_joints;
-    data->has_q = 1;
-    data->has_xyz = a->xyz_mm != NULL;
-    data->has_wires = a->wires_mm != NULL;
-    data->has_dir = a->dir != NULL;
-    data->has_temp = a->temp_c != NULL;
-    data->has_time = a->t_s != NULL;
-    const size_t nj = a->n_joints;
-    for (size_t i = 0U; i < a->n_rows; ++i) {
-        dhcal_row *const row = &data->rows[i];
-        row->line = i + 1U;
-        /* each value through the CSV's own rule and store, column by column as a file
-         * would give them */
-        struct {
-            col_kind kind;
-            size_t count;
-            const double *v;
-        } const groups[6] = {{COL_Q, nj, a->q_deg + i * nj},
-                             {COL_XYZ, 3U, a->xyz_mm != NULL ? a->xyz_mm + i * 3U : NULL},
-                             {COL_WIRE, 3U, a->wires_mm != NULL ? a->wires_mm + i * 3U : NULL},
-                             {COL_DIR, nj, a->dir != NULL ? a->dir + i * nj : NULL},
-                             {COL_TEMP, 1U, a->temp_c != NULL ? a->temp_c + i : NULL},
-                             {COL_TIME, 1U, a->t_s != NULL ? a->t_s + i : NULL}};
-        for (size_t g = 0U; g < 6U; ++g) {
-            /* k < DHC_MAX_JOINTS always holds (count <= n_joints); said for the compiler,
-             * which bounds the column name's digits by it */
-            for (size_t k = 0U; groups[g].v != NULL && k < groups[g].count && k < DHC_MAX_JOINTS;
-                 ++k) {
-                const csv_col col = {groups[g].kind, k};
-                const double v = groups[g].v[k];
-                const char *const rule = isfinite(v) ? value_rule(col.kind, v) : "finite numbers";
-                if (rule != NULL) {
-                    char nb[16];
-                    const int rc = dhcal_error_set(
-                        err, DHCAL_IO_BAD_INPUT, "%s: row %zu, column '%s': %.17g is not %s%s",
-                        name, i + 1U, col_name(col, nb), v,
-                        col.kind == COL_DIR || !isfinite(v) ? "" : "inside ", rule);
-                    dhcal_dataset_free(data);
-                    return rc;
-                }
-                store_value(row, col, v);
-            }
-        }
-    }
-    return DHCAL_IO_OK;
-}
-
-/* ------------------------------------------------------------------ writing */
-
-void dhcal_csv_write_header(dhcal_text *t, const dhcal_csv_columns *cols)
-{
-    for (size_t j = 0U; j < cols->n_joints; ++j) {
-        dhcal_text_printf(t, "%sq%zu", j > 0U ? "," : "", j + 1U);
-    }
-    for (size_t j = 0U; cols->has_dir && j < cols->n_joints; ++j) {
-        dhcal_text_printf(t, ",dir%zu", j + 1U);
-    }
-    dhcal_text_str(t, cols->has_xyz ? ",x,y,z" : "");
-    dhcal_text_str(t, cols->has_wires ? ",L1,L2,L3" : "");
-    dhcal_text_str(t, cols->has_quat ? ",qw,qx,qy,qz" : "");
-    dhcal_text_str(t, cols->has_temp ? ",temp_c" : "");
-    dhcal_text_str(t, cols->has_time ? ",t_s" : "");
-    dhcal_text_str(t, "\n");
-}
-
-void dhcal_csv_write_row(dhcal_text *t, const dhcal_csv_columns *cols, const dhcal_row *row)
-{
-    for (size_t j = 0U; j < cols->n_joints; ++j) {
-        /* 180 / pi, not 1 / DHC_DEG: the same double the writers produced before io had one */
-        dhcal_text_printf(t, "%s%.9f", j > 0U ? "," : "", row->q_rad[j] * 180.0 / DHC_PI);
-    }
-    for (size_t j = 0U; cols->has_dir && j < cols->n_joints; ++j) {
-        dhcal_text_printf(t, ",%d", row->dir[j]);
-    }
-    if (cols->has_xyz) {
-        dhcal_text_printf(t, ",%.6f,%.6f,%.6f", row->xyz_mm[0], row->xyz_mm[1], row->xyz_mm[2]);
-    }
-    if (cols->has_wires) {
-        dhcal_text_printf(t, ",%.6f,%.6f,%.6f", row->wires_mm[0], row->wires_mm[1],
-                          row->wires_mm[2]);
-    }
-    if (cols->has_quat) {
-        dhcal_text_printf(t, ",%.9f,%.9f,%.9f,%.9f", row->quat[0], row->quat[1], row->quat[2],
-                          row->quat[3]);
-    }
-    if (cols->has_temp) {
-        dhcal_text_printf(t, ",%.3f", row->temp_c);
-    }
-    if (cols->has_time) {
-        dhcal_text_printf(t, ",%.6f", row->t_s);
-    }
-    dhcal_text_str(t, "\n");
 }
