@@ -1,6 +1,7 @@
 /* dhcal_analysis.c - fit and diagnose over loaded samples. */
 #include "dhcal_desk/dhcal_analysis.h"
 
+#include "dhcal/dhc_contact.h"
 #include "dhcal/dhc_jacobian.h"
 #include "dhcal_io/dhcal_effect_list.h"
 
@@ -17,7 +18,7 @@
 typedef struct {
     dhc_normal_eq ne;
     dhc_lsq_factor fac;
-    double batch_jac[BATCH_ROWS * DHC_MAX_PARAMS];
+    double batch_jac[(size_t)BATCH_ROWS * DHC_MAX_PARAMS];
     double batch_r[BATCH_ROWS];
 } lsq_scratch;
 
@@ -25,7 +26,8 @@ typedef struct {
 static int add_batch(lsq_scratch *w, size_t rows, size_t p)
 {
     dhc_mat jac;
-    return dhc_mat_init(&jac, rows, p, w->batch_jac, BATCH_ROWS * DHC_MAX_PARAMS) == DHC_OK &&
+    return dhc_mat_init(&jac, rows, p, w->batch_jac, (size_t)BATCH_ROWS * DHC_MAX_PARAMS) ==
+                       DHC_OK &&
                    dhc_normal_eq_add(&w->ne, &jac, w->batch_r, NULL, rows) == DHC_OK
                ? DHCAL_IO_OK
                : DHCAL_IO_FAILED;
@@ -317,12 +319,58 @@ int dhcal_run_fit(const dhc_model *nominal, const char *effects, dhcal_geometry 
         snprintf(err->msg, sizeof err->msg, "too many joints for the parameter limit");
         return DHCAL_IO_BAD_INPUT;
     }
-    const int rc = dhcal_parse_effects(effects, nominal, &set, err);
+    int rc = dhcal_parse_effects(effects, nominal, &set, err);
     if (rc != DHCAL_IO_OK) {
         return rc;
     }
     out->geometry = geometry;
-    return dhcal_fit_from(nominal, &set, noise, s, held, out, err);
+    if (!dhcal_samples_have_contact(s)) {
+        return dhcal_fit_from(nominal, &set, noise, s, held, out, err);
+    }
+    dhc_model *start = malloc(sizeof *start);
+    rc = start != NULL ? dhcal_contact_start(nominal, s, start, &set, err) : DHCAL_IO_FAILED;
+    if (rc == DHCAL_IO_OK) {
+        rc = dhcal_fit_from(start, &set, noise, s, held, out, err);
+    }
+    free(start);
+    return rc;
+}
+
+int dhcal_samples_have_contact(const dhcal_samples *s)
+{
+    for (size_t i = 0U; i < s->n; ++i) {
+        if (s->samples[i].kind >= (uint8_t)DHC_MEAS_PLANE) {
+            return 1;
+        }
+    }
+    return 0;
+}
+
+int dhcal_contact_start(const dhc_model *nominal, const dhcal_samples *s, dhc_model *start,
+                        dhc_param_set *set, dhcal_error *err)
+{
+    *start = *nominal;
+    const dhc_status st = dhc_contact_targets_init(start, dhcal_samples_read, s, s->n, s->flags);
+    if (st == DHC_ERR_UNDERDETERMINED) {
+        snprintf(err->msg, sizeof err->msg,
+                 "%s: the touches do not define their targets: plane and point ids run 1, 2, "
+                 "... without gaps, each plane needs 3 touches not on one line, each point one",
+                 s->path != NULL ? s->path : "data");
+        return DHCAL_IO_BAD_INPUT;
+    }
+    if (st != DHC_OK) {
+        snprintf(err->msg, sizeof err->msg, "%s: the touches' targets: %s",
+                 s->path != NULL ? s->path : "data", dhc_status_str(st));
+        return DHCAL_IO_BAD_INPUT;
+    }
+    if (dhc_params_add_targets(set, start) != DHC_OK) {
+        snprintf(err->msg, sizeof err->msg,
+                 "too many parameters: the model's and the targets' (3 per plane and point) "
+                 "exceed %u",
+                 (unsigned)DHC_MAX_PARAMS);
+        return DHCAL_IO_BAD_INPUT;
+    }
+    return DHCAL_IO_OK;
 }
 
 int dhcal_session_covariates(const dhcal_fit *fit, const dhcal_samples *s, dhcal_covariates *cov,
@@ -828,7 +876,7 @@ static int extrapolate_in(const dhcal_fit *fit, const dhcal_samples *s, const dh
         const dhc_sample *smp = &held->samples[i];
         dhc_mat jac;
         if (dhc_mat_init(&jac, dhc_sample_rows(smp), id_set.count, w->batch_jac,
-                         BATCH_ROWS * DHC_MAX_PARAMS) != DHC_OK ||
+                         (size_t)BATCH_ROWS * DHC_MAX_PARAMS) != DHC_OK ||
             dhc_model_jacobian(&steady, &id_set, smp, opt.orientation_weight_mm_per_rad, &jac,
                                NULL) != DHC_OK) {
             return DHCAL_IO_FAILED;

@@ -188,8 +188,9 @@ typedef struct {
     csv_col cols[CSV_MAX_COLS];
     size_t header_line;
     int has_quat;
-    int plan;    /* a pose plan: q and dir columns only, each dir column on its own */
-    int targets; /* compensation targets: x,y,z; q1..qN, qw..qz, dir1..dirN optional */
+    int measures; /* x,y,z or L1..L3 columns: a row that is no touch measures */
+    int plan;     /* a pose plan: q and dir columns only, each dir column on its own */
+    int targets;  /* compensation targets: x,y,z; q1..qN, qw..qz, dir1..dirN optional */
     span *spans;
     size_t spans_cap;
 } csv_ctx;
@@ -254,8 +255,9 @@ static int parse_header(csv_ctx *c, dhcal_dataset *data)
                                    "%s:%zu: column '%s' is beyond the model's %zu joints", path,
                                    line, dhcal_quote(f.s, f.n, sb), c->n_joints);
         }
-        if (c->targets &&
-            (cls == 0 || col.kind == COL_WIRE || col.kind == COL_TEMP || col.kind == COL_TIME)) {
+        const int contact_col = cls > 0 && (col.kind == COL_PLANE || col.kind == COL_POINT);
+        if (c->targets && (cls == 0 || col.kind == COL_WIRE || col.kind == COL_TEMP ||
+                           col.kind == COL_TIME || contact_col)) {
             return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
                                    "%s:%zu: unknown column '%s' (targets have x,y,z and optionally "
                                    "qw,qx,qy,qz, q1..q%zu, dir1..dir%zu)",
@@ -264,7 +266,7 @@ static int parse_header(csv_ctx *c, dhcal_dataset *data)
         if (cls == 0 && !c->plan) {
             return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
                                    "%s:%zu: unknown column '%s' (known: q1..q%zu, x,y,z, L1,L2,L3, "
-                                   "qw,qx,qy,qz, dir1..dir%zu, temp_c, t_s)",
+                                   "qw,qx,qy,qz, dir1..dir%zu, temp_c, t_s, plane, point)",
                                    path, line, dhcal_quote(f.s, f.n, sb), c->n_joints, c->n_joints);
         }
         if (cls == 0 || (c->plan && col.kind != COL_Q && col.kind != COL_DIR)) {
@@ -320,13 +322,18 @@ static int parse_header(csv_ctx *c, dhcal_dataset *data)
                                "%s:%zu: missing columns x,y,z (the target tool point, mm)", path,
                                line);
     }
-    if (!data->has_xyz && !data->has_wires) {
+    data->has_plane = seen[COL_PLANE][0] != 0U;
+    data->has_point = seen[COL_POINT][0] != 0U;
+    if (!data->has_xyz && !data->has_wires && !data->has_plane && !data->has_point) {
         return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
-                               "%s:%zu: no position columns: need x,y,z or L1,L2,L3", path, line);
+                               "%s:%zu: no position columns: need x,y,z or L1,L2,L3 (or the "
+                               "contact columns plane, point)",
+                               path, line);
     }
     data->has_temp = seen[COL_TEMP][0] != 0U;
     data->has_time = seen[COL_TIME][0] != 0U;
     c->has_quat = data->has_quat;
+    c->measures = data->has_xyz || data->has_wires;
     return DHCAL_IO_OK;
 }
 
@@ -450,6 +457,52 @@ static int out_of_range(csv_ctx *c, csv_col col, span f, const char *range)
                            dhcal_quote(f.s, f.n, sb), range);
 }
 
+/* The row's contact columns: an id in plane or point (not both) makes it a touch. */
+static int contact_of_row(csv_ctx *c, dhcal_row *row)
+{
+    for (size_t k = 0U; k < c->n_cols; ++k) {
+        const csv_col col = c->cols[k];
+        const span f = c->spans[k];
+        if ((col.kind != COL_PLANE && col.kind != COL_POINT) || f.n == 0U) {
+            continue;
+        }
+        double v = 0.0;
+        int rc = parse_value(c, col, f, &v);
+        const char *const rule = rc == DHCAL_IO_OK ? dhcal_csv_value_rule(col.kind, v) : NULL;
+        if (rule != NULL) {
+            char nb[16];
+            char sb[DHCAL_QUOTE_CAP];
+            return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
+                                   "%s:%zu: column '%s': %s is not one of %s", c->rd.path,
+                                   c->rd.line_no, dhcal_csv_col_name(col, nb),
+                                   dhcal_quote(f.s, f.n, sb), rule);
+        }
+        if (rc != DHCAL_IO_OK) {
+            return rc;
+        }
+        dhcal_csv_store_value(row, col, v);
+    }
+    if (row->plane != 0U && row->point != 0U) {
+        return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
+                               "%s:%zu: the row touches plane %u and point %u: a touch is of "
+                               "one target (leave the other column empty)",
+                               c->rd.path, c->rd.line_no, row->plane, row->point);
+    }
+    return DHCAL_IO_OK;
+}
+
+/* A value in a measurement column of a touch row. */
+static int measured_touch(csv_ctx *c, const dhcal_row *row, csv_col col)
+{
+    char nb[16];
+    return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
+                           "%s:%zu: column '%s': a touch of %s %u measures no point: leave "
+                           "x,y,z, L1,L2,L3 and qw,qx,qy,qz empty in its row",
+                           c->rd.path, c->rd.line_no, dhcal_csv_col_name(col, nb),
+                           row->plane != 0U ? "plane" : "point",
+                           row->plane != 0U ? row->plane : row->point);
+}
+
 static int parse_row(csv_ctx *c, dhcal_row *row)
 {
     const size_t n = split_fields(c->rd.buf, c->rd.len, &c->spans, &c->spans_cap);
@@ -464,11 +517,20 @@ static int parse_row(csv_ctx *c, dhcal_row *row)
     }
     memset(row, 0, sizeof *row);
     row->line = c->rd.line_no;
-    for (size_t k = 0U; k < n; ++k) {
+    int rc = contact_of_row(c, row);
+    const int touch = row->plane != 0U || row->point != 0U;
+    for (size_t k = 0U; k < n && rc == DHCAL_IO_OK; ++k) {
         const csv_col col = c->cols[k];
         const span f = c->spans[k];
+        if (col.kind == COL_PLANE || col.kind == COL_POINT) {
+            continue; /* read by contact_of_row */
+        }
+        if (touch && (col.kind == COL_XYZ || col.kind == COL_WIRE || col.kind == COL_QUAT)) {
+            rc = f.n == 0U ? DHCAL_IO_OK : measured_touch(c, row, col);
+            continue;
+        }
         double v = 0.0;
-        const int rc = parse_value(c, col, f, &v);
+        rc = parse_value(c, col, f, &v);
         if (rc != DHCAL_IO_OK) {
             return rc;
         }
@@ -485,7 +547,16 @@ static int parse_row(csv_ctx *c, dhcal_row *row)
         }
         dhcal_csv_store_value(row, col, v);
     }
-    if (c->has_quat) {
+    if (rc != DHCAL_IO_OK) {
+        return rc;
+    }
+    if (!touch && !c->measures && !c->plan && !c->targets) {
+        return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
+                               "%s:%zu: neither a touch nor a measurement: the row has no id in "
+                               "'plane' or 'point', and the file no x,y,z or L1,L2,L3",
+                               c->rd.path, c->rd.line_no);
+    }
+    if (c->has_quat && !touch) {
         /* Each component is finite, but their squares may overflow: the norm then is inf
          * and fails the test like any other wrong norm. */
         const double norm = sqrt(row->quat[0] * row->quat[0] + row->quat[1] * row->quat[1] +

@@ -101,6 +101,8 @@ void dhcal_csv_write_header(dhcal_text *t, const dhcal_csv_columns *cols)
     dhcal_text_str(t, cols->has_quat ? ",qw,qx,qy,qz" : "");
     dhcal_text_str(t, cols->has_temp ? ",temp_c" : "");
     dhcal_text_str(t, cols->has_time ? ",t_s" : "");
+    dhcal_text_str(t, cols->has_plane ? ",plane" : "");
+    dhcal_text_str(t, cols->has_point ? ",point" : "");
     dhcal_text_str(t, "\n");
 }
 
@@ -113,14 +115,22 @@ void dhcal_csv_write_row(dhcal_text *t, const dhcal_csv_columns *cols, const dhc
     for (size_t j = 0U; cols->has_dir && j < cols->n_joints; ++j) {
         dhcal_text_printf(t, ",%d", row->dir[j]);
     }
-    if (cols->has_xyz) {
+    /* a touch measures nothing: its measurement cells stay empty */
+    const int touch = row->plane != 0U || row->point != 0U;
+    if (cols->has_xyz && touch) {
+        dhcal_text_str(t, ",,,");
+    } else if (cols->has_xyz) {
         dhcal_text_printf(t, ",%.6f,%.6f,%.6f", row->xyz_mm[0], row->xyz_mm[1], row->xyz_mm[2]);
     }
-    if (cols->has_wires) {
+    if (cols->has_wires && touch) {
+        dhcal_text_str(t, ",,,");
+    } else if (cols->has_wires) {
         dhcal_text_printf(t, ",%.6f,%.6f,%.6f", row->wires_mm[0], row->wires_mm[1],
                           row->wires_mm[2]);
     }
-    if (cols->has_quat) {
+    if (cols->has_quat && touch) {
+        dhcal_text_str(t, ",,,,");
+    } else if (cols->has_quat) {
         dhcal_text_printf(t, ",%.9f,%.9f,%.9f,%.9f", row->quat[0], row->quat[1], row->quat[2],
                           row->quat[3]);
     }
@@ -129,6 +139,18 @@ void dhcal_csv_write_row(dhcal_text *t, const dhcal_csv_columns *cols, const dhc
     }
     if (cols->has_time) {
         dhcal_text_printf(t, ",%.6f", row->t_s);
+    }
+    if (cols->has_plane) {
+        dhcal_text_str(t, ",");
+        if (row->plane != 0U) {
+            dhcal_text_printf(t, "%u", row->plane);
+        }
+    }
+    if (cols->has_point) {
+        dhcal_text_str(t, ",");
+        if (row->point != 0U) {
+            dhcal_text_printf(t, "%u", row->point);
+        }
     }
     dhcal_text_str(t, "\n");
 }

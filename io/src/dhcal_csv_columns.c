@@ -1,6 +1,7 @@
 /* dhcal_csv_columns.c - the measurement CSV's columns (dhcal_csv_columns.h). */
 #include "dhcal_csv_columns.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -19,6 +20,8 @@ const char *dhcal_csv_col_name(csv_col c, char buf[16])
     case COL_QUAT: return QUAT_NAMES[c.idx];
     case COL_DIR: (void)snprintf(buf, 16U, "dir%zu", c.idx + 1U); return buf;
     case COL_TIME: return "t_s";
+    case COL_PLANE: return "plane";
+    case COL_POINT: return "point";
     case COL_TEMP:
     case COL_KIND_COUNT:
     default: return "temp_c";
@@ -69,6 +72,10 @@ int dhcal_csv_classify(const char *name, size_t n_joints, csv_col *col, size_t *
         *col = (csv_col){COL_TIME, 0U};
         return 1;
     }
+    if (strcmp(name, "plane") == 0 || strcmp(name, "point") == 0) {
+        *col = (csv_col){name[1] == 'l' ? COL_PLANE : COL_POINT, 0U};
+        return 1;
+    }
     col_kind kind = COL_Q;
     if (name[0] == 'q') {
         k = parse_index(name + 1);
@@ -101,6 +108,14 @@ const char *dhcal_csv_value_rule(col_kind kind, double v)
         /* Exactly -1 or +1; written as two comparisons because of -Wfloat-equal. */
         return (v >= 1.0 && v <= 1.0) || (v >= -1.0 && v <= -1.0) ? NULL : "-1 or +1";
     case COL_TIME: return v < -TIME_MAX_S || v > TIME_MAX_S ? "[-1e9, 1e9] s" : NULL;
+    case COL_PLANE:
+        return v >= 1.0 && v <= (double)DHC_MAX_PLANES && floor(v) <= v && floor(v) >= v
+                   ? NULL
+                   : (DHC_MAX_PLANES == 8U ? "the ids 1..8" : "the ids 1..DHC_MAX_PLANES");
+    case COL_POINT:
+        return v >= 1.0 && v <= (double)DHC_MAX_POINTS && floor(v) <= v && floor(v) >= v
+                   ? NULL
+                   : (DHC_MAX_POINTS == 8U ? "the ids 1..8" : "the ids 1..DHC_MAX_POINTS");
     case COL_TEMP:
     case COL_KIND_COUNT:
     default: return v < TEMP_MIN_C || v > TEMP_MAX_C ? "[-60, 150] degC" : NULL;
@@ -117,6 +132,8 @@ void dhcal_csv_store_value(dhcal_row *row, csv_col col, double v)
     case COL_QUAT: row->quat[col.idx] = v; break;
     case COL_DIR: row->dir[col.idx] = v > 0.0 ? 1 : -1; break;
     case COL_TIME: row->t_s = v; break;
+    case COL_PLANE: row->plane = (unsigned)v; break;
+    case COL_POINT: row->point = (unsigned)v; break;
     case COL_TEMP:
     case COL_KIND_COUNT:
     default: row->temp_c = v; break;

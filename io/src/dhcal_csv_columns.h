@@ -23,6 +23,8 @@ typedef enum {
     COL_DIR,
     COL_TEMP,
     COL_TIME,
+    COL_PLANE, /* the plane a touch row touches (1-based id; empty: not a plane touch) */
+    COL_POINT, /* the fixed point it sits at */
     COL_KIND_COUNT
 } col_kind;
 
@@ -32,8 +34,8 @@ typedef struct {
 } csv_col;
 
 /* Each column can appear once, so a valid header has at most this many: q and dir per joint,
- * x,y,z, L1..L3, qw..qz, temp_c and t_s. */
-#define CSV_MAX_COLS (2U * DHC_MAX_JOINTS + 3U + 3U + 4U + 2U)
+ * x,y,z, L1..L3, qw..qz, temp_c, t_s, plane and point. */
+#define CSV_MAX_COLS (2U * DHC_MAX_JOINTS + 3U + 3U + 4U + 2U + 2U)
 #define SEEN_WIDTH (DHC_MAX_JOINTS > 4U ? DHC_MAX_JOINTS : 4U)
 
 /* The column's name ("q2", "x", "plane"); buf holds the numbered ones. */

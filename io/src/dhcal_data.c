@@ -22,7 +22,7 @@ int dhcal_samples_build(const dhc_model *model, const dhcal_dataset *data, const
     }
     out->n = data->n_rows;
     out->wires = data->has_wires && model->measurer.present;
-    if (!out->wires && !data->has_xyz) {
+    if (!out->wires && !data->has_xyz && data->has_wires) {
         const size_t line = data->n_rows > 0U ? data->rows[0].line : 1U;
         dhcal_samples_free(out);
         snprintf(err->msg, sizeof err->msg,
@@ -39,7 +39,11 @@ int dhcal_samples_build(const dhc_model *model, const dhcal_dataset *data, const
         s->temp_c = data->has_temp ? row->temp_c : model->thermal_ref_c;
         /* drift's clock: the t_s column, else the 0-based row number (docs/formats.md, 3.2) */
         s->t_s = data->has_time ? row->t_s : (double)i;
-        if (out->wires) {
+        if (row->plane != 0U || row->point != 0U) {
+            /* a touch: the target's pose is the fit's (dhc_contact.h) */
+            s->kind = (uint8_t)(row->plane != 0U ? DHC_MEAS_PLANE : DHC_MEAS_POINT);
+            s->target = (uint8_t)((row->plane != 0U ? row->plane : row->point) - 1U);
+        } else if (out->wires) {
             memcpy(s->wire_mm, row->wires_mm, sizeof s->wire_mm);
             s->kind = (uint8_t)DHC_MEAS_WIRES;
         } else {

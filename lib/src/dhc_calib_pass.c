@@ -289,23 +289,21 @@ dhc_status dhc_fit_structural_rank(const fit_context *fc, const dhc_model *model
                                    const data_traits *traits, dhc_calib_report *rep)
 {
     const size_t p = fc->set->count;
-    dhc_status st = DHC_OK;
+    int contact = 0;
 #if DHC_WITH_CONTACT
-    const int contact =
-        traits->kind_count[DHC_MEAS_PLANE] + traits->kind_count[DHC_MEAS_POINT] > 0U;
+    contact = traits->kind_count[DHC_MEAS_PLANE] + traits->kind_count[DHC_MEAS_POINT] > 0U;
     memset(rep->blind, 0, sizeof rep->blind);
     if (contact) {
-        st = structural_analysis(fc, model, traits, 0);
-        for (size_t k = 0U; k < p && st == DHC_OK; ++k) {
+        const dhc_status absolute = structural_analysis(fc, model, traits, 0);
+        if (absolute != DHC_OK) {
+            return absolute;
+        }
+        for (size_t k = 0U; k < p; ++k) {
             rep->blind[k] = fc->ws->fac.identifiable[k];
         }
     }
-#else
-    const int contact = 0;
 #endif
-    if (st == DHC_OK) {
-        st = structural_analysis(fc, model, traits, contact);
-    }
+    const dhc_status st = structural_analysis(fc, model, traits, contact);
     if (st != DHC_OK) {
         return st;
     }

@@ -56,6 +56,16 @@ dhc_model dhcal_model_without_drift(const dhc_model *model);
 int dhcal_parse_effects(const char *list, const dhc_model *model, dhc_param_set *set,
                         dhcal_error *err);
 
+/* 1 when some sample is a touch (a plane or a fixed point: dhc_contact.h). */
+int dhcal_samples_have_contact(const dhcal_samples *s);
+
+/* The start of a contact fit: the nominal model with its targets' starting poses from the
+ * used samples (dhc_contact_targets_init), and their parameters appended to set.
+ * DHCAL_IO_BAD_INPUT naming the data for targets the touches do not define or too many
+ * parameters. */
+int dhcal_contact_start(const dhc_model *nominal, const dhcal_samples *s, dhc_model *start,
+                        dhc_param_set *set, dhcal_error *err);
+
 /* The library's fit options for the model: the noise model (NULL or off: unweighted), and
  * link parameters held at their input values when the data determine them only to half
  * their physical range (DHCAL_PLAUSIBLE_*) or worse. */

@@ -28,20 +28,25 @@ typedef struct {
     int dir[DHC_MAX_JOINTS]; /* has_dir: -1 or +1 */
     double temp_c;           /* has_temp */
     double t_s;              /* has_time: time of the measurement, s (drift) */
+    unsigned plane;          /* a touch of plane `plane` (1-based id), nothing measured; 0: not */
+    unsigned point;          /* a touch of fixed point `point` (1-based id); 0: not */
 } dhcal_row;
 
 typedef struct {
     size_t n_rows;
     size_t n_joints;
     int has_xyz, has_wires, has_quat, has_dir, has_temp, has_time;
-    int has_q;       /* always 1 but for compensation targets (dhcal_csv_load_targets) */
-    dhcal_row *rows; /* heap, n_rows entries */
+    int has_plane, has_point; /* the columns are there (a row may still leave them empty) */
+    int has_q;                /* always 1 but for compensation targets (dhcal_csv_load_targets) */
+    dhcal_row *rows;          /* heap, n_rows entries */
 } dhcal_dataset;
 
 /* Loads a measurement CSV for an arm with n_joints joints: '#' comment lines, then a
  * header naming columns in any order: q1..qN (deg, required), and x,y,z and/or L1,L2,L3
- * (at least one complete group), optional qw,qx,qy,qz, dir1..dirN, temp_c, t_s (seconds,
- * any origin, within +-1e9). Rejects: an
+ * (at least one complete group) and/or the contact columns plane, point, optional
+ * qw,qx,qy,qz, dir1..dirN, temp_c, t_s (seconds, any origin, within +-1e9). A row with an id
+ * in plane (or point) is a touch: it leaves x,y,z, L1..L3 and qw..qz empty; every other row
+ * measures them (docs/formats.md 3.4). Rejects: an
  * empty file, a header without rows, unknown / repeated / partial-group / missing columns,
  * a q column beyond n_joints, short or long rows, fields that are not numbers (strtod must
  * consume the whole trimmed field), NaN/Inf, joint angles beyond [-720, 720] deg, lengths
@@ -97,10 +102,11 @@ typedef struct {
 int dhcal_dataset_from_arrays(const dhcal_arrays *a, dhcal_dataset *data, dhcal_error *err);
 
 /* The columns a writer puts down (the has_ flags of dhcal_dataset), always in this order:
- * q1..qN, dir1..dirN, x,y,z, L1,L2,L3, qw,qx,qy,qz, temp_c, t_s. */
+ * q1..qN, dir1..dirN, x,y,z, L1,L2,L3, qw,qx,qy,qz, temp_c, t_s, plane, point. */
 typedef struct {
     size_t n_joints;
     int has_xyz, has_wires, has_quat, has_dir, has_temp, has_time;
+    int has_plane, has_point;
 } dhcal_csv_columns;
 
 /* Appends the header line for cols to t (comment lines, if any, go before it). */
