@@ -12,14 +12,15 @@
 void dhc_calib_default_options(dhc_calib_options *opt)
 {
     DHC_ASSERT(opt != NULL);
+    /* every field not named below is 0 or NULL: no bound, no noise model, no caller memory,
+     * no prior */
+    memset(opt, 0, sizeof *opt);
     opt->max_iterations = 100U;
     opt->rank_rel_tol = 1e-10;
     opt->ssr_rel_tol = 1e-10;
     opt->step_rel_tol = 1e-12;
     opt->noise_rel_tol = 1e-2;
     opt->max_identifiability_checks = 3U;
-    opt->max_std_angle_rad = 0.0;
-    opt->max_std_length_mm = 0.0;
     opt->orientation_weight_mm_per_rad = DHC_ORIENTATION_WEIGHT_MM_PER_RAD;
     opt->outlier_threshold = 6.0;
     opt->outlier_floor_mm = 1e-6;
@@ -28,10 +29,6 @@ void dhc_calib_default_options(dhc_calib_options *opt)
     opt->robust_start = 1; /* a build without it refuses: its callers turn it off, visibly */
     opt->max_outlier_rounds = 3U;
     opt->structural_seed = 12345U;
-    memset(&opt->noise, 0, sizeof opt->noise);
-    opt->joint_sincos = NULL;
-    opt->sample_error2 = NULL;
-    opt->sample_residual = NULL;
 }
 
 static double scaled_step_norm(const dhc_lsq_factor *fac, const double *delta, size_t p)
@@ -648,7 +645,18 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
         return DHC_ERR_CAPACITY;
     }
     int whiten = 0;
-    if (dhc_noise_model_check(&opt->noise, model->arm.n_joints, &whiten) != DHC_OK) {
+    /* a prior is refused where the build leaves it out (DHC_WITH_PRIOR 0) */
+    if (dhc_noise_model_check(&opt->noise, model->arm.n_joints, &whiten) != DHC_OK ||
+        (!DHC_WITH_PRIOR && opt->prior_sd != NULL)) {
+        return DHC_ERR_ARGUMENT;
+    }
+    for (size_t k = 0U; DHC_WITH_PRIOR && opt->prior_sd != NULL && k < set->count; ++k) {
+        if (!(opt->prior_sd[k] >= 0.0) || !dhc_is_finite(opt->prior_sd[k])) {
+            return DHC_ERR_ARGUMENT;
+        }
+    }
+    if (DHC_WITH_PRIOR && opt->prior_sd != NULL && !whiten &&
+        (!(opt->prior_scale_mm > 0.0) || !dhc_is_finite(opt->prior_scale_mm))) {
         return DHC_ERR_ARGUMENT;
     }
     if (!DHC_WITH_ROBUST_START && opt->robust_start) {

@@ -35,6 +35,44 @@ static dhc_status add_batch(dhc_calib_workspace *ws, const double *r, size_t row
     return st;
 }
 
+/* The prior's terms (dhc_calib_options.prior_sd) at model: one row per parameter with a
+ * prior, "measuring" its input value, into the SSR and (accumulate) the normal equations. */
+static void add_prior(const fit_context *fc, const dhc_model *model, int accumulate,
+                      pass_totals *tot)
+{
+#if !DHC_WITH_PRIOR
+    (void)fc;
+    (void)model;
+    (void)accumulate;
+    (void)tot;
+#else
+    const double *const sd = fc->opt->prior_sd;
+    if (sd == NULL) {
+        return;
+    }
+    dhc_normal_eq *const ne = &fc->ws->ne;
+    const size_t p = fc->set->count;
+    for (size_t k = 0U; k < p; ++k) {
+        const uint8_t kind = fc->set->id[k].kind;
+        const int perturbation =
+            (kind >= (uint8_t)DHC_P_BASE_RX && kind <= (uint8_t)DHC_P_BASE_RZ) ||
+            (DHC_WITH_CONTACT && kind == (uint8_t)DHC_P_PLANE_TILT);
+        if (!(sd[k] > 0.0) || perturbation) {
+            continue;
+        }
+        const double w = (WHITEN(fc) ? 1.0 : fc->opt->prior_scale_mm) / sd[k];
+        const double r =
+            w * (dhc_params_value(fc->set, fc->input, k) - dhc_params_value(fc->set, model, k));
+        tot->ssr += r * r;
+        if (accumulate) {
+            ne->jtj[k * p + k] += w * w;
+            ne->jtr[k] += w * r;
+            ne->ssr += r * r;
+        }
+    }
+#endif
+}
+
 /* One pass whose samples are whitened with the covariance at `weights` (with the noise
  * model on): a trial step is judged with the weights of the estimate it starts from, so LM
  * minimises the objective whose gradient it steps along and stops where that gradient
@@ -160,6 +198,7 @@ dhc_status dhc_fit_data_pass_weighted(const fit_context *fc, const dhc_model *mo
         tot->samples++;
         tot->rows += rows;
     }
+    add_prior(fc, model, accumulate, tot);
     if (!dhc_is_finite(tot->ssr)) {
         return DHC_ERR_NONFINITE;
     }

@@ -97,6 +97,15 @@ typedef struct {
      * for every sample the fit used (the others' entries are not defined), so the caller
      * need not evaluate the model again for them. */
     double *sample_residual;
+    /* NULL (the default: least squares), or set->count standard deviations of a prior on
+     * the parameters, centred on the input model's values (the drawing and its tolerances):
+     * the fit then maximises the posterior, minimising SSR + sum_k (w_k (v_k - v_k,input))^2
+     * with w_k = prior_scale_mm / prior_sd[k] (1 / prior_sd[k] with the noise model on,
+     * whose rows are unit-free). 0 (or a perturbation: a base rotation, a plane's tilt): no
+     * prior on that parameter. Directions the data see only weakly then stay near the
+     * drawing instead of following the noise. The SSR and sigma include the prior's terms. */
+    const double *prior_sd;
+    double prior_scale_mm; /* the data's noise per row the prior is weighed against, mm */
 } dhc_calib_options;
 
 typedef struct {

@@ -131,6 +131,11 @@ DHC_STATIC_ASSERT(DHC_MAX_PARAMS <= 256U, "DHC_MAX_PARAMS too large for the inde
 #ifndef DHC_WITH_CONTACT
 #define DHC_WITH_CONTACT 1
 #endif
+/* dhc_calib_options.prior_sd: a prior on the parameters (maximum a posteriori); without it a
+ * fit with a prior is refused */
+#ifndef DHC_WITH_PRIOR
+#define DHC_WITH_PRIOR 1
+#endif
 /* Planes and fixed points one model holds (dhc_contact_targets). */
 #ifndef DHC_MAX_PLANES
 #define DHC_MAX_PLANES (DHC_WITH_CONTACT ? 8U : 1U)
