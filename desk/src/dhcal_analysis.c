@@ -1,7 +1,6 @@
 /* dhcal_analysis.c - fit and diagnose over loaded samples. */
 #include "dhcal_desk/dhcal_analysis.h"
 
-#include "dhcal/dhc_contact.h"
 #include "dhcal/dhc_jacobian.h"
 #include "dhcal_io/dhcal_effect_list.h"
 
@@ -208,14 +207,43 @@ void dhcal_calib_options_for(const dhc_model *model, const dhc_noise_model *nois
     }
 }
 
+/* The prior's standard deviation of each parameter of set (0: none); 1 when any has one. */
+static int prior_of_set(const dhcal_prior *prior, const dhc_param_set *set, double *sd)
+{
+    if (!(prior->scale_mm > 0.0)) {
+        return 0;
+    }
+    int any = 0;
+    for (size_t k = 0U; k < set->count; ++k) {
+        switch ((dhc_param_kind)set->id[k].kind) {
+        case DHC_P_THETA:
+        case DHC_P_ALPHA:
+        case DHC_P_BETA: sd[k] = prior->angle_rad; break;
+        case DHC_P_D:
+        case DHC_P_A:
+        case DHC_P_TOOL_X:
+        case DHC_P_TOOL_Y:
+        case DHC_P_TOOL_Z:
+        case DHC_P_BASE_X:
+        case DHC_P_BASE_Y:
+        case DHC_P_BASE_Z: sd[k] = prior->length_mm; break;
+        default: sd[k] = 0.0; break;
+        }
+        any |= sd[k] > 0.0;
+    }
+    return any;
+}
+
 /* dhcal_fit_from (rejudge 1) and dhcal_fit_kept (rejudge 0: the rows stay as they are). */
 static int fit_rows_from(const dhc_model *start, const dhc_param_set *set,
                          const dhc_noise_model *noise, dhcal_samples *s, const dhcal_samples *held,
                          int rejudge, dhcal_fit *out, dhcal_error *err)
 {
     const dhcal_geometry geometry = out->geometry;
+    const dhcal_prior prior = out->prior;
     memset(out, 0, sizeof *out);
     out->geometry = geometry;
+    out->prior = prior;
     out->model = *start;
     out->set = *set;
     if (noise != NULL) {
@@ -239,6 +267,11 @@ static int fit_rows_from(const dhc_model *start, const dhc_param_set *set,
         opt.max_outlier_rounds = 0U;
     }
     opt.joint_sincos = dhcal_samples_sincos(s, start->arm.n_joints);
+    double prior_sd[DHC_MAX_PARAMS];
+    if (prior_of_set(&out->prior, set, prior_sd)) {
+        opt.prior_sd = prior_sd;
+        opt.prior_scale_mm = out->prior.scale_mm;
+    }
     /* optional: without it the outlier screens evaluate the model again */
     opt.sample_error2 = malloc((s->n + 1U) * sizeof *opt.sample_error2);
     /* optional: the fit's residuals spare the row report a pass */
@@ -314,6 +347,22 @@ int dhcal_run_fit(const dhc_model *nominal, const char *effects, dhcal_geometry 
                   const dhc_noise_model *noise, dhcal_samples *s, const dhcal_samples *held,
                   dhcal_fit *out, dhcal_error *err)
 {
+    return dhcal_run_fit_prior(nominal, effects, geometry, noise, NULL, s, held, out, err);
+}
+
+dhcal_prior dhcal_prior_of_file(const dhcal_model *file)
+{
+    const dhcal_prior p = {file->tolerance_length_mm, file->tolerance_angle_deg * DHC_PI / 180.0,
+                           0.0};
+    return p;
+}
+
+int dhcal_run_fit_prior(const dhc_model *nominal, const char *effects, dhcal_geometry geometry,
+                        const dhc_noise_model *noise, const dhcal_prior *prior, dhcal_samples *s,
+                        const dhcal_samples *held, dhcal_fit *out, dhcal_error *err)
+{
+    const dhcal_prior none = {0.0, 0.0, 0.0};
+    out->prior = prior != NULL ? *prior : none;
     dhc_param_set set;
     if (dhcal_geometry_set(nominal, geometry, &set) != DHCAL_IO_OK) {
         snprintf(err->msg, sizeof err->msg, "too many joints for the parameter limit");
@@ -325,52 +374,19 @@ int dhcal_run_fit(const dhc_model *nominal, const char *effects, dhcal_geometry 
     }
     out->geometry = geometry;
     if (!dhcal_samples_have_contact(s)) {
-        return dhcal_fit_from(nominal, &set, noise, s, held, out, err);
+        rc = out->prior.length_mm > 0.0 || out->prior.angle_rad > 0.0
+                 ? dhcal_prior_scale(nominal, &set, noise, s, &out->prior, err)
+                 : DHCAL_IO_OK;
+        return rc == DHCAL_IO_OK ? dhcal_fit_from(nominal, &set, noise, s, held, out, err) : rc;
     }
     dhc_model *start = malloc(sizeof *start);
-    rc = start != NULL ? dhcal_contact_start(nominal, s, start, &set, err) : DHCAL_IO_FAILED;
+    rc = start != NULL ? dhcal_contact_start(nominal, noise, s, start, &set, &out->prior, err)
+                       : DHCAL_IO_FAILED;
     if (rc == DHCAL_IO_OK) {
         rc = dhcal_fit_from(start, &set, noise, s, held, out, err);
     }
     free(start);
     return rc;
-}
-
-int dhcal_samples_have_contact(const dhcal_samples *s)
-{
-    for (size_t i = 0U; i < s->n; ++i) {
-        if (s->samples[i].kind >= (uint8_t)DHC_MEAS_PLANE) {
-            return 1;
-        }
-    }
-    return 0;
-}
-
-int dhcal_contact_start(const dhc_model *nominal, const dhcal_samples *s, dhc_model *start,
-                        dhc_param_set *set, dhcal_error *err)
-{
-    *start = *nominal;
-    const dhc_status st = dhc_contact_targets_init(start, dhcal_samples_read, s, s->n, s->flags);
-    if (st == DHC_ERR_UNDERDETERMINED) {
-        snprintf(err->msg, sizeof err->msg,
-                 "%s: the touches do not define their targets: plane and point ids run 1, 2, "
-                 "... without gaps, each plane needs 3 touches not on one line, each point one",
-                 s->path != NULL ? s->path : "data");
-        return DHCAL_IO_BAD_INPUT;
-    }
-    if (st != DHC_OK) {
-        snprintf(err->msg, sizeof err->msg, "%s: the touches' targets: %s",
-                 s->path != NULL ? s->path : "data", dhc_status_str(st));
-        return DHCAL_IO_BAD_INPUT;
-    }
-    if (dhc_params_add_targets(set, start) != DHC_OK) {
-        snprintf(err->msg, sizeof err->msg,
-                 "too many parameters: the model's and the targets' (3 per plane and point) "
-                 "exceed %u",
-                 (unsigned)DHC_MAX_PARAMS);
-        return DHCAL_IO_BAD_INPUT;
-    }
-    return DHCAL_IO_OK;
 }
 
 int dhcal_session_covariates(const dhcal_fit *fit, const dhcal_samples *s, dhcal_covariates *cov,

@@ -192,8 +192,29 @@ static int load_effects(const dhcal_jctx *c, const cJSON *fx, dhcal_model *model
     return DHCAL_IO_OK;
 }
 
-static const char *const TOP_KEYS[] = {"name",    "joints",   "tool_mm", "base",
-                                       "gravity", "measurer", "effects", "repeatability_mm"};
+static const char *const TOP_KEYS[] = {"name",    "joints",           "tool_mm",
+                                       "base",    "gravity",          "measurer",
+                                       "effects", "repeatability_mm", "tolerance"};
+static const char *const TOLERANCE_KEYS[] = {"length_mm", "angle_deg"};
+
+/* "tolerance": {"length_mm", "angle_deg"}, each optional, each > 0. */
+static int load_tolerance(const dhcal_jctx *c, const cJSON *root, dhcal_model *model)
+{
+    const cJSON *const t = cJSON_GetObjectItemCaseSensitive(root, "tolerance");
+    if (t == NULL) {
+        return DHCAL_IO_OK;
+    }
+    int rc = dhcal_jcheck_object(c, t, "tolerance", DHCAL_JKEYS(TOLERANCE_KEYS));
+    if (rc == DHCAL_IO_OK) {
+        rc = dhcal_jopt_number(c, t, "tolerance", "length_mm", 1e-6, 100.0, "mm",
+                               &model->tolerance_length_mm);
+    }
+    if (rc == DHCAL_IO_OK) {
+        rc = dhcal_jopt_number(c, t, "tolerance", "angle_deg", 1e-6, 10.0, "deg",
+                               &model->tolerance_angle_deg);
+    }
+    return rc;
+}
 
 static int load_root(dhcal_jctx *c, const cJSON *root, dhcal_model *model)
 {
@@ -260,6 +281,9 @@ static int load_root(dhcal_jctx *c, const cJSON *root, dhcal_model *model)
         dhc_vec3_scale(model->gravity, 1.0 / g, model->gravity);
         rc = dhcal_jopt_number(c, root, "", "repeatability_mm", DHCAL_REPEATABILITY_MIN_MM,
                                DHCAL_REPEATABILITY_MAX_MM, "mm", &model->repeatability_mm);
+    }
+    if (rc == DHCAL_IO_OK) {
+        rc = load_tolerance(c, root, model);
     }
     const cJSON *const meas = cJSON_GetObjectItemCaseSensitive(root, "measurer");
     if (rc == DHCAL_IO_OK && meas != NULL) {
@@ -405,6 +429,18 @@ static void format_model(dhcal_text *sb, const dhcal_model *m)
     if (m->repeatability_mm > 0.0) {
         dhcal_text_printf(sb, ",\n  \"repeatability_mm\": ");
         put_exact(sb, m->repeatability_mm);
+    }
+    if (m->tolerance_length_mm > 0.0 || m->tolerance_angle_deg > 0.0) {
+        dhcal_text_printf(sb, ",\n  \"tolerance\": {");
+        if (m->tolerance_length_mm > 0.0) {
+            dhcal_text_printf(sb, "\"length_mm\": ");
+            put_exact(sb, m->tolerance_length_mm);
+        }
+        if (m->tolerance_angle_deg > 0.0) {
+            dhcal_text_printf(sb, "%s\"angle_deg\": ", m->tolerance_length_mm > 0.0 ? ", " : "");
+            put_exact(sb, m->tolerance_angle_deg);
+        }
+        dhcal_text_printf(sb, "}");
     }
     if (m->has_measurer) {
         dhcal_text_printf(sb, ",\n  \"measurer\": {\n    \"anchors_mm\": [");

@@ -236,8 +236,9 @@ static int run_fit(const dhcal_py_model *m, dhcal_session *s, const char *effect
 {
     static dhcal_fit fit;
     static dhcal_fit_extras extras;
-    int rc = dhcal_run_fit(&m->lib, effects, s->geometry, &s->noise, &s->samples,
-                           s->have_held ? &s->held : NULL, &fit, e);
+    const dhcal_prior prior = dhcal_prior_of_file(&s->file);
+    int rc = dhcal_run_fit_prior(&m->lib, effects, s->geometry, &s->noise, &prior, &s->samples,
+                                 s->have_held ? &s->held : NULL, &fit, e);
     if (rc != DHCAL_IO_OK) {
         return rc;
     }

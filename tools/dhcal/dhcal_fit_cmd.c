@@ -213,8 +213,10 @@ static int do_fit(const dhcal_cli_options *o, dhcal_session *s, dhcal_fit *fit, 
 {
     dhcal_error err;
     memset(&err, 0, sizeof err);
-    const int rc = dhcal_run_fit(&s->model, o->effects, s->geometry, &s->noise, &s->samples,
-                                 s->have_held ? &s->held : NULL, fit, &err);
+    /* the model file's tolerances are the fit's prior on the drawing */
+    const dhcal_prior prior = dhcal_prior_of_file(&s->file);
+    const int rc = dhcal_run_fit_prior(&s->model, o->effects, s->geometry, &s->noise, &prior,
+                                       &s->samples, s->have_held ? &s->held : NULL, fit, &err);
     if (rc != DHCAL_IO_OK) {
         fprintf(stderr, "dhcal: %s\n", err.msg);
         return rc == DHCAL_IO_BAD_INPUT ? EXIT_USAGE : EXIT_COMPUTE;

@@ -35,6 +35,16 @@ const char *dhcal_geometry_name(dhcal_geometry g);
 /* The base parameter set of a geometry level (a subset of dhc_params_base_model). */
 int dhcal_geometry_set(const dhc_model *model, dhcal_geometry g, dhc_param_set *set);
 
+/* A fit's prior on the drawing (dhc_calib_options.prior_sd, centred on the start model): each
+ * link length, tool and base coordinate with standard deviation length_mm, each joint offset,
+ * twist and Hayati beta with angle_rad, weighed against the data's noise per row scale_mm.
+ * The effects and the contact targets have none. All 0: no prior, least squares. */
+typedef struct {
+    double length_mm;
+    double angle_rad;
+    double scale_mm;
+} dhcal_prior;
+
 typedef struct {
     dhcal_error_stats train;   /* over the rows fitted (filled by the caller's evaluation) */
     dhcal_error_stats heldout; /* the model without the session's drift */
@@ -43,6 +53,7 @@ typedef struct {
     dhc_model model;           /* calibrated (nominal when the fit failed) */
     dhc_calib_report rep;
     dhcal_geometry geometry;
+    dhcal_prior prior; /* the caller's, kept by every refit from this one */
     dhc_status status;
     int have_heldout;
 } dhcal_fit;
@@ -56,15 +67,30 @@ dhc_model dhcal_model_without_drift(const dhc_model *model);
 int dhcal_parse_effects(const char *list, const dhc_model *model, dhc_param_set *set,
                         dhcal_error *err);
 
+/* The noise per row a prior is weighed against (prior->scale_mm, when 0): the noise model's
+ * measurement noise, else the rows' scatter with the arm as drawn (touches about their
+ * fitted targets; tracker points about the drawing's predictions, per coordinate): an upper
+ * bound, so the prior errs towards the drawing. */
+int dhcal_prior_scale(const dhc_model *start, const dhc_param_set *set,
+                      const dhc_noise_model *noise, dhcal_samples *s, dhcal_prior *prior,
+                      dhcal_error *err);
+
+/* The drawing's tolerances a contact fit assumes when the model file gives none (its prior,
+ * docs/formats.md 2.1): 0.5 mm on lengths, 0.05 deg on angles. */
+#define DHCAL_CONTACT_TOLERANCE_MM 0.5
+#define DHCAL_CONTACT_TOLERANCE_DEG 0.05
+
 /* 1 when some sample is a touch (a plane or a fixed point: dhc_contact.h). */
 int dhcal_samples_have_contact(const dhcal_samples *s);
 
 /* The start of a contact fit: the nominal model with its targets' starting poses from the
- * used samples (dhc_contact_targets_init), and their parameters appended to set.
- * DHCAL_IO_BAD_INPUT naming the data for targets the touches do not define or too many
- * parameters. */
-int dhcal_contact_start(const dhc_model *nominal, const dhcal_samples *s, dhc_model *start,
-                        dhc_param_set *set, dhcal_error *err);
+ * used samples (dhc_contact_targets_init), their parameters appended to set, and *prior
+ * completed: the drawing's default tolerances when it has none, weighed against the noise
+ * model's noise, else against the touches' scatter with the arm as drawn (the targets alone
+ * fitted). DHCAL_IO_BAD_INPUT naming the data for targets the touches do not define or too
+ * many parameters. */
+int dhcal_contact_start(const dhc_model *nominal, const dhc_noise_model *noise, dhcal_samples *s,
+                        dhc_model *start, dhc_param_set *set, dhcal_prior *prior, dhcal_error *err);
 
 /* The library's fit options for the model: the noise model (NULL or off: unweighted), and
  * link parameters held at their input values when the data determine them only to half
@@ -93,11 +119,21 @@ int dhcal_fit_kept(const dhc_model *start, const dhc_param_set *set, const dhc_n
  * candidate added, a fold left out) fits, so that it does not free them again. */
 void dhcal_set_without_held(const dhcal_fit *fit, dhc_param_set *out);
 
-/* Fits the geometry level plus effects to s from nominal (dhcal_fit_from);
- * DHCAL_IO_BAD_INPUT for a bad effects list. */
+/* Fits the geometry level plus effects to s from nominal (dhcal_fit_from), without a prior
+ * (but for touches: dhcal_contact_start); DHCAL_IO_BAD_INPUT for a bad effects list. */
 int dhcal_run_fit(const dhc_model *nominal, const char *effects, dhcal_geometry geometry,
                   const dhc_noise_model *noise, dhcal_samples *s, const dhcal_samples *held,
                   dhcal_fit *out, dhcal_error *err);
+
+/* dhcal_run_fit with a prior on the drawing (NULL: none); a prior whose scale_mm is 0 takes
+ * the noise's as dhcal_contact_start says, for touches and tracker points alike. */
+int dhcal_run_fit_prior(const dhc_model *nominal, const char *effects, dhcal_geometry geometry,
+                        const dhc_noise_model *noise, const dhcal_prior *prior, dhcal_samples *s,
+                        const dhcal_samples *held, dhcal_fit *out, dhcal_error *err);
+
+/* The prior a model file's "tolerance" gives (docs/formats.md 2.1): lengths and angles as
+ * given (0: none), scale 0 (the fit's to choose). */
+dhcal_prior dhcal_prior_of_file(const dhcal_model *file);
 
 /* Whether the session's covariates vary apart from the pose (dhc_covariate_pose_r2 over the
  * fitted rows): drift and thermal candidates are tried only when they do. */

@@ -37,6 +37,10 @@ typedef struct {
     int has_beta[DHC_MAX_JOINTS]; /* the file gave beta_deg for that joint */
     double gravity[3];            /* unit vector, world frame; default {0, 0, -1} */
     double repeatability_mm;      /* the arm's ISO 9283 pose repeatability RP; 0: not given */
+    /* the drawing's tolerances, standard deviations of its lengths and angles (the fit's
+     * prior, docs/formats.md 2.1); 0: not given */
+    double tolerance_length_mm;
+    double tolerance_angle_deg;
     int has_measurer;
     double anchors_mm[3][3];  /* measurer anchors in the measurer frame */
     dhc_frame measurer_frame; /* T_Meas: measurer frame in the world */
