@@ -62,6 +62,46 @@ void dhcal_json_extras(cJSON *obj, const dhcal_fit *f, const dhcal_fit_extras *x
     }
 }
 
+/* Touches: the targets' fitted poses and their touches; the prior on the drawing. */
+static void json_contact(cJSON *obj, const dhcal_fit *f, const dhcal_samples *s)
+{
+    if (f->prior.scale_mm > 0.0) {
+        cJSON *pr = cJSON_AddObjectToObject(obj, "prior");
+        cJSON_AddNumberToObject(pr, "length_mm", f->prior.length_mm);
+        cJSON_AddNumberToObject(pr, "angle_deg", f->prior.angle_rad * 180.0 / DHC_PI);
+        cJSON_AddNumberToObject(pr, "scale_mm", f->prior.scale_mm);
+    }
+    const dhc_contact_targets *t = &f->model.contact;
+    if (t->n_planes == 0U && t->n_points == 0U) {
+        return;
+    }
+    size_t touches[2][DHC_MAX_PLANES > DHC_MAX_POINTS ? DHC_MAX_PLANES : DHC_MAX_POINTS] = {{0U}};
+    for (size_t i = 0U; i < s->n; ++i) {
+        const dhc_sample *smp = &s->samples[i];
+        if (smp->kind >= (uint8_t)DHC_MEAS_PLANE && s->flags[i] == (uint8_t)DHC_SAMPLE_USED) {
+            touches[smp->kind == (uint8_t)DHC_MEAS_POINT][smp->target]++;
+        }
+    }
+    cJSON *targets = cJSON_AddObjectToObject(obj, "targets");
+    cJSON *planes = cJSON_AddArrayToObject(targets, "planes");
+    for (size_t j = 0U; j < t->n_planes; ++j) {
+        cJSON *p = cJSON_CreateObject();
+        cJSON_AddNumberToObject(p, "id", (double)(j + 1U));
+        cJSON_AddItemToObject(p, "normal", cJSON_CreateDoubleArray(t->plane[j].normal, 3));
+        cJSON_AddNumberToObject(p, "offset_mm", t->plane[j].offset_mm);
+        cJSON_AddNumberToObject(p, "touches", (double)touches[0][j]);
+        cJSON_AddItemToArray(planes, p);
+    }
+    cJSON *points = cJSON_AddArrayToObject(targets, "points");
+    for (size_t j = 0U; j < t->n_points; ++j) {
+        cJSON *p = cJSON_CreateObject();
+        cJSON_AddNumberToObject(p, "id", (double)(j + 1U));
+        cJSON_AddItemToObject(p, "xyz_mm", cJSON_CreateDoubleArray(t->point_mm[j], 3));
+        cJSON_AddNumberToObject(p, "touches", (double)touches[1][j]);
+        cJSON_AddItemToArray(points, p);
+    }
+}
+
 void dhcal_json_fit(cJSON *obj, const dhcal_fit *f, const dhc_model *input, const dhcal_samples *s,
                     const double *row_err)
 {
@@ -93,11 +133,13 @@ void dhcal_json_fit(cJSON *obj, const dhcal_fit *f, const dhc_model *input, cons
             cJSON_AddStringToObject(p, "name", name);
             cJSON_AddNumberToObject(p, "value", dhcal_param_fitted(f, input, k));
             cJSON_AddNumberToObject(p, "std", dhcal_param_display(&f->set, k, f->rep.std_err[k]));
+            cJSON_AddBoolToObject(p, "prior_only", f->rep.unseen[k] != 0U);
             cJSON_AddItemToArray(params, p);
             continue;
         }
         cJSON *u = cJSON_CreateObject();
         cJSON_AddStringToObject(u, "param", name);
+        cJSON_AddBoolToObject(u, "blind", f->rep.blind[k] != 0U);
         cJSON *with = cJSON_AddArrayToObject(u, "confounded_with");
         for (size_t m = 0U; m < f->set.count; ++m) {
             if (f->rep.confounded[k][m]) {
@@ -108,6 +150,7 @@ void dhcal_json_fit(cJSON *obj, const dhcal_fit *f, const dhc_model *input, cons
         }
         cJSON_AddItemToArray(unid, u);
     }
+    json_contact(obj, f, s);
     cJSON *outl = cJSON_AddArrayToObject(obj, "outliers");
     for (size_t i = 0U; i < s->n; ++i) {
         if (dhc_sample_is_outlier(s->flags[i])) {

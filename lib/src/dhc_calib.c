@@ -600,6 +600,32 @@ static dhc_status robust_start(const fit_context *fc, dhc_calib_report *rep, pas
 }
 #endif /* DHC_WITH_ROBUST_START */
 
+#if DHC_WITH_PRIOR
+/* With a prior, what the data alone would not identify (rep->unseen): the analysis of the
+ * normal equations at the estimate less the prior's rows (ws->ne, the last accumulation;
+ * restored after). Borrows ws->fac, which the report has read. */
+static dhc_status mark_unseen(const fit_context *fc, dhc_calib_report *rep)
+{
+    dhc_calib_workspace *const ws = fc->ws;
+    const size_t p = fc->set->count;
+    if (fc->opt->prior_sd == NULL) {
+        return DHC_OK;
+    }
+    for (size_t k = 0U; k < p; ++k) {
+        const double w = dhc_fit_prior_weight(fc, k);
+        ws->ne.jtj[k * p + k] -= w * w;
+    }
+    const dhc_status st = dhc_lsq_analyse(&ws->ne, fc->opt->rank_rel_tol, &ws->fac);
+    for (size_t k = 0U; k < p; ++k) {
+        const double w = dhc_fit_prior_weight(fc, k);
+        ws->ne.jtj[k * p + k] += w * w;
+        rep->unseen[k] =
+            (uint8_t)(st == DHC_OK && rep->identifiable[k] && !ws->fac.identifiable[k]);
+    }
+    return st;
+}
+#endif
+
 static void fill_report(const fit_context *fc, const pass_totals *tot, dhc_calib_report *rep)
 {
     const dhc_calib_workspace *const ws = fc->ws;
@@ -722,6 +748,12 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
         }
     }
     fill_report(&fc, &tot, rep);
+#if DHC_WITH_PRIOR
+    st = mark_unseen(&fc, rep);
+    if (st != DHC_OK) {
+        return st;
+    }
+#endif
     if (rep->freed > 0U) {
         /* What rich data identify changed with the estimate as well (the same point moved
          * off the same axis): the report's structural rank is the estimate's. The

@@ -102,6 +102,9 @@ dhc_status dhc_fit_screen_physical(const fit_context *fc, const dhc_model *model
 dhc_status dhc_fit_structural_rank(const fit_context *fc, const dhc_model *model,
                                    const data_traits *traits, dhc_calib_report *rep);
 
+/* The weight of parameter k's prior row (dhc_calib_options.prior_sd): 0 for none. */
+double dhc_fit_prior_weight(const fit_context *fc, size_t k);
+
 /* The screens (dhc_calib_screen.c). */
 /* What one scan of the used samples' squared errors e2 found. */
 typedef struct {

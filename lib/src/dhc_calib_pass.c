@@ -35,6 +35,20 @@ static dhc_status add_batch(dhc_calib_workspace *ws, const double *r, size_t row
     return st;
 }
 
+#if DHC_WITH_PRIOR
+double dhc_fit_prior_weight(const fit_context *fc, size_t k)
+{
+    const double *const sd = fc->opt->prior_sd;
+    const uint8_t kind = fc->set->id[k].kind;
+    const int perturbation = (kind >= (uint8_t)DHC_P_BASE_RX && kind <= (uint8_t)DHC_P_BASE_RZ) ||
+                             (DHC_WITH_CONTACT && kind == (uint8_t)DHC_P_PLANE_TILT);
+    if (sd == NULL || !(sd[k] > 0.0) || perturbation) {
+        return 0.0;
+    }
+    return (WHITEN(fc) ? 1.0 : fc->opt->prior_scale_mm) / sd[k];
+}
+#endif
+
 /* The prior's terms (dhc_calib_options.prior_sd) at model: one row per parameter with a
  * prior, "measuring" its input value, into the SSR and (accumulate) the normal equations. */
 static void add_prior(const fit_context *fc, const dhc_model *model, int accumulate,
@@ -53,14 +67,10 @@ static void add_prior(const fit_context *fc, const dhc_model *model, int accumul
     dhc_normal_eq *const ne = &fc->ws->ne;
     const size_t p = fc->set->count;
     for (size_t k = 0U; k < p; ++k) {
-        const uint8_t kind = fc->set->id[k].kind;
-        const int perturbation =
-            (kind >= (uint8_t)DHC_P_BASE_RX && kind <= (uint8_t)DHC_P_BASE_RZ) ||
-            (DHC_WITH_CONTACT && kind == (uint8_t)DHC_P_PLANE_TILT);
-        if (!(sd[k] > 0.0) || perturbation) {
+        const double w = dhc_fit_prior_weight(fc, k);
+        if (!(w > 0.0)) {
             continue;
         }
-        const double w = (WHITEN(fc) ? 1.0 : fc->opt->prior_scale_mm) / sd[k];
         const double r =
             w * (dhc_params_value(fc->set, fc->input, k) - dhc_params_value(fc->set, model, k));
         tot->ssr += r * r;

@@ -20,6 +20,30 @@ static const char *outlier_words(uint8_t flag)
 
 /* Where a systematic error shows: the apparent joint error's RMS per joint (deg) and the
  * residual's linear trend over the session (mm from first to last row). */
+/* The prior on the drawing, and the targets of touches as fitted. */
+static void text_contact(const dhcal_fit *f)
+{
+    if (f->prior.scale_mm > 0.0) {
+        printf("prior on the drawing: lengths +- %g mm, angles +- %g deg, against %.3g mm of "
+               "noise per row\n",
+               f->prior.length_mm, f->prior.angle_rad * 180.0 / DHC_PI, f->prior.scale_mm);
+    }
+    const dhc_contact_targets *t = &f->model.contact;
+    for (size_t j = 0U; j < t->n_planes; ++j) {
+        const double *n = t->plane[j].normal;
+        printf("plane %zu: normal (%.5f, %.5f, %.5f), %.3f mm from the base origin\n", j + 1U, n[0],
+               n[1], n[2], t->plane[j].offset_mm);
+    }
+    for (size_t j = 0U; j < t->n_points; ++j) {
+        const double *c = t->point_mm[j];
+        printf("point %zu: (%.3f, %.3f, %.3f) mm\n", j + 1U, c[0], c[1], c[2]);
+    }
+    if (t->n_planes + t->n_points > 0U) {
+        printf("touches see the arm's shape, not where it stands: what they are blind to is kept "
+               "at nominal (below)\n");
+    }
+}
+
 static void text_where(const dhcal_fit *f, const dhcal_session *s)
 {
     const size_t n = s->samples.n;
@@ -164,6 +188,7 @@ void dhcal_cli_text_fit(const dhcal_fit *f, const dhcal_session *s, const dhcal_
                    i + 1U, i + 1U, i + 2U, i + 1U, i + 1U);
         }
     }
+    text_contact(f);
     printf("%-18s %16s %12s\n", "parameter", "value", "std");
     char name[48];
     for (size_t k = 0U; k < f->set.count; ++k) {
@@ -173,6 +198,20 @@ void dhcal_cli_text_fit(const dhcal_fit *f, const dhcal_session *s, const dhcal_
         (void)dhc_params_name(&f->set, k, name, sizeof name);
         printf("%-18s %16.8g %12.3g %s\n", name, dhcal_param_fitted(f, &s->model, k),
                dhcal_param_display(&f->set, k, rep->std_err[k]), dhcal_param_unit(&f->set, k));
+    }
+    size_t unseen = 0U;
+    for (size_t k = 0U; k < f->set.count; ++k) {
+        if (rep->unseen[k]) {
+            (void)dhc_params_name(&f->set, k, name, sizeof name);
+            printf("%s%s",
+                   unseen++ == 0U ? "kept near the drawing by the prior (the data alone do "
+                                    "not identify them): "
+                                  : ", ",
+                   name);
+        }
+    }
+    if (unseen > 0U) {
+        printf("\n");
     }
     for (size_t k = 0U; k < f->set.count; ++k) {
         if (rep->identifiable[k]) {
@@ -186,7 +225,8 @@ void dhcal_cli_text_fit(const dhcal_fit *f, const dhcal_session *s, const dhcal_
             continue;
         }
         printf("%s: %s (kept at nominal)",
-               rep->rank < rep->structural_rank && rep->structurally_identifiable[k]
+               rep->blind[k] ? "blind to touches"
+               : rep->rank < rep->structural_rank && rep->structurally_identifiable[k]
                    ? "not identified from these data"
                    : "not identifiable",
                name);

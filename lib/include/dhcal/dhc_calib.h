@@ -146,6 +146,9 @@ typedef struct {
      * data: not structurally identifiable at exact touches, dhc_contact.h; a rigid motion of
      * the arm or a common scale is such a direction, and noise would otherwise fit it) */
     uint8_t blind[DHC_MAX_PARAMS];
+    /* 1: fitted, but with a prior (dhc_calib_options.prior_sd) that alone holds it near its
+     * input value: the data without the prior would not identify it */
+    uint8_t unseen[DHC_MAX_PARAMS];
     /* confounded[j][k] = 1: unidentifiable parameter j moves with parameter k (none in a
      * build without DHC_WITH_REPORT_EXTRAS) */
     uint8_t confounded[DHC_MAX_PARAMS][DHC_MAX_PARAMS];
