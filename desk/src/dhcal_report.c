@@ -75,7 +75,8 @@ static void json_contact(cJSON *obj, const dhcal_fit *f, const dhcal_samples *s)
     if (t->n_planes == 0U && t->n_points == 0U) {
         return;
     }
-    size_t touches[2][DHC_MAX_PLANES > DHC_MAX_POINTS ? DHC_MAX_PLANES : DHC_MAX_POINTS] = {{0U}};
+    /* touches of each plane (row 0) and point (row 1): both tables' sizes, the larger */
+    size_t touches[2][DHC_MAX_PLANES + DHC_MAX_POINTS] = {{0U}};
     for (size_t i = 0U; i < s->n; ++i) {
         const dhc_sample *smp = &s->samples[i];
         if (smp->kind >= (uint8_t)DHC_MEAS_PLANE && s->flags[i] == (uint8_t)DHC_SAMPLE_USED) {
@@ -133,7 +134,9 @@ void dhcal_json_fit(cJSON *obj, const dhcal_fit *f, const dhc_model *input, cons
             cJSON_AddStringToObject(p, "name", name);
             cJSON_AddNumberToObject(p, "value", dhcal_param_fitted(f, input, k));
             cJSON_AddNumberToObject(p, "std", dhcal_param_display(&f->set, k, f->rep.std_err[k]));
-            cJSON_AddBoolToObject(p, "prior_only", f->rep.unseen[k] != 0U);
+            if (f->prior.scale_mm > 0.0) {
+                cJSON_AddBoolToObject(p, "prior_only", f->rep.unseen[k] != 0U);
+            }
             cJSON_AddItemToArray(params, p);
             continue;
         }

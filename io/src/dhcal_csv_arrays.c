@@ -13,6 +13,36 @@
 
 /* ------------------------------------------------------------------ rows as arrays */
 
+/* Row i's touch columns as the CSV reads them: 0 or an id, not both. */
+static int touch_of_row(const dhcal_arrays *a, size_t i, dhcal_row *row, dhcal_error *err)
+{
+    const double *const ids[2] = {a->plane, a->point};
+    const col_kind kinds[2] = {COL_PLANE, COL_POINT};
+    const char *const name = a->name != NULL ? a->name : "data";
+    for (size_t t = 0U; t < 2U; ++t) {
+        if (ids[t] == NULL || (ids[t][i] >= 0.0 && ids[t][i] <= 0.0)) {
+            continue;
+        }
+        const double v = ids[t][i];
+        const csv_col col = {kinds[t], 0U};
+        const char *const rule = isfinite(v) ? dhcal_csv_value_rule(col.kind, v) : "an id";
+        if (rule != NULL) {
+            char nb[16];
+            return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
+                                   "%s: row %zu, column '%s': %.17g is not 0 or one of %s", name,
+                                   i + 1U, dhcal_csv_col_name(col, nb), v, rule);
+        }
+        dhcal_csv_store_value(row, col, v);
+    }
+    if (row->plane != 0U && row->point != 0U) {
+        return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
+                               "%s: row %zu touches plane %u and point %u: a touch is of one "
+                               "target",
+                               name, i + 1U, row->plane, row->point);
+    }
+    return DHCAL_IO_OK;
+}
+
 int dhcal_dataset_from_arrays(const dhcal_arrays *a, dhcal_dataset *data, dhcal_error *err)
 {
     memset(data, 0, sizeof *data);
@@ -24,7 +54,8 @@ int dhcal_dataset_from_arrays(const dhcal_arrays *a, dhcal_dataset *data, dhcal_
     if (a->n_rows == 0U) {
         return dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s: no rows", name);
     }
-    if (a->q_deg == NULL || (a->xyz_mm == NULL && a->wires_mm == NULL)) {
+    if (a->q_deg == NULL ||
+        (a->xyz_mm == NULL && a->wires_mm == NULL && a->plane == NULL && a->point == NULL)) {
         return dhcal_error_set(err, DHCAL_IO_FAILED,
                                "%s: joint angles and tool points or wire lengths required", name);
     }
@@ -45,10 +76,25 @@ int dhcal_dataset_from_arrays(const dhcal_arrays *a, dhcal_dataset *data, dhcal_
     data->has_dir = a->dir != NULL;
     data->has_temp = a->temp_c != NULL;
     data->has_time = a->t_s != NULL;
+    data->has_plane = a->plane != NULL;
+    data->has_point = a->point != NULL;
     const size_t nj = a->n_joints;
     for (size_t i = 0U; i < a->n_rows; ++i) {
         dhcal_row *const row = &data->rows[i];
         row->line = i + 1U;
+        const int rc = touch_of_row(a, i, row, err);
+        if (rc != DHCAL_IO_OK) {
+            dhcal_dataset_free(data);
+            return rc;
+        }
+        const int touch = row->plane != 0U || row->point != 0U;
+        if (!touch && a->xyz_mm == NULL && a->wires_mm == NULL) {
+            dhcal_dataset_free(data);
+            return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
+                                   "%s: row %zu: neither a touch (plane or point 0) nor a "
+                                   "measurement (no tool points or wire lengths given)",
+                                   name, i + 1U);
+        }
         /* each value through the CSV's own rule and store, column by column as a file
          * would give them */
         struct {
@@ -64,7 +110,9 @@ int dhcal_dataset_from_arrays(const dhcal_arrays *a, dhcal_dataset *data, dhcal_
         for (size_t g = 0U; g < 6U; ++g) {
             /* k < DHC_MAX_JOINTS always holds (count <= n_joints); said for the compiler,
              * which bounds the column name's digits by it */
-            for (size_t k = 0U; groups[g].v != NULL && k < groups[g].count && k < DHC_MAX_JOINTS;
+            const int measured = groups[g].kind == COL_XYZ || groups[g].kind == COL_WIRE;
+            for (size_t k = 0U; groups[g].v != NULL && !(touch && measured) &&
+                                k < groups[g].count && k < DHC_MAX_JOINTS;
                  ++k) {
                 const csv_col col = {groups[g].kind, k};
                 const double v = groups[g].v[k];
@@ -72,12 +120,12 @@ int dhcal_dataset_from_arrays(const dhcal_arrays *a, dhcal_dataset *data, dhcal_
                     isfinite(v) ? dhcal_csv_value_rule(col.kind, v) : "finite numbers";
                 if (rule != NULL) {
                     char nb[16];
-                    const int rc = dhcal_error_set(
+                    const int bad = dhcal_error_set(
                         err, DHCAL_IO_BAD_INPUT, "%s: row %zu, column '%s': %.17g is not %s%s",
                         name, i + 1U, dhcal_csv_col_name(col, nb), v,
                         col.kind == COL_DIR || !isfinite(v) ? "" : "inside ", rule);
                     dhcal_dataset_free(data);
-                    return rc;
+                    return bad;
                 }
                 dhcal_csv_store_value(row, col, v);
             }

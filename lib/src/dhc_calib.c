@@ -602,8 +602,9 @@ static dhc_status robust_start(const fit_context *fc, dhc_calib_report *rep, pas
 
 #if DHC_WITH_PRIOR
 /* With a prior, what the data alone would not identify (rep->unseen): the analysis of the
- * normal equations at the estimate less the prior's rows (ws->ne, the last accumulation;
- * restored after). Borrows ws->fac, which the report has read. */
+ * fitted parameters' normal equations at the estimate less the prior's rows (ws->ne, the last
+ * accumulation; restored after). Borrows ws->fac and ws->scratch, which the report has
+ * read. */
 static dhc_status mark_unseen(const fit_context *fc, dhc_calib_report *rep)
 {
     dhc_calib_workspace *const ws = fc->ws;
@@ -611,14 +612,15 @@ static dhc_status mark_unseen(const fit_context *fc, dhc_calib_report *rep)
     if (fc->opt->prior_sd == NULL) {
         return DHC_OK;
     }
+    /* the fitted parameters only: the held ones hidden by a zero diagonal */
     for (size_t k = 0U; k < p; ++k) {
         const double w = dhc_fit_prior_weight(fc, k);
-        ws->ne.jtj[k * p + k] -= w * w;
+        ws->scratch[k] = ws->ne.jtj[k * p + k];
+        ws->ne.jtj[k * p + k] = rep->identifiable[k] ? ws->scratch[k] - w * w : 0.0;
     }
     const dhc_status st = dhc_lsq_analyse(&ws->ne, fc->opt->rank_rel_tol, &ws->fac);
     for (size_t k = 0U; k < p; ++k) {
-        const double w = dhc_fit_prior_weight(fc, k);
-        ws->ne.jtj[k * p + k] += w * w;
+        ws->ne.jtj[k * p + k] = ws->scratch[k];
         rep->unseen[k] =
             (uint8_t)(st == DHC_OK && rep->identifiable[k] && !ws->fac.identifiable[k]);
     }
@@ -758,7 +760,16 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
         /* What rich data identify changed with the estimate as well (the same point moved
          * off the same axis): the report's structural rank is the estimate's. The
          * structural poses borrow ws->ne and ws->fac, which the report has read. */
+#if DHC_WITH_CONTACT
+        /* what the fit held as blind stays the report's (the analysis again at the estimate
+         * may name another member of a blind group) */
+        uint8_t blind[DHC_MAX_PARAMS];
+        memcpy(blind, rep->blind, sizeof blind);
+#endif
         st = dhc_fit_structural_rank(&fc, &ws->current, &tot.traits, rep);
+#if DHC_WITH_CONTACT
+        memcpy(rep->blind, blind, sizeof blind);
+#endif
         if (st != DHC_OK) {
             return st;
         }

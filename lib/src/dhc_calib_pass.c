@@ -331,6 +331,55 @@ static dhc_status structural_analysis(const fit_context *fc, const dhc_model *mo
     return dhc_lsq_analyse(&ws->ne, fc->opt->rank_rel_tol, &ws->fac);
 }
 
+#if DHC_WITH_CONTACT
+/* The rank of the touches' normal matrix (ws->ne) over the parameters in `in` only: the others
+ * hidden by a zero diagonal (ws->scratch keeps it meanwhile). */
+static dhc_status rank_of(const fit_context *fc, const uint8_t *in, size_t *rank)
+{
+    dhc_calib_workspace *const ws = fc->ws;
+    const size_t p = fc->set->count;
+    for (size_t k = 0U; k < p; ++k) {
+        ws->scratch[k] = ws->ne.jtj[k * p + k];
+        ws->ne.jtj[k * p + k] = in[k] ? ws->scratch[k] : 0.0;
+    }
+    const dhc_status st = dhc_lsq_analyse(&ws->ne, fc->opt->rank_rel_tol, &ws->fac);
+    for (size_t k = 0U; k < p; ++k) {
+        ws->ne.jtj[k * p + k] = ws->scratch[k];
+    }
+    *rank = ws->fac.rank;
+    return st;
+}
+
+/* Which of the parameters absolute points would identify (rep->blind on entry) the touches
+ * cannot: the targets first, then the arm's parameters in the set's order, each kept when it
+ * raises the rank of those kept before it; the others are blind. So a direction the targets
+ * take (a rigid motion, a common scale) is blind in the arm, never in the targets, and one
+ * parameter of a dependent group is held, not all of them. */
+static dhc_status blind_in_order(const fit_context *fc, dhc_calib_report *rep)
+{
+    const size_t p = fc->set->count;
+    uint8_t in[DHC_MAX_PARAMS];
+    for (size_t k = 0U; k < p; ++k) {
+        in[k] = (uint8_t)(fc->set->id[k].kind >= (uint8_t)DHC_P_PLANE_TILT);
+    }
+    size_t rank = 0U;
+    dhc_status st = rank_of(fc, in, &rank);
+    for (size_t k = 0U; k < p && st == DHC_OK; ++k) {
+        if (in[k] || !rep->blind[k]) {
+            continue; /* a target, or a parameter no point would identify: not blind */
+        }
+        in[k] = 1U;
+        size_t with = 0U;
+        st = rank_of(fc, in, &with);
+        const int seen = with > rank;
+        rank = seen ? with : rank;
+        in[k] = (uint8_t)seen;
+        rep->blind[k] = (uint8_t)!seen;
+    }
+    return st;
+}
+#endif
+
 /* Rank the model itself allows: the structural analysis with the data's kind. A data rank
  * below it means the data, not the model, are short. Contact data: what absolute points
  * would identify and touches cannot is blind (a rigid motion, a common scale), held. */
@@ -359,10 +408,12 @@ dhc_status dhc_fit_structural_rank(const fit_context *fc, const dhc_model *model
     rep->structural_rank = fc->ws->fac.rank;
     for (size_t k = 0U; k < p; ++k) {
         rep->structurally_identifiable[k] = fc->ws->fac.identifiable[k];
-#if DHC_WITH_CONTACT
-        rep->blind[k] = (uint8_t)(rep->blind[k] && !fc->ws->fac.identifiable[k]);
-#endif
     }
+#if DHC_WITH_CONTACT
+    if (contact) {
+        return blind_in_order(fc, rep);
+    }
+#endif
     return DHC_OK;
 }
 

@@ -79,9 +79,11 @@ void dhcal_dataset_free(dhcal_dataset *data);
 
 /* Measurement rows handed in as arrays rather than a file (the Python package): row-major,
  * q_deg n_rows x n_joints in degrees (required), xyz_mm and wires_mm (L1..L3) n_rows x 3
- * (one of them, or both as a file may have both); dir (n_rows x n_joints, each -1 or +1),
- * temp_c and t_s (n_rows each) optional (NULL: no such column). name stands for the file in
- * messages. */
+ * (one of them, or both as a file may have both, or neither when every row is a touch);
+ * dir (n_rows x n_joints, each -1 or +1), temp_c and t_s (n_rows each) optional (NULL: no
+ * such column); plane and point (n_rows each: 0, or a touch's 1-based id, as the CSV's
+ * columns: a touch row's xyz_mm and wires_mm entries are not read). name stands for the file
+ * in messages. */
 typedef struct {
     const char *name;
     size_t n_rows;
@@ -92,6 +94,8 @@ typedef struct {
     const double *temp_c;
     const double *t_s;
     const double *wires_mm;
+    const double *plane;
+    const double *point;
 } dhcal_arrays;
 
 /* The dataset dhcal_csv_load would give for a file with these columns and values: every

@@ -133,7 +133,9 @@ class Measurements:
     (N x 3, tool points) or ``wires_mm`` (N x 3, the wire lengths L1..L3 of the model's
     measurer), or both as a file may have both (a model with a measurer fits the wires), and
     the optional columns ``directions`` (N x joints, -1 or +1: the approach direction of each
-    joint), ``temp_c`` and ``t_s`` (N each), or None."""
+    joint), ``temp_c`` and ``t_s`` (N each), or None. Touches (docs/formats.md 3.4): ``plane``
+    and ``point`` (N each: 0, or the 1-based id of the plane or fixed point the row's tool point
+    touched; such a row's ``xyz_mm`` and ``wires_mm`` entries are not read and may be NaN)."""
 
     q_deg: np.ndarray
     xyz_mm: Optional[np.ndarray] = None
@@ -141,6 +143,8 @@ class Measurements:
     temp_c: Optional[np.ndarray] = None
     t_s: Optional[np.ndarray] = None
     wires_mm: Optional[np.ndarray] = None
+    plane: Optional[np.ndarray] = None
+    point: Optional[np.ndarray] = None
 
     def __len__(self) -> int:
         return int(self.q_deg.shape[0])
@@ -168,10 +172,13 @@ def load_measurements(path: PathLike, model: Model) -> Measurements:
         temp = np.empty(nr) if columns.value & 2 else None
         t = np.empty(nr) if columns.value & 4 else None
         wires = np.empty((nr, 3)) if columns.value & 16 else None
-        _native.LIB.dhcal_py_rows_copy(rows, *(_pointer(a) for a in (q, xyz, d, temp, t, wires)))
+        plane = np.empty(nr) if columns.value & 32 else None
+        point = np.empty(nr) if columns.value & 64 else None
+        _native.LIB.dhcal_py_rows_copy(rows, *(_pointer(a) for a in
+                                               (q, xyz, d, temp, t, wires, plane, point)))
     finally:
         _native.LIB.dhcal_py_rows_free(rows)
-    return Measurements(q, xyz, d, temp, t, wires)
+    return Measurements(q, xyz, d, temp, t, wires, plane, point)
 
 
 def _pointer(a: Optional[np.ndarray]) -> Any:
@@ -207,14 +214,27 @@ class _Rows:
         n = q.shape[0]
         if n == 0:
             raise ValueError(f"dhcal: {what}: no rows")
-        if m.xyz_mm is None and m.wires_mm is None:
-            raise ValueError(f"dhcal: {what}: xyz_mm or wires_mm (N x 3, mm) is required")
+        if m.xyz_mm is None and m.wires_mm is None and m.plane is None and m.point is None:
+            raise ValueError(f"dhcal: {what}: xyz_mm or wires_mm (N x 3, mm) is required, or "
+                             "the touches' plane or point ids")
+        ids = [None if v is None else _array(f"{what} {name}", v, (n,))
+               for v, name in ((m.plane, "plane"), (m.point, "point"))]
+        touch = np.zeros(n, dtype=bool)
+        for a in ids:
+            if a is not None:
+                touch |= a != 0.0
         self.arrays = [q]
         optional = [(m.xyz_mm, "xyz_mm", (n, 3)),
                     (m.directions, "directions", (n, model.n_joints)), (m.temp_c, "temp_c", (n,)),
                     (m.t_s, "t_s", (n,)), (m.wires_mm, "wires_mm", (n, 3))]
-        self.arrays += [None if v is None else _array(f"{what} {name}", v, shape)
-                        for v, name, shape in optional]
+        for v, name, shape in optional:
+            if v is not None and name in ("xyz_mm", "wires_mm") and touch.any():
+                # a touch row measures nothing: its entries are not read (NaN allowed)
+                v = np.array(v, dtype=np.float64, copy=True)
+                if v.ndim == 2 and v.shape[0] == n:
+                    v[touch] = 0.0
+            self.arrays.append(None if v is None else _array(f"{what} {name}", v, shape))
+        self.arrays += ids
         self.c = _native.Rows(n, *(_pointer(a) for a in self.arrays))
 
 
