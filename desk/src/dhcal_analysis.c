@@ -207,8 +207,7 @@ void dhcal_calib_options_for(const dhc_model *model, const dhc_noise_model *nois
     }
 }
 
-/* The prior's standard deviation of each parameter of set (0: none); 1 when any has one. */
-static int prior_of_set(const dhcal_prior *prior, const dhc_param_set *set, double *sd)
+int dhcal_prior_of_set(const dhcal_prior *prior, const dhc_param_set *set, double *sd)
 {
     if (!(prior->scale_mm > 0.0)) {
         return 0;
@@ -268,7 +267,7 @@ static int fit_rows_from(const dhc_model *start, const dhc_param_set *set,
     }
     opt.joint_sincos = dhcal_samples_sincos(s, start->arm.n_joints);
     double prior_sd[DHC_MAX_PARAMS];
-    if (prior_of_set(&out->prior, set, prior_sd)) {
+    if (dhcal_prior_of_set(&out->prior, set, prior_sd)) {
         opt.prior_sd = prior_sd;
         opt.prior_scale_mm = out->prior.scale_mm;
     }

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 
 #include "dhcal/dhc_contact.h"
+#include "dhcal/dhc_uncertainty.h"
 #include "dhcal_desk/dhcal_analysis.h"
 
 int dhcal_prior_scale(const dhc_model *start, const dhc_param_set *set,
@@ -97,4 +98,65 @@ int dhcal_contact_start(const dhc_model *nominal, const dhc_noise_model *noise, 
         return DHCAL_IO_BAD_INPUT;
     }
     return contact_prior(start, set, noise, s, prior, err);
+}
+
+/* Deterministic pseudo-random numbers in [0, 1) for the poses the accuracy is predicted at. */
+static double next_uniform(uint32_t *state)
+{
+    uint32_t x = *state;
+    x ^= x << 13;
+    x ^= x >> 17;
+    x ^= x << 5;
+    *state = x;
+    return (double)(x >> 8) / 16777216.0;
+}
+
+int dhcal_predicted_accuracy(const dhcal_fit *fit, const dhcal_samples *s, size_t poses,
+                             double *rms_mm)
+{
+    *rms_mm = 0.0;
+    if (poses == 0U || !(fit->rep.sigma > 0.0)) {
+        return DHCAL_IO_FAILED;
+    }
+    dhc_uncertainty *u = malloc(sizeof *u);
+    if (u == NULL) {
+        return DHCAL_IO_FAILED;
+    }
+    dhc_calib_options opt;
+    dhcal_calib_options_for(&fit->model, &fit->noise, &opt);
+    dhc_status st = dhc_uncertainty_from_samples(u, &fit->model, &fit->set, fit->rep.identifiable,
+                                                 dhcal_samples_read, s, s->n, &fit->noise,
+                                                 opt.orientation_weight_mm_per_rad, fit->rep.sigma);
+    /* the prior's rows, as the fit had them: C = sigma^2 (J^T W J + diag(w^2))^-1 */
+    double sd[DHC_MAX_PARAMS];
+    const size_t p = fit->set.count;
+    if (st == DHC_OK && dhcal_prior_of_set(&fit->prior, &fit->set, sd)) {
+        const int whitened = dhcal_noise_on(&fit->noise);
+        for (size_t k = 0U; k < p; ++k) {
+            if (sd[k] > 0.0 && fit->rep.identifiable[k]) {
+                const double w = (whitened ? 1.0 : fit->prior.scale_mm) / sd[k];
+                u->ne.jtj[k * p + k] += w * w;
+            }
+        }
+        st = dhc_lsq_analyse(&u->ne, 1e-10, &u->fac);
+    }
+    uint32_t state = 0x2545F491U;
+    double sum = 0.0;
+    const dhc_arm *const arm = &fit->model.arm;
+    for (size_t i = 0U; i < poses && st == DHC_OK; ++i) {
+        double q[DHC_MAX_JOINTS];
+        for (size_t j = 0U; j < arm->n_joints; ++j) {
+            q[j] = arm->joint[j].min_rad +
+                   (arm->joint[j].max_rad - arm->joint[j].min_rad) * next_uniform(&state);
+        }
+        double var = 0.0;
+        st = dhc_uncertainty_tool_point(u, &fit->model, &fit->set, q, NULL, NULL, &var);
+        sum += var;
+    }
+    free(u);
+    if (st != DHC_OK) {
+        return DHCAL_IO_FAILED;
+    }
+    *rms_mm = sqrt(sum / (double)poses);
+    return DHCAL_IO_OK;
 }

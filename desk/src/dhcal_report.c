@@ -29,6 +29,9 @@ void dhcal_fit_extras_compute(const dhcal_fit *f, const dhcal_samples *s, const 
     x->have_adequacy = dhcal_assess(f, s, &x->adequacy) == DHCAL_IO_OK;
     x->have_extrapolation =
         held != NULL && dhcal_extrapolate(f, s, held, &x->extrapolation) == DHCAL_IO_OK;
+    x->have_predicted = dhcal_samples_have_contact(s) &&
+                        dhcal_predicted_accuracy(f, s, DHCAL_PREDICTED_POSES,
+                                                 &x->predicted_accuracy_mm) == DHCAL_IO_OK;
 }
 
 static void json_number_or_null(cJSON *obj, const char *key, int have, double v)
@@ -50,6 +53,9 @@ void dhcal_json_extras(cJSON *obj, const dhcal_fit *f, const dhcal_fit_extras *x
         cJSON_AddNumberToObject(obj, "heldout_outside_range",
                                 (double)x->extrapolation.outside_range);
         cJSON_AddNumberToObject(obj, "predicted_std_mm", x->extrapolation.predicted_std_mm);
+    }
+    if (x->have_predicted) {
+        cJSON_AddNumberToObject(obj, "predicted_accuracy_mm", x->predicted_accuracy_mm);
     }
     if (x->have_adequacy) {
         const dhcal_adequacy *a = &x->adequacy;

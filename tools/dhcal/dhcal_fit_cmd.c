@@ -123,6 +123,12 @@ void dhcal_cli_text_extras(const dhcal_fit *f, const dhcal_session *s, const dhc
                "calibration predicts a positioning uncertainty of %.4f mm RMS there\n",
                x->extrapolation.outside_range, s->held.n, x->extrapolation.predicted_std_mm);
     }
+    if (x->have_predicted) {
+        printf("the calibration predicts a positioning accuracy of %.4f mm RMS over the joint "
+               "ranges (the arm's shape as the touches and the prior determine it; the blind "
+               "directions are the drawing's)\n",
+               x->predicted_accuracy_mm);
+    }
     if (!x->have_adequacy) {
         return;
     }

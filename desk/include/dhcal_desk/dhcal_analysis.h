@@ -131,6 +131,19 @@ int dhcal_run_fit_prior(const dhc_model *nominal, const char *effects, dhcal_geo
                         const dhc_noise_model *noise, const dhcal_prior *prior, dhcal_samples *s,
                         const dhcal_samples *held, dhcal_fit *out, dhcal_error *err);
 
+/* The prior's standard deviation of each parameter of set (sd: set->count entries, 0: none);
+ * 1 when any has one. */
+int dhcal_prior_of_set(const dhcal_prior *prior, const dhc_param_set *set, double *sd);
+
+/* The positioning accuracy the fit predicts over the model's joint ranges: the RMS over
+ * `poses` poses drawn uniformly in them (a fixed sequence) of the tool point's standard
+ * deviation from the parameters' covariance, sigma^2 (J^T W J + the prior's rows)^-1 over
+ * the fitted parameters (the held ones, blind directions included, have none: what is
+ * predicted is the accuracy of what the data and the prior determine). DHCAL_IO_FAILED
+ * when it cannot be had (no residual, a singular system). */
+int dhcal_predicted_accuracy(const dhcal_fit *fit, const dhcal_samples *s, size_t poses,
+                             double *rms_mm);
+
 /* The prior a model file's "tolerance" gives (docs/formats.md 2.1): lengths and angles as
  * given (0: none), scale 0 (the fit's to choose). */
 dhcal_prior dhcal_prior_of_file(const dhcal_model *file);

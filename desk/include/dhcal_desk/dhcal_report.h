@@ -23,9 +23,15 @@ typedef struct {
     dhcal_extrapolation extrapolation;
     int have_cv;
     dhcal_cv cv;
+    int have_predicted; /* touches: the accuracy the fit predicts over the joint ranges */
+    double predicted_accuracy_mm;
 } dhcal_fit_extras;
 
-/* Adequacy of the fit on s and, with held (may be NULL), the extrapolation to it; no CV. */
+/* Poses the predicted accuracy of a fit to touches is averaged over. */
+#define DHCAL_PREDICTED_POSES 200U
+
+/* Adequacy of the fit on s and, with held (may be NULL), the extrapolation to it; for touches
+ * the accuracy the fit predicts over the joint ranges; no CV. */
 void dhcal_fit_extras_compute(const dhcal_fit *f, const dhcal_samples *s, const dhcal_samples *held,
                               dhcal_fit_extras *x);
 

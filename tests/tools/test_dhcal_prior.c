@@ -1,0 +1,121 @@
+/* test_dhcal_prior.c - the desk's prior on the drawing (dhcal_prior, dhcal_run_fit_prior) and
+ * the accuracy a fit predicts over the joint ranges (dhcal_predicted_accuracy), against closed
+ * forms where the model is linear: the tool point, p = flange + R t. With n measured points
+ * and a prior of weight w = scale / sd on each tool coordinate, J^T J + w^2 I = (n + w^2) I
+ * (R^T R = I), so the tool point's variance at any pose is 3 sigma^2 / (n + w^2). */
+#include <math.h>
+#include <string.h>
+
+#include "dhc_test_arms.h"
+#include "dhcal/dhc_params.h"
+#include "dhcal_desk/dhcal_analysis.h"
+#include "unity.h"
+
+#define N_ROWS 30U
+
+static dhc_sample g_samples[N_ROWS];
+static uint8_t g_flags[N_ROWS];
+static dhcal_samples g_s;
+static dhcal_fit g_fit;
+static dhc_model g_nominal;
+
+void setUp(void)
+{
+    memset(&g_s, 0, sizeof g_s);
+    memset(&g_fit, 0, sizeof g_fit);
+}
+
+void tearDown(void) {}
+
+/* The paper's arm with its tool 3 mm off the drawing, measured with 0.3 mm of noise. */
+static void measure(void)
+{
+    g_nominal = test_paper3_model();
+    dhc_vec3_set(g_nominal.arm.tool_mm, 20.0, 0.0, 40.0);
+    dhc_model truth = g_nominal;
+    dhc_vec3_set(truth.arm.tool_mm, 22.0, 2.0, 41.0);
+    test_rng rng = {0x9A10ULL};
+    for (size_t k = 0U; k < N_ROWS; ++k) {
+        dhc_sample *s = &g_samples[k];
+        memset(s, 0, sizeof *s);
+        test_random_q(&rng, &truth.arm, s->q_rad);
+        s->temp_c = truth.thermal_ref_c;
+        s->t_s = (double)k;
+        s->kind = (uint8_t)DHC_MEAS_POSITION;
+        dhc_prediction pred;
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_model_predict(&truth, s, &pred));
+        for (size_t c = 0U; c < 3U; ++c) {
+            s->p_mm[c] = pred.p_mm[c] + 0.3 * test_gauss(&rng);
+        }
+        g_flags[k] = (uint8_t)DHC_SAMPLE_USED;
+    }
+    g_s.n = N_ROWS;
+    g_s.samples = g_samples;
+    g_s.flags = g_flags;
+    g_s.path = "simulated";
+}
+
+static void fit_tool(const dhcal_prior *prior)
+{
+    dhc_param_set set;
+    dhc_params_clear(&set);
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(&set, &g_nominal, DHC_EFFECT_TOOL_OFFSET, 0U));
+    dhcal_error err;
+    memset(&err, 0, sizeof err);
+    g_fit.prior = *prior;
+    TEST_ASSERT_EQUAL_MESSAGE(
+        DHCAL_IO_OK, dhcal_fit_from(&g_nominal, &set, NULL, &g_s, NULL, &g_fit, &err), err.msg);
+    TEST_ASSERT_EQUAL(DHC_OK, g_fit.status);
+    TEST_ASSERT_EQUAL_size_t(3U, g_fit.rep.rank);
+}
+
+static void test_predicted_accuracy_is_the_posterior_s(void)
+{
+    measure();
+    const double sds[3] = {0.0, 1.0, 0.05}; /* none, weak, strong */
+    double last = HUGE_VAL;
+    for (size_t c = 0U; c < 3U; ++c) {
+        const dhcal_prior prior = {sds[c], 0.0, sds[c] > 0.0 ? 0.3 : 0.0};
+        fit_tool(&prior);
+        double predicted = 0.0;
+        TEST_ASSERT_EQUAL(DHCAL_IO_OK, dhcal_predicted_accuracy(&g_fit, &g_s, 50U, &predicted));
+        const double w = sds[c] > 0.0 ? 0.3 / sds[c] : 0.0;
+        const double sigma = g_fit.rep.sigma;
+        const double expected = sqrt(3.0 * sigma * sigma / ((double)N_ROWS + w * w));
+        TEST_ASSERT_DOUBLE_WITHIN(1e-9 * expected, expected, predicted);
+        /* the prior's rows counted as data: the weights differ by 36x across the cases */
+        TEST_ASSERT_TRUE(fabs(predicted - last) > 1e-6);
+        last = predicted;
+    }
+}
+
+static void test_the_prior_of_a_set_follows_the_kinds(void)
+{
+    measure();
+    dhc_param_set set;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &g_nominal));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(&set, &g_nominal, DHC_EFFECT_TOOL_OFFSET, 0U));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(&set, &g_nominal, DHC_EFFECT_JOINT_SCALE, 1U));
+    const dhcal_prior prior = {0.5, 0.001, 0.2};
+    double sd[DHC_MAX_PARAMS];
+    TEST_ASSERT_TRUE(dhcal_prior_of_set(&prior, &set, sd));
+    for (size_t k = 0U; k < set.count; ++k) {
+        const uint8_t kind = set.id[k].kind;
+        const double want = kind == DHC_P_THETA || kind == DHC_P_ALPHA || kind == DHC_P_BETA ? 0.001
+                            : kind == DHC_P_D || kind == DHC_P_A || kind == DHC_P_TOOL_X ||
+                                    kind == DHC_P_TOOL_Y || kind == DHC_P_TOOL_Z
+                                ? 0.5
+                                : 0.0; /* an effect: no prior */
+        TEST_ASSERT_EQUAL_DOUBLE(want, sd[k]);
+    }
+    const dhcal_prior none = {0.5, 0.001, 0.0}; /* nothing to weigh it against: no prior */
+    TEST_ASSERT_FALSE(dhcal_prior_of_set(&none, &set, sd));
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_predicted_accuracy_is_the_posterior_s);
+    RUN_TEST(test_the_prior_of_a_set_follows_the_kinds);
+    return UNITY_END();
+}
