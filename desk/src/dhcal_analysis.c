@@ -856,7 +856,8 @@ static int extrapolate_in(const dhcal_fit *fit, const dhcal_samples *s, const dh
         }
         const dhc_sample *smp = &s->samples[i];
         const size_t rows = dhc_sample_rows(smp);
-        if (batch + rows > BATCH_ROWS) {
+        /* room for a whole residual (up to DHC_MAX_ROWS_PER_SAMPLE entries written) */
+        if (batch + DHC_MAX_ROWS_PER_SAMPLE > BATCH_ROWS) {
             if (add_batch(w, batch, p) != DHCAL_IO_OK) {
                 return DHCAL_IO_FAILED;
             }

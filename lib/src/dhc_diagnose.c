@@ -472,7 +472,10 @@ static dhc_status accumulate(const dhc_model *model, dhc_sample_reader read, con
         }
         st = read(ctx, i, &ws->sample);
         size_t k = dhc_sample_rows(&ws->sample);
-        if (st == DHC_OK && (batch + k > DHC_DIAGNOSE_BATCH_ROWS || (batch + k) * p > jac_len)) {
+        /* room for a whole residual (the model writes up to DHC_MAX_ROWS_PER_SAMPLE: a plane
+         * touch's one row and its two zeros) and for the sample's rows of the slope */
+        if (st == DHC_OK && (batch + DHC_MAX_ROWS_PER_SAMPLE > DHC_DIAGNOSE_BATCH_ROWS ||
+                             (batch + k) * p > jac_len)) {
             st = add_rows(ws, batch);
             batch = 0U;
         }

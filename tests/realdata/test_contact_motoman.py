@@ -194,6 +194,11 @@ def main():
     print(f'  drawing    {per_n[0]:.3f} {per_n[1]:.3f} {per_n[2]:.3f}; {all_n:.3f}')
     print(f'  calibrated {per_f[0]:.3f} {per_f[1]:.3f} {per_f[2]:.3f}; {all_f:.3f}')
     check(all_f <= all_n, 'the calibrated arm is no worse than the drawing at the Leica touches')
+    for command in ('diagnose', 'refine'):
+        r = subprocess.run([a.dhcal, command, '--model', nominal_path, '--data', data, '--json'],
+                           capture_output=True, text=True, timeout=600)
+        check(r.returncode == 0, f'dhcal {command} runs on touches ({r.returncode}: '
+                                 f'{r.stderr.strip()[:200]})')
     print('PASS' if not failures else f'FAIL: {len(failures)} check(s)')
     return 0 if not failures else 1
 

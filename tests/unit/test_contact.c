@@ -3,12 +3,14 @@
  * the shape of its workspace against the true arm's (pairwise distances, which no rigid
  * motion or common scale changes: what touching planes cannot see). */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "dhc_test_arms.h"
 #include "dhc_test_samples.h"
 #include "dhcal/dhc_calib.h"
 #include "dhcal/dhc_contact.h"
+#include "dhcal/dhc_diagnose.h"
 #include "dhcal/dhc_params.h"
 #include "unity.h"
 
@@ -320,6 +322,22 @@ static void test_six_joint_arm_from_touches_of_three_planes(void)
     TEST_ASSERT_EQUAL_size_t(2U, lengths_blind); /* d1 and the scale's length */
     /* the planes found are the true ones, less what the blind directions move */
     TEST_ASSERT_DOUBLE_WITHIN(1e-6, 1.0, model.contact.plane[0].normal[2]);
+
+    /* the diagnosis runs on touches: one row each, batched with room for whole residuals */
+    static dhc_candidate cands[DHC_MAX_CANDIDATES];
+    /* on the heap: a write past the workspace's end is caught (memcheck, AddressSanitizer) */
+    dhc_diagnose_workspace *dws = malloc(sizeof *dws);
+    TEST_ASSERT_NOT_NULL(dws);
+    static dhc_diagnosis diag;
+    const size_t nc =
+        dhc_diagnose_candidates(&model, &set, &test_no_covariates, cands, DHC_MAX_CANDIDATES);
+    TEST_ASSERT_TRUE(nc > 0U);
+    dhc_diagnose_options dopt;
+    dhc_diagnose_default_options(&dopt);
+    TEST_ASSERT_EQUAL(DHC_OK,
+                      dhc_diagnose(&model, &set, rep.identifiable, 1e-4, cands, nc,
+                                   test_read_sample, &data, data.n, data.flags, &dopt, dws, &diag));
+    free(dws);
 }
 
 static void test_noisy_touches_end_at_their_noise(void)
