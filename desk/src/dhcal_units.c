@@ -221,13 +221,29 @@ typedef struct {
  * up to a similarity transform. */
 #define UNITS_MIN_JOINT_RANGE_RAD 0.01
 
+/* A touch row (docs/formats.md 3.4): its joint angles, but no point measured. */
+static int is_touch(const dhcal_row *row)
+{
+    return row->plane != 0U || row->point != 0U;
+}
+
+static size_t measured_rows(const dhcal_dataset *data)
+{
+    size_t n = 0U;
+    for (size_t i = 0U; i < data->n_rows; ++i) {
+        n += is_touch(&data->rows[i]) ? 0U : 1U;
+    }
+    return n;
+}
+
 static int work_open(const dhc_model *model, const dhcal_dataset *data, units_work *w)
 {
     memset(w, 0, sizeof *w);
     w->model = model;
     w->data = data;
     w->wires = data->has_wires && model->measurer.present;
-    w->m = data->n_rows < DHCAL_UNITS_MAX_ROWS ? data->n_rows : DHCAL_UNITS_MAX_ROWS;
+    const size_t measured = measured_rows(data);
+    w->m = measured < DHCAL_UNITS_MAX_ROWS ? measured : DHCAL_UNITS_MAX_ROWS;
     w->idx = malloc((w->m + 1U) * sizeof *w->idx);
     w->meas = malloc((3U * w->m + 1U) * sizeof *w->meas);
     w->pred = malloc((3U * w->m + 1U) * sizeof *w->pred);
@@ -240,8 +256,15 @@ static int work_open(const dhc_model *model, const dhcal_dataset *data, units_wo
         lo[j] = HUGE_VAL;
         hi[j] = -HUGE_VAL;
     }
-    for (size_t i = 0U; i < w->m; ++i) {
-        w->idx[i] = i * data->n_rows / w->m; /* evenly spaced over the session */
+    for (size_t i = 0U, k = 0U, seen = 0U; i < w->m; ++i) {
+        /* evenly spaced over the session's measured rows (touches measure no point) */
+        const size_t want = i * measured / w->m;
+        for (; k < data->n_rows; ++k) {
+            if (!is_touch(&data->rows[k]) && seen++ == want) {
+                break;
+            }
+        }
+        w->idx[i] = k++;
         const dhcal_row *row = &data->rows[w->idx[i]];
         memcpy(&w->meas[3U * i], w->wires ? row->wires_mm : row->xyz_mm, 3U * sizeof(double));
         for (size_t j = 0U; j < model->arm.n_joints; ++j) {
@@ -770,7 +793,7 @@ int dhcal_units_check(const dhc_model *model, const dhcal_dataset *data, const c
     }
     if (!data->has_q) {
         check_targets_only(model, data, rep, cause, sizeof cause);
-    } else if (data->n_rows >= DHCAL_UNITS_MIN_ROWS &&
+    } else if (measured_rows(data) >= DHCAL_UNITS_MIN_ROWS &&
                (data->has_xyz || (data->has_wires && model->measurer.present))) {
         units_work w;
         rc = work_open(model, data, &w);

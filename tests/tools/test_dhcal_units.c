@@ -361,6 +361,28 @@ static void test_the_check_names_each_mistake(void)
     (void)check(&m, r, "tool_offset,base_frame", NULL);
 }
 
+/* Touch rows (docs/formats.md 3.4) measure no point: mixed among measured rows, every third
+ * row a touch with its points left at 0, the check judges the measured rows alone (with the
+ * touches' zeros it would see another frame or unit), and still names metres. */
+static void test_touch_rows_are_not_measurements(void)
+{
+    static dhc_model m;
+    arm(&m);
+    static dhcal_row r[N];
+    rows(&m, r, N);
+    for (size_t i = 0U; i < N; i += 3U) {
+        memset(r[i].xyz_mm, 0, sizeof r[i].xyz_mm);
+        r[i].plane = 1U;
+    }
+    (void)check(&m, r, NULL, NULL);
+    for (size_t i = 0U; i < N; ++i) {
+        for (size_t k = 0U; k < 3U; ++k) {
+            r[i].xyz_mm[k] /= 1000.0;
+        }
+    }
+    (void)check(&m, r, NULL, "positions look like metres");
+}
+
 /* One joint swept, the others still, on an arm a millimetre off the model: an arc, which
  * an exchange with a still column only moves onto another axis, where a similarity matches
  * it as well. Neither a swap nor another unit or frame. */
@@ -417,6 +439,7 @@ int main(void)
     RUN_TEST(test_a_mirror_image_fits_only_mirrored);
     RUN_TEST(test_clouds_without_spread_are_refused);
     RUN_TEST(test_the_check_names_each_mistake);
+    RUN_TEST(test_touch_rows_are_not_measurements);
     RUN_TEST(test_a_single_joint_sweep_is_no_swap);
     RUN_TEST(test_a_model_in_metres_is_named);
     return UNITY_END();
