@@ -3,7 +3,6 @@
  * the shape of its workspace against the true arm's (pairwise distances, which no rigid
  * motion or common scale changes: what touching planes cannot see). */
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "dhc_test_arms.h"
@@ -325,9 +324,16 @@ static void test_six_joint_arm_from_touches_of_three_planes(void)
 
     /* the diagnosis runs on touches: one row each, batched with room for whole residuals */
     static dhc_candidate cands[DHC_MAX_CANDIDATES];
-    /* on the heap: a write past the workspace's end is caught (memcheck, AddressSanitizer) */
-    dhc_diagnose_workspace *dws = malloc(sizeof *dws);
-    TEST_ASSERT_NOT_NULL(dws);
+    /* a canary right after the workspace: a write past its end shows there, on every
+     * platform (bare metal has no heap for memcheck or AddressSanitizer to watch) */
+    static struct {
+        dhc_diagnose_workspace ws;
+        double canary[2U * DHC_MAX_ROWS_PER_SAMPLE];
+    } guarded;
+    for (size_t k = 0U; k < 2U * DHC_MAX_ROWS_PER_SAMPLE; ++k) {
+        guarded.canary[k] = 12345.678;
+    }
+    dhc_diagnose_workspace *const dws = &guarded.ws;
     static dhc_diagnosis diag;
     const size_t nc =
         dhc_diagnose_candidates(&model, &set, &test_no_covariates, cands, DHC_MAX_CANDIDATES);
@@ -337,7 +343,9 @@ static void test_six_joint_arm_from_touches_of_three_planes(void)
     TEST_ASSERT_EQUAL(DHC_OK,
                       dhc_diagnose(&model, &set, rep.identifiable, 1e-4, cands, nc,
                                    test_read_sample, &data, data.n, data.flags, &dopt, dws, &diag));
-    free(dws);
+    for (size_t k = 0U; k < 2U * DHC_MAX_ROWS_PER_SAMPLE; ++k) {
+        TEST_ASSERT_EQUAL_DOUBLE(12345.678, guarded.canary[k]);
+    }
 }
 
 static void test_noisy_touches_end_at_their_noise(void)
