@@ -199,6 +199,12 @@ static void touch_plane(const dhc_model *truth, const double n[3], double h, siz
     }
 }
 
+static double distance(const double a[3], const double b[3])
+{
+    return sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                (a[2] - b[2]) * (a[2] - b[2]));
+}
+
 /* RMS over pairs of fresh poses of |p_i - p_j| (truth) - s |p_i - p_j| (model), s the least-
  * squares scale: the error no rigid motion and no common scale of the model removes. */
 static double shape_error_mm(const dhc_model *truth, const dhc_model *model)
@@ -217,14 +223,10 @@ static double shape_error_mm(const dhc_model *truth, const dhc_model *model)
     double mm = 0.0;
     for (size_t i = 0U; i < POSES; ++i) {
         for (size_t j = i + 1U; j < POSES; ++j) {
-            double dt2 = 0.0;
-            double dm2 = 0.0;
-            for (size_t c = 0U; c < 3U; ++c) {
-                dt2 += (pt[i][c] - pt[j][c]) * (pt[i][c] - pt[j][c]);
-                dm2 += (pm[i][c] - pm[j][c]) * (pm[i][c] - pm[j][c]);
-            }
-            st += sqrt(dt2) * sqrt(dm2);
-            mm += dm2;
+            const double dt = distance(pt[i], pt[j]);
+            const double dm = distance(pm[i], pm[j]);
+            st += dt * dm;
+            mm += dm * dm;
         }
     }
     const double scale = st / mm;
@@ -232,13 +234,7 @@ static double shape_error_mm(const dhc_model *truth, const dhc_model *model)
     size_t pairs = 0U;
     for (size_t i = 0U; i < POSES; ++i) {
         for (size_t j = i + 1U; j < POSES; ++j) {
-            double dt2 = 0.0;
-            double dm2 = 0.0;
-            for (size_t c = 0U; c < 3U; ++c) {
-                dt2 += (pt[i][c] - pt[j][c]) * (pt[i][c] - pt[j][c]);
-                dm2 += (pm[i][c] - pm[j][c]) * (pm[i][c] - pm[j][c]);
-            }
-            const double e = sqrt(dt2) - scale * sqrt(dm2);
+            const double e = distance(pt[i], pt[j]) - scale * distance(pm[i], pm[j]);
             sum += e * e;
             pairs++;
         }
