@@ -533,8 +533,8 @@ static void fold_step_ratio(fold_pass *fp, const dhc_normal_eq *ne, const uint8_
  * confirmed step (start; NULL: from a step that lowers their sum of squares), each step
  * relinearised where the last ended (one pass for the equations, one per trial), until a
  * step promises, or a confirmed one misses, less than CV_GN_LEFT; the fold's rows are
- * evaluated there. *done 0: the fold is refitted. ne_k: scratch for every fold's
- * accumulator. */
+ * evaluated there. *done 0: the fold is refitted, from fp->w->current (the last estimate
+ * the steps confirmed, else the fit). ne_k: scratch for every fold's accumulator. */
 static int iterate_fold(const fold_pass *fp, const dhc_normal_eq *ne, const uint8_t *ident_all,
                         size_t f, const dhc_model *start, dhcal_cv *out, dhc_normal_eq *ne_k,
                         int *done, dhcal_error *err)
@@ -546,9 +546,10 @@ static int iterate_fold(const fold_pass *fp, const dhc_normal_eq *ne, const uint
     step_fit sf;
     int refit = 0;
     fold_pass at = *fp;
-    if (start != NULL) {
-        *current = *start;
-    } else {
+    /* *current is always an estimate the other rows' sum of squares confirmed, or the fit:
+     * the refit starts from it when the steps stop short */
+    *current = start != NULL ? *start : *fp->model;
+    if (start == NULL) {
         fold_step_ratio(&at, ne, ident_all, f, out, &lambda, &refit, current, 0.0, NULL);
     }
     for (size_t it = 0U; !refit && it < CV_GN_ITERATIONS; ++it) {
@@ -571,7 +572,9 @@ static int iterate_fold(const fold_pass *fp, const dhc_normal_eq *ne, const uint
             lambda = 0.0;
             fold_step_ratio(&at, ne_k, ident_all, f, out, &lambda, &refit, next, 0.0, NULL);
         }
-        *current = *next;
+        if (!refit) {
+            *current = *next;
+        }
     }
     return DHCAL_IO_OK;
 }
@@ -622,9 +625,11 @@ static int estimate_folds(fold_pass *fp, const dhc_normal_eq *ne, const dhc_nois
             refit_options(fp->model, noise, fp->s, &ropt);
             flags = malloc(fp->s->n + 1U);
         }
-        rc = flags != NULL
-                 ? refit_fold(fp->model, fp->set, &ropt, fp->s, fp->cf, f, flags, fp->w, model, err)
-                 : DHCAL_IO_FAILED;
+        /* from where the iterated steps got to: each lowered the other rows' sum of squares
+         * from the fit's, whose refit would take those steps again */
+        rc = flags != NULL ? refit_fold(&fp->w->current, fp->set, &ropt, fp->s, fp->cf, f, flags,
+                                        fp->w, model, err)
+                           : DHCAL_IO_FAILED;
         out->fold_ss[f] = 0.0;
         out->fold_rows[f] = 0U;
         if (rc == DHCAL_IO_OK) {

@@ -95,25 +95,24 @@ static double current_decrement(const fit_context *fc)
 }
 
 /* Convergence relative to the noise the fit estimates, before a step: the decrement is
- * below (noise_rel_tol sigma)^2, i.e. what is left is under noise_rel_tol standard errors
- * (Mahalanobis). */
-static int nothing_left_to_gain(const fit_context *fc, const pass_totals *tot, double decrement)
+ * below (tol sigma)^2, i.e. what is left is under tol standard errors (Mahalanobis); tol is
+ * the options' noise_rel_tol, or the robust start's looser one for its trimmed fits. */
+static int nothing_left_to_gain(const fit_context *fc, const pass_totals *tot, double decrement,
+                                double tol)
 {
-    const double tol = fc->opt->noise_rel_tol;
     const double sigma2 = residual_variance(fc, tot);
     return tol > 0.0 && sigma2 > 0.0 && decrement <= tol * tol * sigma2;
 }
 
 /* ... and after accepted steps whose gains shrink geometrically (ratio q = gain / previous
  * gain < 1): what the steps still to come can take off the SSR, q gain / (1 - q), is below
- * noise_rel_tol sigma^2. Where the data barely determine a combination of parameters the
+ * tol sigma^2. Where the data barely determine a combination of parameters the
  * SSR is flat and curved along it: the Gauss-Newton model misjudges it and LM creeps along
  * the valley, each step taking a little; the steps' own sizes say nothing about how far the
  * minimum is, the sum of what is left to gain does. */
 static int little_left_to_gain(const fit_context *fc, const pass_totals *tot, double gain,
-                               double previous_gain)
+                               double previous_gain, double tol)
 {
-    const double tol = fc->opt->noise_rel_tol;
     const double sigma2 = residual_variance(fc, tot);
     if (!(tol > 0.0) || !(sigma2 > 0.0) || !(previous_gain > 0.0) || !(gain < previous_gain)) {
         return 0;
@@ -170,7 +169,7 @@ static int link_angle_step_too_far(const dhc_param_set *set, const double *delta
  * the curved valleys of real arms' barely determined parameters and creeps along them. */
 static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *rep,
                                       pass_totals *tot, int accumulated, freeing *fr,
-                                      int *converged)
+                                      double noise_tol, int *converged)
 {
     dhc_calib_workspace *const ws = fc->ws;
     const size_t p = fc->set->count;
@@ -188,7 +187,8 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
     for (size_t it = 0U; st == DHC_OK && it < fc->opt->max_iterations; ++it) {
         rep->iterations++;
         /* A perfect fit leaves nothing to improve; relative tests would divide by ~0. */
-        if (tot->ssr <= 1e-30 * (double)tot->rows || nothing_left_to_gain(fc, tot, decrement)) {
+        if (tot->ssr <= 1e-30 * (double)tot->rows ||
+            nothing_left_to_gain(fc, tot, decrement, noise_tol)) {
             *converged = 1;
             break;
         }
@@ -264,7 +264,7 @@ static dhc_status levenberg_marquardt(const fit_context *fc, dhc_calib_report *r
                 continue;
             }
             if (decrement <= fc->opt->ssr_rel_tol * tot->ssr || step <= fc->opt->step_rel_tol ||
-                little_left_to_gain(fc, tot, gain, previous_gain)) {
+                little_left_to_gain(fc, tot, gain, previous_gain, noise_tol)) {
                 *converged = 1;
                 break;
             }
@@ -476,12 +476,12 @@ static int undo_early_freeing(const fit_context *fc, dhc_calib_report *rep)
  * max_identifiability_checks times), then the worst unsupported link parameter held and the
  * fit repeated (at most MAX_HOLDS times). */
 static dhc_status fit_to_convergence(const fit_context *fc, dhc_calib_report *rep, pass_totals *tot,
-                                     int accumulated, int *converged)
+                                     int accumulated, double noise_tol, int *converged)
 {
     freeing fr = {0U, 1};
     size_t holds = 0U;
     for (;;) {
-        dhc_status st = levenberg_marquardt(fc, rep, tot, accumulated, &fr, converged);
+        dhc_status st = levenberg_marquardt(fc, rep, tot, accumulated, &fr, noise_tol, converged);
         if (st != DHC_OK) {
             return st;
         }
@@ -584,7 +584,8 @@ static dhc_status robust_start(const fit_context *fc, dhc_calib_report *rep, pas
         }
         int converged = 0;
         if (st == DHC_OK) {
-            st = fit_to_convergence(fc, rep, tot, 0, &converged);
+            st = fit_to_convergence(
+                fc, rep, tot, 0, fmax(fc->opt->noise_rel_tol, ROBUST_CSTEP_NOISE_TOL), &converged);
         }
         unmark(fc, (uint8_t)DHC_SAMPLE_ROBUST);
     }
@@ -730,7 +731,8 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
 
     int converged = 0;
     for (size_t round = 0U; round <= opt->max_outlier_rounds; ++round) {
-        st = fit_to_convergence(&fc, rep, &tot, round == 0U && accumulated && !moved, &converged);
+        st = fit_to_convergence(&fc, rep, &tot, round == 0U && accumulated && !moved,
+                                opt->noise_rel_tol, &converged);
         if (st != DHC_OK) {
             return st;
         }

@@ -27,6 +27,11 @@
 #define ROBUST_KEEP 0.75
 #define ROBUST_CSTEPS 2U
 #define ROBUST_K 10.0
+/* A trimmed fit of the robust start stops within this many residual variances of its
+ * minimum (noise_rel_tol, for it alone): it only ranks the rows for the next trim, and
+ * moving on along a valley the data barely see changes their errors by far less than the
+ * noise. The fit after it converges as asked. */
+#define ROBUST_CSTEP_NOISE_TOL 1.0
 /* link parameters held back for want of support, at most, in one fit */
 #define MAX_HOLDS 8U
 #define LAMBDA_MAX 1e12

@@ -358,7 +358,7 @@ static dhc_status rank_of(const fit_context *fc, const uint8_t *in, size_t *rank
 static dhc_status blind_in_order(const fit_context *fc, dhc_calib_report *rep)
 {
     const size_t p = fc->set->count;
-    uint8_t in[DHC_MAX_PARAMS];
+    uint8_t in[DHC_MAX_PARAMS] = {0U};
     for (size_t k = 0U; k < p; ++k) {
         in[k] = (uint8_t)(fc->set->id[k].kind >= (uint8_t)DHC_P_PLANE_TILT);
     }

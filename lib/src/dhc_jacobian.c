@@ -11,6 +11,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "dhc_trig.h"
 #include "dhcal/dhc_contact.h"
 
 static void rotation_column(const double axis[3], const double through[3], const double p[3],
@@ -111,10 +112,20 @@ static int set_has_compliance(const dhc_param_set *set)
 /* Factor by which a joint effect parameter scales its joint's column: d(dq_i)/d(param).
  * (A set never holds the parameters of an effect the build leaves out: dhc_params_add.) */
 static double joint_effect_factor(const dhc_param_id *id, const dhc_sample *s,
-                                  const double *tau_row)
+                                  const double *sincos_q, const double *tau_row)
 {
     const double q = s->q_rad[id->joint];
-    (void)q, (void)tau_row; /* a build without the effects that read them */
+    (void)q, (void)sincos_q, (void)tau_row; /* a build without the effects that read them */
+#if DHC_WITH_EFFECT_JOINT_HARMONIC
+    if (sincos_q != NULL &&
+        (id->kind == (uint8_t)DHC_P_HARMONIC_SIN || id->kind == (uint8_t)DHC_P_HARMONIC_COS)) {
+        double sk;
+        double ck;
+        dhc_sincos_multiple(sincos_q[2U * id->joint], sincos_q[2U * id->joint + 1U],
+                            (size_t)id->aux + 1U, &sk, &ck);
+        return id->kind == (uint8_t)DHC_P_HARMONIC_SIN ? sk : ck;
+    }
+#endif
     switch ((dhc_param_kind)id->kind) {
 #if DHC_WITH_EFFECT_JOINT_SCALE
     case DHC_P_JOINT_SCALE: return q;
@@ -217,7 +228,7 @@ static dhc_status jacobian_prepared(const dhc_model *model, const dhc_arm_trig *
             }
         } else if (id->kind <= (uint8_t)DHC_P_COMPLIANCE) {
             const dhc_param_id joint_theta = {(uint8_t)DHC_P_THETA, id->joint, 0U};
-            const double factor = joint_effect_factor(id, s, ev->tau[id->joint]);
+            const double factor = joint_effect_factor(id, s, sincos_q, ev->tau[id->joint]);
             geometric_column(arm, ev->frames, ev->axes, p_arm, &joint_theta, dp, dw);
             dhc_vec3_scale(dp, factor, dp);
             dhc_vec3_scale(dw, factor, dw);

@@ -67,8 +67,9 @@ dhc_status dhc_normal_eq_init(dhc_normal_eq *ne, size_t n)
 #define DHC_HAS_AVX2() __builtin_cpu_supports("avx2")
 #endif
 /* The batch kernels for x86-64 processors with AVX2, chosen at run time; the portable
- * loops in dhc_normal_eq_add serve every other processor. Unit weights. The same products
- * and sums in the same order as those loops (no fused multiply-adds): the same bits. */
+ * loops in dhc_normal_eq_add serve every other processor. The same products (an equation's
+ * weight times its entry, times the other entry) and sums in the same order as those loops
+ * (no fused multiply-adds): the same bits. */
 #define DHC_AVX2 __attribute__((target("avx2")))
 
 /* sum over the k equations of r_e^2 + |J_e|^2 (four lanes at a time) */
@@ -99,15 +100,16 @@ DHC_AVX2 static double square_sum_avx2(const dhc_mat *jac, const double *r, size
  * batch and each equation's entries feed 32 products. The upper triangle is the caller's
  * transposed copy: the blocks across the diagonal hold a few upper entries too, the same
  * products in the same order, so the copy leaves them as they are. */
-DHC_AVX2 static void add_unweighted_avx2(dhc_normal_eq *ne, const dhc_mat *jac, const double *r,
-                                         size_t k)
+DHC_AVX2 static void add_avx2(dhc_normal_eq *ne, const dhc_mat *jac, const double *r,
+                              const double *w, size_t k)
 {
     const size_t n = ne->n;
     double *const jtj = ne->jtj;
     for (size_t e = 0U; e < k; ++e) {
         const double *const row = &DHC_MAT_AT(jac, e, 0U);
+        const double we = w != NULL ? w[e] : 1.0;
         for (size_t i = 0U; i < n; ++i) {
-            ne->jtr[i] += row[i] * r[e];
+            ne->jtr[i] += (we * row[i]) * r[e];
         }
     }
     const size_t whole_i = n - n % 4U;
@@ -125,18 +127,19 @@ DHC_AVX2 static void add_unweighted_avx2(dhc_normal_eq *ne, const dhc_mat *jac, 
             __m256d c31 = _mm256_loadu_pd(out + 3U * n + j0 + 4U);
             for (size_t e = 0U; e < k; ++e) {
                 const double *const row = &DHC_MAT_AT(jac, e, 0U);
+                const double we = w != NULL ? w[e] : 1.0;
                 const __m256d y0 = _mm256_loadu_pd(row + j0);
                 const __m256d y1 = _mm256_loadu_pd(row + j0 + 4U);
-                __m256d x = _mm256_broadcast_sd(row + i0);
+                __m256d x = _mm256_set1_pd(we * row[i0]);
                 c00 = _mm256_add_pd(c00, _mm256_mul_pd(x, y0));
                 c01 = _mm256_add_pd(c01, _mm256_mul_pd(x, y1));
-                x = _mm256_broadcast_sd(row + i0 + 1U);
+                x = _mm256_set1_pd(we * row[i0 + 1U]);
                 c10 = _mm256_add_pd(c10, _mm256_mul_pd(x, y0));
                 c11 = _mm256_add_pd(c11, _mm256_mul_pd(x, y1));
-                x = _mm256_broadcast_sd(row + i0 + 2U);
+                x = _mm256_set1_pd(we * row[i0 + 2U]);
                 c20 = _mm256_add_pd(c20, _mm256_mul_pd(x, y0));
                 c21 = _mm256_add_pd(c21, _mm256_mul_pd(x, y1));
-                x = _mm256_broadcast_sd(row + i0 + 3U);
+                x = _mm256_set1_pd(we * row[i0 + 3U]);
                 c30 = _mm256_add_pd(c30, _mm256_mul_pd(x, y0));
                 c31 = _mm256_add_pd(c31, _mm256_mul_pd(x, y1));
             }
@@ -155,9 +158,39 @@ DHC_AVX2 static void add_unweighted_avx2(dhc_normal_eq *ne, const dhc_mat *jac, 
         for (size_t j = i < whole_i ? whole_j : 0U; j <= i; ++j) {
             double sum = jtj[i * n + j];
             for (size_t e = 0U; e < k; ++e) {
-                sum += DHC_MAT_AT(jac, e, i) * DHC_MAT_AT(jac, e, j);
+                sum += ((w != NULL ? w[e] : 1.0) * DHC_MAT_AT(jac, e, i)) * DHC_MAT_AT(jac, e, j);
             }
             jtj[i * n + j] = sum;
+        }
+    }
+}
+
+/* The upper triangle from the lower, four by four transposed in registers (the strided
+ * stores of an entry-by-entry copy cost as much as a small batch's sums) */
+DHC_AVX2 static void mirror_avx2(dhc_normal_eq *ne)
+{
+    const size_t n = ne->n;
+    double *const a = ne->jtj;
+    const size_t whole = n - n % 4U;
+    for (size_t i0 = 4U; i0 < whole; i0 += 4U) {
+        for (size_t j0 = 0U; j0 < i0; j0 += 4U) {
+            const __m256d r0 = _mm256_loadu_pd(a + i0 * n + j0);
+            const __m256d r1 = _mm256_loadu_pd(a + (i0 + 1U) * n + j0);
+            const __m256d r2 = _mm256_loadu_pd(a + (i0 + 2U) * n + j0);
+            const __m256d r3 = _mm256_loadu_pd(a + (i0 + 3U) * n + j0);
+            const __m256d lo01 = _mm256_unpacklo_pd(r0, r1);
+            const __m256d hi01 = _mm256_unpackhi_pd(r0, r1);
+            const __m256d lo23 = _mm256_unpacklo_pd(r2, r3);
+            const __m256d hi23 = _mm256_unpackhi_pd(r2, r3);
+            _mm256_storeu_pd(a + j0 * n + i0, _mm256_permute2f128_pd(lo01, lo23, 0x20));
+            _mm256_storeu_pd(a + (j0 + 1U) * n + i0, _mm256_permute2f128_pd(hi01, hi23, 0x20));
+            _mm256_storeu_pd(a + (j0 + 2U) * n + i0, _mm256_permute2f128_pd(lo01, lo23, 0x31));
+            _mm256_storeu_pd(a + (j0 + 3U) * n + i0, _mm256_permute2f128_pd(hi01, hi23, 0x31));
+        }
+    }
+    for (size_t i = 0U; i < n; ++i) {
+        for (size_t j = i < whole ? i - i % 4U : 0U; j < i; ++j) {
+            a[j * n + i] = a[i * n + j];
         }
     }
 }
@@ -194,17 +227,17 @@ dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double
     }
     const int mirror_by_copy = k > 3U;
 #ifdef DHC_LSQ_AVX2
-    const int fast = w == NULL && mirror_by_copy && DHC_HAS_AVX2();
+    const int fast = mirror_by_copy && DHC_HAS_AVX2();
 #else
     const int fast = 0;
 #endif
     double added = 0.0;
 #ifdef DHC_LSQ_AVX2
-    if (fast) {
+    if (fast && w == NULL) {
         added = square_sum_avx2(jac, r, k);
     }
 #endif
-    for (size_t e = 0U; e < k && !fast; ++e) {
+    for (size_t e = 0U; e < k && !(fast && w == NULL); ++e) {
         const double *const row = &DHC_MAT_AT(jac, e, 0U);
         double s2 = r[e] * r[e];
         for (size_t i = 0U; i < n; ++i) {
@@ -221,7 +254,7 @@ dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double
      * where that costs more than a transposed copy, by the copy. Exactly symmetric. */
 #ifdef DHC_LSQ_AVX2
     if (fast) {
-        add_unweighted_avx2(ne, jac, r, k);
+        add_avx2(ne, jac, r, w, k);
     }
 #endif
 #if DHC_SMALL_CODE
@@ -296,7 +329,12 @@ dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double
         }
     }
 #endif
-    for (size_t i = 0U; i < n && mirror_by_copy; ++i) {
+#ifdef DHC_LSQ_AVX2
+    if (fast) {
+        mirror_avx2(ne);
+    }
+#endif
+    for (size_t i = 0U; i < n && mirror_by_copy && !fast; ++i) {
         for (size_t j = 0U; j < i; ++j) {
             ne->jtj[j * n + i] = ne->jtj[i * n + j];
         }

@@ -1,5 +1,6 @@
 /* dhc_model.c - predictions of the full measurement model (geometry + physical effects). */
 #include "dhcal/dhc_model.h"
+#include "dhc_trig.h"
 
 #include <float.h>
 #include <math.h>
@@ -302,8 +303,10 @@ dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_tri
             const double a = fx->harmonic_hi_sin_rad[k];
             const double b = fx->harmonic_hi_cos_rad[k];
             if (fabs(a) > 0.0 || fabs(b) > 0.0) {
-                const double kq = (double)(k + 2U) * q;
-                dq += a * sin(kq) + b * cos(kq);
+                double sk;
+                double ck;
+                dhc_sincos_multiple(sin_q[i], cos_q[i], k + 2U, &sk, &ck);
+                dq += a * sk + b * ck;
             }
         }
         for (size_t j = i; compliant && j < n; ++j) {
@@ -314,9 +317,11 @@ dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_tri
             return DHC_ERR_NONFINITE;
         }
         /* Without effects q_eff is q to the bit, and so are its sine and cosine. */
-        if (fabs(dq) > 0.0) {
+        if (fabs(dq) > 0.0 && DHC_SMALL_CODE) {
             sin_q[i] = sin(out->q_eff_rad[i]);
             cos_q[i] = cos(out->q_eff_rad[i]);
+        } else if (fabs(dq) > 0.0) {
+            dhc_sincos_shifted(q, sin_q[i], cos_q[i], dq, &sin_q[i], &cos_q[i]);
         }
     }
     dhc_forward_frames_trig(&model->arm, trig, ev->length_scale, sin_q, cos_q, ev->frames, ev->axes,

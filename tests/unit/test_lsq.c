@@ -549,27 +549,31 @@ static void test_streaming_result_is_independent_of_chunking(void)
 /* A batch of rows (which the library sums with the processor's vector unit where it has
  * one) gives the same bits as the same rows added three at a time (always the portable
  * loops): every entry is the same products summed in the rows' order, and the matrix is
- * exactly symmetric. Column counts around the batch kernel's blocks of 4 x 8. */
+ * exactly symmetric; with unit weights and with weights of their own. Column counts around
+ * the batch kernel's blocks of 4 x 8. */
 static void test_batches_give_the_bits_of_rows_added_three_at_a_time(void)
 {
     const size_t cols[] = {5U, 8U, 13U, 24U, 31U};
     const size_t batches[] = {4U, 15U, 24U};
-    for (size_t c = 0U; c < sizeof cols / sizeof cols[0]; ++c) {
-        const size_t p = cols[c];
+    double weights[48];
+    for (size_t trial = 0U; trial < 2U * sizeof cols / sizeof cols[0]; ++trial) {
+        const size_t p = cols[trial / 2U];
         const size_t m = 48U;
+        const double *const w = trial % 2U == 1U ? weights : NULL;
         random_jacobian(m, p, -3.0, 3.0);
         for (size_t e = 0U; e < m; ++e) {
             res[e] = uniform(-1.0, 1.0);
+            weights[e] = uniform(0.1, 7.0);
         }
         TEST_ASSERT_EQUAL(DHC_OK, dhc_normal_eq_init(&ne, p));
         for (size_t first = 0U; first < m; first += 3U) {
-            TEST_ASSERT_EQUAL(DHC_OK, add_rows(&ne, p, first, 3U, NULL));
+            TEST_ASSERT_EQUAL(DHC_OK, add_rows(&ne, p, first, 3U, w));
         }
         for (size_t b = 0U; b < sizeof batches / sizeof batches[0]; ++b) {
             TEST_ASSERT_EQUAL(DHC_OK, dhc_normal_eq_init(&ne2, p));
             for (size_t first = 0U; first < m; first += batches[b]) {
                 const size_t k = first + batches[b] <= m ? batches[b] : m - first;
-                TEST_ASSERT_EQUAL(DHC_OK, add_rows(&ne2, p, first, k, NULL));
+                TEST_ASSERT_EQUAL(DHC_OK, add_rows(&ne2, p, first, k, w));
             }
             TEST_ASSERT_EQUAL_MEMORY(ne.jtj, ne2.jtj, p * p * sizeof ne.jtj[0]);
             TEST_ASSERT_EQUAL_MEMORY(ne.jtr, ne2.jtr, p * sizeof ne.jtr[0]);
