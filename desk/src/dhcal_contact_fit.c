@@ -77,7 +77,10 @@ int dhcal_contact_start(const dhc_model *nominal, const dhc_noise_model *noise, 
                         dhc_model *start, dhc_param_set *set, dhcal_prior *prior, dhcal_error *err)
 {
     *start = *nominal;
-    const dhc_status st = dhc_contact_targets_init(start, dhcal_samples_read, s, s->n, s->flags);
+    dhc_status st = dhc_contact_targets_init(start, dhcal_samples_read, s, s->n, s->flags);
+    if (st == DHC_ERR_NO_DATA) {
+        st = DHC_OK; /* lengths only: no target to fit */
+    }
     if (st == DHC_ERR_UNDERDETERMINED) {
         snprintf(err->msg, sizeof err->msg,
                  "%s: the touches do not define their targets: plane and point ids run 1, 2, "

@@ -85,7 +85,7 @@ static void json_contact(cJSON *obj, const dhcal_fit *f, const dhcal_samples *s)
     size_t touches[2][DHC_MAX_PLANES + DHC_MAX_POINTS] = {{0U}};
     for (size_t i = 0U; i < s->n; ++i) {
         const dhc_sample *smp = &s->samples[i];
-        if (smp->kind >= (uint8_t)DHC_MEAS_PLANE && s->flags[i] == (uint8_t)DHC_SAMPLE_USED) {
+        if (dhc_sample_is_contact(smp) && s->flags[i] == (uint8_t)DHC_SAMPLE_USED) {
             touches[smp->kind == (uint8_t)DHC_MEAS_POINT][smp->target]++;
         }
     }
@@ -164,7 +164,7 @@ void dhcal_json_fit(cJSON *obj, const dhcal_fit *f, const dhc_model *input, cons
     for (size_t i = 0U; i < s->n; ++i) {
         if (dhc_sample_is_outlier(s->flags[i])) {
             cJSON *r = cJSON_CreateObject();
-            cJSON_AddNumberToObject(r, "row", (double)(i + 1U));
+            cJSON_AddNumberToObject(r, "row", (double)(dhcal_samples_row(s, i) + 1U));
             cJSON_AddNumberToObject(r, "error_mm", row_err[i]);
             cJSON_AddStringToObject(r, "reason", dhcal_outlier_reason(s->flags[i]));
             cJSON_AddItemToArray(outl, r);

@@ -224,7 +224,7 @@ typedef struct {
 /* A touch row (docs/formats.md 3.4): its joint angles, but no point measured. */
 static int is_touch(const dhcal_row *row)
 {
-    return row->plane != 0U || row->point != 0U;
+    return row->plane != 0U || row->point != 0U || row->pair != 0U;
 }
 
 static size_t measured_rows(const dhcal_dataset *data)

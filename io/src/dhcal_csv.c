@@ -255,7 +255,7 @@ static int parse_header(csv_ctx *c, dhcal_dataset *data)
                                    "%s:%zu: column '%s' is beyond the model's %zu joints", path,
                                    line, dhcal_quote(f.s, f.n, sb), c->n_joints);
         }
-        const int contact_col = cls > 0 && (col.kind == COL_PLANE || col.kind == COL_POINT);
+        const int contact_col = cls > 0 && dhcal_csv_is_contact_col(col.kind);
         if (c->targets && (cls == 0 || col.kind == COL_WIRE || col.kind == COL_TEMP ||
                            col.kind == COL_TIME || contact_col)) {
             return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
@@ -266,7 +266,8 @@ static int parse_header(csv_ctx *c, dhcal_dataset *data)
         if (cls == 0 && !c->plan) {
             return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
                                    "%s:%zu: unknown column '%s' (known: q1..q%zu, x,y,z, L1,L2,L3, "
-                                   "qw,qx,qy,qz, dir1..dir%zu, temp_c, t_s, plane, point)",
+                                   "qw,qx,qy,qz, dir1..dir%zu, temp_c, t_s, plane, point, pair, "
+                                   "distance_mm)",
                                    path, line, dhcal_quote(f.s, f.n, sb), c->n_joints, c->n_joints);
         }
         if (cls == 0 || (c->plan && col.kind != COL_Q && col.kind != COL_DIR)) {
@@ -324,10 +325,19 @@ static int parse_header(csv_ctx *c, dhcal_dataset *data)
     }
     data->has_plane = seen[COL_PLANE][0] != 0U;
     data->has_point = seen[COL_POINT][0] != 0U;
-    if (!data->has_xyz && !data->has_wires && !data->has_plane && !data->has_point) {
+    data->has_pair = seen[COL_PAIR][0] != 0U;
+    if (data->has_pair != (seen[COL_DISTANCE][0] != 0U)) {
+        return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
+                               "%s:%zu: column '%s' without '%s': a length row names its pair "
+                               "and the pair's distance_mm",
+                               path, line, data->has_pair ? "pair" : "distance_mm",
+                               data->has_pair ? "distance_mm" : "pair");
+    }
+    if (!data->has_xyz && !data->has_wires && !data->has_plane && !data->has_point &&
+        !data->has_pair) {
         return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
                                "%s:%zu: no position columns: need x,y,z or L1,L2,L3 (or the "
-                               "contact columns plane, point)",
+                               "contact columns plane, point, pair)",
                                path, line);
     }
     data->has_temp = seen[COL_TEMP][0] != 0U;
@@ -457,13 +467,14 @@ static int out_of_range(csv_ctx *c, csv_col col, span f, const char *range)
                            dhcal_quote(f.s, f.n, sb), range);
 }
 
-/* The row's contact columns: an id in plane or point (not both) makes it a touch. */
+/* The row's contact columns: an id in plane, point or pair (one of them) makes it a touch or
+ * a length row; distance_mm goes with a pair. */
 static int contact_of_row(csv_ctx *c, dhcal_row *row)
 {
     for (size_t k = 0U; k < c->n_cols; ++k) {
         const csv_col col = c->cols[k];
         const span f = c->spans[k];
-        if ((col.kind != COL_PLANE && col.kind != COL_POINT) || f.n == 0U) {
+        if (!dhcal_csv_is_contact_col(col.kind) || f.n == 0U) {
             continue;
         }
         double v = 0.0;
@@ -473,9 +484,9 @@ static int contact_of_row(csv_ctx *c, dhcal_row *row)
             char nb[16];
             char sb[DHCAL_QUOTE_CAP];
             return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
-                                   "%s:%zu: column '%s': %s is not one of %s", c->rd.path,
-                                   c->rd.line_no, dhcal_csv_col_name(col, nb),
-                                   dhcal_quote(f.s, f.n, sb), rule);
+                                   "%s:%zu: column '%s': %s is %s %s", c->rd.path, c->rd.line_no,
+                                   dhcal_csv_col_name(col, nb), dhcal_quote(f.s, f.n, sb),
+                                   col.kind == COL_DISTANCE ? "outside" : "not one of", rule);
         }
         if (rc != DHCAL_IO_OK) {
             return rc;
@@ -488,19 +499,31 @@ static int contact_of_row(csv_ctx *c, dhcal_row *row)
                                "one target (leave the other column empty)",
                                c->rd.path, c->rd.line_no, row->plane, row->point);
     }
+    if (row->pair != 0U && (row->plane != 0U || row->point != 0U)) {
+        return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
+                               "%s:%zu: the row is of pair %u and touches %s %u: a row is a "
+                               "touch or one end of a length, not both",
+                               c->rd.path, c->rd.line_no, row->pair,
+                               row->plane != 0U ? "plane" : "point",
+                               row->plane != 0U ? row->plane : row->point);
+    }
     return DHCAL_IO_OK;
 }
 
-/* A value in a measurement column of a touch row. */
+/* A value in a measurement column of a touch row or a length row. */
 static int measured_touch(csv_ctx *c, const dhcal_row *row, csv_col col)
 {
     char nb[16];
+    const char *const what = row->plane != 0U   ? "a touch of plane"
+                             : row->point != 0U ? "a touch of point"
+                                                : "an end of length pair";
     return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
-                           "%s:%zu: column '%s': a touch of %s %u measures no point: leave "
-                           "x,y,z, L1,L2,L3 and qw,qx,qy,qz empty in its row",
-                           c->rd.path, c->rd.line_no, dhcal_csv_col_name(col, nb),
-                           row->plane != 0U ? "plane" : "point",
-                           row->plane != 0U ? row->plane : row->point);
+                           "%s:%zu: column '%s': %s %u measures no point: leave x,y,z, L1,L2,L3 "
+                           "and qw,qx,qy,qz empty in its row",
+                           c->rd.path, c->rd.line_no, dhcal_csv_col_name(col, nb), what,
+                           row->plane != 0U   ? row->plane
+                           : row->point != 0U ? row->point
+                                              : row->pair);
 }
 
 static int parse_row(csv_ctx *c, dhcal_row *row)
@@ -518,11 +541,11 @@ static int parse_row(csv_ctx *c, dhcal_row *row)
     memset(row, 0, sizeof *row);
     row->line = c->rd.line_no;
     int rc = contact_of_row(c, row);
-    const int touch = row->plane != 0U || row->point != 0U;
+    const int touch = row->plane != 0U || row->point != 0U || row->pair != 0U;
     for (size_t k = 0U; k < n && rc == DHCAL_IO_OK; ++k) {
         const csv_col col = c->cols[k];
         const span f = c->spans[k];
-        if (col.kind == COL_PLANE || col.kind == COL_POINT) {
+        if (dhcal_csv_is_contact_col(col.kind)) {
             continue; /* read by contact_of_row */
         }
         if (touch && (col.kind == COL_XYZ || col.kind == COL_WIRE || col.kind == COL_QUAT)) {
@@ -553,7 +576,7 @@ static int parse_row(csv_ctx *c, dhcal_row *row)
     if (!touch && !c->measures && !c->plan && !c->targets) {
         return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT,
                                "%s:%zu: neither a touch nor a measurement: the row has no id in "
-                               "'plane' or 'point', and the file no x,y,z or L1,L2,L3",
+                               "'plane', 'point' or 'pair', and the file no x,y,z or L1,L2,L3",
                                c->rd.path, c->rd.line_no);
     }
     if (c->has_quat && !touch) {
@@ -638,7 +661,7 @@ static int csv_read_all(csv_ctx *c, dhcal_dataset *data)
         return dhcal_error_set(c->rd.err, DHCAL_IO_BAD_INPUT, "%s:%zu: header but no data rows",
                                c->rd.path, c->header_line);
     }
-    return DHCAL_IO_OK;
+    return data->has_pair ? dhcal_csv_check_pairs(data, c->rd.path, 0, c->rd.err) : DHCAL_IO_OK;
 }
 
 enum { LOAD_MEASUREMENTS = 0, LOAD_PLAN, LOAD_TARGETS };

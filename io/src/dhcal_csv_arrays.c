@@ -13,13 +13,13 @@
 
 /* ------------------------------------------------------------------ rows as arrays */
 
-/* Row i's touch columns as the CSV reads them: 0 or an id, not both. */
+/* Row i's touch and length columns as the CSV reads them: 0 or an id, one of them. */
 static int touch_of_row(const dhcal_arrays *a, size_t i, dhcal_row *row, dhcal_error *err)
 {
-    const double *const ids[2] = {a->plane, a->point};
-    const col_kind kinds[2] = {COL_PLANE, COL_POINT};
+    const double *const ids[4] = {a->plane, a->point, a->pair, a->distance_mm};
+    const col_kind kinds[4] = {COL_PLANE, COL_POINT, COL_PAIR, COL_DISTANCE};
     const char *const name = a->name != NULL ? a->name : "data";
-    for (size_t t = 0U; t < 2U; ++t) {
+    for (size_t t = 0U; t < 4U; ++t) {
         if (ids[t] == NULL || (ids[t][i] >= 0.0 && ids[t][i] <= 0.0)) {
             continue;
         }
@@ -29,8 +29,9 @@ static int touch_of_row(const dhcal_arrays *a, size_t i, dhcal_row *row, dhcal_e
         if (rule != NULL) {
             char nb[16];
             return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
-                                   "%s: row %zu, column '%s': %.17g is not 0 or one of %s", name,
-                                   i + 1U, dhcal_csv_col_name(col, nb), v, rule);
+                                   "%s: row %zu, column '%s': %.17g is not 0 or %s%s", name, i + 1U,
+                                   dhcal_csv_col_name(col, nb), v,
+                                   col.kind == COL_DISTANCE ? "inside " : "one of ", rule);
         }
         dhcal_csv_store_value(row, col, v);
     }
@@ -39,6 +40,12 @@ static int touch_of_row(const dhcal_arrays *a, size_t i, dhcal_row *row, dhcal_e
                                "%s: row %zu touches plane %u and point %u: a touch is of one "
                                "target",
                                name, i + 1U, row->plane, row->point);
+    }
+    if (row->pair != 0U && (row->plane != 0U || row->point != 0U)) {
+        return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
+                               "%s: row %zu is of pair %u and touches a target: a row is a "
+                               "touch or one end of a length, not both",
+                               name, i + 1U, row->pair);
     }
     return DHCAL_IO_OK;
 }
@@ -54,8 +61,11 @@ int dhcal_dataset_from_arrays(const dhcal_arrays *a, dhcal_dataset *data, dhcal_
     if (a->n_rows == 0U) {
         return dhcal_error_set(err, DHCAL_IO_BAD_INPUT, "%s: no rows", name);
     }
-    if (a->q_deg == NULL ||
-        (a->xyz_mm == NULL && a->wires_mm == NULL && a->plane == NULL && a->point == NULL)) {
+    if ((a->pair == NULL) != (a->distance_mm == NULL)) {
+        return dhcal_error_set(err, DHCAL_IO_FAILED, "%s: pair and distance_mm go together", name);
+    }
+    if (a->q_deg == NULL || (a->xyz_mm == NULL && a->wires_mm == NULL && a->plane == NULL &&
+                             a->point == NULL && a->pair == NULL)) {
         return dhcal_error_set(err, DHCAL_IO_FAILED,
                                "%s: joint angles and tool points or wire lengths required", name);
     }
@@ -78,6 +88,7 @@ int dhcal_dataset_from_arrays(const dhcal_arrays *a, dhcal_dataset *data, dhcal_
     data->has_time = a->t_s != NULL;
     data->has_plane = a->plane != NULL;
     data->has_point = a->point != NULL;
+    data->has_pair = a->pair != NULL;
     const size_t nj = a->n_joints;
     for (size_t i = 0U; i < a->n_rows; ++i) {
         dhcal_row *const row = &data->rows[i];
@@ -87,12 +98,13 @@ int dhcal_dataset_from_arrays(const dhcal_arrays *a, dhcal_dataset *data, dhcal_
             dhcal_dataset_free(data);
             return rc;
         }
-        const int touch = row->plane != 0U || row->point != 0U;
+        const int touch = row->plane != 0U || row->point != 0U || row->pair != 0U;
         if (!touch && a->xyz_mm == NULL && a->wires_mm == NULL) {
             dhcal_dataset_free(data);
             return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
-                                   "%s: row %zu: neither a touch (plane or point 0) nor a "
-                                   "measurement (no tool points or wire lengths given)",
+                                   "%s: row %zu: neither a touch nor a length row (plane, point "
+                                   "and pair 0) nor a measurement (no tool points or wire "
+                                   "lengths given)",
                                    name, i + 1U);
         }
         /* each value through the CSV's own rule and store, column by column as a file
@@ -131,7 +143,11 @@ int dhcal_dataset_from_arrays(const dhcal_arrays *a, dhcal_dataset *data, dhcal_
             }
         }
     }
-    return DHCAL_IO_OK;
+    const int rc = data->has_pair ? dhcal_csv_check_pairs(data, name, 1, err) : DHCAL_IO_OK;
+    if (rc != DHCAL_IO_OK) {
+        dhcal_dataset_free(data);
+    }
+    return rc;
 }
 
 /* ------------------------------------------------------------------ writing */
@@ -151,6 +167,7 @@ void dhcal_csv_write_header(dhcal_text *t, const dhcal_csv_columns *cols)
     dhcal_text_str(t, cols->has_time ? ",t_s" : "");
     dhcal_text_str(t, cols->has_plane ? ",plane" : "");
     dhcal_text_str(t, cols->has_point ? ",point" : "");
+    dhcal_text_str(t, cols->has_pair ? ",pair,distance_mm" : "");
     dhcal_text_str(t, "\n");
 }
 
@@ -163,8 +180,8 @@ void dhcal_csv_write_row(dhcal_text *t, const dhcal_csv_columns *cols, const dhc
     for (size_t j = 0U; cols->has_dir && j < cols->n_joints; ++j) {
         dhcal_text_printf(t, ",%d", row->dir[j]);
     }
-    /* a touch measures nothing: its measurement cells stay empty */
-    const int touch = row->plane != 0U || row->point != 0U;
+    /* a touch or a length row measures no point: its measurement cells stay empty */
+    const int touch = row->plane != 0U || row->point != 0U || row->pair != 0U;
     if (cols->has_xyz && touch) {
         dhcal_text_str(t, ",,,");
     } else if (cols->has_xyz) {
@@ -198,6 +215,16 @@ void dhcal_csv_write_row(dhcal_text *t, const dhcal_csv_columns *cols, const dhc
         dhcal_text_str(t, ",");
         if (row->point != 0U) {
             dhcal_text_printf(t, "%u", row->point);
+        }
+    }
+    if (cols->has_pair) {
+        dhcal_text_str(t, ",");
+        if (row->pair != 0U) {
+            dhcal_text_printf(t, "%u", row->pair);
+        }
+        dhcal_text_str(t, ",");
+        if (row->distance_mm > 0.0) {
+            dhcal_text_printf(t, "%.6f", row->distance_mm);
         }
     }
     dhcal_text_str(t, "\n");

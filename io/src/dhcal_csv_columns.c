@@ -22,6 +22,8 @@ const char *dhcal_csv_col_name(csv_col c, char buf[16])
     case COL_TIME: return "t_s";
     case COL_PLANE: return "plane";
     case COL_POINT: return "point";
+    case COL_PAIR: return "pair";
+    case COL_DISTANCE: return "distance_mm";
     case COL_TEMP:
     case COL_KIND_COUNT:
     default: return "temp_c";
@@ -76,6 +78,10 @@ int dhcal_csv_classify(const char *name, size_t n_joints, csv_col *col, size_t *
         *col = (csv_col){name[1] == 'l' ? COL_PLANE : COL_POINT, 0U};
         return 1;
     }
+    if (strcmp(name, "pair") == 0 || strcmp(name, "distance_mm") == 0) {
+        *col = (csv_col){name[1] == 'a' ? COL_PAIR : COL_DISTANCE, 0U};
+        return 1;
+    }
     col_kind kind = COL_Q;
     if (name[0] == 'q') {
         k = parse_index(name + 1);
@@ -116,6 +122,11 @@ const char *dhcal_csv_value_rule(col_kind kind, double v)
         return v >= 1.0 && v <= (double)DHC_MAX_POINTS && floor(v) <= v && floor(v) >= v
                    ? NULL
                    : (DHC_MAX_POINTS == 8U ? "the ids 1..8" : "the ids 1..DHC_MAX_POINTS");
+    case COL_PAIR:
+        return v >= 1.0 && v <= (double)CSV_MAX_PAIR && floor(v) <= v && floor(v) >= v
+                   ? NULL
+                   : "the ids 1..1000000";
+    case COL_DISTANCE: return !(v > 0.0) || v > LEN_MAX_MM ? "(0, 1e5] mm" : NULL;
     case COL_TEMP:
     case COL_KIND_COUNT:
     default: return v < TEMP_MIN_C || v > TEMP_MAX_C ? "[-60, 150] degC" : NULL;
@@ -134,8 +145,92 @@ void dhcal_csv_store_value(dhcal_row *row, csv_col col, double v)
     case COL_TIME: row->t_s = v; break;
     case COL_PLANE: row->plane = (unsigned)v; break;
     case COL_POINT: row->point = (unsigned)v; break;
+    case COL_PAIR: row->pair = (unsigned)v; break;
+    case COL_DISTANCE: row->distance_mm = v; break;
     case COL_TEMP:
     case COL_KIND_COUNT:
     default: row->temp_c = v; break;
     }
+}
+
+int dhcal_csv_is_contact_col(col_kind kind)
+{
+    return kind == COL_PLANE || kind == COL_POINT || kind == COL_PAIR || kind == COL_DISTANCE;
+}
+
+/* "path:line" of a file's row, "path: row N" of rows handed in as arrays */
+static void where(const dhcal_dataset *data, const char *path, int rows, size_t i, char *buf,
+                  size_t cap)
+{
+    if (rows) {
+        snprintf(buf, cap, "%s: row %zu", path, i + 1U);
+    } else {
+        snprintf(buf, cap, "%s:%zu", path, data->rows[i].line);
+    }
+}
+
+/* The row after i of pair id (data->n_rows: none) */
+static size_t next_of_pair(const dhcal_dataset *data, size_t i, unsigned id)
+{
+    size_t k = i + 1U;
+    while (k < data->n_rows && data->rows[k].pair != id) {
+        ++k;
+    }
+    return k;
+}
+
+int dhcal_csv_check_pairs(const dhcal_dataset *data, const char *path, int rows, dhcal_error *err)
+{
+    char a[300];
+    char b[300];
+    for (size_t i = 0U; i < data->n_rows; ++i) {
+        const dhcal_row *const row = &data->rows[i];
+        where(data, path, rows, i, a, sizeof a);
+        if (row->pair == 0U && row->distance_mm > 0.0) {
+            return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
+                                   "%s: a distance_mm without a pair id: a length is between "
+                                   "the tool points of the two rows of one pair",
+                                   a);
+        }
+        if (row->pair == 0U) {
+            continue;
+        }
+        size_t first = 0U;
+        while (data->rows[first].pair != row->pair) {
+            ++first;
+        }
+        if (first < i) {
+            continue; /* checked with its first row */
+        }
+        const size_t second = next_of_pair(data, i, row->pair);
+        if (second == data->n_rows) {
+            return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
+                                   "%s: pair %u has one row: a length needs the two rows whose "
+                                   "tool points it separates",
+                                   a, row->pair);
+        }
+        where(data, path, rows, second, b, sizeof b);
+        const size_t third = next_of_pair(data, second, row->pair);
+        if (third < data->n_rows) {
+            char c[300];
+            where(data, path, rows, third, c, sizeof c);
+            return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
+                                   "%s: pair %u has a third row (the first two: %s, %s): give "
+                                   "each length its own id",
+                                   c, row->pair, a, b);
+        }
+        const double d1 = row->distance_mm;
+        const double d2 = data->rows[second].distance_mm;
+        if (!(d1 > 0.0) && !(d2 > 0.0)) {
+            return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
+                                   "%s: pair %u gives no distance_mm (in neither this row nor %s)",
+                                   a, row->pair, b);
+        }
+        if (d1 > 0.0 && d2 > 0.0 && !(fabs(d1 - d2) <= 1e-9 * fmax(d1, d2))) {
+            return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
+                                   "%s: pair %u's distance_mm %.9g differs from %.9g in %s", b,
+                                   row->pair, d2, d1, a);
+        }
+    }
+    return DHCAL_IO_OK;
 }

@@ -15,23 +15,31 @@ int dhcal_samples_build(const dhc_model *model, const dhcal_dataset *data, const
     const size_t cap = data->n_rows > 0U ? data->n_rows : 1U;
     out->samples = calloc(cap, sizeof *out->samples);
     out->flags = calloc(cap, 1U);
-    if (out->samples == NULL || out->flags == NULL) {
+    out->row_of = calloc(cap, sizeof *out->row_of);
+    uint8_t *const partner = calloc(cap, 1U); /* a length pair's second row */
+    if (out->samples == NULL || out->flags == NULL || out->row_of == NULL || partner == NULL) {
+        free(partner);
         dhcal_samples_free(out);
         snprintf(err->msg, sizeof err->msg, "%s: out of memory for %zu rows", path, data->n_rows);
         return DHCAL_IO_FAILED;
     }
-    out->n = data->n_rows;
     out->wires = data->has_wires && model->measurer.present;
     if (!out->wires && !data->has_xyz && data->has_wires) {
         const size_t line = data->n_rows > 0U ? data->rows[0].line : 1U;
+        free(partner);
         dhcal_samples_free(out);
         snprintf(err->msg, sizeof err->msg,
                  "%s:%zu: wire lengths L1..L3 need a model with a 'measurer' block", path, line);
         return DHCAL_IO_BAD_INPUT;
     }
+    size_t n = 0U;
     for (size_t i = 0U; i < data->n_rows; ++i) {
         const dhcal_row *row = &data->rows[i];
-        dhc_sample *s = &out->samples[i];
+        if (partner[i]) {
+            continue; /* its pair's sample holds it */
+        }
+        out->row_of[n] = i;
+        dhc_sample *s = &out->samples[n++];
         for (size_t j = 0U; j < data->n_joints && j < DHC_MAX_JOINTS; ++j) {
             s->q_rad[j] = row->q_rad[j];
             s->dir[j] = (int8_t)(data->has_dir ? row->dir[j] : 0);
@@ -39,7 +47,20 @@ int dhcal_samples_build(const dhc_model *model, const dhcal_dataset *data, const
         s->temp_c = data->has_temp ? row->temp_c : model->thermal_ref_c;
         /* drift's clock: the t_s column, else the 0-based row number (docs/formats.md, 3.2) */
         s->t_s = data->has_time ? row->t_s : (double)i;
-        if (row->plane != 0U || row->point != 0U) {
+        if (row->pair != 0U) {
+            /* the rows' pairs are whole (dhcal_csv_load): the second is further down */
+            size_t k = i + 1U;
+            while (k < data->n_rows && data->rows[k].pair != row->pair) {
+                ++k;
+            }
+            const dhcal_row *const other = &data->rows[k < data->n_rows ? k : i];
+            partner[k < data->n_rows ? k : i] = 1U;
+            for (size_t j = 0U; j < data->n_joints && j < DHC_MAX_JOINTS; ++j) {
+                s->q2_rad[j] = other->q_rad[j];
+            }
+            s->distance_mm = row->distance_mm > 0.0 ? row->distance_mm : other->distance_mm;
+            s->kind = (uint8_t)DHC_MEAS_DISTANCE;
+        } else if (row->plane != 0U || row->point != 0U) {
             /* a touch: the target's pose is the fit's (dhc_contact.h) */
             s->kind = (uint8_t)(row->plane != 0U ? DHC_MEAS_PLANE : DHC_MEAS_POINT);
             s->target = (uint8_t)((row->plane != 0U ? row->plane : row->point) - 1U);
@@ -53,14 +74,17 @@ int dhcal_samples_build(const dhc_model *model, const dhcal_dataset *data, const
                 if (dhc_rot_from_quat(row->quat, &s->rot) != DHC_OK) {
                     snprintf(err->msg, sizeof err->msg, "%s:%zu: quaternion is not a rotation",
                              path, row->line);
+                    free(partner);
                     dhcal_samples_free(out);
                     return DHCAL_IO_BAD_INPUT;
                 }
                 s->kind = (uint8_t)DHC_MEAS_POSE;
             }
         }
-        out->flags[i] = (uint8_t)DHC_SAMPLE_USED;
+        out->flags[n - 1U] = (uint8_t)DHC_SAMPLE_USED;
     }
+    free(partner);
+    out->n = n;
     /* Without the table every pass of a fit computes these again (optional: no memory, no
      * table, the same results). */
     const size_t nj = model->arm.n_joints;
@@ -89,14 +113,21 @@ int dhcal_samples_check_held(const dhcal_samples *train, const dhcal_samples *he
     return DHCAL_IO_BAD_INPUT;
 }
 
+size_t dhcal_samples_row(const dhcal_samples *s, size_t i)
+{
+    return s->row_of != NULL ? s->row_of[i] : i;
+}
+
 void dhcal_samples_free(dhcal_samples *s)
 {
     free(s->samples);
     free(s->flags);
     free(s->joint_sincos);
+    free(s->row_of);
     s->samples = NULL;
     s->flags = NULL;
     s->joint_sincos = NULL;
+    s->row_of = NULL;
     s->sincos_joints = 0U;
     s->n = 0U;
 }

@@ -70,8 +70,8 @@ typedef struct {
 typedef struct {
     double temp_min_c;
     double temp_max_c;
-    uint8_t dir_seen[DHC_MAX_JOINTS];      /* some sample knows joint i's approach direction */
-    size_t kind_count[DHC_MEAS_POINT + 1]; /* samples of each dhc_meas_kind */
+    uint8_t dir_seen[DHC_MAX_JOINTS];         /* some sample knows joint i's approach direction */
+    size_t kind_count[DHC_MEAS_DISTANCE + 1]; /* samples of each dhc_meas_kind */
 } data_traits;
 
 typedef struct {

@@ -237,8 +237,8 @@ static uint8_t main_kind(const data_traits *t)
 }
 
 /* The kind and target of structural pose k: the data's absolute kind (when they have absolute
- * samples), then each plane and each point of the model in turn (when they have such
- * samples). Data without contact samples: always the absolute kind. */
+ * samples), then each plane and each point of the model in turn, then a length (when they
+ * have such samples). Data without contact samples: always the absolute kind. */
 #if DHC_WITH_CONTACT
 static void structural_slot(const dhc_model *model, const data_traits *t, size_t k, dhc_sample *s)
 {
@@ -249,7 +249,8 @@ static void structural_slot(const dhc_model *model, const data_traits *t, size_t
                                 : 0U;
     const size_t planes = t->kind_count[DHC_MEAS_PLANE] > 0U ? model->contact.n_planes : 0U;
     const size_t points = t->kind_count[DHC_MEAS_POINT] > 0U ? model->contact.n_points : 0U;
-    const size_t slots = absolute + planes + points;
+    const size_t lengths = t->kind_count[DHC_MEAS_DISTANCE] > 0U ? 1U : 0U;
+    const size_t slots = absolute + planes + points + lengths;
     const size_t slot = slots > 0U ? k % slots : 0U;
     s->target = 0U;
     if (slot < absolute || slots == 0U) {
@@ -257,9 +258,12 @@ static void structural_slot(const dhc_model *model, const data_traits *t, size_t
     } else if (slot < absolute + planes) {
         s->kind = (uint8_t)DHC_MEAS_PLANE;
         s->target = (uint8_t)(slot - absolute);
-    } else {
+    } else if (slot < absolute + planes + points) {
         s->kind = (uint8_t)DHC_MEAS_POINT;
         s->target = (uint8_t)(slot - absolute - planes);
+    } else {
+        s->kind = (uint8_t)DHC_MEAS_DISTANCE;
+        s->distance_mm = 1.0; /* any length: the rows' slopes do not depend on it */
     }
 }
 #endif
@@ -280,7 +284,7 @@ static dhc_status structural_analysis(const fit_context *fc, const dhc_model *mo
     const size_t poses =
         (p + rows - 1U) / rows +
         STRUCTURAL_EXTRA_POSES *
-            (contact ? 1U + model->contact.n_planes + model->contact.n_points : 1U);
+            (contact ? 2U + model->contact.n_planes + model->contact.n_points : 1U);
     const double w = fc->opt->orientation_weight_mm_per_rad;
     uint32_t state = fc->opt->structural_seed != 0U ? fc->opt->structural_seed : 1U;
     dhc_status st = dhc_normal_eq_init(&ws->ne, p);
@@ -293,6 +297,9 @@ static dhc_status structural_analysis(const fit_context *fc, const dhc_model *mo
             const dhc_joint *const j = &model->arm.joint[i];
             s->q_rad[i] = j->min_rad + (j->max_rad - j->min_rad) * next_uniform(&state);
             s->dir[i] = (int8_t)(traits->dir_seen[i] ? (next_uniform(&state) < 0.5 ? -1 : 1) : 0);
+#if DHC_WITH_CONTACT
+            s->q2_rad[i] = j->min_rad + (j->max_rad - j->min_rad) * next_uniform(&state);
+#endif
         }
         s->temp_c =
             traits->temp_min_c + (traits->temp_max_c - traits->temp_min_c) * next_uniform(&state);
@@ -302,7 +309,7 @@ static dhc_status structural_analysis(const fit_context *fc, const dhc_model *mo
         }
         /* a touch: the pose moved onto its target (off it, a plane's offset would not take a
          * common scale of the lengths); a pose that cannot be is drawn again */
-        if (s->kind >= (uint8_t)DHC_MEAS_PLANE &&
+        if (dhc_sample_is_contact(s) &&
             dhc_contact_touch(model, &ws->trig, &ws->eval, s, 1e-6) != DHC_OK) {
             continue;
         }
@@ -389,7 +396,9 @@ dhc_status dhc_fit_structural_rank(const fit_context *fc, const dhc_model *model
     const size_t p = fc->set->count;
     int contact = 0;
 #if DHC_WITH_CONTACT
-    contact = traits->kind_count[DHC_MEAS_PLANE] + traits->kind_count[DHC_MEAS_POINT] > 0U;
+    contact = traits->kind_count[DHC_MEAS_PLANE] + traits->kind_count[DHC_MEAS_POINT] +
+                  traits->kind_count[DHC_MEAS_DISTANCE] >
+              0U;
     memset(rep->blind, 0, sizeof rep->blind);
     if (contact) {
         const dhc_status absolute = structural_analysis(fc, model, traits, 0);

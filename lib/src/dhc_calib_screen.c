@@ -59,6 +59,17 @@ static int next_used_error2(const fit_context *fc, const dhc_model *model, const
     return *st == DHC_OK;
 }
 
+#if DHC_WITH_CONTACT
+/* A length (DHC_MEAS_DISTANCE) measures the one thing touches cannot, the scale: a fit of the
+ * rows closest to the start cannot judge it, so the robust start neither trims one nor leaves
+ * one out (the fit's own outlier screen, at its estimate, still does). */
+static int robust_exempt(const fit_context *fc, size_t i, uint8_t mark)
+{
+    return mark == (uint8_t)DHC_SAMPLE_ROBUST && fc->read(fc->ctx, i, &fc->ws->sample) == DHC_OK &&
+           fc->ws->sample.kind == (uint8_t)DHC_MEAS_DISTANCE;
+}
+#endif
+
 /* One pass over the used samples; with mark other than DHC_SAMPLE_USED, samples with e2
  * above limit2 are flagged with it. at as sample_error2's. */
 DHC_ROBUST_SHARED
@@ -80,6 +91,11 @@ dhc_status dhc_fit_scan_errors(const fit_context *fc, const dhc_model *model, co
         if (e2 <= limit2) {
             out->at_most++;
         } else if (mark != (uint8_t)DHC_SAMPLE_USED) {
+#if DHC_WITH_CONTACT
+            if (robust_exempt(fc, i, mark)) {
+                continue;
+            }
+#endif
             fc->flags[i] = mark;
         }
     }
@@ -171,7 +187,8 @@ dhc_status dhc_fit_scan_all(const fit_context *fc, const dhc_model *model, const
     out->used = tot->samples;
     out->pose = tot->pose_samples;
 #if DHC_WITH_CONTACT
-    out->one_row = tot->traits.kind_count[DHC_MEAS_PLANE];
+    out->one_row =
+        tot->traits.kind_count[DHC_MEAS_PLANE] + tot->traits.kind_count[DHC_MEAS_DISTANCE];
 #endif
     out->at_most = tot->samples;
     out->max_e2 = tot->max_e2;

@@ -111,11 +111,12 @@ static int set_has_compliance(const dhc_param_set *set)
 
 /* Factor by which a joint effect parameter scales its joint's column: d(dq_i)/d(param).
  * (A set never holds the parameters of an effect the build leaves out: dhc_params_add.) */
-static double joint_effect_factor(const dhc_param_id *id, const dhc_sample *s,
+static double joint_effect_factor(const dhc_param_id *id, const dhc_sample *s, const double *q_rad,
                                   const double *sincos_q, const double *tau_row)
 {
-    const double q = s->q_rad[id->joint];
-    (void)q, (void)sincos_q, (void)tau_row; /* a build without the effects that read them */
+    const double q = q_rad[id->joint];
+    (void)q, (void)s, (void)sincos_q,
+        (void)tau_row; /* a build without the effects that read them */
 #if DHC_WITH_EFFECT_JOINT_HARMONIC
     if (sincos_q != NULL &&
         (id->kind == (uint8_t)DHC_P_HARMONIC_SIN || id->kind == (uint8_t)DHC_P_HARMONIC_COS)) {
@@ -194,57 +195,99 @@ dhc_status dhc_model_jacobian_prepared(const dhc_model *model, const dhc_arm_tri
                : st;
 }
 
+/* How parameter id moves the tool point (dp, world mm; zero on entry) and turns the last link
+ * (dw, zero on entry) at the evaluation in ev, made at joint angles q_rad (sincos_q theirs, or
+ * NULL) where the arm's tool point is p_arm; drift: the session's drift factor there. */
+static void param_slope(const dhc_model *model, const dhc_param_id *id, const dhc_sample *s,
+                        const double *q_rad, const double *sincos_q, dhc_model_eval *ev,
+                        const double *p_arm, double drift, double dp[3], double dw[3])
+{
+    const dhc_arm *const arm = &model->arm;
+    /* the session's drift scales every move of the arm's point about the base origin; a
+     * move of the base origin itself moves the measured point one to one */
+    double dp_scale = drift;
+    if (is_geometric(id->kind)) {
+        geometric_column(arm, ev->frames, ev->axes, p_arm, id, dp, dw);
+        if (id->kind >= (uint8_t)DHC_P_BASE_X && id->kind <= (uint8_t)DHC_P_BASE_Z) {
+            dp_scale = 1.0;
+        }
+        /* lengths are stored unscaled; the chain used them times the thermal factor */
+        if (id->kind == (uint8_t)DHC_P_D || id->kind == (uint8_t)DHC_P_A ||
+            id->kind >= (uint8_t)DHC_P_TOOL_X) {
+            dhc_vec3_scale(dp, ev->length_scale, dp);
+        }
+    } else if (id->kind <= (uint8_t)DHC_P_COMPLIANCE) {
+        const dhc_param_id joint_theta = {(uint8_t)DHC_P_THETA, id->joint, 0U};
+        const double factor = joint_effect_factor(id, s, q_rad, sincos_q, ev->tau[id->joint]);
+        geometric_column(arm, ev->frames, ev->axes, p_arm, &joint_theta, dp, dw);
+        dhc_vec3_scale(dp, factor, dp);
+        dhc_vec3_scale(dw, factor, dw);
+    } else if (DHC_WITH_EFFECT_THERMAL && id->kind == (uint8_t)DHC_P_THERMAL) {
+        /* scaling every length scales the tool point about the base origin */
+        dhc_vec3_sub(p_arm, arm->base.pos, dp);
+        dhc_vec3_scale(dp, (s->temp_c - model->thermal_ref_c) / ev->length_scale, dp);
+    } else if (DHC_WITH_EFFECT_DRIFT && id->kind == (uint8_t)DHC_P_DRIFT_SCALE) {
+        dhc_vec3_sub(p_arm, arm->base.pos, dp);
+        dhc_vec3_scale(dp, s->t_s - model->drift_ref_s, dp);
+        dp_scale = 1.0;
+    } else if (DHC_WITH_EFFECT_DRIFT && id->kind == (uint8_t)DHC_P_DRIFT_OFFSET) {
+        dp[id->aux % 3U] = s->t_s - model->drift_ref_s;
+        dp_scale = 1.0;
+    }
+    dhc_vec3_scale(dp, dp_scale, dp);
+}
+
+#if DHC_WITH_CONTACT
+/* A DISTANCE sample's row, u . (dp - dp2) with u the unit vector from the second tool point to
+ * the first: jac holds u . dp on entry (ev and pr at the first angles), the second's slopes
+ * are subtracted at its own evaluation, and the first's evaluation is made again (the
+ * caller's residual reads pr, and ev ends there as for every kind). */
+static dhc_status distance_row(const dhc_model *model, const dhc_arm_trig *trig,
+                               const dhc_param_set *set, const dhc_sample *s,
+                               const double *sincos_q, const double u[3], dhc_mat *jac,
+                               dhc_prediction *pr, dhc_model_eval *ev)
+{
+    const int moments = set_has_compliance(set);
+    dhc_status st = dhc_model_evaluate_second(model, trig, s, moments, ev, pr);
+    const double drift = dhc_model_drift_factor(model, s->t_s);
+    for (size_t k = 0U; k < set->count && st == DHC_OK; ++k) {
+        double dp[3] = {0.0, 0.0, 0.0};
+        double dw[3] = {0.0, 0.0, 0.0};
+        param_slope(model, &set->id[k], s, s->q2_rad, NULL, ev, pr->p_arm_mm, drift, dp, dw);
+        DHC_MAT_AT(jac, 0U, k) -= dhc_vec3_dot(u, dp);
+    }
+    return st == DHC_OK ? dhc_model_evaluate_prepared(model, trig, s, sincos_q, moments, ev, pr)
+                        : st;
+}
+#endif
+
 /* dhc_model_jacobian after its argument checks, at the caller's trigonometry. */
 static dhc_status jacobian_prepared(const dhc_model *model, const dhc_arm_trig *trig,
                                     const dhc_param_set *set, const dhc_sample *s,
                                     const double *sincos_q, double weight_mm_per_rad, dhc_mat *jac,
                                     dhc_prediction *pr, dhc_model_eval *ev)
 {
-    const dhc_status st =
+    dhc_status st =
         dhc_model_evaluate_prepared(model, trig, s, sincos_q, set_has_compliance(set), ev, pr);
     if (st != DHC_OK) {
         return st;
     }
-    const dhc_arm *const arm = &model->arm;
-    /* the session's drift scales every move of the arm's point about the base origin; a
-     * move of the base origin itself moves the measured point one to one */
-    const double drift = dhc_model_drift_factor(model, s->t_s);
-    const double *const p_arm = pr->p_arm_mm;
     const int with_orientation = DHC_WITH_POSE_SAMPLES && s->kind == (uint8_t)DHC_MEAS_POSE;
+#if DHC_WITH_CONTACT
+    const int distance = s->kind == (uint8_t)DHC_MEAS_DISTANCE;
+    double u[3] = {0.0, 0.0, 0.0};
+    if (distance) {
+        const double len = dhc_vec3_norm(pr->contact_mm);
+        /* two tool points at one place: the length's slope has no direction (left 0) */
+        dhc_vec3_scale(pr->contact_mm, len > 0.0 ? 1.0 / len : 0.0, u);
+    }
+#endif
+    const double drift = dhc_model_drift_factor(model, s->t_s);
     for (size_t k = 0U; k < set->count; ++k) {
         const dhc_param_id *id = &set->id[k];
         double dp[3] = {0.0, 0.0, 0.0};
         double dw[3] = {0.0, 0.0, 0.0};
-        double dp_scale = drift;
-        if (is_geometric(id->kind)) {
-            geometric_column(arm, ev->frames, ev->axes, p_arm, id, dp, dw);
-            if (id->kind >= (uint8_t)DHC_P_BASE_X && id->kind <= (uint8_t)DHC_P_BASE_Z) {
-                dp_scale = 1.0;
-            }
-            /* lengths are stored unscaled; the chain used them times the thermal factor */
-            if (id->kind == (uint8_t)DHC_P_D || id->kind == (uint8_t)DHC_P_A ||
-                id->kind >= (uint8_t)DHC_P_TOOL_X) {
-                dhc_vec3_scale(dp, ev->length_scale, dp);
-            }
-        } else if (id->kind <= (uint8_t)DHC_P_COMPLIANCE) {
-            const dhc_param_id joint_theta = {(uint8_t)DHC_P_THETA, id->joint, 0U};
-            const double factor = joint_effect_factor(id, s, sincos_q, ev->tau[id->joint]);
-            geometric_column(arm, ev->frames, ev->axes, p_arm, &joint_theta, dp, dw);
-            dhc_vec3_scale(dp, factor, dp);
-            dhc_vec3_scale(dw, factor, dw);
-        } else if (DHC_WITH_EFFECT_THERMAL && id->kind == (uint8_t)DHC_P_THERMAL) {
-            /* scaling every length scales the tool point about the base origin */
-            dhc_vec3_sub(p_arm, arm->base.pos, dp);
-            dhc_vec3_scale(dp, (s->temp_c - model->thermal_ref_c) / ev->length_scale, dp);
-        } else if (DHC_WITH_EFFECT_DRIFT && id->kind == (uint8_t)DHC_P_DRIFT_SCALE) {
-            dhc_vec3_sub(p_arm, arm->base.pos, dp);
-            dhc_vec3_scale(dp, s->t_s - model->drift_ref_s, dp);
-            dp_scale = 1.0;
-        } else if (DHC_WITH_EFFECT_DRIFT && id->kind == (uint8_t)DHC_P_DRIFT_OFFSET) {
-            dp[id->aux % 3U] = s->t_s - model->drift_ref_s;
-            dp_scale = 1.0;
-        }
-        dhc_vec3_scale(dp, dp_scale, dp);
+        param_slope(model, id, s, s->q_rad, sincos_q, ev, pr->p_arm_mm, drift, dp, dw);
         if (s->kind == (uint8_t)DHC_MEAS_WIRES) {
             double col[3];
             wire_rows(model, id, pr->p_mm, dp, col);
@@ -252,6 +295,8 @@ static dhc_status jacobian_prepared(const dhc_model *model, const dhc_arm_trig *
                 DHC_MAT_AT(jac, r, k) = col[r];
             }
 #if DHC_WITH_CONTACT
+        } else if (distance) {
+            DHC_MAT_AT(jac, 0U, k) = dhc_vec3_dot(u, dp);
         } else if (s->kind >= (uint8_t)DHC_MEAS_PLANE) {
             double col[3];
             dhc_contact_column(&model->contact, s, id, pr->p_mm, dp, col);
@@ -263,13 +308,18 @@ static dhc_status jacobian_prepared(const dhc_model *model, const dhc_arm_trig *
             put_column(jac, k, dp, dw, with_orientation, weight_mm_per_rad);
         }
     }
+#if DHC_WITH_CONTACT
+    if (distance) {
+        st = distance_row(model, trig, set, s, sincos_q, u, jac, pr, ev);
+    }
+#endif
     /* A finite prediction can still have infinite slopes: a thermal factor of 0 divides
      * the thermal column by 0, a huge weight overflows the orientation rows (fuzzing). */
-    if (!jac_finite(jac)) {
+    if (st == DHC_OK && !jac_finite(jac)) {
         dhc_mat_fill(jac, 0.0);
         return DHC_ERR_NONFINITE;
     }
-    return DHC_OK;
+    return st;
 }
 
 dhc_status dhc_model_linearize_prepared(const dhc_model *model, const dhc_arm_trig *trig,

@@ -25,7 +25,8 @@ dhc_status dhc_model_init(dhc_model *model, size_t n_joints)
 
 size_t dhc_sample_rows(const dhc_sample *s)
 {
-    if (DHC_WITH_CONTACT && s->kind == (uint8_t)DHC_MEAS_PLANE) {
+    if (DHC_WITH_CONTACT &&
+        (s->kind == (uint8_t)DHC_MEAS_PLANE || s->kind == (uint8_t)DHC_MEAS_DISTANCE)) {
         return 1U;
     }
     return s->kind == (uint8_t)DHC_MEAS_POSE ? 6U : 3U;
@@ -40,6 +41,9 @@ static int kind_known(const dhc_model *model, const dhc_sample *s)
     }
     if (s->kind == (uint8_t)DHC_MEAS_POINT) {
         return s->target < model->contact.n_points;
+    }
+    if (s->kind == (uint8_t)DHC_MEAS_DISTANCE) {
+        return 1;
     }
 #else
     (void)model;
@@ -59,6 +63,16 @@ dhc_status dhc_sample_check(const dhc_model *model, const dhc_sample *s)
     if (!dhc_is_finite(s->temp_c) || !dhc_is_finite(s->t_s)) {
         return DHC_ERR_NONFINITE;
     }
+#if DHC_WITH_CONTACT
+    if (s->kind == (uint8_t)DHC_MEAS_DISTANCE) {
+        if (!dhc_all_finite(s->q2_rad, model->arm.n_joints) || !dhc_is_finite(s->distance_mm)) {
+            return DHC_ERR_NONFINITE;
+        }
+        if (!(s->distance_mm > 0.0)) {
+            return DHC_ERR_ARGUMENT; /* a length between two tool points */
+        }
+    }
+#endif
     for (size_t i = 0U; i < model->arm.n_joints; ++i) {
         if (!dhc_is_finite(s->q_rad[i])) {
             return DHC_ERR_NONFINITE;
@@ -247,6 +261,17 @@ static int carries_left_out_effect(const dhc_model *model)
 }
 #endif
 
+#if DHC_WITH_CONTACT
+/* dhc_model_evaluate_prepared at joint angles q_rad (the sample's q_rad, or a DISTANCE
+ * sample's q2_rad; sincos_q theirs, or NULL), after the argument checks. */
+static dhc_status evaluate_at(const dhc_model *model, const dhc_arm_trig *trig, const dhc_sample *s,
+                              const double *q_rad, const double *sincos_q, int need_moments,
+                              dhc_model_eval *ev, dhc_prediction *out)
+{
+    dhc_status st = dhc_sample_check(model, s);
+#else
+/* One pose per sample: the evaluation itself, without a second pose's wrapper (the
+ * controller's flash holds every byte). */
 dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_trig *trig,
                                        const dhc_sample *s, const double *sincos_q,
                                        int need_moments, dhc_model_eval *ev, dhc_prediction *out)
@@ -255,6 +280,8 @@ dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_tri
         return DHC_ERR_ARGUMENT;
     }
     dhc_status st = dhc_sample_check(model, s);
+    const double *const q_rad = st == DHC_OK ? s->q_rad : NULL;
+#endif
     if (st != DHC_OK) {
         return st;
     }
@@ -277,8 +304,8 @@ dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_tri
     double sin_q[DHC_MAX_JOINTS];
     double cos_q[DHC_MAX_JOINTS];
     for (size_t i = 0U; i < n; ++i) {
-        sin_q[i] = sincos_q != NULL ? sincos_q[2U * i] : sin(s->q_rad[i]);
-        cos_q[i] = sincos_q != NULL ? sincos_q[2U * i + 1U] : cos(s->q_rad[i]);
+        sin_q[i] = sincos_q != NULL ? sincos_q[2U * i] : sin(q_rad[i]);
+        cos_q[i] = sincos_q != NULL ? sincos_q[2U * i + 1U] : cos(q_rad[i]);
     }
     if (ev->has_moments) {
         dhc_forward_frames_trig(&model->arm, trig, ev->length_scale, sin_q, cos_q, ev->frames, NULL,
@@ -290,7 +317,7 @@ dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_tri
     }
     for (size_t i = 0U; i < n; ++i) {
         const dhc_joint_effects *fx = &model->effect[i];
-        const double q = s->q_rad[i];
+        const double q = q_rad[i];
         double dq = DHC_WITH_EFFECT_JOINT_SCALE || DHC_WITH_EFFECT_JOINT_BACKLASH
                         ? fx->scale * q + 0.5 * fx->backlash_rad * (double)s->dir[i]
                         : 0.0;
@@ -317,11 +344,13 @@ dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_tri
             return DHC_ERR_NONFINITE;
         }
         /* Without effects q_eff is q to the bit, and so are its sine and cosine. */
-        if (fabs(dq) > 0.0 && DHC_SMALL_CODE) {
+        if (fabs(dq) > 0.0) {
+#if DHC_SMALL_CODE
             sin_q[i] = sin(out->q_eff_rad[i]);
             cos_q[i] = cos(out->q_eff_rad[i]);
-        } else if (fabs(dq) > 0.0) {
+#else
             dhc_sincos_shifted(q, sin_q[i], cos_q[i], dq, &sin_q[i], &cos_q[i]);
+#endif
         }
     }
     dhc_forward_frames_trig(&model->arm, trig, ev->length_scale, sin_q, cos_q, ev->frames, ev->axes,
@@ -344,7 +373,7 @@ dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_tri
     }
 #if DHC_WITH_CONTACT
     dhc_vec3_set(out->contact_mm, 0.0, 0.0, 0.0);
-    if (s->kind >= (uint8_t)DHC_MEAS_PLANE &&
+    if (dhc_sample_is_contact(s) &&
         dhc_contact_predict(&model->contact, s, out->p_mm, out->contact_mm) != DHC_OK) {
         return DHC_ERR_ARGUMENT;
     }
@@ -361,6 +390,41 @@ dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_tri
     }
     return DHC_OK;
 }
+
+#if DHC_WITH_CONTACT
+dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_trig *trig,
+                                       const dhc_sample *s, const double *sincos_q,
+                                       int need_moments, dhc_model_eval *ev, dhc_prediction *out)
+{
+    if (ev == NULL || out == NULL || trig == NULL) {
+        return DHC_ERR_ARGUMENT;
+    }
+    if (s != NULL && s->kind == (uint8_t)DHC_MEAS_DISTANCE) {
+        /* the second tool point first: ev and out end at the first, as for every kind */
+        dhc_status st = evaluate_at(model, trig, s, s->q2_rad, NULL, need_moments, ev, out);
+        double second[3];
+        dhc_vec3_copy(out->p_mm, second);
+        if (st == DHC_OK) {
+            st = evaluate_at(model, trig, s, s->q_rad, sincos_q, need_moments, ev, out);
+        }
+        dhc_vec3_sub(out->p_mm, second, out->contact_mm);
+        return st == DHC_OK && !dhc_all_finite(out->contact_mm, 3U) ? DHC_ERR_NONFINITE : st;
+    }
+    return evaluate_at(model, trig, s, s != NULL ? s->q_rad : NULL, sincos_q, need_moments, ev,
+                       out);
+}
+
+dhc_status dhc_model_evaluate_second(const dhc_model *model, const dhc_arm_trig *trig,
+                                     const dhc_sample *s, int need_moments, dhc_model_eval *ev,
+                                     dhc_prediction *out)
+{
+    if (ev == NULL || out == NULL || trig == NULL || s == NULL ||
+        s->kind != (uint8_t)DHC_MEAS_DISTANCE) {
+        return DHC_ERR_ARGUMENT;
+    }
+    return evaluate_at(model, trig, s, s->q2_rad, NULL, need_moments, ev, out);
+}
+#endif
 
 dhc_status dhc_model_predict(const dhc_model *model, const dhc_sample *s, dhc_prediction *out)
 {
@@ -443,6 +507,9 @@ dhc_status dhc_model_residual_of(const dhc_sample *s, const dhc_prediction *pred
     if (s->kind == (uint8_t)DHC_MEAS_WIRES) {
         dhc_vec3_sub(s->wire_mm, pred->wire_mm, out);
 #if DHC_WITH_CONTACT
+    } else if (s->kind == (uint8_t)DHC_MEAS_DISTANCE) {
+        /* the length measured less the predicted one (rows 2 and 3 stay 0, as a plane's) */
+        dhc_vec3_set(out, s->distance_mm - dhc_vec3_norm(pred->contact_mm), 0.0, 0.0);
     } else if (s->kind >= (uint8_t)DHC_MEAS_PLANE) {
         /* a touch measures 0: on the plane, at the point (a plane's rows 2 and 3 stay 0) */
         dhc_vec3_scale(pred->contact_mm, -1.0, out);

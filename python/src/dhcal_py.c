@@ -129,12 +129,13 @@ int dhcal_py_rows_load(const char *path, const dhcal_py_model *m, void **rows, s
     *n_rows = d->n_rows;
     *columns = (d->has_dir ? 1 : 0) | (d->has_temp ? 2 : 0) | (d->has_time ? 4 : 0) |
                (d->has_xyz ? 8 : 0) | (d->has_wires ? 16 : 0) | (d->has_plane ? 32 : 0) |
-               (d->has_point ? 64 : 0);
+               (d->has_point ? 64 : 0) | (d->has_pair ? 128 : 0);
     return DHCAL_IO_OK;
 }
 
 void dhcal_py_rows_copy(const void *rows, double *q_deg, double *xyz_mm, double *dir,
-                        double *temp_c, double *t_s, double *wires_mm, double *plane, double *point)
+                        double *temp_c, double *t_s, double *wires_mm, double *plane, double *point,
+                        double *pair, double *distance_mm)
 {
     const dhcal_dataset *d = rows;
     const size_t nj = d->n_joints;
@@ -164,6 +165,12 @@ void dhcal_py_rows_copy(const void *rows, double *q_deg, double *xyz_mm, double 
         if (point != NULL) {
             point[i] = (double)r->point;
         }
+        if (pair != NULL) {
+            pair[i] = (double)r->pair;
+        }
+        if (distance_mm != NULL) {
+            distance_mm[i] = r->distance_mm;
+        }
     }
 }
 
@@ -179,8 +186,10 @@ void dhcal_py_rows_free(void *rows)
 static int rows_to_dataset(const dhcal_py_model *m, const dhcal_py_rows *r, const char *name,
                            dhcal_dataset *data, dhcal_error *e)
 {
-    const dhcal_arrays a = {name,      r->n_rows, m->lib.arm.n_joints, r->q_deg, r->xyz_mm, r->dir,
-                            r->temp_c, r->t_s,    r->wires_mm,         r->plane, r->point};
+    const dhcal_arrays a = {
+        name,          r->n_rows, m->lib.arm.n_joints, r->q_deg, r->xyz_mm, r->dir,
+        r->temp_c,     r->t_s,    r->wires_mm,         r->plane, r->point,  r->pair,
+        r->distance_mm};
     return dhcal_dataset_from_arrays(&a, data, e);
 }
 
@@ -371,11 +380,7 @@ int dhcal_py_units_check(const dhcal_py_model *m, const dhcal_py_rows *train,
     int rc = DHCAL_IO_OK;
     for (size_t k = 0U; k < 2U && rc == DHCAL_IO_OK; ++k) {
         if (rows[k] != NULL) {
-            const dhcal_py_rows *r = rows[k];
-            const dhcal_arrays a = {
-                names[k],  r->n_rows, m->lib.arm.n_joints, r->q_deg, r->xyz_mm, r->dir,
-                r->temp_c, r->t_s,    r->wires_mm,         r->plane, r->point};
-            rc = dhcal_dataset_from_arrays(&a, &sets[k], &e);
+            rc = rows_to_dataset(m, rows[k], names[k], &sets[k], &e);
         }
     }
     if (rc == DHCAL_IO_OK) {

@@ -40,8 +40,10 @@ typedef struct {
     const double *temp_c;
     const double *t_s;
     const double *wires_mm;
-    const double *plane; /* n: 0, or the plane a touch row touches (1-based id) */
-    const double *point; /* n: 0, or the fixed point it sits at */
+    const double *plane;       /* n: 0, or the plane a touch row touches (1-based id) */
+    const double *point;       /* n: 0, or the fixed point it sits at */
+    const double *pair;        /* n: 0, or the length pair a row is one end of (1-based id) */
+    const double *distance_mm; /* n: 0, or the pair's known distance (on one row at least) */
 } dhcal_py_rows;
 
 DHCAL_PY_API const char *dhcal_py_version(void);
@@ -60,14 +62,14 @@ DHCAL_PY_API char *dhcal_py_model_info(const dhcal_py_model *m);
 /* Reads a measurement CSV for the model (dhcal_csv_load). *rows receives a handle for
  * dhcal_py_rows_copy and dhcal_py_rows_free, *n_rows the rows, *columns the optional
  * columns present: bit 0 dir, bit 1 temp_c, bit 2 t_s, bit 3 x,y,z, bit 4 L1..L3, bit 5 plane,
- * bit 6 point. */
+ * bit 6 point, bit 7 pair and distance_mm. */
 DHCAL_PY_API int dhcal_py_rows_load(const char *path, const dhcal_py_model *m, void **rows,
                                     size_t *n_rows, int *columns, char *err, size_t err_cap);
 /* Copies the rows out; angles in degrees (radians / DHC_DEG: within an ulp of the file's).
  * Arrays of absent columns may be NULL. */
 DHCAL_PY_API void dhcal_py_rows_copy(const void *rows, double *q_deg, double *xyz_mm, double *dir,
                                      double *temp_c, double *t_s, double *wires_mm, double *plane,
-                                     double *point);
+                                     double *point, double *pair, double *distance_mm);
 DHCAL_PY_API void dhcal_py_rows_free(void *rows);
 
 /* Runs command "fit", "diagnose" or "refine" as the program runs it with --json: the model

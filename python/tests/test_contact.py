@@ -97,3 +97,50 @@ def test_a_row_touching_two_targets_is_refused(touches) -> None:
     bad[0] = 9.0
     with pytest.raises(dhcal.DhcalInputError, match="row 1, column 'plane': 9 is not 0 or one"):
         dhcal.fit(model, dhcal.Measurements(q, plane=bad))
+
+
+def test_lengths_as_arrays_and_as_a_file_equal_the_program(touches, run_cli, tmp_path) -> None:
+    """The touches and six gauge lengths between two poses each (pair ids, the distance on
+    the first row): the package equals the program, and the lengths see what the planes
+    alone leave blind."""
+    q, ids, _ = touches
+    built = json.loads(MODEL.read_text())
+    built["joints"][1]["a_mm"] += 1.5
+    built["joints"][2]["a_mm"] -= 1.0
+    built["joints"][2]["theta_offset_deg"] = 0.4
+    rng = np.random.default_rng(7)
+    ends = np.round(np.column_stack([rng.uniform(-60, 60, 12), rng.uniform(20, 120, 12),
+                                     rng.uniform(-140, -20, 12)]), 9)
+    pair = np.repeat(np.arange(1.0, 7.0), 2)
+    dist = np.zeros(12)
+    for k in range(6):
+        d = np.linalg.norm(tool_point(built, ends[2 * k]) - tool_point(built, ends[2 * k + 1]))
+        dist[2 * k] = round(float(d), 6)
+    all_q = np.vstack([q, ends])
+    plane = np.concatenate([ids, np.zeros(12)])
+    pairs = np.concatenate([np.zeros(len(ids)), pair])
+    dists = np.concatenate([np.zeros(len(ids)), dist])
+    path = tmp_path / "touches-and-lengths.csv"
+    with open(path, "w") as out:
+        out.write("q1,q2,q3,plane,pair,distance_mm\n")
+        for row, pl, pa, di in zip(all_q, plane, pairs, dists):
+            out.write(",".join(f"{v:.9f}" for v in row) + (f",{int(pl)},," if pl else
+                      f",,{int(pa)}," + (f"{di:.6f}" if di else "")) + "\n")
+    model = dhcal.load_model(MODEL)
+    report = run_cli("fit", "--model", MODEL, "--data", path)
+    arrays = dhcal.fit(model, dhcal.Measurements(all_q, plane=plane, pair=pairs,
+                                                 distance_mm=dists))
+    assert_fit_equal(arrays, report)
+    read = dhcal.load_measurements(path, model)
+    assert list(read.pair) == list(pairs) and list(read.distance_mm) == list(dists)
+    assert_fit_equal(dhcal.fit(model, read), report)
+    planes_only = run_cli("fit", "--model", MODEL, "--data", touches[2])
+    blind = {u["param"] for u in report["unidentifiable"] if u["blind"]}
+    blind_planes = {u["param"] for u in planes_only["unidentifiable"] if u["blind"]}
+    assert blind < blind_planes, (blind, blind_planes)
+    with pytest.raises(ValueError, match="pair and distance_mm go together"):
+        dhcal.fit(model, dhcal.Measurements(all_q, plane=plane, pair=pairs))
+    odd = pairs.copy()
+    odd[-1] = 7.0
+    with pytest.raises(dhcal.DhcalInputError, match="pair 6 has one row"):
+        dhcal.fit(model, dhcal.Measurements(all_q, plane=plane, pair=odd, distance_mm=dists))

@@ -122,7 +122,7 @@ static void test_plans_and_targets_have_no_touches(void)
 
 static void test_written_touches_read_back(void)
 {
-    const dhcal_csv_columns cols = {2U, 0, 1, 1, 0, 0, 0, 1, 1};
+    const dhcal_csv_columns cols = {2U, 0, 1, 1, 0, 0, 0, 1, 1, 0};
     dhcal_row rows[3];
     memset(rows, 0, sizeof rows);
     rows[0].q_rad[0] = 0.25;
@@ -151,9 +151,95 @@ static void test_written_touches_read_back(void)
     TEST_ASSERT_EQUAL_UINT(0U, g_data.rows[2].plane + g_data.rows[2].point);
 }
 
+/* A gauge between two poses: the pair's two rows (anywhere in the file) are one length
+ * sample at the first row, the second row's angles its second pose; the rows around keep
+ * their own samples, and each sample knows its row. */
+static void test_length_pairs_become_one_sample_each(void)
+{
+    const char *const p = write_csv("q1,q2,x,y,z,plane,pair,distance_mm\n"
+                                    "10,20,,,,,7,250.5\n"
+                                    "11,21,,,,1,,\n"
+                                    "12,22,,,,,7,\n"
+                                    "13,23,1,2,3,,,\n"
+                                    "14,24,,,,,2,\n"
+                                    "15,25,,,,,2,99\n");
+    TEST_ASSERT_EQUAL_MESSAGE(DHCAL_IO_OK, dhcal_csv_load(p, 2U, &g_data, &g_err), g_err.msg);
+    TEST_ASSERT_EQUAL_size_t(6U, g_data.n_rows);
+    TEST_ASSERT_TRUE(g_data.has_pair);
+    TEST_ASSERT_EQUAL_UINT(7U, g_data.rows[2].pair);
+    dhc_arm arm;
+    (void)dhc_arm_init(&arm, 2U);
+    const dhc_model m = test_model_of(&arm);
+    dhcal_samples s;
+    TEST_ASSERT_EQUAL(DHCAL_IO_OK, dhcal_samples_build(&m, &g_data, p, &s, &g_err));
+    TEST_ASSERT_EQUAL_size_t(4U, s.n);
+    TEST_ASSERT_EQUAL_UINT8(DHC_MEAS_DISTANCE, s.samples[0].kind);
+    TEST_ASSERT_EQUAL_DOUBLE(250.5, s.samples[0].distance_mm);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-15, 10.0 * TEST_DEG, s.samples[0].q_rad[0]);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-15, 22.0 * TEST_DEG, s.samples[0].q2_rad[1]);
+    TEST_ASSERT_EQUAL_UINT8(DHC_MEAS_PLANE, s.samples[1].kind);
+    TEST_ASSERT_EQUAL_UINT8(DHC_MEAS_POSITION, s.samples[2].kind);
+    TEST_ASSERT_EQUAL_UINT8(DHC_MEAS_DISTANCE, s.samples[3].kind);
+    TEST_ASSERT_EQUAL_DOUBLE(99.0, s.samples[3].distance_mm); /* from the second row */
+    TEST_ASSERT_DOUBLE_WITHIN(1e-15, 25.0 * TEST_DEG, s.samples[3].q2_rad[1]);
+    const size_t rows[4] = {0U, 1U, 3U, 4U};
+    for (size_t i = 0U; i < 4U; ++i) {
+        TEST_ASSERT_EQUAL_size_t(rows[i], dhcal_samples_row(&s, i));
+        TEST_ASSERT_EQUAL_UINT8(DHC_SAMPLE_USED, s.flags[i]);
+    }
+    dhcal_samples_free(&s);
+}
+
+static void test_length_defects_are_named(void)
+{
+    expect_bad("q1,q2,pair,distance_mm\n1,2,1,100\n3,4,2,50\n5,6,2,\n", 2U, "pair 1 has one row");
+    expect_bad("q1,q2,pair,distance_mm\n1,2,1,100\n3,4,1,\n5,6,1,\n", 4U, "pair 1 has a third row");
+    expect_bad("q1,q2,pair,distance_mm\n1,2,1,\n3,4,1,\n", 2U, "pair 1 gives no distance_mm");
+    expect_bad("q1,q2,pair,distance_mm\n1,2,1,100\n3,4,1,100.5\n", 3U,
+               "distance_mm 100.5 differs from 100");
+    expect_bad("q1,q2,x,y,z,pair,distance_mm\n1,2,3,4,5,,100\n", 2U,
+               "a distance_mm without a pair id");
+    expect_bad("q1,q2,plane,pair,distance_mm\n1,2,1,1,100\n", 2U, "touch or one end of a length");
+    expect_bad("q1,q2,x,y,z,pair,distance_mm\n1,2,3,4,5,1,100\n", 2U,
+               "column 'x': an end of length pair 1 measures no point");
+    expect_bad("q1,q2,pair,distance_mm\n1,2,1,-3\n", 2U, "column 'distance_mm': -3 is outside");
+    expect_bad("q1,q2,pair,distance_mm\n1,2,1,nan\n", 2U, "column 'distance_mm'");
+    expect_bad("q1,q2,pair,distance_mm\n1,2,0.5,3\n", 2U, "column 'pair': 0.5 is not one of");
+    expect_bad("q1,q2,pair\n1,2,1\n", 1U, "column 'pair' without 'distance_mm'");
+}
+
+static void test_written_lengths_read_back(void)
+{
+    const dhcal_csv_columns cols = {2U, 1, 0, 0, 0, 0, 0, 0, 0, 1};
+    dhcal_row rows[3];
+    memset(rows, 0, sizeof rows);
+    rows[0].pair = 4U;
+    rows[0].distance_mm = 123.25;
+    rows[0].q_rad[0] = 0.5;
+    rows[1].xyz_mm[0] = 9.0;
+    rows[2].pair = 4U;
+    dhcal_text t = {NULL, 0U, 0U, 0};
+    dhcal_csv_write_header(&t, &cols);
+    for (size_t i = 0U; i < 3U; ++i) {
+        dhcal_csv_write_row(&t, &cols, &rows[i]);
+    }
+    TEST_ASSERT_FALSE(t.failed);
+    TEST_ASSERT_NOT_NULL_MESSAGE(strstr(t.p, "q1,q2,x,y,z,pair,distance_mm\n"), t.p);
+    TEST_ASSERT_NOT_NULL_MESSAGE(strstr(t.p, ",,,,4,123.250000\n"), t.p);
+    const char *const p = write_csv(t.p);
+    free(t.p);
+    TEST_ASSERT_EQUAL_MESSAGE(DHCAL_IO_OK, dhcal_csv_load(p, 2U, &g_data, &g_err), g_err.msg);
+    TEST_ASSERT_EQUAL_UINT(4U, g_data.rows[2].pair);
+    TEST_ASSERT_EQUAL_DOUBLE(123.25, g_data.rows[0].distance_mm);
+    TEST_ASSERT_EQUAL_DOUBLE(9.0, g_data.rows[1].xyz_mm[0]);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
+    RUN_TEST(test_length_pairs_become_one_sample_each);
+    RUN_TEST(test_length_defects_are_named);
+    RUN_TEST(test_written_lengths_read_back);
     RUN_TEST(test_touches_mixed_with_measured_points);
     RUN_TEST(test_touches_alone);
     RUN_TEST(test_contact_defects_are_named);

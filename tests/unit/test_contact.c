@@ -368,6 +368,90 @@ static void test_noisy_touches_end_at_their_noise(void)
     TEST_ASSERT_TRUE(shape_error_mm(&truth, &model) < before / 5.0);
 }
 
+/* RMS over pairs of fresh poses of |p_i - p_j| (truth) - |p_i - p_j| (model): the lengths
+ * across the workspace, scale and all. */
+static double length_error_mm(const dhc_model *truth, const dhc_model *model)
+{
+    enum { POSES = 40 };
+    static double pt[POSES][3];
+    static double pm[POSES][3];
+    test_rng g = {0xFACEULL};
+    for (size_t k = 0U; k < POSES; ++k) {
+        double q[DHC_MAX_JOINTS];
+        test_random_q(&g, &truth->arm, q);
+        tool_point(truth, q, pt[k]);
+        tool_point(model, q, pm[k]);
+    }
+    double sum = 0.0;
+    size_t pairs = 0U;
+    for (size_t i = 0U; i < POSES; ++i) {
+        for (size_t j = i + 1U; j < POSES; ++j) {
+            const double e = distance(pt[i], pt[j]) - distance(pm[i], pm[j]);
+            sum += e * e;
+            pairs++;
+        }
+    }
+    return sqrt(sum / (double)pairs);
+}
+
+/* A gauge's length between the true arm's tool points at two random poses, count times. */
+static void measure_lengths(const dhc_model *truth, size_t count, test_rng *g)
+{
+    for (size_t k = 0U; k < count; ++k) {
+        dhc_sample *s = &data.s[data.n];
+        memset(s, 0, sizeof *s);
+        test_random_q(g, &truth->arm, s->q_rad);
+        test_random_q(g, &truth->arm, s->q2_rad);
+        double a[3];
+        double b[3];
+        tool_point(truth, s->q_rad, a);
+        tool_point(truth, s->q2_rad, b);
+        s->distance_mm = distance(a, b);
+        s->temp_c = truth->thermal_ref_c;
+        s->kind = (uint8_t)DHC_MEAS_DISTANCE;
+        data.flags[data.n++] = (uint8_t)DHC_SAMPLE_USED;
+    }
+}
+
+/* Three planes and a gauge: the lengths fix the common scale the planes leave blind, so only
+ * the arm's height (d1) and its turn about the base axis (theta1) stay blind, and the lengths
+ * across the workspace come out true. */
+static void test_a_gauge_length_sees_the_scale_planes_cannot(void)
+{
+    static dhc_model truth;
+    static dhc_model model;
+    six_joint_arms(&truth, &model);
+    test_rng g = {0xC0FFEEULL};
+    touch_three_planes(&truth, 0.0, &g);
+    const size_t touches = data.n;
+    measure_lengths(&truth, 12U, &g);
+    TEST_ASSERT_EQUAL(
+        DHC_OK, dhc_contact_targets_init(&model, test_read_sample, &data, data.n, data.flags));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &model));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_targets(&set, &model));
+    const double before = length_error_mm(&truth, &model);
+    dhc_calib_options opt;
+    dhc_calib_default_options(&opt);
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_calib_fit(&model, &set, test_read_sample, &data, data.n,
+                                            data.flags, &opt, &ws, &rep));
+    TEST_ASSERT_EQUAL_size_t(touches + 12U, rep.rows); /* one row per length too */
+    TEST_ASSERT_TRUE(rep.rms_mm < 1e-6);
+    size_t blind = 0U;
+    size_t lengths_blind = 0U;
+    for (size_t k = 0U; k < set.count; ++k) {
+        const uint8_t kind = set.id[k].kind;
+        blind += rep.blind[k];
+        lengths_blind += rep.blind[k] && (kind == (uint8_t)DHC_P_A || kind == (uint8_t)DHC_P_D);
+    }
+    TEST_ASSERT_EQUAL_size_t(2U, blind);
+    TEST_ASSERT_EQUAL_size_t(1U, lengths_blind);
+    TEST_ASSERT_TRUE(rep.blind[param_index(DHC_P_D, 0U)]);
+    TEST_ASSERT_TRUE(rep.blind[param_index(DHC_P_THETA, 0U)]);
+    const double after = length_error_mm(&truth, &model);
+    TEST_ASSERT_TRUE_MESSAGE(before > 1.0, "the drawing's lengths are a millimetre off");
+    TEST_ASSERT_TRUE_MESSAGE(after < 1e-4, "the lengths across the workspace come out true");
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -375,5 +459,6 @@ int main(void)
     RUN_TEST(test_starting_targets_of_a_planar_arm);
     RUN_TEST(test_six_joint_arm_from_touches_of_three_planes);
     RUN_TEST(test_noisy_touches_end_at_their_noise);
+    RUN_TEST(test_a_gauge_length_sees_the_scale_planes_cannot);
     return UNITY_END();
 }

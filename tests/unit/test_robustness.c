@@ -181,7 +181,33 @@ static void ref_frames(const dhc_arm *arm, const double *q, double ls, ref_frame
 
 /* What dhc_model.h's header says the model predicts: effective angles (compliance moments
  * at the measured angles), tool point, last-link rotation, wire lengths. */
+static void ref_predict_one(const dhc_model *m, const dhc_sample *s, double out[3],
+                            ref_frame *tool);
+
+/* The prediction: a length's, the distance of its two tool points (out[0]; tool at the
+ * first), every other kind's by ref_predict_one. */
 static void ref_predict(const dhc_model *m, const dhc_sample *s, double out[3], ref_frame *tool)
+{
+    if (s->kind != (uint8_t)DHC_MEAS_DISTANCE) {
+        ref_predict_one(m, s, out, tool);
+        return;
+    }
+    dhc_sample second = *s;
+    second.kind = (uint8_t)DHC_MEAS_POSITION;
+    memcpy(second.q_rad, s->q2_rad, sizeof second.q_rad);
+    ref_frame tool2;
+    double p2[3];
+    ref_predict_one(m, &second, p2, &tool2);
+    dhc_sample first = *s;
+    first.kind = (uint8_t)DHC_MEAS_POSITION;
+    ref_predict_one(m, &first, out, tool);
+    const double d[3] = {out[0] - p2[0], out[1] - p2[1], out[2] - p2[2]};
+    out[0] = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    out[1] = 0.0;
+    out[2] = 0.0;
+}
+
+static void ref_predict_one(const dhc_model *m, const dhc_sample *s, double out[3], ref_frame *tool)
 {
     const size_t n = m->arm.n_joints;
     const double ls = 1.0 + m->thermal_per_k * (s->temp_c - m->thermal_ref_c);
@@ -499,9 +525,11 @@ static void check_jacobian(const dhc_model *m, const dhc_sample *s, double L, in
     /* the differences round at the tool point's size (a plane's distance may be far smaller) */
     const double mag = fmax(norm_n(base_out, 3U), norm_n(base_tool.p, 3U));
     /* The two models agree on the prediction itself first (rounding of ~30 products). */
-    const double *lib_out = s->kind == (uint8_t)DHC_MEAS_WIRES ? pred.wire_mm
-                            : dhc_sample_is_contact(s)         ? pred.contact_mm
-                                                               : pred.p_mm;
+    const double length[3] = {norm_n(pred.contact_mm, 3U), 0.0, 0.0};
+    const double *lib_out = s->kind == (uint8_t)DHC_MEAS_WIRES      ? pred.wire_mm
+                            : s->kind == (uint8_t)DHC_MEAS_DISTANCE ? length
+                            : dhc_sample_is_contact(s)              ? pred.contact_mm
+                                                                    : pred.p_mm;
     for (size_t r = 0U; r < 3U; ++r) {
         TEST_ASSERT_DOUBLE_WITHIN(1e-12 * mag, base_out[r], lib_out[r]);
         for (size_t c = 0U; c < 3U; ++c) {
@@ -562,8 +590,9 @@ static void test_model_jacobian_matches_independent_differences_on_random_arms(v
 {
     test_rng g = {0x0DDC0FFEE1234567ULL};
     const double scales[5] = {1e-6, 1e-3, 1.0, 1e3, 1e6};
-    const dhc_meas_kind kinds[5] = {DHC_MEAS_POSITION, DHC_MEAS_POSE, DHC_MEAS_WIRES,
-                                    DHC_MEAS_PLANE, DHC_MEAS_POINT};
+    const dhc_meas_kind kinds[6] = {DHC_MEAS_POSITION, DHC_MEAS_POSE,  DHC_MEAS_WIRES,
+                                    DHC_MEAS_PLANE,    DHC_MEAS_POINT, DHC_MEAS_DISTANCE};
+    size_t lengths_checked = 0U;
     static dhc_model m;
     jac_columns_checked = 0U;
     memset(jac_kind_checked, 0, sizeof jac_kind_checked);
@@ -597,7 +626,10 @@ static void test_model_jacobian_matches_independent_differences_on_random_arms(v
             }
             s.temp_c = m.thermal_ref_c + test_range(&g, -10.0, 10.0);
             s.t_s = m.drift_ref_s + test_range(&g, -500.0, 500.0);
-            s.kind = (uint8_t)kinds[(c + pose) % 5U];
+            s.kind = (uint8_t)kinds[(c + pose) % 6U];
+            test_random_q(&g, &m.arm, s.q2_rad);
+            s.distance_mm = L;
+            lengths_checked += s.kind == (uint8_t)DHC_MEAS_DISTANCE ? 1U : 0U;
             check_jacobian(&m, &s, L, compliant);
         }
     }
@@ -607,6 +639,7 @@ static void test_model_jacobian_matches_independent_differences_on_random_arms(v
         TEST_ASSERT_EQUAL_MESSAGE(1U, jac_kind_checked[k], "a parameter kind never checked");
     }
     TEST_ASSERT_GREATER_THAN(3U, hayati_joints);
+    TEST_ASSERT_GREATER_THAN(CASES(60U) / 3U, lengths_checked);
 }
 
 /* ------------------------------------------------------------------ fit helpers */

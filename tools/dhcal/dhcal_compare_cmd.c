@@ -53,7 +53,8 @@ static void print_worst_rows(const dhcal_session *s, const double *err_mm, size_
     printf("%6s %8s %12s\n", "row", "line", "error_mm");
     for (size_t k = 0U; k < shown; ++k) {
         const size_t i = order[k].row;
-        printf("%6zu %8zu %12.4f\n", i + 1U, s->data.rows[i].line, err_mm[i]);
+        const size_t row = dhcal_samples_row(&s->samples, i);
+        printf("%6zu %8zu %12.4f\n", row + 1U, s->data.rows[row].line, err_mm[i]);
     }
     free(order);
 }

@@ -248,8 +248,9 @@ void dhcal_cli_text_fit(const dhcal_fit *f, const dhcal_session *s, const dhcal_
     }
     for (size_t i = 0U; i < s->samples.n; ++i) {
         if (dhc_sample_is_outlier(s->samples.flags[i])) {
-            printf("outlier: row %zu (line %zu), error %.4f mm, left out: %s\n", i + 1U,
-                   s->data.rows[i].line, row_err[i], outlier_words(s->samples.flags[i]));
+            const size_t row = dhcal_samples_row(&s->samples, i);
+            printf("outlier: row %zu (line %zu), error %.4f mm, left out: %s\n", row + 1U,
+                   s->data.rows[row].line, row_err[i], outlier_words(s->samples.flags[i]));
         }
     }
 }

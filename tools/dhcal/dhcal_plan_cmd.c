@@ -139,7 +139,7 @@ static size_t draw_candidates(const dhc_model *m, size_t k, uint64_t seed, int a
 static int write_plan(const char *path, const dhc_model *m, const double *q_rad,
                       const size_t *chosen, size_t n, dhcal_error *err)
 {
-    const dhcal_csv_columns cols = {m->arm.n_joints, 0, 0, 0, 0, 0, 0, 0, 0};
+    const dhcal_csv_columns cols = {m->arm.n_joints, 0, 0, 0, 0, 0, 0, 0, 0, 0};
     dhcal_text t = {NULL, 0U, 0U, 0};
     dhcal_text_str(&t, "# dhcal plan: poses to measure, in the order chosen\n");
     dhcal_csv_write_header(&t, &cols);

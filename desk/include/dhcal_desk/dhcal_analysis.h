@@ -80,7 +80,8 @@ int dhcal_prior_scale(const dhc_model *start, const dhc_param_set *set,
 #define DHCAL_CONTACT_TOLERANCE_MM 0.5
 #define DHCAL_CONTACT_TOLERANCE_DEG 0.05
 
-/* 1 when some sample is a touch (a plane or a fixed point: dhc_contact.h). */
+/* 1 when some sample measures no point in the world: a touch (a plane or a fixed point:
+ * dhc_contact.h) or a length between two tool points (DHC_MEAS_DISTANCE). */
 int dhcal_samples_have_contact(const dhcal_samples *s);
 
 /* The start of a contact fit: the nominal model with its targets' starting poses from the

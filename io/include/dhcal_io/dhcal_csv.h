@@ -30,6 +30,9 @@ typedef struct {
     double t_s;              /* has_time: time of the measurement, s (drift) */
     unsigned plane;          /* a touch of plane `plane` (1-based id), nothing measured; 0: not */
     unsigned point;          /* a touch of fixed point `point` (1-based id); 0: not */
+    unsigned pair;           /* one of the two rows of a length `pair` (1-based id); 0: not */
+    double distance_mm;      /* pair rows: the known distance of the two tool points; 0: not
+                                given in this row (the other row gives it) */
 } dhcal_row;
 
 typedef struct {
@@ -37,6 +40,7 @@ typedef struct {
     size_t n_joints;
     int has_xyz, has_wires, has_quat, has_dir, has_temp, has_time;
     int has_plane, has_point; /* the columns are there (a row may still leave them empty) */
+    int has_pair;             /* columns pair and distance_mm */
     int has_q;                /* always 1 but for compensation targets (dhcal_csv_load_targets) */
     dhcal_row *rows;          /* heap, n_rows entries */
 } dhcal_dataset;
@@ -82,8 +86,9 @@ void dhcal_dataset_free(dhcal_dataset *data);
  * (one of them, or both as a file may have both, or neither when every row is a touch);
  * dir (n_rows x n_joints, each -1 or +1), temp_c and t_s (n_rows each) optional (NULL: no
  * such column); plane and point (n_rows each: 0, or a touch's 1-based id, as the CSV's
- * columns: a touch row's xyz_mm and wires_mm entries are not read). name stands for the file
- * in messages. */
+ * columns: a touch row's xyz_mm and wires_mm entries are not read); pair and distance_mm
+ * (n_rows each, both or neither: 0, or a length row's pair id and, 0 or the pair's distance,
+ * as the CSV's). name stands for the file in messages. */
 typedef struct {
     const char *name;
     size_t n_rows;
@@ -96,6 +101,8 @@ typedef struct {
     const double *wires_mm;
     const double *plane;
     const double *point;
+    const double *pair;
+    const double *distance_mm;
 } dhcal_arrays;
 
 /* The dataset dhcal_csv_load would give for a file with these columns and values: every
@@ -106,11 +113,12 @@ typedef struct {
 int dhcal_dataset_from_arrays(const dhcal_arrays *a, dhcal_dataset *data, dhcal_error *err);
 
 /* The columns a writer puts down (the has_ flags of dhcal_dataset), always in this order:
- * q1..qN, dir1..dirN, x,y,z, L1,L2,L3, qw,qx,qy,qz, temp_c, t_s, plane, point. */
+ * q1..qN, dir1..dirN, x,y,z, L1,L2,L3, qw,qx,qy,qz, temp_c, t_s, plane, point, pair,
+ * distance_mm. */
 typedef struct {
     size_t n_joints;
     int has_xyz, has_wires, has_quat, has_dir, has_temp, has_time;
-    int has_plane, has_point;
+    int has_plane, has_point, has_pair;
 } dhcal_csv_columns;
 
 /* Appends the header line for cols to t (comment lines, if any, go before it). */

@@ -20,15 +20,23 @@ typedef struct {
      * layout of dhc_calib_options.joint_sincos: computed once, read by every pass */
     double *joint_sincos;
     size_t sincos_joints;
+    /* NULL, or each sample's row in source (0-based): a length pair's two rows make one
+     * sample, so samples may be fewer than rows */
+    size_t *row_of;
 } dhcal_samples;
+
+/* The source row (0-based) of sample i: its first row for a length pair. */
+size_t dhcal_samples_row(const dhcal_samples *s, size_t i);
 
 /* The table for a model of n_joints joints, or NULL when s has none that fits it. */
 const double *dhcal_samples_sincos(const dhcal_samples *s, size_t n_joints);
 
 /* Builds samples. Raw wire lengths L1..L3 are used as they are (residuals in wire-length
  * space, where noise is independent and equal) whenever the model has a measurer;
- * otherwise the tool point x,y,z (with qw..qz: a pose). Directions default to 0
- * (unknown), temperature to the model's thermal reference, time to the 0-based row number.
+ * otherwise the tool point x,y,z (with qw..qz: a pose); a touch row is a touch, and the two
+ * rows of a length pair are one DHC_MEAS_DISTANCE sample, at its first row (the second
+ * row's angles in q2_rad). Directions default to 0 (unknown), temperature to the model's
+ * thermal reference, time to the 0-based row number.
  * DHCAL_IO_BAD_INPUT (message names file and line) for wire-only data and a model without
  * a measurer. */
 int dhcal_samples_build(const dhc_model *model, const dhcal_dataset *data, const char *path,

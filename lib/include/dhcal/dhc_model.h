@@ -92,7 +92,8 @@ typedef enum {
     DHC_MEAS_POSE = 1,     /* tool point and last-link orientation, 6 rows */
     DHC_MEAS_WIRES = 2,    /* raw draw-wire lengths L1..L3, 3 rows (mm) */
     DHC_MEAS_PLANE = 3,    /* the tool point touches plane `target`: 1 row (mm) */
-    DHC_MEAS_POINT = 4     /* the tool point sits at fixed point `target`: 3 rows (mm) */
+    DHC_MEAS_POINT = 4,    /* the tool point sits at fixed point `target`: 3 rows (mm) */
+    DHC_MEAS_DISTANCE = 5  /* the tool points at q and q2 are distance_mm apart: 1 row (mm) */
 } dhc_meas_kind;
 
 typedef struct {
@@ -105,6 +106,10 @@ typedef struct {
     int8_t dir[DHC_MAX_JOINTS];   /* last approach direction, -1 or +1 (0: unknown) */
     uint8_t kind;                 /* dhc_meas_kind */
     uint8_t target;               /* PLANE, POINT: the plane's or the point's index */
+#if DHC_WITH_CONTACT
+    double q2_rad[DHC_MAX_JOINTS]; /* DISTANCE: the joint angles of the second tool point */
+    double distance_mm;            /* DISTANCE: their known distance (a ball bar, a gauge) */
+#endif
 } dhc_sample;
 
 /* Fills *out with measurement `index` (0-based, < n). Any status other than DHC_OK aborts
@@ -129,18 +134,20 @@ typedef struct {
     double p_mm[3];
     dhc_mat3 rot;
     double wire_mm[3];    /* WIRES samples only */
-    double contact_mm[3]; /* PLANE: the signed distance n . p - h (then 0, 0); POINT: p - c */
+    double contact_mm[3]; /* PLANE: the signed distance n . p - h (then 0, 0); POINT: p - c;
+                             DISTANCE: p - p2, p2 the tool point at q2 */
 } dhc_prediction;
 
 /* A model around an arm of n_joints joints: no effects, gravity -z, no measurer,
  * thermal reference 20 C. DHC_ERR_CAPACITY for a bad joint count. */
 dhc_status dhc_model_init(dhc_model *model, size_t n_joints);
 
-/* Rows a sample contributes: 1 (PLANE), 3 or 6 (POSE). */
+/* Rows a sample contributes: 1 (PLANE, DISTANCE), 3 or 6 (POSE). */
 size_t dhc_sample_rows(const dhc_sample *s);
 
 #if DHC_WITH_CONTACT
-/* 1 for the contact kinds (PLANE, POINT). */
+/* 1 for the kinds that touch a target (PLANE, POINT). DISTANCE, the other kind that measures
+ * no point in the world, touches none. */
 int dhc_sample_is_contact(const dhc_sample *s);
 
 /* What the model predicts for a contact sample whose tool point is p (world, mm): PLANE the
@@ -152,7 +159,7 @@ dhc_status dhc_contact_predict(const dhc_contact_targets *t, const dhc_sample *s
 
 /* Checks a sample for non-finite values, kinds and directions against the model.
  * DHC_ERR_NONFINITE, DHC_ERR_ARGUMENT (unknown kind, dir not in {-1,0,1}, wires without a
- * measurer in the model, a contact target the model does not have). */
+ * measurer in the model, a contact target the model does not have, a DISTANCE not above 0). */
 dhc_status dhc_sample_check(const dhc_model *model, const dhc_sample *s);
 
 /* Factor 1 + k (T - T0) by which thermal expansion scales every link length. */
@@ -203,6 +210,16 @@ dhc_status dhc_model_evaluate(const dhc_model *model, const dhc_sample *s, int n
 dhc_status dhc_model_evaluate_prepared(const dhc_model *model, const dhc_arm_trig *trig,
                                        const dhc_sample *s, const double *sincos_q,
                                        int need_moments, dhc_model_eval *ev, dhc_prediction *out);
+
+#if DHC_WITH_CONTACT
+/* A DISTANCE sample (whose evaluation puts p - p2 in contact_mm, ev and out at its first
+ * angles): the evaluation at its second angles q2, p2 in out->p_mm, ev there. What the slopes
+ * of its length need beside the first's. DHC_ERR_ARGUMENT for another kind; errors of
+ * dhc_model_evaluate_prepared. */
+dhc_status dhc_model_evaluate_second(const dhc_model *model, const dhc_arm_trig *trig,
+                                     const dhc_sample *s, int need_moments, dhc_model_eval *ev,
+                                     dhc_prediction *out);
+#endif
 
 /* World position of anchor k (0..2). */
 void dhc_measurer_anchor_world(const dhc_measurer_model *m, size_t k, double out[3]);

@@ -135,7 +135,11 @@ class Measurements:
     the optional columns ``directions`` (N x joints, -1 or +1: the approach direction of each
     joint), ``temp_c`` and ``t_s`` (N each), or None. Touches (docs/formats.md 3.4): ``plane``
     and ``point`` (N each: 0, or the 1-based id of the plane or fixed point the row's tool point
-    touched; such a row's ``xyz_mm`` and ``wires_mm`` entries are not read and may be NaN)."""
+    touched; such a row's ``xyz_mm`` and ``wires_mm`` entries are not read and may be NaN).
+    Lengths: ``pair`` and ``distance_mm`` (N each, both or neither: 0, or the 1-based id of the
+    length pair the row is one end of, two rows per id; the pair's distance between the two
+    rows' tool points in mm on one of its rows at least, 0 elsewhere); a length row measures
+    no point either."""
 
     q_deg: np.ndarray
     xyz_mm: Optional[np.ndarray] = None
@@ -145,6 +149,8 @@ class Measurements:
     wires_mm: Optional[np.ndarray] = None
     plane: Optional[np.ndarray] = None
     point: Optional[np.ndarray] = None
+    pair: Optional[np.ndarray] = None
+    distance_mm: Optional[np.ndarray] = None
 
     def __len__(self) -> int:
         return int(self.q_deg.shape[0])
@@ -174,11 +180,14 @@ def load_measurements(path: PathLike, model: Model) -> Measurements:
         wires = np.empty((nr, 3)) if columns.value & 16 else None
         plane = np.empty(nr) if columns.value & 32 else None
         point = np.empty(nr) if columns.value & 64 else None
+        pair = np.empty(nr) if columns.value & 128 else None
+        dist = np.empty(nr) if columns.value & 128 else None
         _native.LIB.dhcal_py_rows_copy(rows, *(_pointer(a) for a in
-                                               (q, xyz, d, temp, t, wires, plane, point)))
+                                               (q, xyz, d, temp, t, wires, plane, point, pair,
+                                                dist)))
     finally:
         _native.LIB.dhcal_py_rows_free(rows)
-    return Measurements(q, xyz, d, temp, t, wires, plane, point)
+    return Measurements(q, xyz, d, temp, t, wires, plane, point, pair, dist)
 
 
 def _pointer(a: Optional[np.ndarray]) -> Any:
@@ -214,13 +223,17 @@ class _Rows:
         n = q.shape[0]
         if n == 0:
             raise ValueError(f"dhcal: {what}: no rows")
-        if m.xyz_mm is None and m.wires_mm is None and m.plane is None and m.point is None:
+        if (m.xyz_mm is None and m.wires_mm is None and m.plane is None and m.point is None
+                and m.pair is None):
             raise ValueError(f"dhcal: {what}: xyz_mm or wires_mm (N x 3, mm) is required, or "
-                             "the touches' plane or point ids")
+                             "the touches' plane or point ids, or the lengths' pair ids")
+        if (m.pair is None) != (m.distance_mm is None):
+            raise ValueError(f"dhcal: {what}: pair and distance_mm go together")
         ids = [None if v is None else _array(f"{what} {name}", v, (n,))
-               for v, name in ((m.plane, "plane"), (m.point, "point"))]
+               for v, name in ((m.plane, "plane"), (m.point, "point"), (m.pair, "pair"),
+                               (m.distance_mm, "distance_mm"))]
         touch = np.zeros(n, dtype=bool)
-        for a in ids:
+        for a in ids[:3]:
             if a is not None:
                 touch |= a != 0.0
         self.arrays = [q]

@@ -28,6 +28,8 @@ class Rows(ctypes.Structure):
         ("wires_mm", ctypes.POINTER(ctypes.c_double)),
         ("plane", ctypes.POINTER(ctypes.c_double)),
         ("point", ctypes.POINTER(ctypes.c_double)),
+        ("pair", ctypes.POINTER(ctypes.c_double)),
+        ("distance_mm", ctypes.POINTER(ctypes.c_double)),
     ]
 
 
@@ -62,7 +64,7 @@ def _load() -> ctypes.PyDLL:
                                        ctypes.POINTER(c_size_t), ctypes.POINTER(c_int),
                                        c_char_p, c_size_t]
     lib.dhcal_py_rows_copy.restype = None
-    lib.dhcal_py_rows_copy.argtypes = [c_void_p, pd, pd, pd, pd, pd, pd, pd, pd]
+    lib.dhcal_py_rows_copy.argtypes = [c_void_p, pd, pd, pd, pd, pd, pd, pd, pd, pd, pd]
     lib.dhcal_py_rows_free.restype = None
     lib.dhcal_py_rows_free.argtypes = [c_void_p]
     lib.dhcal_py_run.restype = c_int
