@@ -122,8 +122,9 @@ static double joint_effect_factor(const dhc_param_id *id, const dhc_sample *s, c
         (id->kind == (uint8_t)DHC_P_HARMONIC_SIN || id->kind == (uint8_t)DHC_P_HARMONIC_COS)) {
         double sk;
         double ck;
-        dhc_sincos_multiple(sincos_q[2U * id->joint], sincos_q[2U * id->joint + 1U],
-                            (size_t)id->aux + 1U, &sk, &ck);
+        const size_t j = id->joint;
+        dhc_sincos_multiple(sincos_q[2U * j], sincos_q[2U * j + 1U], (size_t)id->aux + 1U, &sk,
+                            &ck);
         return id->kind == (uint8_t)DHC_P_HARMONIC_SIN ? sk : ck;
     }
 #endif
@@ -309,17 +310,18 @@ static dhc_status jacobian_prepared(const dhc_model *model, const dhc_arm_trig *
         }
     }
 #if DHC_WITH_CONTACT
-    if (distance) {
-        st = distance_row(model, trig, set, s, sincos_q, u, jac, pr, ev);
+    st = distance ? distance_row(model, trig, set, s, sincos_q, u, jac, pr, ev) : DHC_OK;
+    if (st != DHC_OK) {
+        return st;
     }
 #endif
     /* A finite prediction can still have infinite slopes: a thermal factor of 0 divides
      * the thermal column by 0, a huge weight overflows the orientation rows (fuzzing). */
-    if (st == DHC_OK && !jac_finite(jac)) {
+    if (!jac_finite(jac)) {
         dhc_mat_fill(jac, 0.0);
         return DHC_ERR_NONFINITE;
     }
-    return st;
+    return DHC_OK;
 }
 
 dhc_status dhc_model_linearize_prepared(const dhc_model *model, const dhc_arm_trig *trig,

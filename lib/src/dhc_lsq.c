@@ -196,6 +196,22 @@ DHC_AVX2 static void mirror_avx2(dhc_normal_eq *ne)
 }
 #endif
 
+/* sum over the k equations of w_e (r_e^2 + |J_e|^2) (w NULL: 1): what they add at most to any
+ * entry of the sums */
+static double weighted_square_sum(const dhc_mat *jac, const double *r, const double *w, size_t k)
+{
+    double added = 0.0;
+    for (size_t e = 0U; e < k; ++e) {
+        const double *const row = &DHC_MAT_AT(jac, e, 0U);
+        double s2 = r[e] * r[e];
+        for (size_t i = 0U; i < jac->cols; ++i) {
+            s2 += row[i] * row[i];
+        }
+        added += (w != NULL ? w[e] : 1.0) * s2;
+    }
+    return added;
+}
+
 dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double *r,
                              const double *w, size_t k)
 {
@@ -228,23 +244,12 @@ dhc_status dhc_normal_eq_add(dhc_normal_eq *ne, const dhc_mat *jac, const double
     const int mirror_by_copy = k > 3U;
 #ifdef DHC_LSQ_AVX2
     const int fast = mirror_by_copy && DHC_HAS_AVX2();
+    const double added =
+        fast && w == NULL ? square_sum_avx2(jac, r, k) : weighted_square_sum(jac, r, w, k);
 #else
     const int fast = 0;
+    const double added = weighted_square_sum(jac, r, w, k);
 #endif
-    double added = 0.0;
-#ifdef DHC_LSQ_AVX2
-    if (fast && w == NULL) {
-        added = square_sum_avx2(jac, r, k);
-    }
-#endif
-    for (size_t e = 0U; e < k && !(fast && w == NULL); ++e) {
-        const double *const row = &DHC_MAT_AT(jac, e, 0U);
-        double s2 = r[e] * r[e];
-        for (size_t i = 0U; i < n; ++i) {
-            s2 += row[i] * row[i];
-        }
-        added += (w != NULL ? w[e] : 1.0) * s2;
-    }
     if (!dhc_is_finite(2.0 * (bound + added))) {
         return DHC_ERR_NONFINITE;
     }
