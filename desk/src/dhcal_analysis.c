@@ -233,6 +233,14 @@ int dhcal_prior_of_set(const dhcal_prior *prior, const dhc_param_set *set, doubl
     return any;
 }
 
+void dhcal_fit_carry(const dhcal_fit *from, dhcal_fit *to)
+{
+    to->geometry = from->geometry;
+    to->prior = from->prior;
+    to->prior_centre = from->prior_centre;
+    to->have_prior_centre = from->have_prior_centre;
+}
+
 /* dhcal_fit_from (rejudge 1) and dhcal_fit_kept (rejudge 0: the rows stay as they are). */
 static int fit_rows_from(const dhc_model *start, const dhc_param_set *set,
                          const dhc_noise_model *noise, dhcal_samples *s, const dhcal_samples *held,
@@ -240,9 +248,19 @@ static int fit_rows_from(const dhc_model *start, const dhc_param_set *set,
 {
     const dhcal_geometry geometry = out->geometry;
     const dhcal_prior prior = out->prior;
+    const int have_centre = out->have_prior_centre;
+    dhc_model *const centre = malloc(sizeof *centre);
+    if (centre == NULL) {
+        snprintf(err->msg, sizeof err->msg, "out of memory");
+        return DHCAL_IO_FAILED;
+    }
+    *centre = have_centre ? out->prior_centre : *start;
     memset(out, 0, sizeof *out);
     out->geometry = geometry;
     out->prior = prior;
+    out->prior_centre = *centre;
+    out->have_prior_centre = 1;
+    free(centre);
     out->model = *start;
     out->set = *set;
     if (noise != NULL) {
@@ -270,6 +288,7 @@ static int fit_rows_from(const dhc_model *start, const dhc_param_set *set,
     if (dhcal_prior_of_set(&out->prior, set, prior_sd)) {
         opt.prior_sd = prior_sd;
         opt.prior_scale_mm = out->prior.scale_mm;
+        opt.prior_centre = &out->prior_centre;
     }
     /* optional: without it the outlier screens evaluate the model again */
     opt.sample_error2 = malloc((s->n + 1U) * sizeof *opt.sample_error2);
@@ -362,6 +381,7 @@ int dhcal_run_fit_prior(const dhc_model *nominal, const char *effects, dhcal_geo
 {
     const dhcal_prior none = {0.0, 0.0, 0.0};
     out->prior = prior != NULL ? *prior : none;
+    out->have_prior_centre = 0; /* a fit of its own: the prior centred on its start */
     dhc_param_set set;
     if (dhcal_geometry_set(nominal, geometry, &set) != DHCAL_IO_OK) {
         snprintf(err->msg, sizeof err->msg, "too many joints for the parameter limit");

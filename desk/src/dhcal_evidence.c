@@ -345,7 +345,8 @@ static void try_one(const judge_ctx *j, const dhc_candidate_result *cand, size_t
     }
     t->cv_gain = j->out->cv.rms_mm > 0.0 ? 1.0 - t->cv.rms_mm / j->out->cv.rms_mm : 0.0;
     fold_gain_test(&j->out->cv, &t->cv, t);
-    trial->geometry = fit->geometry;
+    /* the fit's prior, centred where the fit's is: every candidate weighed the same way */
+    dhcal_fit_carry(fit, trial);
     if (dhcal_fit_kept(have_estimate ? &estimate : &fit->model, &set, &fit->noise, j->s, j->held,
                        trial, &e2) != DHCAL_IO_OK) {
         return;

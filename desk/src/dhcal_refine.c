@@ -66,7 +66,7 @@ static int hold_implausible(const dhc_model *nominal, const dhc_noise_model *noi
             set.id[m - 1U] = set.id[m];
         }
         set.count--;
-        refit.geometry = out->fit.geometry;
+        dhcal_fit_carry(&out->fit, &refit);
         dhcal_error e2;
         memset(&e2, 0, sizeof e2);
         uint8_t *flags = malloc(s->n + 1U);

@@ -688,6 +688,10 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
         (!(opt->prior_scale_mm > 0.0) || !dhc_is_finite(opt->prior_scale_mm))) {
         return DHC_ERR_ARGUMENT;
     }
+    if (DHC_WITH_PRIOR && opt->prior_sd != NULL && opt->prior_centre != NULL &&
+        opt->prior_centre->arm.n_joints != model->arm.n_joints) {
+        return DHC_ERR_ARGUMENT; /* a centre of another arm */
+    }
     if (!DHC_WITH_ROBUST_START && opt->robust_start) {
         return DHC_ERR_ARGUMENT; /* left out of this build (DHC_WITH_ROBUST_START 0) */
     }

@@ -66,13 +66,15 @@ static void add_prior(const fit_context *fc, const dhc_model *model, int accumul
     }
     dhc_normal_eq *const ne = &fc->ws->ne;
     const size_t p = fc->set->count;
+    const dhc_model *const centre =
+        fc->opt->prior_centre != NULL ? fc->opt->prior_centre : fc->input;
     for (size_t k = 0U; k < p; ++k) {
         const double w = dhc_fit_prior_weight(fc, k);
         if (!(w > 0.0)) {
             continue;
         }
         const double r =
-            w * (dhc_params_value(fc->set, fc->input, k) - dhc_params_value(fc->set, model, k));
+            w * (dhc_params_value(fc->set, centre, k) - dhc_params_value(fc->set, model, k));
         tot->ssr += r * r;
         if (accumulate) {
             ne->jtj[k * p + k] += w * w;

@@ -89,6 +89,39 @@ static void test_predicted_accuracy_is_the_posterior_s(void)
     }
 }
 
+/* A refit started from the fit (as refine's steps and the candidates' trials start) keeps the
+ * prior centred on the drawing: the same objective, the same estimate. Centred on its own
+ * start instead, the strong prior here (w^2 = 36 against 30 rows) would pull the estimate
+ * 36 / 66 of the way back towards that start's data-side, a millimetre off. */
+static void test_a_refit_keeps_the_prior_on_the_drawing(void)
+{
+    measure();
+    const dhcal_prior prior = {0.05, 0.0, 0.3};
+    fit_tool(&prior);
+    const dhcal_fit first = g_fit;
+    TEST_ASSERT_TRUE(first.have_prior_centre);
+    TEST_ASSERT_EQUAL_DOUBLE(g_nominal.arm.tool_mm[0], first.prior_centre.arm.tool_mm[0]);
+    /* the data alone would put the tool about 2 mm off the drawing: the prior holds it part
+     * of the way (its weight is the rows') */
+    TEST_ASSERT_TRUE(fabs(first.model.arm.tool_mm[1] - g_nominal.arm.tool_mm[1]) > 0.3);
+    dhcal_error err;
+    memset(&err, 0, sizeof err);
+    TEST_ASSERT_EQUAL_MESSAGE(
+        DHCAL_IO_OK, dhcal_fit_kept(&first.model, &first.set, NULL, &g_s, NULL, &g_fit, &err),
+        err.msg);
+    for (size_t c = 0U; c < 3U; ++c) {
+        TEST_ASSERT_DOUBLE_WITHIN(1e-6, first.model.arm.tool_mm[c], g_fit.model.arm.tool_mm[c]);
+        TEST_ASSERT_EQUAL_DOUBLE(g_nominal.arm.tool_mm[c], g_fit.prior_centre.arm.tool_mm[c]);
+    }
+    /* what a trial carries */
+    dhcal_fit trial;
+    memset(&trial, 0, sizeof trial);
+    dhcal_fit_carry(&first, &trial);
+    TEST_ASSERT_EQUAL_DOUBLE(0.05, trial.prior.length_mm);
+    TEST_ASSERT_TRUE(trial.have_prior_centre);
+    TEST_ASSERT_EQUAL_DOUBLE(g_nominal.arm.tool_mm[2], trial.prior_centre.arm.tool_mm[2]);
+}
+
 static void test_the_prior_of_a_set_follows_the_kinds(void)
 {
     measure();
@@ -116,6 +149,7 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_predicted_accuracy_is_the_posterior_s);
+    RUN_TEST(test_a_refit_keeps_the_prior_on_the_drawing);
     RUN_TEST(test_the_prior_of_a_set_follows_the_kinds);
     return UNITY_END();
 }

@@ -54,9 +54,17 @@ typedef struct {
     dhc_calib_report rep;
     dhcal_geometry geometry;
     dhcal_prior prior; /* the caller's, kept by every refit from this one */
+    /* the model the prior is centred on (the drawing, with a contact fit's starting targets):
+     * the first fit's start, kept by every refit from this one wherever it starts */
+    dhc_model prior_centre;
+    int have_prior_centre;
     dhc_status status;
     int have_heldout;
 } dhcal_fit;
+
+/* What a refit from `from` keeps of it, into `to` before the refit: the geometry level, the
+ * prior and the prior's centre. */
+void dhcal_fit_carry(const dhcal_fit *from, dhcal_fit *to);
 
 /* The model without the calibration session's drift (drift_scale, drift_offset): what
  * another session's measurements (held-out rows, a controller) see. */

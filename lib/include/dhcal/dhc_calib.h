@@ -98,7 +98,8 @@ typedef struct {
      * need not evaluate the model again for them. */
     double *sample_residual;
     /* NULL (the default: least squares), or set->count standard deviations of a prior on
-     * the parameters, centred on the input model's values (the drawing and its tolerances):
+     * the parameters, centred on prior_centre's values (NULL: the input model's; the drawing
+     * and its tolerances):
      * the fit then maximises the posterior, minimising SSR + sum_k (w_k (v_k - v_k,input))^2
      * with w_k = prior_scale_mm / prior_sd[k] (1 / prior_sd[k] with the noise model on,
      * whose rows are unit-free). 0 (or a perturbation: a base rotation, a plane's tilt): no
@@ -106,6 +107,10 @@ typedef struct {
      * drawing instead of following the noise. The SSR and sigma include the prior's terms. */
     const double *prior_sd;
     double prior_scale_mm; /* the data's noise per row the prior is weighed against, mm */
+    /* NULL, or the model the prior is centred on when the fit starts elsewhere (a refit
+     * started from an earlier estimate, weighed against the same drawing); read only with
+     * prior_sd, of the model's arm (DHC_ERR_ARGUMENT otherwise) */
+    const dhc_model *prior_centre;
 } dhc_calib_options;
 
 typedef struct {
