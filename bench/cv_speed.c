@@ -34,7 +34,7 @@ static double now_s(void)
 }
 
 typedef int (*cv_fn)(const dhc_model *, const dhc_param_set *, const dhc_noise_model *,
-                     const dhcal_samples *, dhcal_cv *, dhcal_error *);
+                     const dhcal_fit *, const dhcal_samples *, dhcal_cv *, dhcal_error *);
 
 /* The best wall-clock time of up to repeat runs (fewer once they have taken a second in
  * all); *out holds the last run's result. Negative on failure. */
@@ -45,7 +45,7 @@ static double best_time(cv_fn fn, const dhcal_fit *fit, const dhc_param_set *set
     double spent = 0.0;
     for (int k = 0; k < repeat && (k == 0 || spent < 1.0); ++k) {
         const double t0 = now_s();
-        if (fn(&fit->model, set, &fit->noise, s, out, err) != DHCAL_IO_OK) {
+        if (fn(&fit->model, set, &fit->noise, fit, s, out, err) != DHCAL_IO_OK) {
             return -1.0;
         }
         const double dt = now_s() - t0;

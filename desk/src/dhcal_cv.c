@@ -67,6 +67,19 @@ static int make_folds(const dhcal_samples *s, cv_folds *cf, dhcal_error *err)
  * on all rows, a few dozen steps at most (where it creeps they hold its prediction to far
  * below the noise), and no screen: the rows are decided, every candidate is judged on the
  * same rows and folds. */
+/* The prior a fit carries (prior_of: dhcal_fit.prior, centred on its prior_centre; NULL:
+ * none) on set's parameters, into opt; sd (DHC_MAX_PARAMS) holds the standard deviations. */
+static void prior_options(const dhcal_fit *prior_of, const dhc_param_set *set, double *sd,
+                          dhc_calib_options *opt)
+{
+    if (prior_of != NULL && prior_of->have_prior_centre &&
+        dhcal_prior_of_set(&prior_of->prior, set, sd)) {
+        opt->prior_sd = sd;
+        opt->prior_scale_mm = prior_of->prior.scale_mm;
+        opt->prior_centre = &prior_of->prior_centre;
+    }
+}
+
 static void refit_options(const dhc_model *start, const dhc_noise_model *noise,
                           const dhcal_samples *s, dhc_calib_options *opt)
 {
@@ -143,8 +156,8 @@ static void finish(dhcal_cv *out, size_t folds)
 }
 
 int dhcal_cross_validate_refit(const dhc_model *start, const dhc_param_set *set,
-                               const dhc_noise_model *noise, const dhcal_samples *s, dhcal_cv *out,
-                               dhcal_error *err)
+                               const dhc_noise_model *noise, const dhcal_fit *prior_of,
+                               const dhcal_samples *s, dhcal_cv *out, dhcal_error *err)
 {
     memset(out, 0, sizeof *out);
     cv_folds cf;
@@ -153,6 +166,8 @@ int dhcal_cross_validate_refit(const dhc_model *start, const dhc_param_set *set,
     }
     dhc_calib_options opt;
     refit_options(start, noise, s, &opt);
+    double prior_sd[DHC_MAX_PARAMS];
+    prior_options(prior_of, set, prior_sd, &opt);
     opt.sample_error2 = malloc((s->n + 1U) * sizeof *opt.sample_error2); /* optional */
     uint8_t *flags = malloc(s->n + 1U);
     cv_scratch *w = malloc(sizeof *w);
@@ -308,6 +323,37 @@ static void sum_folds(const dhc_normal_eq *ne, size_t folds, size_t without, siz
     }
 }
 
+/* The weight of the prior's row on parameter k (0: none), as the fit weighs it */
+static double prior_weight(const fold_pass *fp, size_t k)
+{
+    const double *const sd = fp->opt->prior_sd;
+    return sd != NULL && sd[k] > 0.0 ? (fp->whiten ? 1.0 : fp->opt->prior_scale_mm) / sd[k] : 0.0;
+}
+
+/* The prior's rows at model, w_k (centre_k - v_k), added to a fold's equations (sys NULL:
+ * only their sum of squares, returned): the folds' estimates are the fit's maximum a
+ * posteriori on their rows, as the fit's is on all of them. */
+static double add_prior_rows(const fold_pass *fp, const dhc_model *model, dhc_normal_eq *sys)
+{
+    double ss = 0.0;
+    const size_t p = fp->set->count;
+    for (size_t k = 0U; fp->opt->prior_sd != NULL && k < p; ++k) {
+        const double w = prior_weight(fp, k);
+        if (!(w > 0.0)) {
+            continue;
+        }
+        const double r = w * (dhc_params_value(fp->set, fp->opt->prior_centre, k) -
+                              dhc_params_value(fp->set, model, k));
+        ss += r * r;
+        if (sys != NULL) {
+            sys->jtj[k * p + k] += w * w;
+            sys->jtr[k] += w * r;
+            sys->ssr += r * r;
+        }
+    }
+    return ss;
+}
+
 /* dhc_lsq_analyse with the columns keep[] leaves out hidden (a zero diagonal: never a
  * pivot), as the fit keeps its parameter set between analyses. ne's diagonal is edited. */
 static dhc_status analyse_keeping(dhc_normal_eq *ne, const uint8_t *keep, double tol,
@@ -422,6 +468,7 @@ static dhc_status evaluate_trial(fold_pass *fp, const dhc_model *model, size_t f
             *ssr += r[k] * r[k];
         }
     }
+    *ssr += add_prior_rows(fp, model, NULL); /* as the other rows' equations carry them */
     return st == DHC_OK && !dhc_is_finite(*ssr) ? DHC_ERR_NONFINITE : st;
 }
 
@@ -472,6 +519,7 @@ static void fold_step_ratio(fold_pass *fp, const dhc_normal_eq *ne, const uint8_
     step_fit *const sf = fit != NULL ? fit : &none;
     *sf = none;
     sum_folds(ne, fp->cf->folds, f, p, sys);
+    (void)add_prior_rows(fp, fp->model, sys);
     dhc_status st = analyse_keeping(sys, ident_all, fp->opt->rank_rel_tol, fac);
     if (st != DHC_OK || sys->rows <= fac->rank) {
         return;
@@ -589,6 +637,7 @@ static int estimate_folds(fold_pass *fp, const dhc_normal_eq *ne, const dhc_nois
     dhc_model *const model = &fp->w->refit_model;
     dhc_model *const step = &fp->w->step;
     sum_folds(ne, fp->cf->folds, SIZE_MAX, fp->set->count, all);
+    (void)add_prior_rows(fp, fp->model, all);
     if (dhc_lsq_analyse(all, fp->opt->rank_rel_tol, fac_all) != DHC_OK) {
         snprintf(err->msg, sizeof err->msg, "cross-validation: the rows cannot be analysed");
         return DHCAL_IO_FAILED;
@@ -623,6 +672,9 @@ static int estimate_folds(fold_pass *fp, const dhc_normal_eq *ne, const dhc_nois
         }
         if (flags == NULL) {
             refit_options(fp->model, noise, fp->s, &ropt);
+            ropt.prior_sd = fp->opt->prior_sd; /* the folds' prior, whose sd outlive them */
+            ropt.prior_scale_mm = fp->opt->prior_scale_mm;
+            ropt.prior_centre = fp->opt->prior_centre;
             flags = malloc(fp->s->n + 1U);
         }
         /* from where the iterated steps got to: each lowered the other rows' sum of squares
@@ -652,28 +704,29 @@ static int estimate_folds(fold_pass *fp, const dhc_normal_eq *ne, const dhc_nois
 }
 
 static int cv_run(const dhc_model *start, const dhc_param_set *set, const dhc_noise_model *noise,
-                  const dhcal_samples *s, dhcal_cv *out, dhc_model *estimate, int *have_estimate,
-                  dhcal_error *err);
+                  const dhcal_fit *prior_of, const dhcal_samples *s, dhcal_cv *out,
+                  dhc_model *estimate, int *have_estimate, dhcal_error *err);
 
 int dhcal_cross_validate(const dhc_model *start, const dhc_param_set *set,
-                         const dhc_noise_model *noise, const dhcal_samples *s, dhcal_cv *out,
-                         dhcal_error *err)
+                         const dhc_noise_model *noise, const dhcal_fit *prior_of,
+                         const dhcal_samples *s, dhcal_cv *out, dhcal_error *err)
 {
-    return dhcal_cross_validate_step(start, set, noise, s, out, NULL, NULL, err);
+    return dhcal_cross_validate_step(start, set, noise, prior_of, s, out, NULL, NULL, err);
 }
 
 int dhcal_cross_validate_step(const dhc_model *start, const dhc_param_set *set,
-                              const dhc_noise_model *noise, const dhcal_samples *s, dhcal_cv *out,
-                              dhc_model *estimate, int *have_estimate, dhcal_error *err)
+                              const dhc_noise_model *noise, const dhcal_fit *prior_of,
+                              const dhcal_samples *s, dhcal_cv *out, dhc_model *estimate,
+                              int *have_estimate, dhcal_error *err)
 {
     memset(out, 0, sizeof *out);
-    return cv_run(start, set, noise, s, out, estimate, have_estimate, err);
+    return cv_run(start, set, noise, prior_of, s, out, estimate, have_estimate, err);
 }
 
 /* The accumulation, the folds' estimates and (estimate not NULL) the all-rows step. */
 static int cv_run(const dhc_model *start, const dhc_param_set *set, const dhc_noise_model *noise,
-                  const dhcal_samples *s, dhcal_cv *out, dhc_model *estimate, int *have_estimate,
-                  dhcal_error *err)
+                  const dhcal_fit *prior_of, const dhcal_samples *s, dhcal_cv *out,
+                  dhc_model *estimate, int *have_estimate, dhcal_error *err)
 {
     if (have_estimate != NULL) {
         *have_estimate = 0;
@@ -684,6 +737,8 @@ static int cv_run(const dhc_model *start, const dhc_param_set *set, const dhc_no
     }
     dhc_calib_options opt;
     dhcal_calib_options_for(start, noise, &opt);
+    double prior_sd[DHC_MAX_PARAMS];
+    prior_options(prior_of, set, prior_sd, &opt);
     fold_pass fp; /* about 2 KiB: the desk's stack, not a static that would keep its
                      pointers to this call's locals */
     memset(&fp, 0, sizeof fp);

@@ -339,7 +339,7 @@ static void try_one(const judge_ctx *j, const dhc_candidate_result *cand, size_t
      * end (from the fit itself a refit creeps for tens of iterations) */
     dhc_model estimate;
     int have_estimate = 0;
-    if (dhcal_cross_validate_step(&fit->model, &set, &fit->noise, j->s, &t->cv, &estimate,
+    if (dhcal_cross_validate_step(&fit->model, &set, &fit->noise, fit, j->s, &t->cv, &estimate,
                                   &have_estimate, &e2) != DHCAL_IO_OK) {
         return;
     }

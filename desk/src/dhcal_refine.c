@@ -149,7 +149,7 @@ static int fit_start(const dhc_model *nominal, const char *effects, const dhcal_
         if (rc == DHCAL_IO_OK) {
             dhc_param_set cv_set;
             dhcal_set_without_held(&out->fit, &cv_set);
-            rc = dhcal_cross_validate(&out->fit.model, &cv_set, noise, s, &out->cv, err);
+            rc = dhcal_cross_validate(&out->fit.model, &cv_set, noise, &out->fit, s, &out->cv, err);
         }
         return rc;
     }
@@ -185,7 +185,8 @@ static int fit_start(const dhc_model *nominal, const char *effects, const dhcal_
         dhcal_cv cv;
         dhc_param_set cv_set;
         dhcal_set_without_held(&trial, &cv_set);
-        if (dhcal_cross_validate(&trial.model, &cv_set, noise, s, &cv, &e2) != DHCAL_IO_OK) {
+        if (dhcal_cross_validate(&trial.model, &cv_set, noise, &trial, s, &cv, &e2) !=
+            DHCAL_IO_OK) {
             snprintf(reasons[g], sizeof reasons[g], "cannot be cross-validated");
             continue;
         }

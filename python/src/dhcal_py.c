@@ -267,7 +267,7 @@ static int run_fit(const dhcal_py_model *m, dhcal_session *s, const char *effect
     }
     dhcal_fit_extras_compute(&fit, &s->samples, s->have_held ? &s->held : NULL, &extras);
     if (cv) {
-        extras.have_cv = dhcal_cross_validate(&fit.model, &fit.set, &s->noise, &s->samples,
+        extras.have_cv = dhcal_cross_validate(&fit.model, &fit.set, &s->noise, &fit, &s->samples,
                                               &extras.cv, e) == DHCAL_IO_OK;
         rc = extras.have_cv ? DHCAL_IO_OK : DHCAL_IO_FAILED;
     }

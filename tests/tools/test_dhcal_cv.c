@@ -80,10 +80,11 @@ static double fit_and_compare(const dhc_model *nominal, const char *effects,
     dhcal_cv fast;
     dhcal_cv refit;
     TEST_ASSERT_EQUAL_MESSAGE(
-        DHCAL_IO_OK, dhcal_cross_validate(&g_fit.model, &set, noise, &g_s, &fast, &err), err.msg);
-    TEST_ASSERT_EQUAL_MESSAGE(
-        DHCAL_IO_OK, dhcal_cross_validate_refit(&g_fit.model, &set, noise, &g_s, &refit, &err),
+        DHCAL_IO_OK, dhcal_cross_validate(&g_fit.model, &set, noise, NULL, &g_s, &fast, &err),
         err.msg);
+    TEST_ASSERT_EQUAL_MESSAGE(
+        DHCAL_IO_OK,
+        dhcal_cross_validate_refit(&g_fit.model, &set, noise, NULL, &g_s, &refit, &err), err.msg);
     /* the same folds over the same rows */
     TEST_ASSERT_EQUAL_size_t(folds, fast.folds);
     TEST_ASSERT_EQUAL_size_t(folds, refit.folds);
@@ -189,9 +190,10 @@ static void test_curved_candidate_iterates(void)
     dhcal_cv fast;
     dhcal_cv refit;
     TEST_ASSERT_EQUAL_MESSAGE(
-        DHCAL_IO_OK, dhcal_cross_validate(&g_fit.model, &set, NULL, &g_s, &fast, &err), err.msg);
+        DHCAL_IO_OK, dhcal_cross_validate(&g_fit.model, &set, NULL, NULL, &g_s, &fast, &err),
+        err.msg);
     TEST_ASSERT_EQUAL_MESSAGE(
-        DHCAL_IO_OK, dhcal_cross_validate_refit(&g_fit.model, &set, NULL, &g_s, &refit, &err),
+        DHCAL_IO_OK, dhcal_cross_validate_refit(&g_fit.model, &set, NULL, NULL, &g_s, &refit, &err),
         err.msg);
     TEST_ASSERT_TRUE_MESSAGE(fast.iterated_folds > 0U, "no fold needed its steps iterated");
     TEST_ASSERT_EQUAL_size_t_MESSAGE(0U, fast.refit_folds, "the fast path fell back to refits");
@@ -217,7 +219,7 @@ static void test_contract(void)
     memcpy(before, g_flags, g_s.n);
     dhcal_cv cv;
     TEST_ASSERT_EQUAL(DHCAL_IO_OK,
-                      dhcal_cross_validate(&g_fit.model, &g_fit.set, NULL, &g_s, &cv, &err));
+                      dhcal_cross_validate(&g_fit.model, &g_fit.set, NULL, NULL, &g_s, &cv, &err));
     TEST_ASSERT_EQUAL_MEMORY(before, g_flags, g_s.n);
     TEST_ASSERT_EQUAL_size_t(59U, cv.rows);
     TEST_ASSERT_EQUAL_size_t(12U, cv.fold_rows[3]); /* 59 used rows over 5 folds */
@@ -225,7 +227,7 @@ static void test_contract(void)
         g_flags[i] = i < 1U ? (uint8_t)DHC_SAMPLE_USED : (uint8_t)DHC_SAMPLE_OUTLIER;
     }
     TEST_ASSERT_EQUAL(DHCAL_IO_FAILED,
-                      dhcal_cross_validate(&g_fit.model, &g_fit.set, NULL, &g_s, &cv, &err));
+                      dhcal_cross_validate(&g_fit.model, &g_fit.set, NULL, NULL, &g_s, &cv, &err));
     TEST_ASSERT_NOT_NULL(strstr(err.msg, "two rows"));
 }
 

@@ -9,6 +9,7 @@
 #include "dhc_test_arms.h"
 #include "dhcal/dhc_params.h"
 #include "dhcal_desk/dhcal_analysis.h"
+#include "dhcal_desk/dhcal_cv.h"
 #include "unity.h"
 
 #define N_ROWS 30U
@@ -122,6 +123,98 @@ static void test_a_refit_keeps_the_prior_on_the_drawing(void)
     TEST_ASSERT_EQUAL_DOUBLE(g_nominal.arm.tool_mm[2], trial.prior_centre.arm.tool_mm[2]);
 }
 
+/* Sample i's flange point f and rotation R (columns from unit tool offsets): the model's
+ * tool point is f + R t, linear in the tool offset t. */
+static void flange_of(size_t i, double f[3], double r[3][3])
+{
+    dhc_model m = g_nominal;
+    dhc_vec3_set(m.arm.tool_mm, 0.0, 0.0, 0.0);
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_model_tool_point(&m, g_samples[i].q_rad, NULL, f));
+    for (size_t c = 0U; c < 3U; ++c) {
+        double p[3];
+        dhc_vec3_set(m.arm.tool_mm, c == 0U ? 1.0 : 0.0, c == 1U ? 1.0 : 0.0, c == 2U ? 1.0 : 0.0);
+        TEST_ASSERT_EQUAL(DHC_OK, dhc_model_tool_point(&m, g_samples[i].q_rad, NULL, p));
+        for (size_t k = 0U; k < 3U; ++k) {
+            r[k][c] = p[k] - f[k];
+        }
+    }
+}
+
+/* The folds' estimates carry the fit's prior: with the tool offset alone the model is linear,
+ * and fold f's maximum a posteriori is closed, t_f = (sum over the other rows of R^T (p - f)
+ * + w^2 t0) / (n_other + w^2). Both methods (downdated steps, refits) give the closed form's
+ * CV; without the prior the CV is another number. */
+static void test_the_folds_carry_the_prior(void)
+{
+    measure();
+    const dhcal_prior prior = {0.05, 0.0, 0.3};
+    fit_tool(&prior);
+    const double w2 = (0.3 / 0.05) * (0.3 / 0.05);
+    static double b[N_ROWS][3]; /* R^T (p - f) of each row */
+    for (size_t i = 0U; i < N_ROWS; ++i) {
+        double f[3];
+        double r[3][3];
+        flange_of(i, f, r);
+        for (size_t c = 0U; c < 3U; ++c) {
+            b[i][c] = 0.0;
+            for (size_t k = 0U; k < 3U; ++k) {
+                b[i][c] += r[k][c] * (g_samples[i].p_mm[k] - f[k]);
+            }
+        }
+    }
+    const size_t folds = DHCAL_CV_FOLDS;
+    double ss = 0.0;
+    for (size_t fold = 0U; fold < folds; ++fold) {
+        double t[3];
+        double n_other = 0.0;
+        for (size_t c = 0U; c < 3U; ++c) {
+            t[c] = w2 * g_nominal.arm.tool_mm[c];
+        }
+        for (size_t i = 0U; i < N_ROWS; ++i) {
+            if (i % folds != fold) {
+                n_other += 1.0;
+                for (size_t c = 0U; c < 3U; ++c) {
+                    t[c] += b[i][c];
+                }
+            }
+        }
+        for (size_t c = 0U; c < 3U; ++c) {
+            t[c] /= n_other + w2;
+        }
+        for (size_t i = fold; i < N_ROWS; i += folds) {
+            double f[3];
+            double r[3][3];
+            flange_of(i, f, r);
+            for (size_t k = 0U; k < 3U; ++k) {
+                const double e = g_samples[i].p_mm[k] - f[k] -
+                                 (r[k][0] * t[0] + r[k][1] * t[1] + r[k][2] * t[2]);
+                ss += e * e;
+            }
+        }
+    }
+    const double expected = sqrt(ss / (double)N_ROWS);
+    dhcal_cv fast;
+    dhcal_cv refit;
+    dhcal_cv plain;
+    dhcal_error err;
+    memset(&err, 0, sizeof err);
+    TEST_ASSERT_EQUAL_MESSAGE(
+        DHCAL_IO_OK,
+        dhcal_cross_validate(&g_fit.model, &g_fit.set, NULL, &g_fit, &g_s, &fast, &err), err.msg);
+    TEST_ASSERT_EQUAL_MESSAGE(
+        DHCAL_IO_OK,
+        dhcal_cross_validate_refit(&g_fit.model, &g_fit.set, NULL, &g_fit, &g_s, &refit, &err),
+        err.msg);
+    TEST_ASSERT_EQUAL_MESSAGE(
+        DHCAL_IO_OK, dhcal_cross_validate(&g_fit.model, &g_fit.set, NULL, NULL, &g_s, &plain, &err),
+        err.msg);
+    TEST_ASSERT_EQUAL_size_t(folds, fast.folds);
+    TEST_ASSERT_DOUBLE_WITHIN(1e-6 * expected, expected, fast.rms_mm);
+    /* the refits stop at Levenberg-Marquardt's tolerance, a little short of the closed form */
+    TEST_ASSERT_DOUBLE_WITHIN(1e-3 * expected, expected, refit.rms_mm);
+    TEST_ASSERT_TRUE(fabs(plain.rms_mm - expected) > 0.01 * expected);
+}
+
 static void test_the_prior_of_a_set_follows_the_kinds(void)
 {
     measure();
@@ -150,6 +243,7 @@ int main(void)
     UNITY_BEGIN();
     RUN_TEST(test_predicted_accuracy_is_the_posterior_s);
     RUN_TEST(test_a_refit_keeps_the_prior_on_the_drawing);
+    RUN_TEST(test_the_folds_carry_the_prior);
     RUN_TEST(test_the_prior_of_a_set_follows_the_kinds);
     return UNITY_END();
 }

@@ -334,8 +334,8 @@ static int run_fit(const dhcal_cli_options *o, dhcal_session *s)
         if (o->cv) {
             dhcal_error err;
             memset(&err, 0, sizeof err);
-            extras.have_cv = dhcal_cross_validate(&fit.model, &fit.set, &s->noise, &s->samples,
-                                                  &extras.cv, &err) == DHCAL_IO_OK;
+            extras.have_cv = dhcal_cross_validate(&fit.model, &fit.set, &s->noise, &fit,
+                                                  &s->samples, &extras.cv, &err) == DHCAL_IO_OK;
             /* asked for and not computable: a failed computation, as for diagnose --cv; a
              * script must not take a report without cv_rms_mm for a success */
             if (!extras.have_cv) {

@@ -61,18 +61,24 @@ typedef struct {
  *
  * dhcal_cross_validate_refit: the reference. Each fold refitted by Levenberg-Marquardt
  * (dhc_calib_fit, from start, at most DHCAL_CV_MAX_ITERATIONS iterations, the screens
- * off). */
+ * off).
+ *
+ * prior_of (NULL: none): the fit whose prior on the drawing (dhcal_fit.prior, centred on its
+ * prior_centre) the folds' estimates carry, as that fit carried it on all rows: each fold's
+ * equations gain the prior's rows, its estimate is the maximum a posteriori of its other
+ * rows. Without it a contact fit's folds would follow what only the prior held. */
 int dhcal_cross_validate(const dhc_model *start, const dhc_param_set *set,
-                         const dhc_noise_model *noise, const dhcal_samples *s, dhcal_cv *out,
-                         dhcal_error *err);
+                         const dhc_noise_model *noise, const dhcal_fit *prior_of,
+                         const dhcal_samples *s, dhcal_cv *out, dhcal_error *err);
 /* dhcal_cross_validate, and with estimate (may be NULL) the same step on every row: the
  * linearised refit of set from start, confirmed as a fold's step is (*have_estimate 1), or
  * not to be trusted (0: the caller refits). One pass more. */
 int dhcal_cross_validate_step(const dhc_model *start, const dhc_param_set *set,
-                              const dhc_noise_model *noise, const dhcal_samples *s, dhcal_cv *out,
-                              dhc_model *estimate, int *have_estimate, dhcal_error *err);
+                              const dhc_noise_model *noise, const dhcal_fit *prior_of,
+                              const dhcal_samples *s, dhcal_cv *out, dhc_model *estimate,
+                              int *have_estimate, dhcal_error *err);
 int dhcal_cross_validate_refit(const dhc_model *start, const dhc_param_set *set,
-                               const dhc_noise_model *noise, const dhcal_samples *s, dhcal_cv *out,
-                               dhcal_error *err);
+                               const dhc_noise_model *noise, const dhcal_fit *prior_of,
+                               const dhcal_samples *s, dhcal_cv *out, dhcal_error *err);
 
 #endif /* DHCAL_CV_H */
