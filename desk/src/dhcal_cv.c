@@ -330,26 +330,37 @@ static double prior_weight(const fold_pass *fp, size_t k)
     return sd != NULL && sd[k] > 0.0 ? (fp->whiten ? 1.0 : fp->opt->prior_scale_mm) / sd[k] : 0.0;
 }
 
-/* The prior's rows at model, w_k (centre_k - v_k), added to a fold's equations (sys NULL:
- * only their sum of squares, returned): the folds' estimates are the fit's maximum a
- * posteriori on their rows, as the fit's is on all of them. */
-static double add_prior_rows(const fold_pass *fp, const dhc_model *model, dhc_normal_eq *sys)
+/* The prior's row on parameter k at model, w_k (centre_k - v_k), and its weight (0: none) */
+static double prior_row(const fold_pass *fp, const dhc_model *model, size_t k, double *w)
 {
-    double ss = 0.0;
+    *w = prior_weight(fp, k);
+    return *w > 0.0 ? *w * (dhc_params_value(fp->set, fp->opt->prior_centre, k) -
+                            dhc_params_value(fp->set, model, k))
+                    : 0.0;
+}
+
+/* The prior's rows at model added to a fold's equations: the folds' estimates are the fit's
+ * maximum a posteriori on their rows, as the fit's is on all of them. */
+static void add_prior_rows(const fold_pass *fp, const dhc_model *model, dhc_normal_eq *sys)
+{
     const size_t p = fp->set->count;
     for (size_t k = 0U; fp->opt->prior_sd != NULL && k < p; ++k) {
-        const double w = prior_weight(fp, k);
-        if (!(w > 0.0)) {
-            continue;
-        }
-        const double r = w * (dhc_params_value(fp->set, fp->opt->prior_centre, k) -
-                              dhc_params_value(fp->set, model, k));
+        double w = 0.0;
+        const double r = prior_row(fp, model, k, &w);
+        sys->jtj[k * p + k] += w * w;
+        sys->jtr[k] += w * r;
+        sys->ssr += r * r;
+    }
+}
+
+/* Their sum of squares at model (what the other rows' equations carry beside their own) */
+static double prior_ss(const fold_pass *fp, const dhc_model *model)
+{
+    double ss = 0.0;
+    for (size_t k = 0U; fp->opt->prior_sd != NULL && k < fp->set->count; ++k) {
+        double w = 0.0;
+        const double r = prior_row(fp, model, k, &w);
         ss += r * r;
-        if (sys != NULL) {
-            sys->jtj[k * p + k] += w * w;
-            sys->jtr[k] += w * r;
-            sys->ssr += r * r;
-        }
     }
     return ss;
 }
@@ -468,7 +479,7 @@ static dhc_status evaluate_trial(fold_pass *fp, const dhc_model *model, size_t f
             *ssr += r[k] * r[k];
         }
     }
-    *ssr += add_prior_rows(fp, model, NULL); /* as the other rows' equations carry them */
+    *ssr += prior_ss(fp, model); /* as the other rows' equations carry them */
     return st == DHC_OK && !dhc_is_finite(*ssr) ? DHC_ERR_NONFINITE : st;
 }
 
@@ -519,7 +530,7 @@ static void fold_step_ratio(fold_pass *fp, const dhc_normal_eq *ne, const uint8_
     step_fit *const sf = fit != NULL ? fit : &none;
     *sf = none;
     sum_folds(ne, fp->cf->folds, f, p, sys);
-    (void)add_prior_rows(fp, fp->model, sys);
+    add_prior_rows(fp, fp->model, sys);
     dhc_status st = analyse_keeping(sys, ident_all, fp->opt->rank_rel_tol, fac);
     if (st != DHC_OK || sys->rows <= fac->rank) {
         return;
@@ -637,7 +648,7 @@ static int estimate_folds(fold_pass *fp, const dhc_normal_eq *ne, const dhc_nois
     dhc_model *const model = &fp->w->refit_model;
     dhc_model *const step = &fp->w->step;
     sum_folds(ne, fp->cf->folds, SIZE_MAX, fp->set->count, all);
-    (void)add_prior_rows(fp, fp->model, all);
+    add_prior_rows(fp, fp->model, all);
     if (dhc_lsq_analyse(all, fp->opt->rank_rel_tol, fac_all) != DHC_OK) {
         snprintf(err->msg, sizeof err->msg, "cross-validation: the rows cannot be analysed");
         return DHCAL_IO_FAILED;
