@@ -221,17 +221,11 @@ typedef struct {
  * up to a similarity transform. */
 #define UNITS_MIN_JOINT_RANGE_RAD 0.01
 
-/* A touch row (docs/formats.md 3.4): its joint angles, but no point measured. */
-static int is_touch(const dhcal_row *row)
-{
-    return row->plane != 0U || row->point != 0U || row->pair != 0U;
-}
-
 static size_t measured_rows(const dhcal_dataset *data)
 {
     size_t n = 0U;
     for (size_t i = 0U; i < data->n_rows; ++i) {
-        n += is_touch(&data->rows[i]) ? 0U : 1U;
+        n += dhcal_row_is_touch_or_length(&data->rows[i]) ? 0U : 1U;
     }
     return n;
 }
@@ -260,7 +254,7 @@ static int work_open(const dhc_model *model, const dhcal_dataset *data, units_wo
         /* evenly spaced over the session's measured rows (touches measure no point) */
         const size_t want = i * measured / w->m;
         for (; k < data->n_rows; ++k) {
-            if (!is_touch(&data->rows[k]) && seen++ == want) {
+            if (!dhcal_row_is_touch_or_length(&data->rows[k]) && seen++ == want) {
                 break;
             }
         }

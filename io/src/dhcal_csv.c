@@ -541,7 +541,7 @@ static int parse_row(csv_ctx *c, dhcal_row *row)
     memset(row, 0, sizeof *row);
     row->line = c->rd.line_no;
     int rc = contact_of_row(c, row);
-    const int touch = row->plane != 0U || row->point != 0U || row->pair != 0U;
+    const int touch = dhcal_row_is_touch_or_length(row);
     for (size_t k = 0U; k < n && rc == DHCAL_IO_OK; ++k) {
         const csv_col col = c->cols[k];
         const span f = c->spans[k];

@@ -98,7 +98,7 @@ int dhcal_dataset_from_arrays(const dhcal_arrays *a, dhcal_dataset *data, dhcal_
             dhcal_dataset_free(data);
             return rc;
         }
-        const int touch = row->plane != 0U || row->point != 0U || row->pair != 0U;
+        const int touch = dhcal_row_is_touch_or_length(row);
         if (!touch && a->xyz_mm == NULL && a->wires_mm == NULL) {
             dhcal_dataset_free(data);
             return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
@@ -181,7 +181,7 @@ void dhcal_csv_write_row(dhcal_text *t, const dhcal_csv_columns *cols, const dhc
         dhcal_text_printf(t, ",%d", row->dir[j]);
     }
     /* a touch or a length row measures no point: its measurement cells stay empty */
-    const int touch = row->plane != 0U || row->point != 0U || row->pair != 0U;
+    const int touch = dhcal_row_is_touch_or_length(row);
     if (cols->has_xyz && touch) {
         dhcal_text_str(t, ",,,");
     } else if (cols->has_xyz) {

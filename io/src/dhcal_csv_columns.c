@@ -2,6 +2,8 @@
 #include "dhcal_csv_columns.h"
 
 #include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -169,68 +171,82 @@ static void where(const dhcal_dataset *data, const char *path, int rows, size_t 
     }
 }
 
-/* The row after i of pair id (data->n_rows: none) */
-static size_t next_of_pair(const dhcal_dataset *data, size_t i, unsigned id)
+int dhcal_row_is_touch_or_length(const dhcal_row *row)
+{
+    return row->plane != 0U || row->point != 0U || row->pair != 0U;
+}
+
+size_t dhcal_dataset_next_of_pair(const dhcal_dataset *data, size_t i)
 {
     size_t k = i + 1U;
-    while (k < data->n_rows && data->rows[k].pair != id) {
+    while (k < data->n_rows && data->rows[k].pair != data->rows[i].pair) {
         ++k;
     }
     return k;
 }
 
-int dhcal_csv_check_pairs(const dhcal_dataset *data, const char *path, int rows, dhcal_error *err)
+/* The defects of the pair whose first row is i (its second: second, or n_rows), named with
+ * both rows */
+static int pair_defect(const dhcal_dataset *data, const char *path, int rows, size_t i,
+                       size_t second, dhcal_error *err)
 {
     char a[300];
     char b[300];
-    for (size_t i = 0U; i < data->n_rows; ++i) {
-        const dhcal_row *const row = &data->rows[i];
-        where(data, path, rows, i, a, sizeof a);
-        if (row->pair == 0U && row->distance_mm > 0.0) {
-            return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
-                                   "%s: a distance_mm without a pair id: a length is between "
-                                   "the tool points of the two rows of one pair",
-                                   a);
-        }
-        if (row->pair == 0U) {
-            continue;
-        }
-        size_t first = 0U;
-        while (data->rows[first].pair != row->pair) {
-            ++first;
-        }
-        if (first < i) {
-            continue; /* checked with its first row */
-        }
-        const size_t second = next_of_pair(data, i, row->pair);
-        if (second == data->n_rows) {
-            return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
-                                   "%s: pair %u has one row: a length needs the two rows whose "
-                                   "tool points it separates",
-                                   a, row->pair);
-        }
-        where(data, path, rows, second, b, sizeof b);
-        const size_t third = next_of_pair(data, second, row->pair);
-        if (third < data->n_rows) {
-            char c[300];
-            where(data, path, rows, third, c, sizeof c);
-            return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
-                                   "%s: pair %u has a third row (the first two: %s, %s): give "
-                                   "each length its own id",
-                                   c, row->pair, a, b);
-        }
-        const double d1 = row->distance_mm;
-        const double d2 = data->rows[second].distance_mm;
-        if (!(d1 > 0.0) && !(d2 > 0.0)) {
-            return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
-                                   "%s: pair %u gives no distance_mm (in neither this row nor %s)",
-                                   a, row->pair, b);
-        }
-        if (d1 > 0.0 && d2 > 0.0 && !(fabs(d1 - d2) <= 1e-9 * fmax(d1, d2))) {
-            return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
-                                   "%s: pair %u's distance_mm %.9g differs from %.9g in %s", b,
-                                   row->pair, d2, d1, a);
-        }
+    const dhcal_row *const row = &data->rows[i];
+    where(data, path, rows, i, a, sizeof a);
+    if (second == data->n_rows) {
+        return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
+                               "%s: pair %u has one row: a length needs the two rows whose "
+                               "tool points it separates",
+                               a, row->pair);
+    }
+    where(data, path, rows, second, b, sizeof b);
+    const size_t third = dhcal_dataset_next_of_pair(data, second);
+    if (third < data->n_rows) {
+        char c[300];
+        where(data, path, rows, third, c, sizeof c);
+        return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
+                               "%s: pair %u has a third row (the first two: %s, %s): give "
+                               "each length its own id",
+                               c, row->pair, a, b);
+    }
+    const double d1 = row->distance_mm;
+    const double d2 = data->rows[second].distance_mm;
+    if (!(d1 > 0.0) && !(d2 > 0.0)) {
+        return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
+                               "%s: pair %u gives no distance_mm (in neither this row nor %s)", a,
+                               row->pair, b);
+    }
+    if (d1 > 0.0 && d2 > 0.0 && !(fabs(d1 - d2) <= 1e-9 * fmax(d1, d2))) {
+        return dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
+                               "%s: pair %u's distance_mm %.9g differs from %.9g in %s", b,
+                               row->pair, d2, d1, a);
     }
     return DHCAL_IO_OK;
+}
+
+int dhcal_csv_check_pairs(const dhcal_dataset *data, const char *path, int rows, dhcal_error *err)
+{
+    uint8_t *const second_row = calloc(data->n_rows + 1U, 1U); /* a pair's second row */
+    if (second_row == NULL) {
+        return dhcal_error_set(err, DHCAL_IO_FAILED, "%s: out of memory", path);
+    }
+    int rc = DHCAL_IO_OK;
+    for (size_t i = 0U; i < data->n_rows && rc == DHCAL_IO_OK; ++i) {
+        const dhcal_row *const row = &data->rows[i];
+        if (row->pair == 0U && row->distance_mm > 0.0) {
+            char a[300];
+            where(data, path, rows, i, a, sizeof a);
+            rc = dhcal_error_set(err, DHCAL_IO_BAD_INPUT,
+                                 "%s: a distance_mm without a pair id: a length is between the "
+                                 "tool points of the two rows of one pair",
+                                 a);
+        } else if (row->pair != 0U && !second_row[i]) {
+            const size_t second = dhcal_dataset_next_of_pair(data, i);
+            second_row[second] = 1U;
+            rc = pair_defect(data, path, rows, i, second, err);
+        }
+    }
+    free(second_row);
+    return rc;
 }

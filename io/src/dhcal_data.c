@@ -49,10 +49,7 @@ int dhcal_samples_build(const dhc_model *model, const dhcal_dataset *data, const
         s->t_s = data->has_time ? row->t_s : (double)i;
         if (row->pair != 0U) {
             /* the rows' pairs are whole (dhcal_csv_load): the second is further down */
-            size_t k = i + 1U;
-            while (k < data->n_rows && data->rows[k].pair != row->pair) {
-                ++k;
-            }
+            const size_t k = dhcal_dataset_next_of_pair(data, i);
             const dhcal_row *const other = &data->rows[k < data->n_rows ? k : i];
             partner[k < data->n_rows ? k : i] = 1U;
             for (size_t j = 0U; j < data->n_joints && j < DHC_MAX_JOINTS; ++j) {

@@ -81,6 +81,12 @@ int dhcal_csv_load_targets(const char *path, size_t n_joints, dhcal_dataset *tar
 /* Frees the rows and empties *data; NULL and already-empty datasets are fine. */
 void dhcal_dataset_free(dhcal_dataset *data);
 
+/* 1 for a row that measures no point: a touch (plane, point) or an end of a length (pair). */
+int dhcal_row_is_touch_or_length(const dhcal_row *row);
+
+/* The row after row i (of a length pair) with i's pair id; data->n_rows when there is none. */
+size_t dhcal_dataset_next_of_pair(const dhcal_dataset *data, size_t i);
+
 /* Measurement rows handed in as arrays rather than a file (the Python package): row-major,
  * q_deg n_rows x n_joints in degrees (required), xyz_mm and wires_mm (L1..L3) n_rows x 3
  * (one of them, or both as a file may have both, or neither when every row is a touch);
