@@ -63,6 +63,11 @@ static int contact_prior(const dhc_model *start, const dhc_param_set *set,
     return dhcal_prior_scale(start, set, noise, s, prior, err);
 }
 
+double dhcal_prior_weight(double scale_mm, double sd, int whitened)
+{
+    return sd > 0.0 ? (whitened ? 1.0 : scale_mm) / sd : 0.0;
+}
+
 int dhcal_samples_have_contact(const dhcal_samples *s)
 {
     for (size_t i = 0U; i < s->n; ++i) {
@@ -137,7 +142,7 @@ int dhcal_predicted_accuracy(const dhcal_fit *fit, const dhcal_samples *s, size_
         const int whitened = dhcal_noise_on(&fit->noise);
         for (size_t k = 0U; k < p; ++k) {
             if (sd[k] > 0.0 && fit->rep.identifiable[k]) {
-                const double w = (whitened ? 1.0 : fit->prior.scale_mm) / sd[k];
+                const double w = dhcal_prior_weight(fit->prior.scale_mm, sd[k], whitened);
                 u->ne.jtj[k * p + k] += w * w;
             }
         }

@@ -327,7 +327,7 @@ static void sum_folds(const dhc_normal_eq *ne, size_t folds, size_t without, siz
 static double prior_weight(const fold_pass *fp, size_t k)
 {
     const double *const sd = fp->opt->prior_sd;
-    return sd != NULL && sd[k] > 0.0 ? (fp->whiten ? 1.0 : fp->opt->prior_scale_mm) / sd[k] : 0.0;
+    return sd != NULL ? dhcal_prior_weight(fp->opt->prior_scale_mm, sd[k], fp->whiten) : 0.0;
 }
 
 /* The prior's row on parameter k at model, w_k (centre_k - v_k), and its weight (0: none) */

@@ -49,6 +49,15 @@ static void expect_bad(const char *text, size_t line, const char *needle)
     TEST_ASSERT_NULL(g_data.rows);
 }
 
+/* The library samples of the rows loaded (g_data, from path p), for a 2-joint arm. */
+static void build_samples(const char *p, dhcal_samples *s)
+{
+    dhc_arm arm;
+    (void)dhc_arm_init(&arm, 2U);
+    const dhc_model m = test_model_of(&arm);
+    TEST_ASSERT_EQUAL(DHCAL_IO_OK, dhcal_samples_build(&m, &g_data, p, s, &g_err));
+}
+
 static void test_touches_mixed_with_measured_points(void)
 {
     const char *const p = write_csv("# touches of two planes, a sphere seat, and tracker points\n"
@@ -71,11 +80,8 @@ static void test_touches_mixed_with_measured_points(void)
     TEST_ASSERT_DOUBLE_WITHIN(1e-15, 11.0 * TEST_DEG, g_data.rows[1].q_rad[0]);
 
     /* the samples: touches of the target index id - 1, the measured row a point */
-    dhc_arm arm;
-    (void)dhc_arm_init(&arm, 2U);
-    const dhc_model m = test_model_of(&arm);
     dhcal_samples s;
-    TEST_ASSERT_EQUAL(DHCAL_IO_OK, dhcal_samples_build(&m, &g_data, p, &s, &g_err));
+    build_samples(p, &s);
     TEST_ASSERT_EQUAL_UINT8(DHC_MEAS_PLANE, s.samples[0].kind);
     TEST_ASSERT_EQUAL_UINT8(0U, s.samples[0].target);
     TEST_ASSERT_EQUAL_UINT8(DHC_MEAS_PLANE, s.samples[1].kind);
@@ -167,11 +173,8 @@ static void test_length_pairs_become_one_sample_each(void)
     TEST_ASSERT_EQUAL_size_t(6U, g_data.n_rows);
     TEST_ASSERT_TRUE(g_data.has_pair);
     TEST_ASSERT_EQUAL_UINT(7U, g_data.rows[2].pair);
-    dhc_arm arm;
-    (void)dhc_arm_init(&arm, 2U);
-    const dhc_model m = test_model_of(&arm);
     dhcal_samples s;
-    TEST_ASSERT_EQUAL(DHCAL_IO_OK, dhcal_samples_build(&m, &g_data, p, &s, &g_err));
+    build_samples(p, &s);
     TEST_ASSERT_EQUAL_size_t(4U, s.n);
     TEST_ASSERT_EQUAL_UINT8(DHC_MEAS_DISTANCE, s.samples[0].kind);
     TEST_ASSERT_EQUAL_DOUBLE(250.5, s.samples[0].distance_mm);

@@ -207,18 +207,27 @@ static double distance(const double a[3], const double b[3])
 
 /* RMS over pairs of fresh poses of |p_i - p_j| (truth) - s |p_i - p_j| (model), s the least-
  * squares scale: the error no rigid motion and no common scale of the model removes. */
-static double shape_error_mm(const dhc_model *truth, const dhc_model *model)
+enum { WORKSPACE_POSES = 60 };
+static double pt[WORKSPACE_POSES][3];
+static double pm[WORKSPACE_POSES][3];
+
+/* The truth's and the model's tool points (pt, pm) at `poses` random poses from seed. */
+static void workspace_points(const dhc_model *truth, const dhc_model *model, uint64_t seed,
+                             size_t poses)
 {
-    enum { POSES = 60 };
-    static double pt[POSES][3];
-    static double pm[POSES][3];
-    test_rng g = {0xF00DULL};
-    for (size_t k = 0U; k < POSES; ++k) {
+    test_rng g = {seed};
+    for (size_t k = 0U; k < poses; ++k) {
         double q[DHC_MAX_JOINTS];
         test_random_q(&g, &truth->arm, q);
         tool_point(truth, q, pt[k]);
         tool_point(model, q, pm[k]);
     }
+}
+
+static double shape_error_mm(const dhc_model *truth, const dhc_model *model)
+{
+    enum { POSES = WORKSPACE_POSES };
+    workspace_points(truth, model, 0xF00DULL, POSES);
     double st = 0.0;
     double mm = 0.0;
     for (size_t i = 0U; i < POSES; ++i) {
@@ -373,15 +382,7 @@ static void test_noisy_touches_end_at_their_noise(void)
 static double length_error_mm(const dhc_model *truth, const dhc_model *model)
 {
     enum { POSES = 40 };
-    static double pt[POSES][3];
-    static double pm[POSES][3];
-    test_rng g = {0xFACEULL};
-    for (size_t k = 0U; k < POSES; ++k) {
-        double q[DHC_MAX_JOINTS];
-        test_random_q(&g, &truth->arm, q);
-        tool_point(truth, q, pt[k]);
-        tool_point(model, q, pm[k]);
-    }
+    workspace_points(truth, model, 0xFACEULL, POSES);
     double sum = 0.0;
     size_t pairs = 0U;
     for (size_t i = 0U; i < POSES; ++i) {

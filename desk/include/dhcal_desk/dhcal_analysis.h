@@ -88,6 +88,11 @@ int dhcal_prior_scale(const dhc_model *start, const dhc_param_set *set,
 #define DHCAL_CONTACT_TOLERANCE_MM 0.5
 #define DHCAL_CONTACT_TOLERANCE_DEG 0.05
 
+/* The weight of the prior's row on a parameter of standard deviation sd (0: no prior on it),
+ * as the fit weighs it (dhc_calib_options.prior_sd): scale_mm / sd, 1 / sd with whitened
+ * (unit-free) rows. */
+double dhcal_prior_weight(double scale_mm, double sd, int whitened);
+
 /* 1 when some sample measures no point in the world: a touch (a plane or a fixed point:
  * dhc_contact.h) or a length between two tool points (DHC_MEAS_DISTANCE). */
 int dhcal_samples_have_contact(const dhcal_samples *s);
