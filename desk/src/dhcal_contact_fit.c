@@ -135,14 +135,17 @@ int dhcal_predicted_accuracy(const dhcal_fit *fit, const dhcal_samples *s, size_
     dhc_status st = dhc_uncertainty_from_samples(u, &fit->model, &fit->set, fit->rep.identifiable,
                                                  dhcal_samples_read, s, s->n, &fit->noise,
                                                  opt.orientation_weight_mm_per_rad, fit->rep.sigma);
-    /* the prior's rows, as the fit had them: C = sigma^2 (J^T W J + diag(w^2))^-1 */
+    /* the posterior's covariance: the data's information J^T W J / sigma^2 and the drawing's
+     * tolerances' 1 / sd^2, C = sigma^2 (J^T W J + diag((sigma / sd)^2))^-1. Not the fit's
+     * prior rows (weighed against prior.scale_mm, the noise the prior was set against): what
+     * the data cannot see (a common scale without a length) is as uncertain as the
+     * tolerances say, whatever the rows' scatter. */
     double sd[DHC_MAX_PARAMS];
     const size_t p = fit->set.count;
     if (st == DHC_OK && dhcal_prior_of_set(&fit->prior, &fit->set, sd)) {
-        const int whitened = dhcal_noise_on(&fit->noise);
         for (size_t k = 0U; k < p; ++k) {
             if (sd[k] > 0.0 && fit->rep.identifiable[k]) {
-                const double w = dhcal_prior_weight(fit->prior.scale_mm, sd[k], whitened);
+                const double w = fit->rep.sigma / sd[k];
                 u->ne.jtj[k * p + k] += w * w;
             }
         }

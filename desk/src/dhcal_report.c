@@ -142,6 +142,7 @@ void dhcal_json_fit(cJSON *obj, const dhcal_fit *f, const dhc_model *input, cons
             cJSON_AddNumberToObject(p, "std", dhcal_param_display(&f->set, k, f->rep.std_err[k]));
             if (f->prior.scale_mm > 0.0) {
                 cJSON_AddBoolToObject(p, "prior_only", f->rep.unseen[k] != 0U);
+                cJSON_AddBoolToObject(p, "blind", f->rep.blind[k] != 0U);
             }
             cJSON_AddItemToArray(params, p);
             continue;

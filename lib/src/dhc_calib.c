@@ -57,7 +57,8 @@ static dhc_status analyse_keeping_set(const fit_context *fc, dhc_calib_report *r
     const int first = rep->iterations == 0U;
     for (size_t j = 0U; j < n; ++j) {
         ws->scratch[j] = ne->jtj[j * n + j];
-        if ((!first && !rep->identifiable[j]) || (DHC_WITH_CONTACT && rep->blind[j])) {
+        if ((!first && !rep->identifiable[j]) ||
+            (DHC_WITH_CONTACT && rep->blind[j] == DHC_BLIND_HELD)) {
             ne->jtj[j * n + j] = 0.0;
         }
     }

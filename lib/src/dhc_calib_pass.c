@@ -383,9 +383,36 @@ static dhc_status blind_in_order(const fit_context *fc, dhc_calib_report *rep)
         const int seen = with > rank;
         rank = seen ? with : rank;
         in[k] = (uint8_t)seen;
-        rep->blind[k] = (uint8_t)!seen;
+        rep->blind[k] = (uint8_t)(seen ? 0U : DHC_BLIND_HELD);
     }
     return st;
+}
+
+/* A blind parameter that moves the arm rigidly: joint 1's offset and height (a turn about and
+ * a shift along the base axis), the base frame's pose. */
+static int moves_arm_rigidly(const dhc_param_id *id)
+{
+    const int joint1 =
+        id->joint == 0U && (id->kind == (uint8_t)DHC_P_THETA || id->kind == (uint8_t)DHC_P_D);
+    return joint1 || (id->kind >= (uint8_t)DHC_P_BASE_X && id->kind <= (uint8_t)DHC_P_BASE_RZ);
+}
+
+/* With a prior, a blind parameter that does not move the arm rigidly (one member of a common
+ * scale) is left to the prior (DHC_BLIND_PRIOR): the maximum a posteriori spreads the scale
+ * over every length by its tolerance, and the scale's uncertainty stays in the covariance. */
+static void leave_to_prior(const fit_context *fc, dhc_calib_report *rep)
+{
+#if DHC_WITH_PRIOR
+    for (size_t k = 0U; k < fc->set->count; ++k) {
+        if (rep->blind[k] != 0U && dhc_fit_prior_weight(fc, k) > 0.0 &&
+            !moves_arm_rigidly(&fc->set->id[k])) {
+            rep->blind[k] = (uint8_t)DHC_BLIND_PRIOR;
+        }
+    }
+#else
+    (void)fc;
+    (void)rep;
+#endif
 }
 #endif
 
@@ -422,7 +449,9 @@ dhc_status dhc_fit_structural_rank(const fit_context *fc, const dhc_model *model
     }
 #if DHC_WITH_CONTACT
     if (contact) {
-        return blind_in_order(fc, rep);
+        const dhc_status blind = blind_in_order(fc, rep);
+        leave_to_prior(fc, rep);
+        return blind;
     }
 #endif
     return DHC_OK;

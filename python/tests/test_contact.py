@@ -99,6 +99,12 @@ def test_a_row_touching_two_targets_is_refused(touches) -> None:
         dhcal.fit(model, dhcal.Measurements(q, plane=bad))
 
 
+def all_blind(report: dict) -> set:
+    """What the report calls blind: held (unidentifiable) or left to the prior (fitted)."""
+    return ({u["param"] for u in report["unidentifiable"] if u["blind"]}
+            | {p["name"] for p in report["parameters"] if p.get("blind")})
+
+
 def test_lengths_as_arrays_and_as_a_file_equal_the_program(touches, run_cli, tmp_path) -> None:
     """The touches and six gauge lengths between two poses each (pair ids, the distance on
     the first row): the package equals the program, and the lengths see what the planes
@@ -135,8 +141,7 @@ def test_lengths_as_arrays_and_as_a_file_equal_the_program(touches, run_cli, tmp
     assert list(read.pair) == list(pairs) and list(read.distance_mm) == list(dists)
     assert_fit_equal(dhcal.fit(model, read), report)
     planes_only = run_cli("fit", "--model", MODEL, "--data", touches[2])
-    blind = {u["param"] for u in report["unidentifiable"] if u["blind"]}
-    blind_planes = {u["param"] for u in planes_only["unidentifiable"] if u["blind"]}
+    blind, blind_planes = all_blind(report), all_blind(planes_only)
     assert blind < blind_planes, (blind, blind_planes)
     with pytest.raises(ValueError, match="pair and distance_mm go together"):
         dhcal.fit(model, dhcal.Measurements(all_q, plane=plane, pair=pairs))

@@ -175,13 +175,14 @@ def main():
           f'({[p["touches"] for p in planes]})')
     blind = {u['param'] for u in rep['unidentifiable'] if u['blind']}
     prior_only = {p['name'] for p in rep['parameters'] if p['prior_only']}
-    print(f'blind to the touches: {sorted(blind)}; held near the drawing by the prior only: '
-          f'{sorted(prior_only)}')
+    scale = {p['name'] for p in rep['parameters'] if p['blind']}
+    print(f'blind to the touches: {sorted(blind)} held, {sorted(scale)} left to the prior; held '
+          f'near the drawing by the prior only: {sorted(prior_only)}')
     check({'theta1', 'd1'} <= blind, 'the torso joint E (never moved) is blind: its offset '
           'and the height along its axis')
-    lengths = sorted(n for n in blind if n[0] in 'ad' and n[1:].isdigit())
-    check(len(lengths) >= 2, 'besides the height, a common scale is blind (another link length '
-          f'held: planes give no length reference): {lengths}')
+    lengths = sorted(n for n in scale if n[0] in 'ad' and n[1:].isdigit())
+    check(len(lengths) == 1, 'besides the height, a common scale is blind (one link length left '
+          f'to the prior: planes give no length reference): {lengths}')
     check('theta2' in prior_only | blind, 'the shoulder offset S is not seen by the touches')
     check(0.0 < rep['rms_mm'] < 0.93, f'the touches fit their planes better than the drawing '
           f'(0.93 mm, SOURCE.md): {rep["rms_mm"]:.3f} mm')

@@ -1,8 +1,9 @@
 /* test_dhcal_prior.c - the desk's prior on the drawing (dhcal_prior, dhcal_run_fit_prior) and
  * the accuracy a fit predicts over the joint ranges (dhcal_predicted_accuracy), against closed
  * forms where the model is linear: the tool point, p = flange + R t. With n measured points
- * and a prior of weight w = scale / sd on each tool coordinate, J^T J + w^2 I = (n + w^2) I
- * (R^T R = I), so the tool point's variance at any pose is 3 sigma^2 / (n + w^2). */
+ * of scatter sigma and a tolerance sd on each tool coordinate, the posterior's information is
+ * (n / sigma^2 + 1 / sd^2) I (R^T R = I), so the tool point's variance at any pose is
+ * 3 sigma^2 / (n + (sigma / sd)^2), whatever the weight the fit gave the prior's rows. */
 #include <math.h>
 #include <string.h>
 
@@ -80,11 +81,11 @@ static void test_predicted_accuracy_is_the_posterior_s(void)
         fit_tool(&prior);
         double predicted = 0.0;
         TEST_ASSERT_EQUAL(DHCAL_IO_OK, dhcal_predicted_accuracy(&g_fit, &g_s, 50U, &predicted));
-        const double w = sds[c] > 0.0 ? 0.3 / sds[c] : 0.0;
         const double sigma = g_fit.rep.sigma;
+        const double w = sds[c] > 0.0 ? sigma / sds[c] : 0.0;
         const double expected = sqrt(3.0 * sigma * sigma / ((double)N_ROWS + w * w));
         TEST_ASSERT_DOUBLE_WITHIN(1e-9 * expected, expected, predicted);
-        /* the prior's rows counted as data: the weights differ by 36x across the cases */
+        /* the tolerances' information differs by 400x across the cases */
         TEST_ASSERT_TRUE(fabs(predicted - last) > 1e-6);
         last = predicted;
     }

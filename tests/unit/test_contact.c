@@ -453,6 +453,80 @@ static void test_a_gauge_length_sees_the_scale_planes_cannot(void)
     TEST_ASSERT_TRUE_MESSAGE(after < 1e-4, "the lengths across the workspace come out true");
 }
 
+/* The prior's cost of a model: sum over the parameters with a tolerance of
+ * ((value - drawing) / sd)^2. */
+static double prior_cost(const dhc_model *m, const dhc_model *drawing, const double *sd)
+{
+    double c = 0.0;
+    for (size_t k = 0U; k < set.count; ++k) {
+        if (sd[k] > 0.0) {
+            const double e =
+                (dhc_params_value(&set, m, k) - dhc_params_value(&set, drawing, k)) / sd[k];
+            c += e * e;
+        }
+    }
+    return c;
+}
+
+/* Planes alone with a prior on the drawing: the common scale they cannot see is left to the
+ * prior (DHC_BLIND_PRIOR: fitted, one length marked), the rigid motions stay held. Both the
+ * fit that holds one length of the scale (no prior) and the one that leaves it to the prior
+ * put every touch on its plane; of the arms that do, the prior's is the one nearest the
+ * drawing by its tolerances: its prior cost is below the held fit's (by far more than one
+ * tolerance's chi-square: the seen lengths and angles, millimetres and degrees off the
+ * drawing, make up most of both). */
+static void test_planes_alone_leave_the_scale_to_the_prior(void)
+{
+    static dhc_model truth;
+    static dhc_model start;
+    static dhc_model held;
+    static dhc_model map;
+    six_joint_arms(&truth, &start);
+    test_rng g = {0xC0FFEEULL};
+    touch_three_planes(&truth, 0.0, &g);
+    TEST_ASSERT_EQUAL(
+        DHC_OK, dhc_contact_targets_init(&start, test_read_sample, &data, data.n, data.flags));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &start));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_targets(&set, &start));
+    static double sd[DHC_MAX_PARAMS];
+    for (size_t k = 0U; k < set.count; ++k) {
+        const uint8_t kind = set.id[k].kind;
+        sd[k] = kind >= (uint8_t)DHC_P_PLANE_TILT                      ? 0.0
+                : kind == (uint8_t)DHC_P_A || kind == (uint8_t)DHC_P_D ? 0.5
+                                                                       : 0.05 * TEST_DEG;
+    }
+    dhc_calib_options opt;
+    dhc_calib_default_options(&opt);
+    held = start;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_calib_fit(&held, &set, test_read_sample, &data, data.n,
+                                            data.flags, &opt, &ws, &rep));
+    TEST_ASSERT_TRUE(rep.rms_mm < 1e-6);
+    opt.prior_sd = sd;
+    opt.prior_scale_mm = 1e-3; /* noise-free touches: the prior decides only what they leave */
+    map = start;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_calib_fit(&map, &set, test_read_sample, &data, data.n, data.flags,
+                                            &opt, &ws, &rep));
+    TEST_ASSERT_TRUE(rep.rms_mm < 1e-3);
+    TEST_ASSERT_EQUAL(DHC_BLIND_HELD, rep.blind[param_index(DHC_P_THETA, 0U)]);
+    TEST_ASSERT_EQUAL(DHC_BLIND_HELD, rep.blind[param_index(DHC_P_D, 0U)]);
+    size_t left_to_prior = 0U;
+    for (size_t k = 0U; k < set.count; ++k) {
+        if (rep.blind[k] == DHC_BLIND_PRIOR) {
+            const uint8_t kind = set.id[k].kind;
+            TEST_ASSERT_TRUE_MESSAGE(kind == (uint8_t)DHC_P_A || kind == (uint8_t)DHC_P_D,
+                                     "only a length of the scale is left to the prior");
+            TEST_ASSERT_TRUE(rep.identifiable[k] && rep.std_err[k] > 0.0);
+            left_to_prior++;
+        }
+    }
+    TEST_ASSERT_EQUAL_size_t(1U, left_to_prior);
+    const double cost_held = prior_cost(&held, &start, sd);
+    const double cost_map = prior_cost(&map, &start, sd);
+    /* holding one length gives the same arm twice, and equal costs */
+    TEST_ASSERT_TRUE_MESSAGE(cost_map < cost_held - 100.0,
+                             "the prior's arm is nearer the drawing than the held one's");
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -461,5 +535,6 @@ int main(void)
     RUN_TEST(test_six_joint_arm_from_touches_of_three_planes);
     RUN_TEST(test_noisy_touches_end_at_their_noise);
     RUN_TEST(test_a_gauge_length_sees_the_scale_planes_cannot);
+    RUN_TEST(test_planes_alone_leave_the_scale_to_the_prior);
     return UNITY_END();
 }

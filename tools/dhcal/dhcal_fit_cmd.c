@@ -125,8 +125,9 @@ void dhcal_cli_text_extras(const dhcal_fit *f, const dhcal_session *s, const dhc
     }
     if (x->have_predicted) {
         printf("the calibration predicts a positioning accuracy of %.4f mm RMS over the joint "
-               "ranges (the arm's shape as the touches and the prior determine it; the blind "
-               "directions are the drawing's)\n",
+               "ranges (the arm's shape as the touches and the prior determine it, a scale no "
+               "length sees as uncertain as the tolerances; where the arm stands is not in "
+               "it)\n",
                x->predicted_accuracy_mm);
     }
     if (!x->have_adequacy) {
@@ -205,9 +206,18 @@ void dhcal_cli_text_fit(const dhcal_fit *f, const dhcal_session *s, const dhcal_
         printf("%-18s %16.8g %12.3g %s\n", name, dhcal_param_fitted(f, &s->model, k),
                dhcal_param_display(&f->set, k, rep->std_err[k]), dhcal_param_unit(&f->set, k));
     }
+    for (size_t k = 0U; k < f->set.count; ++k) {
+        if (rep->identifiable[k] && rep->blind[k] == DHC_BLIND_PRIOR) {
+            (void)dhc_params_name(&f->set, k, name, sizeof name);
+            printf("blind to touches: %s (a common scale of the lengths: no length reference "
+                   "sees it; the prior spreads it over every length by its tolerance, and its "
+                   "uncertainty counts in the predicted accuracy)\n",
+                   name);
+        }
+    }
     size_t unseen = 0U;
     for (size_t k = 0U; k < f->set.count; ++k) {
-        if (rep->unseen[k]) {
+        if (rep->unseen[k] && rep->blind[k] == 0U) {
             (void)dhc_params_name(&f->set, k, name, sizeof name);
             printf("%s%s",
                    unseen++ == 0U ? "kept near the drawing by the prior (the data alone do "

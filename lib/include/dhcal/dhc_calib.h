@@ -113,6 +113,10 @@ typedef struct {
     const dhc_model *prior_centre;
 } dhc_calib_options;
 
+/* dhc_calib_report.blind */
+#define DHC_BLIND_HELD 1U
+#define DHC_BLIND_PRIOR 2U
+
 typedef struct {
     size_t iterations;  /* LM iterations, all rounds */
     int converged;      /* 1 when the last round met its tolerance */
@@ -147,9 +151,14 @@ typedef struct {
     double std_err[DHC_MAX_PARAMS]; /* standard errors (0 for unidentifiable) */
     uint8_t identifiable[DHC_MAX_PARAMS];
     uint8_t structurally_identifiable[DHC_MAX_PARAMS];
-    /* 1: held at its input value because data of this kind cannot see it at all (contact
-     * data: not structurally identifiable at exact touches, dhc_contact.h; a rigid motion of
-     * the arm or a common scale is such a direction, and noise would otherwise fit it) */
+    /* Data of this kind cannot see it at all (contact data: not structurally identifiable at
+     * exact touches, dhc_contact.h; a rigid motion of the arm or a common scale is such a
+     * direction, and noise would otherwise fit it): DHC_BLIND_HELD, held at its input value;
+     * DHC_BLIND_PRIOR, fitted with the prior alone holding it (a common scale, which the
+     * prior spreads over every length by their tolerances instead of putting it on one
+     * length: its covariance then counts in the tool's uncertainty). A rigid motion of the
+     * whole arm (joint 1's offset and height, the base frame) is always held: no accuracy of
+     * the arm's shape depends on it. 0: seen. */
     uint8_t blind[DHC_MAX_PARAMS];
     /* 1: fitted, but with a prior (dhc_calib_options.prior_sd) that alone holds it near its
      * input value: the data without the prior would not identify it */
