@@ -119,6 +119,7 @@ dhc_status dhs_plant_init(dhs_plant *p, const dhs_scenario *sc, uint64_t run_see
         dhs_wires_init(&p->wires, &p->sc.measurer, p->tool_mm, run_seed);
     }
     dhs_rng_seed(&p->sensor_rng, run_seed, DHS_STREAM_SENSORS);
+    dhs_probe_init(&p->probe, &p->sc.probe, p->tool_mm, run_seed);
     return DHC_OK;
 }
 
@@ -545,6 +546,7 @@ static void update_outputs(dhs_plant *p)
     }
     dhs_arm_pose_from_cs(&p->arm, c, sn, &p->pose);
     dhc_vec3_scale(p->pose.tool_m, 1e3, p->tool_mm);
+    dhs_probe_follow(&p->probe, p->tool_mm, dhs_plant_time_ns(p));
     p->wires_stale = 1;
     if (++p->ms_phase == p->steps_per_ms) {
         p->ms_phase = 0U;
@@ -623,6 +625,11 @@ uint32_t dhs_plant_wire_counter(dhs_plant *p, size_t k)
     return dhs_wires_register(&p->wires, dhs_wires_counts(&p->wires, k, &p->sensor_rng));
 }
 
+int dhs_plant_probe(const dhs_plant *p)
+{
+    return dhs_probe_closed(&p->probe, dhs_plant_time_ns(p));
+}
+
 void dhs_plant_get_truth(const dhs_plant *p, dhs_plant_truth *t)
 {
     memset(t, 0, sizeof *t);
@@ -640,4 +647,5 @@ void dhs_plant_get_truth(const dhs_plant *p, dhs_plant_truth *t)
     if (p->has_wires) {
         dhs_wires_lengths(&p->wires, p->tool_mm, t->wire_mm);
     }
+    t->probe_gap_mm = p->sc.probe.present ? p->probe.gap_mm : HUGE_VAL;
 }

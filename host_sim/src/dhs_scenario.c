@@ -268,7 +268,12 @@ dhc_status dhs_scenario_check(const dhs_scenario *sc, const char **what, size_t 
                   m->zero_length_true_mm[2] >= 0.0,
               "wire zero lengths must be >= 0");
     }
-    return DHC_OK;
+    const char *probe_what = NULL;
+    const dhc_status probe = dhs_probe_check(&sc->probe, &probe_what);
+    if (probe != DHC_OK && what != NULL) {
+        *what = probe_what;
+    }
+    return probe;
 }
 
 void dhs_scenario_add_random_errors(dhs_scenario *sc, double sd_theta_rad, double sd_d_mm,

@@ -548,11 +548,122 @@ static int parse_small_sections(const dhcal_jctx *c, const cJSON *root, dhs_scen
     return DHCAL_IO_OK;
 }
 
+/* "+x" .. "-z" as +-1..3 (0 for anything else). */
+static int face_of(const char *s)
+{
+    static const char *const faces[] = {"+x", "+y", "+z", "-x", "-y", "-z"};
+    for (int k = 0; k < 6; ++k) {
+        if (strcmp(s, faces[k]) == 0) {
+            return k < 3 ? k + 1 : -(k - 2);
+        }
+    }
+    return 0;
+}
+
+static int parse_probe_box(const dhcal_jctx *c, const cJSON *item, const char *path, dhs_box *b)
+{
+    static const char *const keys[] = {"centre_mm", "size_mm", "rpy_deg", "touch", "gauge"};
+    int rc = dhcal_jcheck_object(c, item, path, DHCAL_JKEYS(keys));
+    double centre[3] = {0.0, 0.0, 0.0};
+    double size[3] = {0.0, 0.0, 0.0};
+    double rpy_deg[3] = {0.0, 0.0, 0.0};
+    if (rc != DHCAL_IO_OK ||
+        (rc = get_vec3(c, item, path, "centre_mm", 1, DHCAL_JANY, centre)) != DHCAL_IO_OK ||
+        (rc = get_vec3(c, item, path, "size_mm", 1, DHCAL_JPOS, size)) != DHCAL_IO_OK ||
+        (rc = dhcal_jopt_vector(c, item, path, "rpy_deg", 3U, -360.0, 360.0, "deg", rpy_deg)) !=
+            DHCAL_IO_OK) {
+        return rc;
+    }
+    const double rpy[3] = {rpy_deg[0] * DHC_PI / 180.0, rpy_deg[1] * DHC_PI / 180.0,
+                           rpy_deg[2] * DHC_PI / 180.0};
+    dhs_probe_box(b, centre, size, rpy);
+    const cJSON *touch = cJSON_GetObjectItemCaseSensitive(item, "touch");
+    const cJSON *gauge = cJSON_GetObjectItemCaseSensitive(item, "gauge");
+    char at[DHCAL_JPATH_CAP];
+    if (touch != NULL) {
+        dhcal_jpath_key(at, path, "touch");
+        const int face = cJSON_IsString(touch) ? face_of(touch->valuestring) : 0;
+        if (face == 0) {
+            return dhcal_jfail(c, at,
+                               "expected the touched face, one of \"+x\" \"+y\" \"+z\" "
+                               "\"-x\" \"-y\" \"-z\"");
+        }
+        b->touch_face = (int8_t)face;
+    }
+    if (gauge != NULL) {
+        dhcal_jpath_key(at, path, "gauge");
+        const int face = cJSON_IsString(gauge) && strlen(gauge->valuestring) == 1U
+                             ? face_of((char[3]){'+', gauge->valuestring[0], '\0'})
+                             : 0;
+        if (face == 0 || touch != NULL) {
+            return dhcal_jfail(c, at,
+                               "expected the gauge's axis, \"x\", \"y\" or \"z\" (and no "
+                               "\"touch\" on the same box)");
+        }
+        b->gauge_axis = (uint8_t)face;
+    }
+    return DHCAL_IO_OK;
+}
+
+static int parse_probe(const dhcal_jctx *c, const cJSON *root, dhs_probe_params *pr)
+{
+    static const char *const keys[] = {"tip_radius_mm", "trigger_delay_ms", "repeatability_mm",
+                                       "boxes", "spheres"};
+    static const char *const sphere_keys[] = {"centre_mm", "radius_mm"};
+    const cJSON *o = NULL;
+    int rc = dhcal_jobject(c, root, "", "probe", 0, DHCAL_JKEYS(keys), &o);
+    if (rc != DHCAL_IO_OK || o == NULL) {
+        return rc;
+    }
+    pr->present = 1;
+    double delay_ms = 0.0;
+    if ((rc = dhcal_jopt_number(c, o, "probe", "tip_radius_mm", 0.0, 50.0, "mm",
+                                &pr->tip_radius_mm)) != DHCAL_IO_OK ||
+        (rc = dhcal_jopt_number(c, o, "probe", "trigger_delay_ms", 0.0, 100.0, "ms", &delay_ms)) !=
+            DHCAL_IO_OK ||
+        (rc = dhcal_jopt_number(c, o, "probe", "repeatability_mm", 0.0, 1.0, "mm",
+                                &pr->repeat_sd_mm)) != DHCAL_IO_OK) {
+        return rc;
+    }
+    pr->trigger_delay_ns = delay_ms * 1e6;
+    const cJSON *boxes = cJSON_GetObjectItemCaseSensitive(o, "boxes");
+    const cJSON *spheres = cJSON_GetObjectItemCaseSensitive(o, "spheres");
+    if ((boxes != NULL && (!cJSON_IsArray(boxes) || dhcal_jcount(boxes) > DHS_MAX_PROBE_BOXES)) ||
+        (spheres != NULL &&
+         (!cJSON_IsArray(spheres) || dhcal_jcount(spheres) > DHS_MAX_PROBE_SPHERES))) {
+        return dhcal_jfail(c, boxes != NULL && !cJSON_IsArray(boxes) ? "probe.boxes" : "probe",
+                           "expected arrays of at most %u boxes and %u spheres",
+                           (unsigned)DHS_MAX_PROBE_BOXES, (unsigned)DHS_MAX_PROBE_SPHERES);
+    }
+    char at[DHCAL_JPATH_CAP];
+    const cJSON *item = NULL;
+    cJSON_ArrayForEach(item, boxes)
+    {
+        dhcal_jpath_index(at, "probe.boxes", pr->n_boxes);
+        if ((rc = parse_probe_box(c, item, at, &pr->box[pr->n_boxes])) != DHCAL_IO_OK) {
+            return rc;
+        }
+        pr->n_boxes++;
+    }
+    cJSON_ArrayForEach(item, spheres)
+    {
+        dhcal_jpath_index(at, "probe.spheres", pr->n_spheres);
+        dhs_sphere *s = &pr->sphere[pr->n_spheres];
+        if ((rc = dhcal_jcheck_object(c, item, at, DHCAL_JKEYS(sphere_keys))) != DHCAL_IO_OK ||
+            (rc = get_vec3(c, item, at, "centre_mm", 1, DHCAL_JANY, s->centre_mm)) != DHCAL_IO_OK ||
+            (rc = get_num(c, item, at, "radius_mm", 1, DHCAL_JPOS, &s->radius_mm)) != DHCAL_IO_OK) {
+            return rc;
+        }
+        pr->n_spheres++;
+    }
+    return DHCAL_IO_OK;
+}
+
 static int parse_root(const dhcal_jctx *c, const cJSON *root, dhs_scenario_file *out)
 {
     static const char *const keys[] = {"name",     "comment",        "seed",   "model",   "truth",
                                        "physics",  "joint_defaults", "joints", "payload", "drive",
-                                       "measurer", "noise",          "poses"};
+                                       "measurer", "noise",          "poses",  "probe"};
     int rc = dhcal_jcheck_object(c, root, "", DHCAL_JKEYS(keys));
     if (rc != DHCAL_IO_OK) {
         return rc;
@@ -605,7 +716,8 @@ static int parse_root(const dhcal_jctx *c, const cJSON *root, dhs_scenario_file 
 
     if ((rc = parse_truth(c, root, sc)) != DHCAL_IO_OK ||
         (rc = parse_small_sections(c, root, sc)) != DHCAL_IO_OK ||
-        (rc = parse_measurer(c, root, &out->model, sc)) != DHCAL_IO_OK) {
+        (rc = parse_measurer(c, root, &out->model, sc)) != DHCAL_IO_OK ||
+        (rc = parse_probe(c, root, &sc->probe)) != DHCAL_IO_OK) {
         return rc;
     }
 

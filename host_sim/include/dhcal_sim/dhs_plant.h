@@ -43,7 +43,8 @@
  *   (dhs_cs): about a quarter of the step's cost otherwise.
  * Sensors are sampled when read: encoder counts = round(motor angle x 4 lines / 2 pi) into
  * a 16-bit wrapping register (zero at joint angle 0); tacho = kg w_m (1 + ripple sin(c
- * theta_m)) + noise into a 12-bit offset-binary ADC; wire counters as dhs_wires.h.
+ * theta_m)) + noise into a 12-bit offset-binary ADC; wire counters as dhs_wires.h; the touch
+ * probe's switch as dhs_probe.h, its contact followed every physics step.
  */
 #ifndef DHS_PLANT_H
 #define DHS_PLANT_H
@@ -53,6 +54,7 @@
 
 #include "dhcal/dhc_status.h"
 #include "dhs_arm.h"
+#include "dhs_probe.h"
 #include "dhs_rng.h"
 #include "dhs_scenario.h"
 #include "dhs_wires.h"
@@ -106,6 +108,7 @@ typedef struct {
     double tool_mm[3];
     int has_wires;
     dhs_wires wires;
+    dhs_probe probe;
     dhs_rng sensor_rng;
 } dhs_plant;
 
@@ -121,6 +124,8 @@ typedef struct {
     double spring_nm[DHC_MAX_JOINTS]; /* transmitted torque (rigid joints: 0) */
     double tool_mm[3];                /* true tool point, world */
     double wire_mm[3];                /* true wire lengths (0 without a measurer) */
+    double probe_gap_mm;              /* the probe's ball to the nearest solid (dhs_probe.h;
+                                         HUGE_VAL without a probe) */
 } dhs_plant_truth;
 
 /* Sets up the plant of scenario sc at rest: gear outputs at q_start_rad (motor = N q,
@@ -161,6 +166,9 @@ uint16_t dhs_plant_tacho_adc(dhs_plant *p, size_t j);
 /* Wire counter register k (0..2), counter_bits wide, with one reading's noise; 0 when the
  * scenario has no measurer. */
 uint32_t dhs_plant_wire_counter(dhs_plant *p, size_t k);
+
+/* The touch probe's switch (dhs_probe.h): 1 closed, 0 open (and without a probe). */
+int dhs_plant_probe(const dhs_plant *p);
 
 /* The truth behind the sensors. */
 void dhs_plant_get_truth(const dhs_plant *p, dhs_plant_truth *t);

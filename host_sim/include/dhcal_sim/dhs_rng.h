@@ -28,7 +28,8 @@ enum {
     DHS_STREAM_POSES = 2,    /* joint targets and approach directions */
     DHS_STREAM_NOISE = 3,    /* measurement noise, quantisation phase */
     DHS_STREAM_SLIP = 4,     /* friction-wheel slip */
-    DHS_STREAM_SENSORS = 5   /* dynamic plant: tacho noise, wire read noise */
+    DHS_STREAM_SENSORS = 5,  /* dynamic plant: tacho noise, wire read noise */
+    DHS_STREAM_PROBE = 6     /* touch probe: trigger depths */
 };
 
 /* Seeds r from (seed, stream). Never yields the all-zero state. */

@@ -21,6 +21,8 @@
  *                                  by gravity of the link masses (true geometry)
  *   measurer scale / offset        wheel radius and zero lengths differ from the nominal
  *   measurer anchors / frame       anchor_true_mm / frame_true differ from the model's
+ *   touch probe                    its trigger depth scatter and delay (dhs_probe.h); the
+ *                                  solids stand where the scenario puts them
  */
 #ifndef DHS_SCENARIO_H
 #define DHS_SCENARIO_H
@@ -30,6 +32,7 @@
 
 #include "dhcal/dhc_kinematics.h"
 #include "dhcal/dhc_status.h"
+#include "dhs_probe.h"
 
 /* Harmonics of the transmission error per joint. */
 #define DHS_MAX_HARMONICS 8U
@@ -115,6 +118,7 @@ typedef struct {
     double dac_range_v;             /* 12-bit offset-binary DAC: code 0 = -range, 4096 = +range */
     double adc_range_v;             /* 12-bit offset-binary tacho ADC over +-range */
     dhs_measurer_params measurer;
+    dhs_probe_params probe;      /* a touch probe on the tool and the solids it can touch */
     double noise_xyz_mm;         /* dataset mode, x,y,z columns: Gaussian per coordinate */
     double min_axis_distance_mm; /* dataset targets: tool at least this far from axis 1 */
     double min_anchor_plane_mm;  /* ... and this far in front of the measurer's anchor plane */

@@ -44,7 +44,13 @@
  *     "zero_length_error_mm": [0,0,0]       controller's zero length minus the true one,
  *     "slip_sd_mm_per_sqrt_mm": 0, "noise_mm": 0 },
  *   "noise": {"xyz_mm": 0},
- *   "poses": {"min_axis_distance_mm": 150, "min_anchor_plane_mm": 150}
+ *   "poses": {"min_axis_distance_mm": 150, "min_anchor_plane_mm": 150},
+ *   "probe": {                              a touch probe on the tool (dhs_probe.h)
+ *     "tip_radius_mm": 0 (0..50), "trigger_delay_ms": 0 (0..100), "repeatability_mm": 0 (0..1),
+ *     "boxes": [{"centre_mm": REQUIRED [3], "size_mm": REQUIRED [3] > 0, "rpy_deg": [0,0,0],
+ *                "touch": "+x".."-z" (the face a calibration touches), or
+ *                "gauge": "x" | "y" | "z" (a gauge block: its two ends along that axis)}],
+ *     "spheres": [{"centre_mm": REQUIRED [3], "radius_mm": REQUIRED > 0}] }
  * }
  * Numbers must be finite; masses, inertias, frictions, noises >= 0; R, L, Ke, Kt, Jm, gear
  * ratios, stiffness, wheel radii > 0; integers where named (seed, lines, order, cycles,
