@@ -87,6 +87,16 @@ static fw_port_status sim_write_dacs(void *ctx, const uint16_t codes[DHC_MAX_JOI
     return FW_PORT_OK;
 }
 
+static fw_port_status sim_read_probe(void *ctx, int *closed)
+{
+    const fw_sim *s = ctx;
+    if (s->powered_off) {
+        return FW_PORT_ERR_IO;
+    }
+    *closed = dhs_plant_probe(&s->plant);
+    return FW_PORT_OK;
+}
+
 static fw_port_status sim_read_wires(void *ctx, uint16_t counts[3])
 {
     fw_sim *s = ctx;
@@ -171,6 +181,7 @@ dhc_status fw_sim_init(fw_sim *sim, const dhs_scenario *sc, uint64_t run_seed,
     port->read_tachos = sim_read_tachos;
     port->write_dacs = sim_write_dacs;
     port->read_wires = sim_read_wires;
+    port->read_probe = sc->probe.present ? sim_read_probe : NULL;
     port->nv.ctx = sim;
     port->nv.size = FW_SIM_NV_SIZE;
     port->nv.read = sim_nv_read;

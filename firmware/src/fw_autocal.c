@@ -4,6 +4,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "dhcal/dhc_contact.h"
 #include "dhcal_fw/fw_calstore.h"
 
 const dhc_candidate_scope fw_autocal_scope = {1, 0, 0};
@@ -24,12 +25,14 @@ static dhc_status read_sample(const void *ctx, size_t index, dhc_sample *out)
 }
 
 /* RMS of the per-sample residual norms; err (may be NULL, n <= FW_ACQ_MAX_SAMPLES) receives
- * the norms of the samples that have a residual, *used how many. */
-static double wire_errors(const dhc_model *model, const dhc_sample *samples, size_t n, double *err,
-                          size_t *used)
+ * the norms of the samples that have a residual, *used how many, *rows_used (may be NULL)
+ * their rows. */
+static double sample_errors(const dhc_model *model, const dhc_sample *samples, size_t n,
+                            double *err, size_t *used, size_t *rows_used)
 {
     double ss = 0.0;
     size_t u = 0U;
+    size_t all_rows = 0U;
     for (size_t i = 0U; i < n; ++i) {
         double r[DHC_MAX_ROWS_PER_SAMPLE];
         size_t rows = 0U;
@@ -46,17 +49,62 @@ static double wire_errors(const dhc_model *model, const dhc_sample *samples, siz
             err[u] = sqrt(e2);
         }
         ++u;
+        all_rows += rows;
     }
     if (used != NULL) {
         *used = u;
+    }
+    if (rows_used != NULL) {
+        *rows_used = all_rows;
     }
     return u > 0U ? sqrt(ss / (double)u) : -1.0;
 }
 
 double fw_wire_rms(const dhc_model *model, const dhc_sample *samples, size_t n)
 {
-    return wire_errors(model, samples, n, NULL, NULL);
+    return sample_errors(model, samples, n, NULL, NULL, NULL);
 }
+
+#if DHC_WITH_CONTACT
+static int any_contact(const dhc_sample *samples, size_t n)
+{
+    for (size_t i = 0U; i < n; ++i) {
+        if (samples[i].kind >= (uint8_t)DHC_MEAS_PLANE) {
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* Touches and lengths: the targets' starting poses on model (the planes' and points' the
+ * tool points of model put them at; none for lengths alone), their parameters appended to
+ * set when set is not NULL. */
+static dhc_status start_targets(dhc_model *model, dhc_param_set *set, const sample_buf *buf)
+{
+    dhc_status st = dhc_contact_targets_init(model, read_sample, buf, buf->n, NULL);
+    if (st == DHC_ERR_NO_DATA) {
+        st = DHC_OK;
+    }
+    return st == DHC_OK && set != NULL ? dhc_params_add_targets(set, model) : st;
+}
+
+/* The stored model against touches: its arm held, its targets fitted to these samples (a
+ * stored calibration keeps no targets: they belong to the cell, not to the arm). */
+static dhc_status fit_stored_targets(fw_autocal_workspace *ws, const sample_buf *buf,
+                                     const dhc_calib_options *opt)
+{
+    dhc_param_set targets;
+    dhc_params_clear(&targets);
+    dhc_status st = start_targets(&ws->stored, &targets, buf);
+    if (st != DHC_OK || targets.count == 0U) {
+        return st;
+    }
+    memset(ws->flags, 0, sizeof ws->flags);
+    dhc_calib_report rep;
+    return dhc_calib_fit(&ws->stored, &targets, read_sample, buf, buf->n, ws->flags, opt, &ws->cal,
+                         &rep);
+}
+#endif
 
 /* Median of v[0 .. n) (sorted in place; n <= FW_ACQ_MAX_SAMPLES, insertion sort). */
 static double median(double *v, size_t n)
@@ -188,6 +236,12 @@ fw_fault fw_autocal_configured(const fw_autocal_config *cfg, dhc_model *model,
     }
     memset(ws->flags, 0, sizeof ws->flags);
     ws->geo = *model;
+#if DHC_WITH_CONTACT
+    const int contact = any_contact(samples, n);
+    if (contact && start_targets(&ws->geo, &set, &buf) != DHC_OK) {
+        return FW_FAULT_UNDERDETERMINED; /* a plane whose touches do not span it */
+    }
+#endif
     const dhc_status fit =
         dhc_calib_fit(&ws->geo, &set, read_sample, &buf, n, ws->flags, &opt, &ws->cal, &res->geo);
     if (fit != DHC_OK) {
@@ -232,7 +286,7 @@ fw_fault fw_autocal_configured(const fw_autocal_config *cfg, dhc_model *model,
         }
     }
     size_t used_new = 0U;
-    res->new_rms_mm = wire_errors(model, samples, n, ws->err_new, &used_new);
+    res->new_rms_mm = sample_errors(model, samples, n, ws->err_new, &used_new, NULL);
     res->new_median_mm = median(ws->err_new, used_new);
     /* Akaike's final prediction error: the in-sample RMS of a fit with p parameters on m
      * equations underestimates its error on new data by about sqrt((m - p) / (m + p)). */
@@ -245,14 +299,21 @@ fw_fault fw_autocal_configured(const fw_autocal_config *cfg, dhc_model *model,
     }
     uint32_t seq = 0U;
     const fw_cal_status ls = fw_cal_load(nv, &ws->stored, &seq);
+#if DHC_WITH_CONTACT
+    if (ls == FW_CAL_OK && contact && fit_stored_targets(ws, &buf, &opt) != DHC_OK) {
+        return FW_FAULT_NONE; /* the stored arm cannot be judged on these touches: keep it */
+    }
+#endif
     if (ls == FW_CAL_OK) {
         size_t used_old = 0U;
-        res->stored_rms_mm = wire_errors(&ws->stored, samples, n, ws->err_old, &used_old);
+        size_t rows_old = 0U;
+        res->stored_rms_mm =
+            sample_errors(&ws->stored, samples, n, ws->err_old, &used_old, &rows_old);
         res->stored_median_mm = median(ws->err_old, used_old);
         /* significantly better (see fw_autocal.h): log(stored / FPE) above z standard
          * deviations of that log-ratio, sd(log s) ~ 1 / sqrt(2 dof) per RMS estimate */
         const double dof_new = m_rows - p_fit;
-        const double dof_old = 3.0 * (double)used_old;
+        const double dof_old = (double)rows_old;
         const int better = dof_new > 0.0 && dof_old > 0.0 && res->new_fpe_mm > 0.0 &&
                            res->stored_rms_mm > 0.0 &&
                            log(res->stored_rms_mm / res->new_fpe_mm) >

@@ -259,6 +259,7 @@ fw_port_status fw_can_link_init(fw_can_link *link, const fw_can_transport *trans
     port->read_tachos = link_read_tachos;
     port->write_dacs = link_write_dacs;
     port->read_wires = link_read_wires;
+    port->read_probe = NULL; /* the drives' bus carries none: a port adds its own line */
     return FW_PORT_OK;
 }
 

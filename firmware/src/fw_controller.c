@@ -9,7 +9,8 @@ const char *fw_fault_name(fw_fault f)
     static const char *const names[FW_FAULT_COUNT] = {
         "none",         "encoder_jump",  "tacho_mismatch",  "drive_saturated", "wires_inconsistent",
         "port_timeout", "port_io",       "storage",         "settle_timeout",  "joint_limit",
-        "argument",     "not_converged", "underdetermined", "numeric",         "stopped"};
+        "argument",     "not_converged", "underdetermined", "numeric",         "stopped",
+        "probe"};
     return (unsigned)f < (unsigned)FW_FAULT_COUNT ? names[f] : "unknown";
 }
 

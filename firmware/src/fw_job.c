@@ -184,6 +184,27 @@ fw_fault fw_job_acquire_recorded(fw_job *job, const dhc_sample *samples, size_t 
     return FW_FAULT_NONE;
 }
 
+#if DHC_WITH_CONTACT
+fw_fault fw_job_touch(fw_job *job, const fw_touch_config *touch)
+{
+    job->n_samples = 0U;
+    job->n_touches = 0U;
+    fw_acq_stats_reset(&job->acq);
+    if (job->ctrl.fault != FW_FAULT_NONE) {
+        return job->ctrl.fault;
+    }
+    if (touch == NULL) {
+        return FW_FAULT_ARGUMENT;
+    }
+    job->n_touches = fw_touch_plan(&job->nominal, touch, job->touches, FW_TOUCH_MAX);
+    if (job->n_touches == 0U) {
+        return FW_FAULT_ARGUMENT;
+    }
+    return fw_touch_acquire(&job->ctrl, &job->nominal, touch, job->touches, job->n_touches,
+                            job->samples, FW_ACQ_MAX_SAMPLES, &job->n_samples);
+}
+#endif
+
 fw_fault fw_job_calibrate(fw_job *job, const fw_nvstore *nv)
 {
     job->calibrated_ok = 0;

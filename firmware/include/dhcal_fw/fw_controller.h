@@ -47,6 +47,8 @@ typedef enum {
     FW_FAULT_NUMERIC,            /* samples or model that break the arithmetic (non-finite,
                                     singular) */
     FW_FAULT_STOPPED,            /* stopped on request (an operator, a signal) */
+    FW_FAULT_PROBE,              /* a touch-off found no surface within its travel, or the
+                                    probe's switch was closed before it began (fw_touch.h) */
     FW_FAULT_COUNT
 } fw_fault;
 

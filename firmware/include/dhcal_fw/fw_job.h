@@ -25,6 +25,7 @@
 #include "dhcal_fw/fw_nvstore.h"
 #include "dhcal_fw/fw_plan.h"
 #include "dhcal_fw/fw_port.h"
+#include "dhcal_fw/fw_touch.h"
 
 typedef struct {
     double q_start_rad[DHC_MAX_JOINTS]; /* where the arm stands at boot: the counters are
@@ -75,6 +76,10 @@ typedef struct {
     int calibrated_ok; /* result, geometric and calibrated are valid */
     fw_plan_workspace plan_ws;
     fw_autocal_workspace autocal_ws;
+#if DHC_WITH_CONTACT
+    fw_touch touches[FW_TOUCH_MAX]; /* the touch plan (fw_job_touch) */
+    size_t n_touches;
+#endif
 } fw_job;
 
 /* Defaults for the nominal model's arm: the servo's defaults with the model's joint
@@ -108,6 +113,16 @@ fw_fault fw_job_acquire(fw_job *job);
  * with finite angles and lengths. */
 fw_fault fw_job_acquire_recorded(fw_job *job, const dhc_sample *samples, size_t n,
                                  const fw_acq_stats *acq);
+
+#if DHC_WITH_CONTACT
+/* Plan and acquire by touching, in place of fw_job_plan and fw_job_acquire (fw_touch.h): the
+ * touch-offs of the cell touch describes (copied), planned on the nominal model, become the
+ * job's samples (a plane's touches, a gauge's pairs); fw_job_calibrate then fits the arm with
+ * every plane's pose. FW_FAULT_ARGUMENT when the plan is empty or larger than the samples
+ * (FW_ACQ_MAX_SAMPLES) or a region is out of reach, FW_FAULT_PROBE as fw_touch_off, or the
+ * controller's fault. */
+fw_fault fw_job_touch(fw_job *job, const fw_touch_config *touch);
+#endif
 
 /* Calibrate, diagnose, refit and store (fw_autocal_configured) on the job's samples; nv
  * may be NULL (nothing stored). FW_FAULT_STORAGE still leaves the calibration valid

@@ -36,6 +36,8 @@ typedef struct {
     fw_port_status (*write_dacs)(void *ctx, const uint16_t codes[DHC_MAX_JOINTS]);
     /* Draw-wire measurer friction-wheel counters, 16-bit, wrapping. */
     fw_port_status (*read_wires)(void *ctx, uint16_t counts[3]);
+    /* The touch probe's switch (1 closed, 0 open), or NULL: no probe (fw_touch.h). */
+    fw_port_status (*read_probe)(void *ctx, int *closed);
     fw_nvstore nv;
 } fw_port;
 
