@@ -182,7 +182,12 @@ fw_fault fw_touch_off(fw_ctrl *c, const fw_touch *t, double speed_mm_s,
         fw_ctrl_fault(c, FW_FAULT_PROBE, 0U);
         return c->fault;
     }
-    const double ticks = ceil(t->travel_mm / (speed_mm_s * c->cfg.tick_s));
+    const double ticks_real = ceil(t->travel_mm / (speed_mm_s * c->cfg.tick_s));
+    if (!(ticks_real >= 1.0 && ticks_real <= 1e7)) {
+        return FW_FAULT_ARGUMENT; /* a creep of more than about three hours is no touch-off */
+    }
+    const uint32_t n_ticks = (uint32_t)ticks_real;
+    const double ticks = (double)n_ticks;
     double q_ref[DHC_MAX_JOINTS];
     double qd_ref[DHC_MAX_JOINTS];
     for (size_t j = 0U; j < DHC_MAX_JOINTS; ++j) {
@@ -190,9 +195,9 @@ fw_fault fw_touch_off(fw_ctrl *c, const fw_touch *t, double speed_mm_s,
         dir[j] = qd_ref[j] < 0.0 ? (int8_t)-1 : (int8_t)1;
         q_ref[j] = t->from_rad[j];
     }
-    for (double k = 1.0; k <= ticks && !closed; k += 1.0) {
+    for (uint32_t k = 1U; k <= n_ticks && !closed; ++k) {
         for (size_t j = 0U; j < c->n; ++j) {
-            q_ref[j] = t->from_rad[j] + (t->to_rad[j] - t->from_rad[j]) * (k / ticks);
+            q_ref[j] = t->from_rad[j] + (t->to_rad[j] - t->from_rad[j]) * ((double)k / ticks);
         }
         if (fw_ctrl_tick(c, q_ref, qd_ref) != FW_FAULT_NONE ||
             probe_closed(c, &closed) != FW_FAULT_NONE) {
