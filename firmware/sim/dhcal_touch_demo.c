@@ -31,6 +31,8 @@
 #include "dhcal_fw/fw_ik.h"
 #include "dhcal_fw/fw_job.h"
 #include "dhcal_fw/fw_touch.h"
+#include "dhcal_io/dhcal_csv.h"
+#include "dhcal_io/dhcal_file.h"
 #include "dhcal_io/dhcal_io.h"
 #include "dhcal_io/dhcal_json.h"
 #include "dhcal_io/dhcal_model_map.h"
@@ -143,9 +145,55 @@ static int cell_drawing(const dhs_probe_params *pr, fw_touch_config *tc)
     return tc->n_planes + tc->n_gauges > 0U ? 0 : -1;
 }
 
+/* The job's samples as a measurement file (docs/formats.md 3.4): a plane touch one row with its
+ * plane's id, a gauge pair two rows with one pair id and the distance on the first; what the
+ * desk (`dhcal fit`) and the twin programs (tests/target/twin) read. 0, or -1 (said). */
+static int write_samples(const char *dir)
+{
+    const size_t nj = nominal.arm.n_joints;
+    char path[4200];
+    snprintf(path, sizeof path, "%s/touch-samples.csv", dir);
+    dhcal_text t = {NULL, 0U, 0U, 0};
+    dhcal_csv_columns cols;
+    memset(&cols, 0, sizeof cols);
+    cols.n_joints = nj;
+    cols.has_plane = 1;
+    cols.has_pair = 1;
+    dhcal_csv_write_header(&t, &cols);
+    unsigned pair = 0U;
+    for (size_t i = 0U; i < job.n_samples; ++i) {
+        const dhc_sample *s = &job.samples[i];
+        dhcal_row row;
+        memset(&row, 0, sizeof row);
+        memcpy(row.q_rad, s->q_rad, sizeof row.q_rad);
+        if (s->kind == (uint8_t)DHC_MEAS_PLANE) {
+            row.plane = (unsigned)s->target + 1U;
+            dhcal_csv_write_row(&t, &cols, &row);
+            continue;
+        }
+        row.pair = ++pair;
+        row.distance_mm = s->distance_mm;
+        dhcal_csv_write_row(&t, &cols, &row);
+        memcpy(row.q_rad, s->q2_rad, sizeof row.q_rad);
+        row.distance_mm = 0.0;
+        dhcal_csv_write_row(&t, &cols, &row);
+    }
+    dhcal_error err;
+    memset(&err, 0, sizeof err);
+    const int rc =
+        t.failed || t.p == NULL ? DHCAL_IO_FAILED : dhcal_file_write_atomic(path, t.p, t.len, &err);
+    free(t.p);
+    if (rc != DHCAL_IO_OK) {
+        fprintf(stderr, "dhcal-touch-demo: %s: %s\n", path,
+                err.msg[0] != '\0' ? err.msg : "out of memory");
+        return -1;
+    }
+    return 0;
+}
+
 static const char usage_text[] =
-    "usage: dhcal-touch-demo --scenario S.json [--json] [--targets N] [--per-plane N]\n"
-    "                        [--per-gauge N] [--speed MM_S]\n"
+    "usage: dhcal-touch-demo --scenario S.json [--json] [--out DIR] [--targets N]\n"
+    "                        [--per-plane N] [--per-gauge N] [--speed MM_S]\n"
     "  The controller calibrates the scenario's arm from touch-offs of its probe (the\n"
     "  scenario's probe section: faces marked touch, boxes marked gauge) and positions\n"
     "  fresh targets before and after (docs/cli.md, dhcal-touch-demo).\n"
@@ -153,10 +201,12 @@ static const char usage_text[] =
     "  --per-plane N   touches of each plane (default 20); --per-gauge N: pairs of end\n"
     "                  touches of each gauge (default 6)\n"
     "  --speed MM_S    approach speed, (0, 50] mm/s (default 2)\n"
+    "  --out DIR       write the touches to DIR/touch-samples.csv (docs/formats.md 3.4)\n"
     "  --json          one JSON object on standard output, the log on standard error\n";
 
 typedef struct {
     const char *scenario;
+    const char *out_dir;
     int json;
     size_t n_targets;
     fw_touch_config touch;
@@ -176,9 +226,18 @@ static int count_arg(const char *s, size_t lo, size_t hi, size_t *out)
 /* 0, -1 (--help), or 2 (bad usage, said). */
 static int parse_options(int argc, char **argv, touch_options *o)
 {
-    enum { OPT_SCENARIO = 256, OPT_JSON, OPT_TARGETS, OPT_PER_PLANE, OPT_PER_GAUGE, OPT_SPEED };
+    enum {
+        OPT_SCENARIO = 256,
+        OPT_JSON,
+        OPT_OUT,
+        OPT_TARGETS,
+        OPT_PER_PLANE,
+        OPT_PER_GAUGE,
+        OPT_SPEED
+    };
     static const struct option longs[] = {{"scenario", required_argument, NULL, OPT_SCENARIO},
                                           {"json", no_argument, NULL, OPT_JSON},
+                                          {"out", required_argument, NULL, OPT_OUT},
                                           {"targets", required_argument, NULL, OPT_TARGETS},
                                           {"per-plane", required_argument, NULL, OPT_PER_PLANE},
                                           {"per-gauge", required_argument, NULL, OPT_PER_GAUGE},
@@ -198,6 +257,7 @@ static int parse_options(int argc, char **argv, touch_options *o)
         switch (c) {
         case OPT_SCENARIO: o->scenario = optarg; break;
         case OPT_JSON: o->json = 1; break;
+        case OPT_OUT: o->out_dir = optarg; break;
         case OPT_TARGETS: bad = count_arg(optarg, 3U, MAX_TARGETS, &o->n_targets) != 0; break;
         case OPT_PER_PLANE: bad = count_arg(optarg, 3U, 40U, &per_plane) != 0; break;
         case OPT_PER_GAUGE: bad = count_arg(optarg, 1U, 12U, &per_gauge) != 0; break;
@@ -327,6 +387,9 @@ int main(int argc, char **argv)
             "params, rank %zu); stored: %s\n",
             res->geo.rms_mm, res->geo.max_mm, res->geo.n_params, res->geo.rank,
             res->saved ? "yes" : "no");
+    if (o.out_dir != NULL && write_samples(o.out_dir) != 0) {
+        return 1;
+    }
     cJSON *obj = cJSON_CreateObject();
     blind_names(res, cJSON_AddArrayToObject(obj, "blind"), log);
     if (position_targets(&job.calibrated, o.n_targets, 3003U, &after) != 0) {

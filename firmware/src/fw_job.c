@@ -170,8 +170,15 @@ fw_fault fw_job_acquire_recorded(fw_job *job, const dhc_sample *samples, size_t 
     for (size_t i = 0U; i < n; ++i) {
         const dhc_sample *s = &samples[i];
         /* a recording is outside input: the fit's screens expect the acquisition's checks */
-        const int ok = s->kind == (uint8_t)DHC_MEAS_WIRES && dhc_is_finite(s->temp_c) &&
-                       dhc_all_finite(s->wire_mm, 3U) && dhc_all_finite(s->q_rad, nj);
+        int ok = s->kind == (uint8_t)DHC_MEAS_WIRES && dhc_is_finite(s->temp_c) &&
+                 dhc_all_finite(s->wire_mm, 3U) && dhc_all_finite(s->q_rad, nj);
+#if DHC_WITH_CONTACT
+        /* or the touch-offs' samples (fw_touch_acquire's) */
+        const int angles = dhc_is_finite(s->temp_c) && dhc_all_finite(s->q_rad, nj);
+        ok = ok || (s->kind == (uint8_t)DHC_MEAS_PLANE && s->target < DHC_MAX_PLANES && angles) ||
+             (s->kind == (uint8_t)DHC_MEAS_DISTANCE && angles && dhc_all_finite(s->q2_rad, nj) &&
+              s->distance_mm > 0.0 && s->distance_mm <= 1e5);
+#endif
         if (!ok) {
             return FW_FAULT_ARGUMENT;
         }

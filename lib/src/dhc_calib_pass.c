@@ -388,6 +388,7 @@ static dhc_status blind_in_order(const fit_context *fc, dhc_calib_report *rep)
     return st;
 }
 
+#if DHC_WITH_PRIOR
 /* A blind parameter that moves the arm rigidly: joint 1's offset and height (a turn about and
  * a shift along the base axis), the base frame's pose. */
 static int moves_arm_rigidly(const dhc_param_id *id)
@@ -402,18 +403,21 @@ static int moves_arm_rigidly(const dhc_param_id *id)
  * over every length by its tolerance, and the scale's uncertainty stays in the covariance. */
 static void leave_to_prior(const fit_context *fc, dhc_calib_report *rep)
 {
-#if DHC_WITH_PRIOR
     for (size_t k = 0U; k < fc->set->count; ++k) {
         if (rep->blind[k] != 0U && dhc_fit_prior_weight(fc, k) > 0.0 &&
             !moves_arm_rigidly(&fc->set->id[k])) {
             rep->blind[k] = (uint8_t)DHC_BLIND_PRIOR;
         }
     }
+}
 #else
+/* Without a prior every blind parameter stays held. */
+static void leave_to_prior(const fit_context *fc, dhc_calib_report *rep)
+{
     (void)fc;
     (void)rep;
-#endif
 }
+#endif
 #endif
 
 /* Rank the model itself allows: the structural analysis with the data's kind. A data rank

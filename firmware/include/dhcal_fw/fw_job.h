@@ -110,7 +110,9 @@ fw_fault fw_job_acquire(fw_job *job);
  * Lets a controller without the arm attached (a bench, a bare-metal test under an emulator)
  * calibrate exactly as the job that collected them would. FW_FAULT_ARGUMENT (nothing kept)
  * when n is 0 or above FW_ACQ_MAX_SAMPLES, or a sample is not a DHC_MEAS_WIRES sample
- * with finite angles and lengths. */
+ * with finite angles and lengths (with DHC_WITH_CONTACT: nor a plane touch of a plane below
+ * DHC_MAX_PLANES, nor a length with finite angles at both ends and a distance in (0, 1e5]
+ * mm, as fw_job_touch takes them). */
 fw_fault fw_job_acquire_recorded(fw_job *job, const dhc_sample *samples, size_t n,
                                  const fw_acq_stats *acq);
 

@@ -113,13 +113,43 @@ def comparison_sees_differences():
     return ok
 
 
+def touch_parity(a):
+    """job_replay's touch mode on the controller's touches, on both sides."""
+    touches = os.path.abspath(os.path.join(a.scratch, "touch_planes.bin"))
+    rc, out = run([a.prepare, "touch", a.touch_csv, touches])
+    if rc != 0:
+        print(out, end="")
+        print(f"FAIL: twin_prepare touch exited {rc}")
+        return 1
+    env = dict(os.environ, DHCAL_QEMU_OPTS="-icount shift=0")
+    label = "job, touches of 3 planes and 3 gauges"
+    rc_h, out_h = run([a.host, touches, "touch"])
+    rc_t, out_t = run([a.emulator, a.target, touches, "touch"], env=env)
+    bad = []
+    if rc_h != 0 or rc_t != 0:
+        print(f"--- host ({rc_h})\n{out_h}--- target ({rc_t})\n{out_t}", end="")
+        bad.append(f"{label}: host exited {rc_h}, target {rc_t}")
+    else:
+        b, target = compare(label, out_h, out_t)
+        planes = sum(1 for k in parse(out_h)[0] if k.endswith(".offset"))
+        print(f"{label}: {planes} planes found on both")
+        if planes != 3:
+            b.append(f"{label}: {planes} planes, not 3")
+        bad += b + cost(label, target)
+    for b in bad:
+        print("FAIL:", b)
+    print(f"{'FAILED' if bad else 'OK'}: touch parity of the Cortex-M4 and the host")
+    return 1 if bad else 0
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--emulator", required=True)
     ap.add_argument("--prepare", required=True)
     ap.add_argument("--csv", required=True)
     ap.add_argument("--scratch", required=True)
-    ap.add_argument("what", choices=["fit", "job"])
+    ap.add_argument("what", choices=["fit", "job", "touch"])
+    ap.add_argument("--touch-csv", help="touch: dhcal-touch-demo's touch-samples.csv")
     ap.add_argument("--host", required=True)
     ap.add_argument("--target", required=True)
     ap.add_argument("--no-diagnosis", action="store_true",
@@ -131,6 +161,8 @@ def main():
         print("FAIL: the comparison does not tell a 2e-9 difference from a 1e-10 one")
         return 1
     os.makedirs(a.scratch, exist_ok=True)
+    if a.what == "touch":
+        return touch_parity(a)
     demo = os.path.abspath(os.path.join(a.scratch, f"{a.what}_demo3.bin"))
     arm6 = os.path.abspath(os.path.join(a.scratch, f"{a.what}_arm6.bin"))
     for cmd in ([a.prepare, "csv", a.csv, demo], [a.prepare, "arm6", arm6]):

@@ -1,6 +1,6 @@
 /* job_replay.c - the controller's job (fw_job) on recorded samples, the same on the
  * Cortex-M4 and on the host (twin.h):
- *   job_replay FILE [configured|diagnose|live]
+ *   job_replay FILE [configured|diagnose|live|touch]
  * FILE: wire samples of the paper's 3-DOF arm as dhcal-demo collected them. The job boots
  * on a port whose arm stands still at the start pose (nothing moves: the samples are
  * recorded), plans, takes the recording as its acquisition (fw_job_acquire_recorded),
@@ -14,7 +14,10 @@
  * the instructions fw_job_calibrate took (0 on the host). `live`: the job acquires through
  * the port (fw_job_acquire), whose arm never moves: the controller must stop with a fault,
  * drives at zero, before it takes a sample. So the program holds everything a controller
- * runs: its linked bytes are the controller's flash for the library (scripts/target-report). */
+ * runs: its linked bytes are the controller's flash for the library (scripts/target-report).
+ * `touch`: FILE holds the touches dhcal-touch-demo's controller took (planes and gauge
+ * lengths, twin.h's version 2); the job calibrates the arm with the planes' poses from them
+ * (no noise model, no diagnosis, as dhcal-touch-demo) and prints the planes it found too. */
 #include <string.h>
 
 #include "dhc_test_arms.h"
@@ -125,10 +128,11 @@ int twin_main(int argc, char **argv)
     const int configured = argc == 3 && strcmp(argv[2], "configured") == 0;
     const int diagnose = argc == 3 && strcmp(argv[2], "diagnose") == 0;
     const int live = argc == 3 && strcmp(argv[2], "live") == 0;
-    if ((argc != 2 && !configured && !diagnose && !live) ||
+    const int touch = argc == 3 && strcmp(argv[2], "touch") == 0;
+    if ((argc != 2 && !configured && !diagnose && !live && !touch) ||
         twin_load_samples(argv[1], recorded, TWIN_MAX_SAMPLES, &n, &nj) != 0 || nj != 3U) {
-        twin_puts("usage: job_replay FILE [configured|diagnose|live] (wire samples of the "
-                  "3-DOF paper arm)\n");
+        twin_puts("usage: job_replay FILE [configured|diagnose|live|touch] (wire samples, or "
+                  "touches, of the 3-DOF paper arm)\n");
         return 2;
     }
     dhc_model nominal = test_paper3_model();
@@ -164,9 +168,13 @@ int twin_main(int argc, char **argv)
     if (diagnose) {
         cfg.autocal.diagnose = 1; /* whatever the build's default */
     }
+    if (touch) {
+        cfg.noise_model = 0;
+        cfg.autocal.diagnose = 0;
+    }
 
     fw_fault f = fw_job_boot(&job, &cfg, &nominal, &port, &io);
-    if (f == FW_FAULT_NONE) {
+    if (f == FW_FAULT_NONE && !touch) {
         f = fw_job_plan(&job);
     }
     if (f == FW_FAULT_NONE) {
@@ -224,6 +232,17 @@ int twin_main(int argc, char **argv)
         key[2] = (char)('0' + (int)(k / 10U));
         key[3] = (char)('0' + (int)(k % 10U));
         twin_put_double(key, dhc_params_value(&set, &stored, k));
+    }
+    for (size_t k = 0U; touch && k < job.calibrated.contact.n_planes; ++k) {
+        char key[16] = "plane0.n0";
+        key[5] = (char)('0' + (int)k);
+        for (size_t c = 0U; c < 3U; ++c) {
+            key[8] = (char)('0' + (int)c);
+            twin_put_double(key, job.calibrated.contact.plane[k].normal[c]);
+        }
+        char off[16] = "plane0.offset";
+        off[5] = (char)('0' + (int)k);
+        twin_put_double(off, job.calibrated.contact.plane[k].offset_mm);
     }
     put_store();
     /* What the controller does with the calibration: points moved to on the stored model

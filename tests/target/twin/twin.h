@@ -7,7 +7,9 @@
  * A sample file (twin_prepare writes it) is an array of little-endian IEEE-754 doubles:
  *   1, n_joints, kind (dhc_meas_kind), n_samples, then per sample
  *   q_rad[n_joints], dir[n_joints], m[3] (wires or tool point, mm), and for pose samples
- *   the orientation's 9 entries, row by row.
+ *   the orientation's 9 entries, row by row. Version 2 (touches, DHC_WITH_CONTACT builds):
+ *   2, n_joints, 0, n_samples, then per sample its kind (DHC_MEAS_PLANE or
+ *   DHC_MEAS_DISTANCE), target, q_rad[n_joints], q2_rad[n_joints], distance_mm.
  * Doubles, not dhc_sample: size_t and padding differ between the two ABIs. */
 #ifndef DHC_TWIN_H
 #define DHC_TWIN_H

@@ -63,6 +63,36 @@ static int count_of(double v, size_t max, size_t *out)
     return 0;
 }
 
+#if DHC_WITH_CONTACT
+/* Version 2: touches (twin.h). */
+static int load_touches(const char *path, size_t len, dhc_sample *s, size_t nj, size_t count)
+{
+    const size_t per = 2U * nj + 3U;
+    if (len / sizeof(double) != 4U + count * per) {
+        return bad_file(path, "its length does not match its sample count");
+    }
+    const double *v = file_buf + 4;
+    for (size_t i = 0U; i < count; ++i, v += per) {
+        dhc_sample *o = &s[i];
+        memset(o, 0, sizeof *o);
+        size_t kind = 0U;
+        size_t target = 0U;
+        if (count_of(v[0], (size_t)DHC_MEAS_DISTANCE, &kind) != 0 ||
+            (kind != (size_t)DHC_MEAS_PLANE && kind != (size_t)DHC_MEAS_DISTANCE) ||
+            count_of(v[1], DHC_MAX_PLANES - 1U, &target) != 0) {
+            return bad_file(path, "a sample neither a plane touch nor a length");
+        }
+        o->kind = (uint8_t)kind;
+        o->target = (uint8_t)target;
+        o->temp_c = 20.0;
+        memcpy(o->q_rad, v + 2, nj * sizeof(double));
+        memcpy(o->q2_rad, v + 2U + nj, nj * sizeof(double));
+        o->distance_mm = v[2U + 2U * nj];
+    }
+    return 0;
+}
+#endif
+
 int twin_load_samples(const char *path, dhc_sample *s, size_t cap, size_t *n, size_t *n_joints)
 {
     size_t len = 0U;
@@ -74,11 +104,20 @@ int twin_load_samples(const char *path, dhc_sample *s, size_t cap, size_t *n, si
     size_t kind = 0U;
     size_t count = 0U;
     if (len % sizeof(double) != 0U || len < 4U * sizeof(double) ||
-        count_of(file_buf[0], 1U, &version) != 0 || version != 1U ||
+        count_of(file_buf[0], 2U, &version) != 0 || version == 0U ||
         count_of(file_buf[1], DHC_MAX_JOINTS, &nj) != 0 || nj == 0U ||
         count_of(file_buf[2], (size_t)DHC_MEAS_WIRES, &kind) != 0 ||
         count_of(file_buf[3], cap, &count) != 0) {
         return bad_file(path, "not a sample file of at most TWIN_MAX_SAMPLES samples");
+    }
+    if (version == 2U) {
+#if DHC_WITH_CONTACT
+        *n = count;
+        *n_joints = nj;
+        return load_touches(path, len, s, nj, count);
+#else
+        return bad_file(path, "touches: a library without contact rows (DHC_WITH_CONTACT)");
+#endif
     }
     const size_t per = 2U * nj + 3U + (kind == (size_t)DHC_MEAS_POSE ? 9U : 0U);
     if (len / sizeof(double) != 4U + count * per) {

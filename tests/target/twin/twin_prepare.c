@@ -4,7 +4,12 @@
  *                                 as wire samples; degrees to radians here, once
  *   twin_prepare arm6 OUT         60 pose samples of the paper's actual 6-DOF arm (Table 1,
  *                                 every joint offset 2 deg) at random poses, with noise:
- *                                 uniform +-0.05 mm on the point, +-0.1 mrad about each axis */
+ *                                 uniform +-0.05 mm on the point, +-0.1 mrad about each axis
+ *   twin_prepare touch IN.csv OUT dhcal-touch-demo's touch-samples.csv (q1..qn deg, plane,
+ *                                 pair, distance_mm: docs/formats.md 3.4) as touch samples
+ *                                 (version 2 of twin.h's format: a plane touch one sample, a
+ *                                 pair's two rows one length sample) */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -141,14 +146,110 @@ static int arm6(const char *path)
     return write_out(path);
 }
 
+/* The fields of one CSV line (empty ones kept: "1,,"), at most cap; returns how many. */
+static size_t split(char *line, char **field, size_t cap)
+{
+    size_t n = 0U;
+    line[strcspn(line, "\r\n")] = '\0';
+    for (char *p = line; n < cap; ++p) {
+        field[n++] = p;
+        p = strchr(p, ',');
+        if (p == NULL) {
+            break;
+        }
+        *p = '\0';
+    }
+    return n;
+}
+
+/* One CSV number (an empty field: 0). */
+static int number(const char *s, double *v)
+{
+    char *end = NULL;
+    *v = s[0] == '\0' ? 0.0 : strtod(s, &end);
+    return s[0] == '\0' || (end != s && *end == '\0') ? 0 : -1;
+}
+
+static int touches(const char *in, const char *path)
+{
+    FILE *f = fopen(in, "r");
+    char line[1024];
+    char *field[DHC_MAX_JOINTS + 3U];
+    size_t nj = 0U;
+    if (f == NULL || fgets(line, sizeof line, f) == NULL) {
+        fprintf(stderr, "twin_prepare: cannot read %s\n", in);
+        if (f != NULL) {
+            (void)fclose(f);
+        }
+        return 1;
+    }
+    const size_t cols = split(line, field, DHC_MAX_JOINTS + 3U);
+    nj = cols >= 4U ? cols - 3U : 0U;
+    if (nj == 0U || strcmp(field[nj], "plane") != 0 || strcmp(field[nj + 1U], "pair") != 0 ||
+        strcmp(field[nj + 2U], "distance_mm") != 0) {
+        fprintf(stderr, "twin_prepare: %s: not q1..qn,plane,pair,distance_mm\n", in);
+        (void)fclose(f);
+        return 1;
+    }
+    static double rows[2U * TWIN_ROWS_MAX][DHC_MAX_JOINTS + 3U];
+    size_t n = 0U;
+    while (fgets(line, sizeof line, f) != NULL && n < 2U * TWIN_ROWS_MAX) {
+        int bad = split(line, field, DHC_MAX_JOINTS + 3U) != cols;
+        for (size_t c = 0U; c < cols && !bad; ++c) {
+            bad = number(field[c], &rows[n][c]) != 0;
+        }
+        if (bad) {
+            fprintf(stderr, "twin_prepare: %s:%zu: not %zu fields\n", in, n + 2U, cols);
+            (void)fclose(f);
+            return 1;
+        }
+        ++n;
+    }
+    (void)fclose(f);
+    size_t samples = 0U;
+    for (size_t i = 0U; i < n; ++i) {
+        samples += rows[i][nj] > 0.0 || rows[i][nj + 2U] > 0.0; /* a plane, or a pair's first */
+    }
+    put(2.0);
+    put((double)nj);
+    put(0.0); /* kinds per sample */
+    put((double)samples);
+    for (size_t i = 0U; i < n; ++i) {
+        const int plane = rows[i][nj] > 0.0;
+        if (!plane && !(rows[i][nj + 2U] > 0.0)) {
+            continue; /* a pair's second row, taken with its first */
+        }
+        const size_t second = i + 1U;
+        if (!plane && (second >= n || fabs(rows[second][nj + 1U] - rows[i][nj + 1U]) > 0.5)) {
+            fprintf(stderr, "twin_prepare: %s:%zu: a pair's second row must follow it\n", in,
+                    i + 2U);
+            return 1;
+        }
+        put(plane ? (double)DHC_MEAS_PLANE : (double)DHC_MEAS_DISTANCE);
+        put(plane ? rows[i][nj] - 1.0 : 0.0);
+        for (size_t j = 0U; j < nj; ++j) {
+            put(rows[i][j] * DHC_PI / 180.0);
+        }
+        for (size_t j = 0U; j < nj; ++j) {
+            put(plane ? 0.0 : rows[second][j] * DHC_PI / 180.0);
+        }
+        put(plane ? 0.0 : rows[i][nj + 2U]);
+    }
+    return write_out(path);
+}
+
 int main(int argc, char **argv)
 {
+    if (argc == 4 && strcmp(argv[1], "touch") == 0) {
+        return touches(argv[2], argv[3]);
+    }
     if (argc == 4 && strcmp(argv[1], "csv") == 0) {
         return from_csv(argv[2], argv[3]);
     }
     if (argc == 3 && strcmp(argv[1], "arm6") == 0) {
         return arm6(argv[2]);
     }
-    fprintf(stderr, "usage: twin_prepare csv IN.csv OUT | twin_prepare arm6 OUT\n");
+    fprintf(stderr, "usage: twin_prepare csv IN.csv OUT | twin_prepare arm6 OUT | "
+                    "twin_prepare touch IN.csv OUT\n");
     return 2;
 }
