@@ -52,6 +52,7 @@ static const char *const help_text =
     "usage: dhcal-fw --machine M.json [options]\n"
     "       dhcal-fw --machine M.json --port sim --scenario S.json [options]\n"
     "       dhcal-fw --gpio-chip NAME --enc-lines A,B --gpio-watch N\n"
+    "       dhcal-fw --gpio-chip NAME --probe-line L --probe-watch N\n"
     "The controller's calibration run: plan the poses, move the arm through them and read\n"
     "the draw-wire measurer, calibrate (geometry, diagnosis, the named effect) and store the\n"
     "result; prints one JSON object. The machine file configures the controller; an option\n"
@@ -89,7 +90,11 @@ static const char *const help_text =
     "  --enc-lines A,B       their line offsets\n"
     "  --gpio-watch N        instead of the run: decode N quadrature steps from the GPIO\n"
     "                        lines (or stop at the first missed edge) and report\n"
-    "  --gpio-timeout-ms N   --gpio-watch gives up after this long without edges (3000)\n"
+    "  --gpio-timeout-ms N   --gpio-watch and --probe-watch give up after this long\n"
+    "                        without edges (3000)\n"
+    "  --probe-line L        the touch probe's switch on line L of --gpio-chip (fw_touch.h)\n"
+    "  --probe-active high|low  the level the line reads with the switch closed (high)\n"
+    "  --probe-watch N       instead of the run: report the switch's first N closings\n"
     "  --help                this text\n"
     "Exit codes: 0 completed, 1 fault or failure (see the JSON), 2 usage, configuration,\n"
     "or a missing interface, GPIO chip or line.\n";
@@ -103,6 +108,7 @@ typedef struct {
     const char *params_out;
     const char *gpio_chip;
     const char *plan;
+    const char *probe_active;
     unsigned long long reply_timeout_us;
     unsigned long long can_id_offset;
     unsigned long long start_timeout_ms;
@@ -114,6 +120,9 @@ typedef struct {
     unsigned long long gpio_watch;
     unsigned long long gpio_timeout_ms;
     unsigned long long gpio_stall_ms;
+    unsigned long long probe_line;
+    unsigned long long probe_watch;
+    int have_probe_line;
     unsigned enc_line[2];
     int have_lines;
     /* which numbers the command line gave (the machine file gives the others) */
@@ -190,6 +199,8 @@ static int set_option(options *o, const char *key, const char *val)
         {"gpio-watch", &o->gpio_watch, 1000000ULL, &ignored},
         {"gpio-timeout-ms", &o->gpio_timeout_ms, 600000ULL, &ignored},
         {"gpio-stall-ms", &o->gpio_stall_ms, 600000ULL, &ignored},
+        {"probe-line", &o->probe_line, 1023ULL, &o->have_probe_line},
+        {"probe-watch", &o->probe_watch, 1000000ULL, &ignored},
     };
     for (size_t i = 0U; i < sizeof nums / sizeof nums[0]; ++i) {
         if (strcmp(key, nums[i].name) == 0) {
@@ -212,7 +223,8 @@ static int set_option(options *o, const char *key, const char *val)
                 {"nv", &o->nv},
                 {"params-out", &o->params_out},
                 {"gpio-chip", &o->gpio_chip},
-                {"plan", &o->plan}};
+                {"plan", &o->plan},
+                {"probe-active", &o->probe_active}};
     for (size_t i = 0U; i < sizeof strs / sizeof strs[0]; ++i) {
         if (strcmp(key, strs[i].name) == 0) {
             if (val[0] == '\0') {
@@ -249,6 +261,9 @@ static const struct option long_options[] = {{"machine", required_argument, NULL
                                              {"gpio-watch", required_argument, NULL, 0},
                                              {"gpio-timeout-ms", required_argument, NULL, 0},
                                              {"gpio-stall-ms", required_argument, NULL, 0},
+                                             {"probe-line", required_argument, NULL, 0},
+                                             {"probe-active", required_argument, NULL, 0},
+                                             {"probe-watch", required_argument, NULL, 0},
                                              {"help", no_argument, NULL, 'h'},
                                              {NULL, 0, NULL, 0}};
 
@@ -285,10 +300,11 @@ static int parse_args(int argc, char **argv, options *o)
     if (strcmp(o->port, "linux") != 0 && strcmp(o->port, "sim") != 0) {
         return usage("--port: '%s' is neither linux nor sim", o->port);
     }
-    if (o->gpio_watch == 0U && o->machine == NULL) {
+    const int watching = o->gpio_watch > 0U || o->probe_watch > 0U;
+    if (!watching && o->machine == NULL) {
         return usage("%s", "--machine is required (the controller's machine file)");
     }
-    if (o->gpio_watch == 0U && strcmp(o->port, "sim") == 0 && o->scenario == NULL) {
+    if (!watching && strcmp(o->port, "sim") == 0 && o->scenario == NULL) {
         return usage("%s", "--port sim needs --scenario (the simulated arm)");
     }
     if (strcmp(o->port, "linux") == 0 && o->scenario != NULL) {
@@ -301,10 +317,17 @@ static int parse_args(int argc, char **argv, options *o)
     if (o->plan != NULL && (o->have_samples || o->have_candidates)) {
         return usage("%s", "--plan gives the poses: not with --samples or --plan-candidates");
     }
-    if ((o->gpio_chip != NULL) != (o->have_lines != 0)) {
-        return usage("%s", "--gpio-chip and --enc-lines go together");
+    if ((o->gpio_chip != NULL) != (o->have_lines != 0 || o->have_probe_line != 0)) {
+        return usage("%s", "--gpio-chip goes with --enc-lines or --probe-line");
     }
-    if (o->gpio_watch > 0U && o->gpio_chip == NULL) {
+    if (o->probe_watch > 0U && (o->gpio_chip == NULL || !o->have_probe_line)) {
+        return usage("%s", "--probe-watch needs --gpio-chip and --probe-line");
+    }
+    if (o->probe_active != NULL && strcmp(o->probe_active, "high") != 0 &&
+        strcmp(o->probe_active, "low") != 0) {
+        return usage("--probe-active: '%s' is neither high nor low", o->probe_active);
+    }
+    if (o->gpio_watch > 0U && (o->gpio_chip == NULL || !o->have_lines)) {
         return usage("%s", "--gpio-watch needs --gpio-chip and --enc-lines");
     }
     if (o->have_reply_timeout && o->reply_timeout_us == 0U) {
@@ -448,6 +471,57 @@ static int run_gpio_watch(const options *o)
     cJSON_AddStringToObject(obj, "detail", r.detail);
     (void)dhcal_json_print(obj, "dhcal-fw");
     return r.fault ? EXIT_FAULT : 0;
+}
+
+/* The switch's first o->probe_watch closings on --probe-line (each open -> closed change),
+ * or the time without a change that ended the watch. */
+static int run_probe_watch(const options *o)
+{
+    static fw_linux_probe probe;
+    char why[256];
+    const int active_low = o->probe_active != NULL && strcmp(o->probe_active, "low") == 0;
+    const fw_linux_gpio_status st = fw_linux_probe_open(
+        &probe, o->gpio_chip, (unsigned)o->probe_line, active_low, why, sizeof why);
+    if (st != FW_LINUX_GPIO_OK) {
+        fprintf(stderr, "dhcal-fw: %s\n", why);
+        return st == FW_LINUX_GPIO_ERR ? EXIT_FAULT : EXIT_USAGE;
+    }
+    int closed = fw_linux_probe_closed(&probe);
+    const int at_start = closed;
+    fprintf(stderr, "dhcal-fw: watching the probe on %s line %llu\n", o->gpio_chip, o->probe_line);
+    unsigned long long closings = 0U;
+    unsigned long long changes = 0U;
+    char detail[96] = "ok";
+    while (closed >= 0 && closings < o->probe_watch) {
+        int now = 0;
+        const int r = fw_linux_probe_wait(&probe, (int)o->gpio_timeout_ms, &now);
+        if (r < 0) {
+            (void)snprintf(detail, sizeof detail, "reading the line failed: %s", strerror(errno));
+            closed = -1;
+            break;
+        }
+        if (r == 0) {
+            (void)snprintf(detail, sizeof detail, "no change for %llu ms", o->gpio_timeout_ms);
+            break;
+        }
+        changes++;
+        closings += now == 1 && closed == 0;
+        closed = now;
+    }
+    fw_linux_probe_close(&probe);
+    cJSON *obj = cJSON_CreateObject();
+    cJSON_AddStringToObject(obj, "mode", "probe-watch");
+    cJSON_AddStringToObject(obj, "chip", o->gpio_chip);
+    cJSON_AddNumberToObject(obj, "line", (double)o->probe_line);
+    cJSON_AddStringToObject(obj, "active", active_low ? "low" : "high");
+    cJSON_AddBoolToObject(obj, "closed_at_start", at_start == 1);
+    cJSON_AddNumberToObject(obj, "closings", (double)closings);
+    cJSON_AddNumberToObject(obj, "changes", (double)changes);
+    const int done = closings == o->probe_watch;
+    cJSON_AddStringToObject(obj, "fault", done ? "none" : fw_fault_name(FW_FAULT_PROBE));
+    cJSON_AddStringToObject(obj, "detail", detail);
+    (void)dhcal_json_print(obj, "dhcal-fw");
+    return done ? 0 : EXIT_FAULT;
 }
 
 /* ---------------------------------------------------------------- the calibration run */
@@ -793,5 +867,7 @@ int main(int argc, char **argv)
                 strerror(errno));
         return EXIT_FAULT;
     }
-    return o.gpio_watch > 0U ? run_gpio_watch(&o) : run_calibration(&o);
+    return o.probe_watch > 0U  ? run_probe_watch(&o)
+           : o.gpio_watch > 0U ? run_gpio_watch(&o)
+                               : run_calibration(&o);
 }

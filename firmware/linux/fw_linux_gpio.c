@@ -178,3 +178,71 @@ void fw_linux_gpio_close(fw_linux_gpio_enc *enc)
 {
     release(enc);
 }
+
+/* ---------------------------------------------------------------- the touch probe */
+
+fw_linux_gpio_status fw_linux_probe_open(fw_linux_probe *p, const char *chip, unsigned line,
+                                         int active_low, char *why, size_t why_cap)
+{
+    memset(p, 0, sizeof *p);
+    p->chip = chip[0] == '/' ? gpiod_chip_open(chip) : gpiod_chip_open_by_name(chip);
+    if (p->chip == NULL) {
+        (void)snprintf(why, why_cap, "no GPIO chip %s: %s", chip, strerror(errno));
+        return FW_LINUX_GPIO_NO_CHIP;
+    }
+    const unsigned n_lines = gpiod_chip_num_lines(p->chip);
+    p->line = line < n_lines ? gpiod_chip_get_line(p->chip, line) : NULL;
+    if (p->line == NULL) {
+        (void)snprintf(why, why_cap, "GPIO chip %s has %u lines: no line %u (probe)", chip, n_lines,
+                       line);
+        fw_linux_probe_close(p);
+        return FW_LINUX_GPIO_NO_LINE;
+    }
+    const int flags = active_low ? GPIOD_LINE_REQUEST_FLAG_ACTIVE_LOW : 0;
+    if (gpiod_line_request_both_edges_events_flags(p->line, consumer, flags) != 0) {
+        (void)snprintf(why, why_cap, "GPIO chip %s: line %u: edge events: %s", chip, line,
+                       strerror(errno));
+        gpiod_line_release(p->line);
+        p->line = NULL;
+        fw_linux_probe_close(p);
+        return FW_LINUX_GPIO_ERR;
+    }
+    return FW_LINUX_GPIO_OK;
+}
+
+int fw_linux_probe_closed(fw_linux_probe *p)
+{
+    return gpiod_line_get_value(p->line);
+}
+
+int fw_linux_probe_wait(fw_linux_probe *p, int timeout_ms, int *closed)
+{
+    struct pollfd fd = {gpiod_line_event_get_fd(p->line), POLLIN, 0};
+    int r;
+    do {
+        r = poll(&fd, 1U, timeout_ms);
+    } while (r < 0 && errno == EINTR);
+    if (r <= 0) {
+        return r;
+    }
+    /* the level after the edges, not their types: a bounce's pair of edges leaves it as is */
+    static struct gpiod_line_event ev[FW_LINUX_GPIO_BATCH];
+    if ((fd.revents & POLLIN) == 0 ||
+        gpiod_line_event_read_multiple(p->line, ev, FW_LINUX_GPIO_BATCH) < 0) {
+        return -1;
+    }
+    *closed = fw_linux_probe_closed(p);
+    return *closed < 0 ? -1 : 1;
+}
+
+void fw_linux_probe_close(fw_linux_probe *p)
+{
+    if (p->line != NULL) {
+        gpiod_line_release(p->line);
+        p->line = NULL;
+    }
+    if (p->chip != NULL) {
+        gpiod_chip_close(p->chip);
+        p->chip = NULL;
+    }
+}

@@ -1,5 +1,6 @@
 /* fw_linux_gpio.h - an encoder's quadrature A/B lines through the GPIO character device
- * (libgpiod v1.6 API, as Debian bookworm ships it), decoded by fw_quadrature.
+ * (libgpiod v1.6 API, as Debian bookworm ships it), decoded by fw_quadrature; and the touch
+ * probe's switch (fw_touch.h) on one input line.
  *
  * Both lines are requested for both-edge events; their two event file descriptors are
  * waited on with one poll(), and the pending events of each line are read in batches of
@@ -62,5 +63,26 @@ void fw_linux_gpio_watch(fw_linux_gpio_enc *enc, int64_t steps, uint32_t timeout
                          uint32_t stall_ms, fw_linux_gpio_result *r);
 
 void fw_linux_gpio_close(fw_linux_gpio_enc *enc);
+
+/* ---- the touch probe's switch on one input line (fw_port.read_probe, fw_touch.h). The line
+ * is requested for both-edge events with the logical level the switch closed reads as 1:
+ * active_low for a probe whose output pulls the line low on a touch (a normally-closed
+ * output wired fail-safe: a cut wire reads as a touch, and the touch-off faults). */
+typedef struct {
+    struct gpiod_chip *chip;
+    struct gpiod_line *line;
+} fw_linux_probe;
+
+fw_linux_gpio_status fw_linux_probe_open(fw_linux_probe *p, const char *chip, unsigned line,
+                                         int active_low, char *why, size_t why_cap);
+
+/* 1 closed, 0 open, -1 reading the line failed. */
+int fw_linux_probe_closed(fw_linux_probe *p);
+
+/* Waits at most timeout_ms for the line to change and drains its events: 1 it changed
+ * (*closed the switch's state now), 0 timeout, -1 reading failed. */
+int fw_linux_probe_wait(fw_linux_probe *p, int timeout_ms, int *closed);
+
+void fw_linux_probe_close(fw_linux_probe *p);
 
 #endif /* FW_LINUX_GPIO_H */

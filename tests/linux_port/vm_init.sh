@@ -177,6 +177,47 @@ if [ -n "$CHIP" ]; then
     fi
 fi
 
+# ---------------------------------------------------------------- (e) touch probe on GPIO
+if [ -n "$CHIP" ]; then
+    # The probe's switch on line 2, closed 5 times by gpio-sim's pull (what the probe's
+    # output does to the input), once with the active level high and once low.
+    PULL=/sys/bus/gpio/devices/$CHIP/sim_gpio2/pull
+    for active in high low; do
+        [ $active = high ] && { OPEN=pull-down; CLOSE=pull-up; } || { OPEN=pull-up; CLOSE=pull-down; }
+        echo $OPEN >$PULL
+        dhcal-fw --gpio-chip "$CHIP" --probe-line 2 --probe-active $active --probe-watch 5 \
+            --gpio-timeout-ms 10000 >fw-p-$active.json 2>fw-p-$active.err &
+        FW=$!
+        i=0
+        while ! grep -q watching fw-p-$active.err 2>/dev/null && [ $i -lt 100 ]; do
+            usleep 100000; i=$((i + 1))
+        done
+        for k in 1 2 3 4 5; do
+            echo $CLOSE >$PULL; usleep 200000
+            echo $OPEN >$PULL; usleep 200000
+        done
+        wait $FW
+        RC=$?
+        show "OUT fw-p-$active" fw-p-$active.json; show "ERR fw-p-$active" fw-p-$active.err
+        if [ "$RC" = 0 ] && [ "$(field fw-p-$active.json closings)" = 5 ] &&
+            [ "$(field fw-p-$active.json closed_at_start)" = false ]; then
+            result probe-$active PASS "5 closings of the probe's switch on gpio-sim line 2, active $active"
+        else
+            result probe-$active FAIL "exit $RC, closings '$(field fw-p-$active.json closings)', $(field fw-p-$active.json detail)"
+        fi
+    done
+    echo pull-down >$PULL
+    # Nothing touched: the watch ends with the fault and the time it waited.
+    dhcal-fw --gpio-chip "$CHIP" --probe-line 2 --probe-watch 1 --gpio-timeout-ms 500 \
+        >fw-p-none.json 2>fw-p-none.err
+    RC=$?
+    if [ "$RC" = 1 ] && [ "$(field fw-p-none.json fault)" = probe ]; then
+        result probe-silent PASS "no closing: fault probe, $(field fw-p-none.json detail)"
+    else
+        result probe-silent FAIL "exit $RC, fault '$(field fw-p-none.json fault)'"
+    fi
+fi
+
 # ---------------------------------------------------------------- configuration errors
 err_case() { # name expected-text dhcal-fw-options...
     name=$1; want=$2; shift 2
@@ -191,6 +232,8 @@ err_case() { # name expected-text dhcal-fw-options...
 err_case missing-interface "no CAN interface" --can nosuch0
 err_case missing-chip "no GPIO chip" --gpio-chip gpiochip99 --enc-lines 0,1
 [ -n "$CHIP" ] && err_case missing-line "no line 9" --gpio-chip "$CHIP" --enc-lines 0,9
+[ -n "$CHIP" ] && err_case missing-probe-line "no line 9 (probe)" --gpio-chip "$CHIP" \
+    --probe-line 9 --probe-watch 1
 
 dmesg | grep -iE "gpio|can:|vcan|kfifo|drop" | sed 's/^/DMESG /'
 if [ $FAILED = 0 ]; then echo "RESULT: ALL PASS"; else echo "RESULT: SOME FAILED"; fi

@@ -3,7 +3,8 @@
 # with an initramfs of busybox, dhcal-fw and dhcal-sim (and the shared libraries they
 # use), and runs vm_init.sh's cases inside: the calibration run over vcan0 compared with
 # the sim port's run on this host, a lost CAN frame, a bus timeout, GPIO quadrature on
-# gpio-sim with and without a missed edge, and configuration errors.
+# gpio-sim with and without a missed edge, the touch probe's switch on a gpio-sim line (active
+# high and low, and silent), and configuration errors.
 #
 # usage: vm_run.sh --cache DIR --work DIR --fw dhcal-fw --sim dhcal-sim --machine M.json
 #                  --scenario S.json [--can-check linux_can_check] [--samples N]
@@ -126,7 +127,7 @@ fail=0
 cases="calibration lost-frame"
 [ -n "$CAN_CHECK" ] && cases="can-transport $cases"
 for c in $cases bus-timeout sigterm encoder-count missed-edge missing-interface \
-         missing-chip missing-line; do
+         missing-chip missing-line probe-high probe-low probe-silent missing-probe-line; do
     line=$(grep "^CASE $c " "$WORK/console.log" | head -n1 || true)
     case $line in
         "CASE $c PASS"*) ;;
