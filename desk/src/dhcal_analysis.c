@@ -371,7 +371,7 @@ int dhcal_run_fit(const dhc_model *nominal, const char *effects, dhcal_geometry 
 dhcal_prior dhcal_prior_of_file(const dhcal_model *file)
 {
     const dhcal_prior p = {file->tolerance_length_mm, file->tolerance_angle_deg * DHC_PI / 180.0,
-                           0.0};
+                           0.0, 0.0};
     return p;
 }
 
@@ -379,7 +379,7 @@ int dhcal_run_fit_prior(const dhc_model *nominal, const char *effects, dhcal_geo
                         const dhc_noise_model *noise, const dhcal_prior *prior, dhcal_samples *s,
                         const dhcal_samples *held, dhcal_fit *out, dhcal_error *err)
 {
-    const dhcal_prior none = {0.0, 0.0, 0.0};
+    const dhcal_prior none = {0.0, 0.0, 0.0, 0.0};
     out->prior = prior != NULL ? *prior : none;
     out->have_prior_centre = 0; /* a fit of its own: the prior centred on its start */
     dhc_param_set set;

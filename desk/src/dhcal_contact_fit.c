@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "dhcal/dhc_contact.h"
 #include "dhcal/dhc_uncertainty.h"
@@ -49,6 +50,159 @@ int dhcal_prior_scale(const dhc_model *start, const dhc_param_set *set,
     return rc;
 }
 
+/* The samples of s without plane p's touches (keep 0), or only those (keep 1), planes
+ * renumbered without a gap, into out (its arrays: buf and flags, s->n each). */
+static void plane_subset(const dhcal_samples *s, size_t p, int keep, dhcal_samples *out,
+                         dhc_sample *buf, uint8_t *flags)
+{
+    memset(out, 0, sizeof *out);
+    out->samples = buf;
+    out->flags = flags;
+    out->path = s->path;
+    out->wires = s->wires;
+    for (size_t i = 0U; i < s->n; ++i) {
+        const dhc_sample *x = &s->samples[i];
+        const int on_p = x->kind == (uint8_t)DHC_MEAS_PLANE && x->target == p;
+        if (on_p != keep) {
+            continue;
+        }
+        buf[out->n] = *x;
+        if (x->kind == (uint8_t)DHC_MEAS_PLANE) {
+            buf[out->n].target = (uint8_t)(keep ? 0U : x->target - (x->target > p ? 1U : 0U));
+        }
+        flags[out->n++] = s->flags[i];
+    }
+}
+
+/* Scratch of the leave-one-plane-out scores: two sample arrays of the data's length. */
+typedef struct {
+    dhc_sample *samples[2];
+    uint8_t *flags[2];
+    dhcal_fit arm;
+    dhcal_fit plane;
+    dhc_model start;
+} loo_scratch;
+
+static void loo_free(loo_scratch *w)
+{
+    for (size_t k = 0U; w != NULL && k < 2U; ++k) {
+        free(w->samples[k]);
+        free(w->flags[k]);
+    }
+    free(w);
+}
+
+static loo_scratch *loo_alloc(size_t n)
+{
+    loo_scratch *w = calloc(1U, sizeof *w);
+    for (size_t k = 0U; w != NULL && k < 2U; ++k) {
+        w->samples[k] = malloc(n * sizeof *w->samples[k]);
+        w->flags[k] = malloc(n);
+        if (w->samples[k] == NULL || w->flags[k] == NULL) {
+            loo_free(w);
+            return NULL;
+        }
+    }
+    return w;
+}
+
+/* The leave-one-plane-out score of a prior (dhcal_contact_start): the RMS of every plane's
+ * touches about the plane fitted to them alone, with the arm fitted to the other rows. -1 when
+ * a fold cannot be fitted. */
+static double loo_score(const dhc_model *nominal, const dhc_param_set *base, const dhcal_samples *s,
+                        size_t planes, const dhcal_prior *prior, loo_scratch *w)
+{
+    double ss = 0.0;
+    size_t rows = 0U;
+    dhcal_error err;
+    for (size_t p = 0U; p < planes; ++p) {
+        dhcal_samples rest;
+        dhcal_samples held;
+        plane_subset(s, p, 0, &rest, w->samples[0], w->flags[0]);
+        plane_subset(s, p, 1, &held, w->samples[1], w->flags[1]);
+        dhc_param_set set = *base;
+        dhcal_prior pr = *prior;
+        if (dhcal_contact_start(nominal, NULL, &rest, &w->start, &set, &pr, &err) != DHCAL_IO_OK) {
+            return -1.0;
+        }
+        w->arm.prior = pr;
+        w->arm.have_prior_centre = 0;
+        if (dhcal_fit_from(&w->start, &set, NULL, &rest, NULL, &w->arm, &err) != DHCAL_IO_OK) {
+            return -1.0;
+        }
+        /* the plane left out, from its own touches with that arm held */
+        w->start = w->arm.model;
+        memset(&w->start.contact, 0, sizeof w->start.contact);
+        dhc_param_set targets;
+        dhc_params_clear(&targets);
+        if (dhc_contact_targets_init(&w->start, dhcal_samples_read, &held, held.n, held.flags) !=
+                DHC_OK ||
+            dhc_params_add_targets(&targets, &w->start) != DHC_OK) {
+            return -1.0;
+        }
+        memset(&w->plane.prior, 0, sizeof w->plane.prior);
+        w->plane.have_prior_centre = 0;
+        if (dhcal_fit_from(&w->start, &targets, NULL, &held, NULL, &w->plane, &err) !=
+            DHCAL_IO_OK) {
+            return -1.0;
+        }
+        ss += w->plane.rep.rms_mm * w->plane.rep.rms_mm * (double)w->plane.rep.rows;
+        rows += w->plane.rep.rows;
+    }
+    return rows > 0U ? sqrt(ss / (double)rows) : -1.0;
+}
+
+/* The prior's noise scale by leave-one-plane-out cross-validation (dhcal_contact_start);
+ * prior->scale_mm holds the drawing's scatter on entry. Leaves prior as it is when there are
+ * too few planes, memory runs out, or a fold fails. */
+static void choose_scale(const dhc_model *start, const dhc_param_set *set, dhcal_samples *s,
+                         dhcal_prior *prior)
+{
+    const size_t planes = start->contact.n_planes;
+    if (planes < DHCAL_PRIOR_CV_MIN_PLANES || s->n == 0U) {
+        return;
+    }
+    dhc_model nominal = *start;
+    memset(&nominal.contact, 0, sizeof nominal.contact);
+    dhc_param_set base;
+    dhc_params_clear(&base);
+    for (size_t k = 0U; k < set->count; ++k) {
+        if (set->id[k].kind < (uint8_t)DHC_P_PLANE_TILT) {
+            base.id[base.count++] = set->id[k];
+        }
+    }
+    loo_scratch *w = loo_alloc(s->n);
+    if (w == NULL) {
+        return;
+    }
+    double score[DHCAL_PRIOR_CV_STEPS];
+    double scale[DHCAL_PRIOR_CV_STEPS];
+    for (size_t k = 0U; k < DHCAL_PRIOR_CV_STEPS; ++k) {
+        dhcal_prior candidate = *prior;
+        scale[k] = prior->scale_mm * pow(10.0, -0.5 * (double)k);
+        candidate.scale_mm = scale[k];
+        score[k] = loo_score(&nominal, &base, s, planes, &candidate, w);
+        if (!(score[k] >= 0.0)) {
+            loo_free(w);
+            return;
+        }
+    }
+    loo_free(w);
+    /* the discrepancy principle: of the scales at least as large as the scatter the planes
+     * left out show (a fit that claims less noise than new touches have follows its rows'
+     * structure, not the arm's), the one that predicts them best */
+    size_t chosen = 0U;
+    for (size_t k = 1U; k < DHCAL_PRIOR_CV_STEPS; ++k) {
+        if (scale[k] >= score[k] && score[k] < score[chosen]) {
+            chosen = k;
+        }
+    }
+    if (scale[chosen] >= score[chosen]) {
+        prior->scale_mm = scale[chosen];
+        prior->cv_rms_mm = score[chosen];
+    }
+}
+
 /* A contact fit never goes without a prior: touches leave directions of the arm weakly seen,
  * and a fit that follows their noise there makes the arm worse. Without the caller's, the
  * drawing's default tolerances (DHCAL_CONTACT_TOLERANCE_*). */
@@ -60,7 +214,12 @@ static int contact_prior(const dhc_model *start, const dhc_param_set *set,
         prior->length_mm = DHCAL_CONTACT_TOLERANCE_MM;
         prior->angle_rad = DHCAL_CONTACT_TOLERANCE_DEG * DHC_PI / 180.0;
     }
-    return dhcal_prior_scale(start, set, noise, s, prior, err);
+    const int chosen = prior->scale_mm > 0.0 || (noise != NULL && dhcal_noise_on(noise));
+    const int rc = dhcal_prior_scale(start, set, noise, s, prior, err);
+    if (rc == DHCAL_IO_OK && !chosen) {
+        choose_scale(start, set, s, prior);
+    }
+    return rc;
 }
 
 double dhcal_prior_weight(double scale_mm, double sd, int whitened)

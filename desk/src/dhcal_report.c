@@ -76,6 +76,9 @@ static void json_contact(cJSON *obj, const dhcal_fit *f, const dhcal_samples *s)
         cJSON_AddNumberToObject(pr, "length_mm", f->prior.length_mm);
         cJSON_AddNumberToObject(pr, "angle_deg", f->prior.angle_rad * 180.0 / DHC_PI);
         cJSON_AddNumberToObject(pr, "scale_mm", f->prior.scale_mm);
+        if (f->prior.cv_rms_mm > 0.0) {
+            cJSON_AddNumberToObject(pr, "cv_rms_mm", f->prior.cv_rms_mm);
+        }
     }
     const dhc_contact_targets *t = &f->model.contact;
     if (t->n_planes == 0U && t->n_points == 0U) {

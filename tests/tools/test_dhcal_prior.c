@@ -77,7 +77,7 @@ static void test_predicted_accuracy_is_the_posterior_s(void)
     const double sds[3] = {0.0, 1.0, 0.05}; /* none, weak, strong */
     double last = HUGE_VAL;
     for (size_t c = 0U; c < 3U; ++c) {
-        const dhcal_prior prior = {sds[c], 0.0, sds[c] > 0.0 ? 0.3 : 0.0};
+        const dhcal_prior prior = {sds[c], 0.0, sds[c] > 0.0 ? 0.3 : 0.0, 0.0};
         fit_tool(&prior);
         double predicted = 0.0;
         TEST_ASSERT_EQUAL(DHCAL_IO_OK, dhcal_predicted_accuracy(&g_fit, &g_s, 50U, &predicted));
@@ -98,7 +98,7 @@ static void test_predicted_accuracy_is_the_posterior_s(void)
 static void test_a_refit_keeps_the_prior_on_the_drawing(void)
 {
     measure();
-    const dhcal_prior prior = {0.05, 0.0, 0.3};
+    const dhcal_prior prior = {0.05, 0.0, 0.3, 0.0};
     fit_tool(&prior);
     const dhcal_fit first = g_fit;
     TEST_ASSERT_TRUE(first.have_prior_centre);
@@ -148,7 +148,7 @@ static void flange_of(size_t i, double f[3], double r[3][3])
 static void test_the_folds_carry_the_prior(void)
 {
     measure();
-    const dhcal_prior prior = {0.05, 0.0, 0.3};
+    const dhcal_prior prior = {0.05, 0.0, 0.3, 0.0};
     fit_tool(&prior);
     const double w2 = (0.3 / 0.05) * (0.3 / 0.05);
     static double b[N_ROWS][3]; /* R^T (p - f) of each row */
@@ -223,7 +223,7 @@ static void test_the_prior_of_a_set_follows_the_kinds(void)
     TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &g_nominal));
     TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(&set, &g_nominal, DHC_EFFECT_TOOL_OFFSET, 0U));
     TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_effect(&set, &g_nominal, DHC_EFFECT_JOINT_SCALE, 1U));
-    const dhcal_prior prior = {0.5, 0.001, 0.2};
+    const dhcal_prior prior = {0.5, 0.001, 0.2, 0.0};
     double sd[DHC_MAX_PARAMS];
     TEST_ASSERT_TRUE(dhcal_prior_of_set(&prior, &set, sd));
     for (size_t k = 0U; k < set.count; ++k) {
@@ -235,7 +235,7 @@ static void test_the_prior_of_a_set_follows_the_kinds(void)
                                 : 0.0; /* an effect: no prior */
         TEST_ASSERT_EQUAL_DOUBLE(want, sd[k]);
     }
-    const dhcal_prior none = {0.5, 0.001, 0.0}; /* nothing to weigh it against: no prior */
+    const dhcal_prior none = {0.5, 0.001, 0.0, 0.0}; /* nothing to weigh it against: no prior */
     TEST_ASSERT_FALSE(dhcal_prior_of_set(&none, &set, sd));
 }
 

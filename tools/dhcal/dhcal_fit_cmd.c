@@ -25,8 +25,14 @@ static void text_contact(const dhcal_fit *f)
 {
     if (f->prior.scale_mm > 0.0) {
         printf("prior on the drawing: lengths +- %g mm, angles +- %g deg, against %.3g mm of "
-               "noise per row\n",
+               "noise per row",
                f->prior.length_mm, f->prior.angle_rad * 180.0 / DHC_PI, f->prior.scale_mm);
+        if (f->prior.cv_rms_mm > 0.0) {
+            printf(" (leave-one-plane-out: each plane left out fits the arm from the others to "
+                   "%.3g mm)",
+                   f->prior.cv_rms_mm);
+        }
+        printf("\n");
     }
     const dhc_contact_targets *t = &f->model.contact;
     for (size_t j = 0U; j < t->n_planes; ++j) {

@@ -43,6 +43,9 @@ typedef struct {
     double length_mm;
     double angle_rad;
     double scale_mm;
+    /* > 0: scale_mm was chosen by leave-one-plane-out cross-validation (dhcal_contact_start),
+     * and this is the held-out planes' RMS it gave */
+    double cv_rms_mm;
 } dhcal_prior;
 
 typedef struct {
@@ -100,9 +103,24 @@ int dhcal_samples_have_contact(const dhcal_samples *s);
 /* The start of a contact fit: the nominal model with its targets' starting poses from the
  * used samples (dhc_contact_targets_init), their parameters appended to set, and *prior
  * completed: the drawing's default tolerances when it has none, weighed against the noise
- * model's noise, else against the touches' scatter with the arm as drawn (the targets alone
- * fitted). DHCAL_IO_BAD_INPUT naming the data for targets the touches do not define or too
- * many parameters. */
+ * model's noise; else, with touches of DHCAL_PRIOR_CV_MIN_PLANES planes or more, against the
+ * noise scale that predicts a plane left out best (leave-one-plane-out cross-validation,
+ * prior->cv_rms_mm; see below); else against the touches' scatter with the arm as drawn (the
+ * targets alone fitted). DHCAL_IO_BAD_INPUT naming the data for targets the touches do not
+ * define or too many parameters.
+ * The cross-validation: for each candidate scale, the drawing's scatter times 1, 1/3, 1/10,
+ * ... (DHCAL_PRIOR_CV_STEPS), each plane in turn is left out, the arm fitted to the other
+ * rows with the prior at that scale, and the left-out plane's pose fitted to its own touches
+ * with that arm held: the RMS of those touches about their plane over every plane left out is
+ * the scale's score. A plane the fit never saw tests the arm's shape where the touches do not
+ * (a fold of interleaved rows does not: its rows' plane is fitted from its neighbours). The
+ * scale taken is, of those at least as large as their score (the discrepancy principle: a
+ * prior weighed against less noise than new touches show lets the fit follow its rows'
+ * structure rather than the arm's), the one with the best score; the drawing's scatter when
+ * none is. A plane's score sees only the arm's errors along its normal, never within it:
+ * that is what the discrepancy guards. */
+#define DHCAL_PRIOR_CV_MIN_PLANES 3U
+#define DHCAL_PRIOR_CV_STEPS 6U
 int dhcal_contact_start(const dhc_model *nominal, const dhc_noise_model *noise, dhcal_samples *s,
                         dhc_model *start, dhc_param_set *set, dhcal_prior *prior, dhcal_error *err);
 
