@@ -50,6 +50,38 @@ int dhcal_prior_scale(const dhc_model *start, const dhc_param_set *set,
     return rc;
 }
 
+/* The nominal model with its targets' starting poses from the used samples of s, their
+ * parameters appended to set (dhcal_contact_start without the prior). */
+static int targets_start(const dhc_model *nominal, const dhcal_samples *s, dhc_model *start,
+                         dhc_param_set *set, dhcal_error *err)
+{
+    *start = *nominal;
+    dhc_status st = dhc_contact_targets_init(start, dhcal_samples_read, s, s->n, s->flags);
+    if (st == DHC_ERR_NO_DATA) {
+        st = DHC_OK; /* lengths only: no target to fit */
+    }
+    if (st == DHC_ERR_UNDERDETERMINED) {
+        snprintf(err->msg, sizeof err->msg,
+                 "%s: the touches do not define their targets: plane and point ids run 1, 2, "
+                 "... without gaps, each plane needs 3 touches not on one line, each point one",
+                 s->path != NULL ? s->path : "data");
+        return DHCAL_IO_BAD_INPUT;
+    }
+    if (st != DHC_OK) {
+        snprintf(err->msg, sizeof err->msg, "%s: the touches' targets: %s",
+                 s->path != NULL ? s->path : "data", dhc_status_str(st));
+        return DHCAL_IO_BAD_INPUT;
+    }
+    if (dhc_params_add_targets(set, start) != DHC_OK) {
+        snprintf(err->msg, sizeof err->msg,
+                 "too many parameters: the model's and the targets' (3 per plane and point) "
+                 "exceed %u",
+                 (unsigned)DHC_MAX_PARAMS);
+        return DHCAL_IO_BAD_INPUT;
+    }
+    return DHCAL_IO_OK;
+}
+
 /* The samples of s without plane p's touches (keep 0), or only those (keep 1), planes
  * renumbered without a gap, into out (its arrays: buf and flags, s->n each). */
 static void plane_subset(const dhcal_samples *s, size_t p, int keep, dhcal_samples *out,
@@ -121,11 +153,10 @@ static double loo_score(const dhc_model *nominal, const dhc_param_set *base, con
         plane_subset(s, p, 0, &rest, w->samples[0], w->flags[0]);
         plane_subset(s, p, 1, &held, w->samples[1], w->flags[1]);
         dhc_param_set set = *base;
-        dhcal_prior pr = *prior;
-        if (dhcal_contact_start(nominal, NULL, &rest, &w->start, &set, &pr, &err) != DHCAL_IO_OK) {
+        if (targets_start(nominal, &rest, &w->start, &set, &err) != DHCAL_IO_OK) {
             return -1.0;
         }
-        w->arm.prior = pr;
+        w->arm.prior = *prior;
         w->arm.have_prior_centre = 0;
         if (dhcal_fit_from(&w->start, &set, NULL, &rest, NULL, &w->arm, &err) != DHCAL_IO_OK) {
             return -1.0;
@@ -240,31 +271,8 @@ int dhcal_samples_have_contact(const dhcal_samples *s)
 int dhcal_contact_start(const dhc_model *nominal, const dhc_noise_model *noise, dhcal_samples *s,
                         dhc_model *start, dhc_param_set *set, dhcal_prior *prior, dhcal_error *err)
 {
-    *start = *nominal;
-    dhc_status st = dhc_contact_targets_init(start, dhcal_samples_read, s, s->n, s->flags);
-    if (st == DHC_ERR_NO_DATA) {
-        st = DHC_OK; /* lengths only: no target to fit */
-    }
-    if (st == DHC_ERR_UNDERDETERMINED) {
-        snprintf(err->msg, sizeof err->msg,
-                 "%s: the touches do not define their targets: plane and point ids run 1, 2, "
-                 "... without gaps, each plane needs 3 touches not on one line, each point one",
-                 s->path != NULL ? s->path : "data");
-        return DHCAL_IO_BAD_INPUT;
-    }
-    if (st != DHC_OK) {
-        snprintf(err->msg, sizeof err->msg, "%s: the touches' targets: %s",
-                 s->path != NULL ? s->path : "data", dhc_status_str(st));
-        return DHCAL_IO_BAD_INPUT;
-    }
-    if (dhc_params_add_targets(set, start) != DHC_OK) {
-        snprintf(err->msg, sizeof err->msg,
-                 "too many parameters: the model's and the targets' (3 per plane and point) "
-                 "exceed %u",
-                 (unsigned)DHC_MAX_PARAMS);
-        return DHCAL_IO_BAD_INPUT;
-    }
-    return contact_prior(start, set, noise, s, prior, err);
+    const int rc = targets_start(nominal, s, start, set, err);
+    return rc == DHCAL_IO_OK ? contact_prior(start, set, noise, s, prior, err) : rc;
 }
 
 /* Deterministic pseudo-random numbers in [0, 1) for the poses the accuracy is predicted at. */

@@ -497,7 +497,6 @@ static int run_probe_watch(const options *o)
         const int r = fw_linux_probe_wait(&probe, (int)o->gpio_timeout_ms, &now);
         if (r < 0) {
             (void)snprintf(detail, sizeof detail, "reading the line failed: %s", strerror(errno));
-            closed = -1;
             break;
         }
         if (r == 0) {
