@@ -699,7 +699,11 @@ dhc_status dhc_calib_fit(dhc_model *model, const dhc_param_set *set, dhc_sample_
     /* memset, not a compound literal: the report is ~5 KiB and M4 stacks are small. */
     memset(rep, 0, sizeof *rep);
     rep->n_params = set->count;
+#if DHC_WITH_CONTACT
+    const fit_context fc = {set, read, ctx, n, flags, opt, ws, whiten, model, 0};
+#else
     const fit_context fc = {set, read, ctx, n, flags, opt, ws, whiten, model};
+#endif
     ws->current = *model;
     memset(ws->freed_early, 0, sizeof ws->freed_early);
 

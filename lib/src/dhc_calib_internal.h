@@ -65,7 +65,14 @@ typedef struct {
     dhc_calib_workspace *ws;
     int whiten;             /* the noise model is on */
     const dhc_model *input; /* the caller's model: where held parameters stay */
+#if DHC_WITH_CONTACT
+    /* which used samples the outlier screen's scans see: 0 every one, SCREEN_LENGTHS the
+     * lengths only, SCREEN_NOT_LENGTHS the others (each kind judged by its own scatter) */
+    int screen;
+#endif
 } fit_context;
+#define SCREEN_LENGTHS 1
+#define SCREEN_NOT_LENGTHS 2
 
 typedef struct {
     double temp_min_c;

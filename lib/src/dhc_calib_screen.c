@@ -46,10 +46,26 @@ static dhc_status sample_error2(const fit_context *fc, const dhc_model *model,
 
 /* The walk every error scan makes: 1 with the next used sample from *i on and its squared
  * error; 0 at the end, or on an error (*st). */
+#if DHC_WITH_CONTACT
+/* Sample i is outside the scans' kind (fit_context.screen). */
+static int screened_out(const fit_context *fc, size_t i)
+{
+    if (fc->screen == 0 || fc->read(fc->ctx, i, &fc->ws->sample) != DHC_OK) {
+        return 0;
+    }
+    const int length = fc->ws->sample.kind == (uint8_t)DHC_MEAS_DISTANCE;
+    return fc->screen == SCREEN_LENGTHS ? !length : length;
+}
+#endif
+
 static int next_used_error2(const fit_context *fc, const dhc_model *model, const pass_totals *at,
                             size_t *i, double *e2, size_t *rows, dhc_status *st)
 {
-    while (*i < fc->n && fc->flags[*i] != (uint8_t)DHC_SAMPLE_USED) {
+    while (*i < fc->n && (fc->flags[*i] != (uint8_t)DHC_SAMPLE_USED
+#if DHC_WITH_CONTACT
+                          || screened_out(fc, *i)
+#endif
+                              )) {
         ++*i;
     }
     if (*i == fc->n) {
@@ -181,7 +197,12 @@ DHC_ROBUST_SHARED
 dhc_status dhc_fit_scan_all(const fit_context *fc, const dhc_model *model, const pass_totals *tot,
                             error_scan *out)
 {
-    if (tot == NULL || !tot->own_weights) {
+#if DHC_WITH_CONTACT
+    const int filtered = fc->screen != 0; /* the totals count every kind */
+#else
+    const int filtered = 0;
+#endif
+    if (tot == NULL || !tot->own_weights || filtered) {
         return dhc_fit_scan_errors(fc, model, NULL, HUGE_VAL, (uint8_t)DHC_SAMPLE_USED, out);
     }
     out->used = tot->samples;
@@ -216,6 +237,43 @@ dhc_status dhc_fit_robust_sigma(const fit_context *fc, const dhc_model *model,
     return st;
 }
 
+#if DHC_WITH_CONTACT
+/* With lengths among touches: each kind judged by its own robust scatter (a length by the
+ * lengths', a touch by the touches'), since a length sees the scale the touches cannot and
+ * its residual then holds what the prior kept; lengths fewer than 3 are not judged (no
+ * scatter of their own to judge them by). 1 when it screened, 0 when the data are of one
+ * kind by the pass totals tot (NULL: not known), which the caller screens together. */
+static int flag_per_kind(const fit_context *fc, const dhc_model *model, const pass_totals *tot,
+                         size_t *flagged, dhc_status *st)
+{
+    const size_t lengths = tot != NULL ? tot->traits.kind_count[DHC_MEAS_DISTANCE] : 0U;
+    if (lengths == 0U || lengths == tot->samples) {
+        return 0; /* one kind (the scans would read every sample twice more for nothing) */
+    }
+    fit_context by_kind = *fc;
+    double sigma[2] = {0.0, 0.0};
+    size_t used[2] = {0U, 0U};
+    for (int k = 0; k < 2 && *st == DHC_OK; ++k) {
+        by_kind.screen = k == 0 ? SCREEN_LENGTHS : SCREEN_NOT_LENGTHS;
+        *st = dhc_fit_robust_sigma(&by_kind, model, NULL, &sigma[k], &used[k]);
+    }
+    if (*st != DHC_OK || used[0] == 0U || used[1] == 0U) {
+        return 0;
+    }
+    for (int k = 0; k < 2 && *st == DHC_OK; ++k) {
+        if (used[k] < 3U) {
+            continue;
+        }
+        by_kind.screen = k == 0 ? SCREEN_LENGTHS : SCREEN_NOT_LENGTHS;
+        error_scan kept;
+        *st = dhc_fit_scan_errors(&by_kind, model, NULL, sq(fc->opt->outlier_threshold * sigma[k]),
+                                  (uint8_t)DHC_SAMPLE_OUTLIER, &kept);
+        *flagged += kept.used - kept.at_most;
+    }
+    return 1;
+}
+#endif
+
 /* Flags samples whose error is many robust sigmas; returns how many were newly flagged.
  * tot as robust_sigma's. */
 dhc_status dhc_fit_flag_outliers(const fit_context *fc, const dhc_model *model,
@@ -225,6 +283,12 @@ dhc_status dhc_fit_flag_outliers(const fit_context *fc, const dhc_model *model,
     if (fc->opt->outlier_threshold <= 0.0) {
         return DHC_OK;
     }
+#if DHC_WITH_CONTACT
+    dhc_status by_kind = DHC_OK;
+    if (flag_per_kind(fc, model, tot, flagged, &by_kind) || by_kind != DHC_OK) {
+        return by_kind;
+    }
+#endif
     double sigma;
     size_t used;
     dhc_status st = dhc_fit_robust_sigma(fc, model, tot, &sigma, &used);

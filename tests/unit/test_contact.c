@@ -527,6 +527,35 @@ static void test_planes_alone_leave_the_scale_to_the_prior(void)
                              "the prior's arm is nearer the drawing than the held one's");
 }
 
+/* Lengths among touches are judged by the lengths' own scatter: a gauge typed 3 mm off is left
+ * out, and it alone (python/tests/test_contact.py: exact lengths a prior keeps off are not). */
+static void test_lengths_are_judged_by_their_own_scatter(void)
+{
+    static dhc_model truth;
+    static dhc_model model;
+    static dhc_model start;
+    six_joint_arms(&truth, &start);
+    test_rng g = {0xBEEFULL};
+    touch_three_planes(&truth, 0.01, &g);
+    const size_t touches = data.n;
+    measure_lengths(&truth, 12U, &g);
+    data.s[touches + 5U].distance_mm += 3.0; /* a typo */
+    TEST_ASSERT_EQUAL(
+        DHC_OK, dhc_contact_targets_init(&start, test_read_sample, &data, data.n, data.flags));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &start));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_targets(&set, &start));
+    dhc_calib_options opt;
+    dhc_calib_default_options(&opt);
+    model = start;
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_calib_fit(&model, &set, test_read_sample, &data, data.n,
+                                            data.flags, &opt, &ws, &rep));
+    for (size_t i = 0U; i < data.n; ++i) {
+        TEST_ASSERT_EQUAL_MESSAGE(i == touches + 5U, dhc_sample_is_outlier(data.flags[i]),
+                                  "the typed-off gauge, and only it, is left out");
+        data.flags[i] = (uint8_t)DHC_SAMPLE_USED;
+    }
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -536,5 +565,6 @@ int main(void)
     RUN_TEST(test_noisy_touches_end_at_their_noise);
     RUN_TEST(test_a_gauge_length_sees_the_scale_planes_cannot);
     RUN_TEST(test_planes_alone_leave_the_scale_to_the_prior);
+    RUN_TEST(test_lengths_are_judged_by_their_own_scatter);
     return UNITY_END();
 }
