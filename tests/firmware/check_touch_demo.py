@@ -11,8 +11,11 @@ Passes when:
     gauge's pairs became samples (one per plane touch, one per pair);
   - the blind directions are named: the arm's turn about its base axis and its height
     (theta1, d1), and nothing else (the gauges give the scale);
-  - a scenario without a probe is refused with exit 2, naming the file.
-Usage: check_touch_demo.py --demo PATH --scenario S.json [--max-seconds S]
+  - a scenario without a probe is refused with exit 2, naming the file;
+  - with --dhcal: the desk's `dhcal fit` on the touches the controller wrote (--out,
+    touch-samples.csv) fits them about as well as the controller did (within 2x and 2 um),
+    blind in theta1 and d1 only, its prior weighed against the noise leaving planes out finds.
+Usage: check_touch_demo.py --demo PATH --scenario S.json [--dhcal PATH] [--max-seconds S]
 """
 import argparse
 import json
@@ -28,6 +31,7 @@ def main():
     ap.add_argument("--demo", required=True)
     ap.add_argument("--scenario", required=True)
     ap.add_argument("--max-seconds", type=float, default=120.0)
+    ap.add_argument("--dhcal", default=None)
     args = ap.parse_args()
     failed = 0
 
@@ -36,8 +40,9 @@ def main():
         print(("PASS: " if ok else "FAIL: ") + what)
         failed += 0 if ok else 1
 
+    scratch = tempfile.TemporaryDirectory(prefix="dhcal-touch-demo-")
     t0 = time.time()
-    run = subprocess.run([args.demo, "--scenario", args.scenario, "--json"],
+    run = subprocess.run([args.demo, "--scenario", args.scenario, "--json", "--out", scratch.name],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, check=False)
     seconds = time.time() - t0
     sys.stdout.write(run.stderr)
@@ -55,6 +60,26 @@ def main():
     check(sorted(r["blind"]) == ["d1", "theta1"],
           f"blind: the arm's turn about its base axis and its height only: {r['blind']}")
     check(seconds <= args.max_seconds, f"runs within {args.max_seconds:.0f} s ({seconds:.1f} s)")
+
+    if args.dhcal is not None:
+        with open(args.scenario) as f:
+            model = os.path.join(os.path.dirname(os.path.abspath(args.scenario)),
+                                 json.load(f)["model"])
+        desk = subprocess.run([args.dhcal, "fit", "--model", model, "--data",
+                               os.path.join(scratch.name, "touch-samples.csv"), "--json"],
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                              check=False)
+        if desk.returncode != 0:
+            check(False, f"dhcal fit on the controller's touches: exit {desk.returncode}: "
+                         f"{desk.stderr.strip()[:200]}")
+        else:
+            d = json.loads(desk.stdout)
+            blind = sorted(u["param"] for u in d["unidentifiable"] if u["blind"])
+            check(d["rms_mm"] <= 2.0 * r["fit_rms_mm"] + 0.002 and blind == ["d1", "theta1"] and
+                  d["prior"].get("cv_rms_mm", 0.0) > 0.0,
+                  f"the desk fits the controller's touches to {d['rms_mm']:.4f} mm (the "
+                  f"controller {r['fit_rms_mm']:.4f}), blind {blind}, prior {d['prior']}")
+    scratch.cleanup()
 
     with tempfile.TemporaryDirectory(prefix="dhcal-touch-") as tmp:
         plain = os.path.join(tmp, "no-probe.json")
