@@ -323,6 +323,10 @@ static int parse_args(int argc, char **argv, options *o)
     if (o->probe_watch > 0U && (o->gpio_chip == NULL || !o->have_probe_line)) {
         return usage("%s", "--probe-watch needs --gpio-chip and --probe-line");
     }
+    if (o->have_probe_line && o->probe_watch == 0U) {
+        return usage("%s", "--probe-line goes with --probe-watch (the calibration run takes no "
+                           "touches yet)");
+    }
     if (o->probe_active != NULL && strcmp(o->probe_active, "high") != 0 &&
         strcmp(o->probe_active, "low") != 0) {
         return usage("--probe-active: '%s' is neither high nor low", o->probe_active);
@@ -488,10 +492,13 @@ static int run_probe_watch(const options *o)
     }
     int closed = fw_linux_probe_closed(&probe);
     const int at_start = closed;
+    char detail[96] = "ok";
+    if (closed < 0) {
+        (void)snprintf(detail, sizeof detail, "reading the line failed: %s", strerror(errno));
+    }
     fprintf(stderr, "dhcal-fw: watching the probe on %s line %llu\n", o->gpio_chip, o->probe_line);
     unsigned long long closings = 0U;
     unsigned long long changes = 0U;
-    char detail[96] = "ok";
     while (closed >= 0 && closings < o->probe_watch) {
         int now = 0;
         const int r = fw_linux_probe_wait(&probe, (int)o->gpio_timeout_ms, &now);

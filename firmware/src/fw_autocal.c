@@ -89,13 +89,15 @@ static dhc_status start_targets(dhc_model *model, dhc_param_set *set, const samp
 }
 
 /* The stored model against touches: its arm held, its targets fitted to these samples (a
- * stored calibration keeps no targets: they belong to the cell, not to the arm). */
+ * stored calibration keeps no targets: they belong to the cell, not to the arm); *fitted
+ * counts the targets' parameters, which the comparison charges the stored model with. */
 static dhc_status fit_stored_targets(fw_autocal_workspace *ws, const sample_buf *buf,
-                                     const dhc_calib_options *opt)
+                                     const dhc_calib_options *opt, size_t *fitted)
 {
     dhc_param_set targets;
     dhc_params_clear(&targets);
     dhc_status st = start_targets(&ws->stored, &targets, buf);
+    *fitted = targets.count;
     if (st != DHC_OK || targets.count == 0U) {
         return st;
     }
@@ -299,8 +301,10 @@ fw_fault fw_autocal_configured(const fw_autocal_config *cfg, dhc_model *model,
     }
     uint32_t seq = 0U;
     const fw_cal_status ls = fw_cal_load(nv, &ws->stored, &seq);
+    size_t stored_fitted = 0U; /* parameters fitted to judge the stored model: its targets' */
 #if DHC_WITH_CONTACT
-    if (ls == FW_CAL_OK && contact && fit_stored_targets(ws, &buf, &opt) != DHC_OK) {
+    if (ls == FW_CAL_OK && contact &&
+        fit_stored_targets(ws, &buf, &opt, &stored_fitted) != DHC_OK) {
         return FW_FAULT_NONE; /* the stored arm cannot be judged on these touches: keep it */
     }
 #endif
@@ -313,10 +317,16 @@ fw_fault fw_autocal_configured(const fw_autocal_config *cfg, dhc_model *model,
         /* significantly better (see fw_autocal.h): log(stored / FPE) above z standard
          * deviations of that log-ratio, sd(log s) ~ 1 / sqrt(2 dof) per RMS estimate */
         const double dof_new = m_rows - p_fit;
-        const double dof_old = (double)rows_old;
+        const double m_old = (double)rows_old;
+        const double p_old = (double)stored_fitted;
+        const double dof_old = m_old - p_old;
+        /* the stored model's own final prediction error where its targets were fitted to
+         * these rows, as the new one's */
+        const double stored_fpe =
+            dof_old > 0.0 ? res->stored_rms_mm * sqrt((m_old + p_old) / dof_old) : -1.0;
         const int better = dof_new > 0.0 && dof_old > 0.0 && res->new_fpe_mm > 0.0 &&
-                           res->stored_rms_mm > 0.0 &&
-                           log(res->stored_rms_mm / res->new_fpe_mm) >
+                           stored_fpe > 0.0 &&
+                           log(stored_fpe / res->new_fpe_mm) >
                                FW_AUTOCAL_Z * sqrt(0.5 / dof_new + 0.5 / dof_old) &&
                            res->new_median_mm <= res->stored_median_mm;
         if (!better) {

@@ -200,8 +200,12 @@ fw_fault fw_job_touch(fw_job *job, const fw_touch_config *touch)
     if (job->ctrl.fault != FW_FAULT_NONE) {
         return job->ctrl.fault;
     }
-    if (touch == NULL) {
-        return FW_FAULT_ARGUMENT;
+    if (touch == NULL || touch->n_planes > FW_TOUCH_MAX_PLANES ||
+        touch->n_gauges > FW_TOUCH_MAX_GAUGES || touch->per_plane > FW_ACQ_MAX_SAMPLES ||
+        touch->per_gauge > FW_ACQ_MAX_SAMPLES ||
+        touch->n_planes * touch->per_plane + touch->n_gauges * touch->per_gauge >
+            FW_ACQ_MAX_SAMPLES) {
+        return FW_FAULT_ARGUMENT; /* more samples than the job keeps: refused before moving */
     }
     job->n_touches = fw_touch_plan(&job->nominal, touch, job->touches, FW_TOUCH_MAX);
     if (job->n_touches == 0U) {

@@ -16,6 +16,7 @@ void fw_touch_default_config(fw_touch_config *cfg)
     cfg->per_gauge = 6U;
     cfg->standoff_mm = 5.0;
     cfg->overtravel_mm = 5.0;
+    cfg->clearance_mm = 40.0;
     cfg->speed_mm_s = 2.0;
     cfg->seed = 2828U;
 }
@@ -75,15 +76,18 @@ static int plan_one(const dhc_model *model, const fw_touch_config *cfg, const do
 {
     double from[3];
     double to[3];
+    double clear[3];
     along(at, -cfg->standoff_mm, d, from);
     along(at, cfg->overtravel_mm, d, to);
+    along(at, -cfg->standoff_mm - cfg->clearance_mm, d, clear);
     memset(t, 0, sizeof *t);
     t->travel_mm = cfg->standoff_mm + cfg->overtravel_mm;
     for (unsigned k = 0U; k < 4U; ++k) {
         const unsigned b = (branch + k) % 4U;
         if (reach(model, from, b, 0, t->from_rad)) {
             memcpy(t->to_rad, t->from_rad, sizeof t->to_rad);
-            if (reach(model, to, b, 1, t->to_rad)) {
+            memcpy(t->clear_rad, t->from_rad, sizeof t->clear_rad);
+            if (reach(model, to, b, 1, t->to_rad) && reach(model, clear, b, 1, t->clear_rad)) {
                 return 1;
             }
         }
@@ -94,10 +98,13 @@ static int plan_one(const dhc_model *model, const fw_touch_config *cfg, const do
 size_t fw_touch_plan(const dhc_model *model, const fw_touch_config *cfg, fw_touch *touches,
                      size_t cap)
 {
+    if (cfg->n_planes > FW_TOUCH_MAX_PLANES || cfg->n_gauges > FW_TOUCH_MAX_GAUGES ||
+        cfg->per_plane > cap || cfg->per_gauge > cap) {
+        return 0U; /* (and no product below wraps) */
+    }
     const size_t want = cfg->n_planes * cfg->per_plane + 2U * cfg->n_gauges * cfg->per_gauge;
-    if (want == 0U || want > cap || cfg->n_planes > FW_TOUCH_MAX_PLANES ||
-        cfg->n_gauges > FW_TOUCH_MAX_GAUGES || !(cfg->speed_mm_s > 0.0) ||
-        !(cfg->standoff_mm > 0.0) || !(cfg->overtravel_mm > 0.0)) {
+    if (want == 0U || want > cap || !(cfg->speed_mm_s > 0.0) || !(cfg->standoff_mm > 0.0) ||
+        !(cfg->overtravel_mm > 0.0) || !(cfg->clearance_mm >= 0.0)) {
         return 0U;
     }
     size_t n = 0U;
@@ -162,6 +169,18 @@ static fw_fault probe_closed(fw_ctrl *c, int *closed)
     return FW_FAULT_NONE;
 }
 
+/* A move straight to q in joint space, without the controller's approach from one side
+ * (fw_ctrl_move_to's pre-pose, approach_rad back on every joint, could put the stylus a few
+ * millimetres into the surface the approach pose stands off). */
+static fw_fault move_direct(fw_ctrl *c, const double q[DHC_MAX_JOINTS])
+{
+    const double approach = c->cfg.approach_rad;
+    c->cfg.approach_rad = 0.0;
+    const fw_fault f = fw_ctrl_move_to(c, q, NULL);
+    c->cfg.approach_rad = approach;
+    return f;
+}
+
 fw_fault fw_touch_off(fw_ctrl *c, const fw_touch *t, double speed_mm_s,
                       double q_rad[DHC_MAX_JOINTS], int8_t dir[DHC_MAX_JOINTS])
 {
@@ -171,7 +190,10 @@ fw_fault fw_touch_off(fw_ctrl *c, const fw_touch *t, double speed_mm_s,
     if (c->port->read_probe == NULL || !(speed_mm_s > 0.0) || !(t->travel_mm > 0.0)) {
         return FW_FAULT_ARGUMENT;
     }
-    if (fw_ctrl_move_to(c, t->from_rad, NULL) != FW_FAULT_NONE) {
+    /* from the clearance pose, straight down the surface's normal: a joint-space move between
+     * two poses near a surface can dip into it on the way */
+    if (move_direct(c, t->clear_rad) != FW_FAULT_NONE ||
+        move_direct(c, t->from_rad) != FW_FAULT_NONE) {
         return c->fault;
     }
     int closed = 0;
@@ -210,7 +232,11 @@ fw_fault fw_touch_off(fw_ctrl *c, const fw_touch *t, double speed_mm_s,
     }
     memcpy(q_rad, c->q_rad, DHC_MAX_JOINTS * sizeof q_rad[0]); /* the tick that saw it */
     memcpy(c->dir, dir, sizeof c->dir);
-    return fw_ctrl_move_to(c, t->from_rad, NULL); /* back off: the stylus is deflected */
+    /* back off the way it came: straight back along the creep's line, then out to clearance */
+    if (move_direct(c, t->from_rad) != FW_FAULT_NONE) {
+        return c->fault;
+    }
+    return move_direct(c, t->clear_rad);
 }
 
 fw_fault fw_touch_acquire(fw_ctrl *c, const dhc_model *model, const fw_touch_config *cfg,
@@ -231,17 +257,18 @@ fw_fault fw_touch_acquire(fw_ctrl *c, const dhc_model *model, const fw_touch_con
         s.temp_c = model->thermal_ref_c;
         s.kind = t->kind;
         s.target = t->target;
-        if (fw_touch_off(c, t, cfg->speed_mm_s, s.q_rad, s.dir) != FW_FAULT_NONE) {
-            return c->fault;
+        const fw_fault f = fw_touch_off(c, t, cfg->speed_mm_s, s.q_rad, s.dir);
+        if (f != FW_FAULT_NONE) {
+            return f; /* the controller's, or a refused touch-off's (no probe, a bad speed) */
         }
         if (t->kind == (uint8_t)DHC_MEAS_DISTANCE) {
             int8_t dir2[DHC_MAX_JOINTS];
             if (i + 1U >= n || !touches[i + 1U].second_end || touches[i + 1U].target != t->target) {
                 return FW_FAULT_ARGUMENT;
             }
-            if (fw_touch_off(c, &touches[i + 1U], cfg->speed_mm_s, s.q2_rad, dir2) !=
-                FW_FAULT_NONE) {
-                return c->fault;
+            const fw_fault f2 = fw_touch_off(c, &touches[i + 1U], cfg->speed_mm_s, s.q2_rad, dir2);
+            if (f2 != FW_FAULT_NONE) {
+                return f2;
             }
             s.distance_mm = cfg->gauge[t->target].ends_mm;
             ++i;

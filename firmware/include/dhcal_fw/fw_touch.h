@@ -9,16 +9,20 @@
  * and a gauge's length is measured between two touches along its axis, where a sideways
  * offset e changes the distance by e^2 / (2 L) only.
  *
- * A touch-off (fw_touch_off): move to the approach pose (the tool standoff_mm off the surface
- * as drawn, on its outside), check the switch is open, then creep in a straight joint-space
+ * A touch-off (fw_touch_off): move to the clearance pose (clearance_mm further out along the
+ * normal: moves between touches run there, as a CNC probe retracts to a clearance plane), then
+ * straight to the approach pose (the tool standoff_mm off the surface as drawn, on its
+ * outside; no approach from one side, whose pre-pose could dip into the surface), check the
+ * switch is open, then creep in a straight joint-space
  * line toward the pose overtravel_mm past the surface at speed_mm_s until the switch closes;
  * keep the encoder angles of the tick that saw it (the sample: a plane touch, or one end of a
- * gauge's pair), and go back to the approach pose. The arm then stands speed x (the probe's
- * delay + up to one tick) further along the approach than where it touched: along the
- * surface's normal, a constant a plane's offset takes, and equal at a gauge's two ends; keep
- * the speed low (the default 2 mm/s: 2 um per millisecond). No contact within the overtravel,
- * or a switch already closed at the approach pose: FW_FAULT_PROBE (the cell is not where the
- * configuration says, or the probe is not connected).
+ * gauge's pair), and go straight back to the approach pose along the creep's line and out to
+ * the clearance pose. The arm then
+ * stands speed x (the probe's delay + up to one tick) further along the approach than where it
+ * touched: along the surface's normal, a constant a plane's offset takes, and equal at a gauge's
+ * two ends; keep the speed low (the default 2 mm/s: 2 um per millisecond). No contact within the
+ * overtravel, or a switch already closed at the approach pose: FW_FAULT_PROBE (the cell is not
+ * where the configuration says, or the probe is not connected).
  *
  * Built only with the library's contact rows (DHC_WITH_CONTACT): a controller that calibrates
  * by touching builds lib with them (what that costs in flash: scripts/target-report
@@ -66,12 +70,14 @@ typedef struct {
     size_t per_gauge;     /* pairs of end touches of each gauge */
     double standoff_mm;   /* the approach starts this far outside the surface as drawn */
     double overtravel_mm; /* and gives up this far inside it */
+    double clearance_mm;  /* moves between touches run this much further out still */
     double speed_mm_s;    /* approach speed */
     uint32_t seed;        /* where on the regions the touches fall, which arm branch */
 } fw_touch_config;
 
 /* One touch-off: the approach pose and the pose past the surface the creep aims at. */
 typedef struct {
+    double clear_rad[DHC_MAX_JOINTS]; /* clearance_mm further out than from_rad */
     double from_rad[DHC_MAX_JOINTS];
     double to_rad[DHC_MAX_JOINTS];
     double travel_mm;   /* from -> to, as drawn */
@@ -81,7 +87,7 @@ typedef struct {
 } fw_touch;
 
 /* Defaults: no planes or gauges, 20 touches a plane, 6 pairs a gauge, 5 mm standoff and
- * overtravel, 2 mm/s, seed 2828. */
+ * overtravel, 40 mm clearance, 2 mm/s, seed 2828. */
 void fw_touch_default_config(fw_touch_config *cfg);
 
 /* The touch-offs of the configuration on the model (inverse kinematics of the approach and
@@ -100,7 +106,9 @@ fw_fault fw_touch_off(fw_ctrl *c, const fw_touch *t, double speed_mm_s,
                       double q_rad[DHC_MAX_JOINTS], int8_t dir[DHC_MAX_JOINTS]);
 
 /* Every touch-off of the plan, as samples: a plane touch one DHC_MEAS_PLANE sample, a gauge's
- * two ends one DHC_MEAS_DISTANCE sample (end B's angles in q2_rad, the gauge's ends_mm).
+ * two ends one DHC_MEAS_DISTANCE sample (end B's angles in q2_rad, the gauge's ends_mm; the
+ * sample keeps end A's approach directions only: a backlash effect sees end B wrongly, so a
+ * machine with backlash calibrates its lengths' ends from the same side).
  * *n_done counts the samples kept (the ones before a fault). */
 fw_fault fw_touch_acquire(fw_ctrl *c, const dhc_model *model, const fw_touch_config *cfg,
                           const fw_touch *touches, size_t n, dhc_sample *samples, size_t cap,

@@ -1,7 +1,8 @@
 /* test_touch.c - the controller's touch-offs (fw_touch.h) against host_sim's probe: the
  * encoder angles kept at the switch put the TRUE arm's ball on the surface (the truth's own
  * kinematics, within the trigger's depth and the distance the creep covers in the probe's
- * delay and one tick), a surface that is not where the drawing says faults FW_FAULT_PROBE with
+ * delay and one tick), each touch-off meets the surface once (the moves to and from it stay
+ * clear), a surface that is not where the drawing says faults FW_FAULT_PROBE with
  * the drives at zero, as does a switch closed before the approach, and a port without a probe
  * is refused. Host only (links host_sim). */
 #include <math.h>
@@ -88,7 +89,10 @@ static void test_the_kept_angles_put_the_true_ball_on_the_surface(void)
     for (size_t i = 0U; i < 4U; ++i) {
         double q[DHC_MAX_JOINTS] = {0.0};
         int8_t dir[DHC_MAX_JOINTS] = {0};
+        const uint64_t contacts = sim.plant.probe.touches;
         TEST_ASSERT_EQUAL(FW_FAULT_NONE, fw_touch_off(&ctrl, &touches[i], tc.speed_mm_s, q, dir));
+        /* one contact per touch-off: neither the approach nor the back-off dips into the table */
+        TEST_ASSERT_EQUAL_UINT64(contacts + 1U, sim.plant.probe.touches);
         double p[3];
         TEST_ASSERT_EQUAL(DHC_OK, dhc_model_tool_point(&truth, q, NULL, p));
         /* the ball's centre is TIP above the top at contact; the switch is seen up to the

@@ -193,7 +193,12 @@ static int touches(const char *in, const char *path)
     }
     static double rows[2U * TWIN_ROWS_MAX][DHC_MAX_JOINTS + 3U];
     size_t n = 0U;
-    while (fgets(line, sizeof line, f) != NULL && n < 2U * TWIN_ROWS_MAX) {
+    while (fgets(line, sizeof line, f) != NULL) {
+        if (n == 2U * TWIN_ROWS_MAX) {
+            fprintf(stderr, "twin_prepare: %s: more than %u rows\n", in, 2U * TWIN_ROWS_MAX);
+            (void)fclose(f);
+            return 1;
+        }
         int bad = split(line, field, DHC_MAX_JOINTS + 3U) != cols;
         for (size_t c = 0U; c < cols && !bad; ++c) {
             bad = number(field[c], &rows[n][c]) != 0;
