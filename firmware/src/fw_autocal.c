@@ -126,6 +126,28 @@ static double median(double *v, size_t n)
     return (n % 2U) != 0U ? v[n / 2U] : 0.5 * (v[n / 2U - 1U] + v[n / 2U]);
 }
 
+/* The new calibration is significantly better than the stored one in ws->stored (see
+ * fw_autocal.h): log(stored FPE / new FPE) above z standard deviations of that log-ratio,
+ * sd(log s) ~ 1 / sqrt(2 dof) per RMS estimate, and the new median no worse. The stored
+ * model's FPE charges it the parameters fitted to judge it here (stored_fitted: its targets,
+ * refitted to touches), as the new one's charges its own. Fills res's stored_* fields. */
+static int clearly_better(fw_autocal_workspace *ws, const dhc_sample *samples, size_t n,
+                          size_t stored_fitted, double dof_new, fw_autocal_result *res)
+{
+    size_t used_old = 0U;
+    size_t rows_old = 0U;
+    res->stored_rms_mm = sample_errors(&ws->stored, samples, n, ws->err_old, &used_old, &rows_old);
+    res->stored_median_mm = median(ws->err_old, used_old);
+    const double m_old = (double)rows_old;
+    const double p_old = (double)stored_fitted;
+    const double dof_old = m_old - p_old;
+    const double stored_fpe =
+        dof_old > 0.0 ? res->stored_rms_mm * sqrt((m_old + p_old) / dof_old) : -1.0;
+    return dof_new > 0.0 && dof_old > 0.0 && res->new_fpe_mm > 0.0 && stored_fpe > 0.0 &&
+           log(stored_fpe / res->new_fpe_mm) > FW_AUTOCAL_Z * sqrt(0.5 / dof_new + 0.5 / dof_old) &&
+           res->new_median_mm <= res->stored_median_mm;
+}
+
 void fw_autocal_default_config(fw_autocal_config *cfg)
 {
     memset(cfg, 0, sizeof *cfg);
@@ -309,26 +331,7 @@ fw_fault fw_autocal_configured(const fw_autocal_config *cfg, dhc_model *model,
     }
 #endif
     if (ls == FW_CAL_OK) {
-        size_t used_old = 0U;
-        size_t rows_old = 0U;
-        res->stored_rms_mm =
-            sample_errors(&ws->stored, samples, n, ws->err_old, &used_old, &rows_old);
-        res->stored_median_mm = median(ws->err_old, used_old);
-        /* significantly better (see fw_autocal.h): log(stored / FPE) above z standard
-         * deviations of that log-ratio, sd(log s) ~ 1 / sqrt(2 dof) per RMS estimate */
-        const double dof_new = m_rows - p_fit;
-        const double m_old = (double)rows_old;
-        const double p_old = (double)stored_fitted;
-        const double dof_old = m_old - p_old;
-        /* the stored model's own final prediction error where its targets were fitted to
-         * these rows, as the new one's */
-        const double stored_fpe =
-            dof_old > 0.0 ? res->stored_rms_mm * sqrt((m_old + p_old) / dof_old) : -1.0;
-        const int better = dof_new > 0.0 && dof_old > 0.0 && res->new_fpe_mm > 0.0 &&
-                           stored_fpe > 0.0 &&
-                           log(stored_fpe / res->new_fpe_mm) >
-                               FW_AUTOCAL_Z * sqrt(0.5 / dof_new + 0.5 / dof_old) &&
-                           res->new_median_mm <= res->stored_median_mm;
+        const int better = clearly_better(ws, samples, n, stored_fitted, m_rows - p_fit, res);
         if (!better) {
             return FW_FAULT_NONE; /* the stored one is not clearly worse: keep it */
         }
