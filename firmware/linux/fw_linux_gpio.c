@@ -14,6 +14,16 @@
 
 static const char *const consumer = "dhcal-fw";
 
+/* The chip by name ("gpiochip0") or /dev path; NULL with why said. */
+static struct gpiod_chip *open_chip(const char *chip, char *why, size_t why_cap)
+{
+    struct gpiod_chip *c = chip[0] == '/' ? gpiod_chip_open(chip) : gpiod_chip_open_by_name(chip);
+    if (c == NULL) {
+        (void)snprintf(why, why_cap, "no GPIO chip %s: %s", chip, strerror(errno));
+    }
+    return c;
+}
+
 static void release(fw_linux_gpio_enc *enc)
 {
     for (size_t k = 0U; k < 2U; ++k) {
@@ -32,9 +42,8 @@ fw_linux_gpio_status fw_linux_gpio_open(fw_linux_gpio_enc *enc, const char *chip
                                         unsigned line_b, char *why, size_t why_cap)
 {
     memset(enc, 0, sizeof *enc);
-    enc->chip = chip[0] == '/' ? gpiod_chip_open(chip) : gpiod_chip_open_by_name(chip);
+    enc->chip = open_chip(chip, why, why_cap);
     if (enc->chip == NULL) {
-        (void)snprintf(why, why_cap, "no GPIO chip %s: %s", chip, strerror(errno));
         return FW_LINUX_GPIO_NO_CHIP;
     }
     const unsigned offsets[2] = {line_a, line_b};
@@ -185,9 +194,8 @@ fw_linux_gpio_status fw_linux_probe_open(fw_linux_probe *p, const char *chip, un
                                          int active_low, char *why, size_t why_cap)
 {
     memset(p, 0, sizeof *p);
-    p->chip = chip[0] == '/' ? gpiod_chip_open(chip) : gpiod_chip_open_by_name(chip);
+    p->chip = open_chip(chip, why, why_cap);
     if (p->chip == NULL) {
-        (void)snprintf(why, why_cap, "no GPIO chip %s: %s", chip, strerror(errno));
         return FW_LINUX_GPIO_NO_CHIP;
     }
     const unsigned n_lines = gpiod_chip_num_lines(p->chip);

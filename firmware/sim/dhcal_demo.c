@@ -197,16 +197,9 @@ static void where_it_fails(const dhc_model *m, size_t n, FILE *log)
 /* path := t's text, replaced whole (io's atomic write); t is freed. */
 static int finish_file(const char *path, dhcal_text *t)
 {
-    if (t->failed || t->p == NULL) {
-        free(t->p);
-        fprintf(stderr, "dhcal-demo: %s: out of memory\n", path);
-        return -1;
-    }
     dhcal_error err;
     memset(&err, 0, sizeof err);
-    const int rc = dhcal_file_write_atomic(path, t->p, t->len, &err);
-    free(t->p);
-    if (rc != DHCAL_IO_OK) {
+    if (dhcal_file_write_text(path, t, &err) != DHCAL_IO_OK) {
         fprintf(stderr, "dhcal-demo: %s\n", err.msg);
         return -1;
     }

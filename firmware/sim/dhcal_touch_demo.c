@@ -180,12 +180,8 @@ static int write_samples(const char *dir)
     }
     dhcal_error err;
     memset(&err, 0, sizeof err);
-    const int rc =
-        t.failed || t.p == NULL ? DHCAL_IO_FAILED : dhcal_file_write_atomic(path, t.p, t.len, &err);
-    free(t.p);
-    if (rc != DHCAL_IO_OK) {
-        fprintf(stderr, "dhcal-touch-demo: %s: %s\n", path,
-                err.msg[0] != '\0' ? err.msg : "out of memory");
+    if (dhcal_file_write_text(path, &t, &err) != DHCAL_IO_OK) {
+        fprintf(stderr, "dhcal-touch-demo: %s\n", err.msg);
         return -1;
     }
     return 0;

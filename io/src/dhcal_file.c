@@ -112,3 +112,18 @@ int dhcal_file_write_atomic(const char *path, const char *data, size_t len, dhca
     free(tmp);
     return rc;
 }
+
+int dhcal_file_write_text(const char *path, dhcal_text *t, dhcal_error *err)
+{
+    int rc = DHCAL_IO_FAILED;
+    if (t->failed || t->p == NULL) {
+        if (err != NULL) {
+            (void)snprintf(err->msg, sizeof err->msg, "%s: out of memory", path);
+        }
+    } else {
+        rc = dhcal_file_write_atomic(path, t->p, t->len, err);
+    }
+    free(t->p);
+    t->p = NULL;
+    return rc;
+}

@@ -15,6 +15,7 @@
 #include <stddef.h>
 
 #include "dhcal_io/dhcal_error.h"
+#include "dhcal_io/dhcal_text.h"
 
 /* path := data[0..len), atomically:
  *   1. creates "<path>.tmp.<pid>.<k>" (k = 0..99, the first free one) in path's directory
@@ -31,5 +32,9 @@
  * Cost: O(len) time plus one fsync of the file and one of the directory; memory: one heap
  * copy of the temporary file's name (strlen(path) + 48 bytes), freed on return. */
 int dhcal_file_write_atomic(const char *path, const char *data, size_t len, dhcal_error *err);
+
+/* dhcal_file_write_atomic of a text built in memory, which is freed either way: DHCAL_IO_FAILED
+ * with "path: out of memory" when building it failed (nothing written). */
+int dhcal_file_write_text(const char *path, dhcal_text *t, dhcal_error *err);
 
 #endif /* DHCAL_FILE_H */
