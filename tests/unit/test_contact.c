@@ -279,6 +279,16 @@ static size_t param_index(dhc_param_kind kind, size_t joint)
     return 0U;
 }
 
+/* The targets' starting poses on model from the touches in data, and the set: the base
+ * model's parameters and the targets'. */
+static void start_contact_fit(dhc_model *model)
+{
+    TEST_ASSERT_EQUAL(DHC_OK,
+                      dhc_contact_targets_init(model, test_read_sample, &data, data.n, data.flags));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, model));
+    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_targets(&set, model));
+}
+
 static void test_six_joint_arm_from_touches_of_three_planes(void)
 {
     static dhc_model truth;
@@ -360,10 +370,7 @@ static void test_noisy_touches_end_at_their_noise(void)
     six_joint_arms(&truth, &model);
     test_rng g = {0xBEEFULL};
     touch_three_planes(&truth, 0.02, &g);
-    TEST_ASSERT_EQUAL(
-        DHC_OK, dhc_contact_targets_init(&model, test_read_sample, &data, data.n, data.flags));
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &model));
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_targets(&set, &model));
+    start_contact_fit(&model);
     const double before = shape_error_mm(&truth, &model);
     dhc_calib_options opt;
     dhc_calib_default_options(&opt);
@@ -426,10 +433,7 @@ static void test_a_gauge_length_sees_the_scale_planes_cannot(void)
     touch_three_planes(&truth, 0.0, &g);
     const size_t touches = data.n;
     measure_lengths(&truth, 12U, &g);
-    TEST_ASSERT_EQUAL(
-        DHC_OK, dhc_contact_targets_init(&model, test_read_sample, &data, data.n, data.flags));
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &model));
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_targets(&set, &model));
+    start_contact_fit(&model);
     const double before = length_error_mm(&truth, &model);
     dhc_calib_options opt;
     dhc_calib_default_options(&opt);
@@ -484,10 +488,7 @@ static void test_planes_alone_leave_the_scale_to_the_prior(void)
     six_joint_arms(&truth, &start);
     test_rng g = {0xC0FFEEULL};
     touch_three_planes(&truth, 0.0, &g);
-    TEST_ASSERT_EQUAL(
-        DHC_OK, dhc_contact_targets_init(&start, test_read_sample, &data, data.n, data.flags));
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &start));
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_targets(&set, &start));
+    start_contact_fit(&start);
     static double sd[DHC_MAX_PARAMS];
     for (size_t k = 0U; k < set.count; ++k) {
         const uint8_t kind = set.id[k].kind;
@@ -540,10 +541,7 @@ static void test_lengths_are_judged_by_their_own_scatter(void)
     const size_t touches = data.n;
     measure_lengths(&truth, 12U, &g);
     data.s[touches + 5U].distance_mm += 3.0; /* a typo */
-    TEST_ASSERT_EQUAL(
-        DHC_OK, dhc_contact_targets_init(&start, test_read_sample, &data, data.n, data.flags));
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_base_model(&set, &start));
-    TEST_ASSERT_EQUAL(DHC_OK, dhc_params_add_targets(&set, &start));
+    start_contact_fit(&start);
     dhc_calib_options opt;
     dhc_calib_default_options(&opt);
     model = start;
